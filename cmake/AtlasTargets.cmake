@@ -1,0 +1,45 @@
+# Helpers shared by every Atlas target: warnings (errors in CI), sanitizers.
+
+add_library(atlas_warnings INTERFACE)
+target_compile_options(atlas_warnings INTERFACE -Wall -Wextra -Wpedantic -Wshadow=local
+  -Wnon-virtual-dtor -Wno-missing-field-initializers
+  # GCC 12 reports false -Wrestrict positives inside std::string (GCC bug 105329).
+  -Wno-restrict)
+if(ATLAS_WERROR)
+  target_compile_options(atlas_warnings INTERFACE -Werror)
+endif()
+if(ATLAS_SANITIZE)
+  target_compile_options(atlas_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer
+    -fno-sanitize-recover=undefined)
+  target_link_options(atlas_warnings INTERFACE -fsanitize=address,undefined)
+endif()
+
+# atlas_module(NAME DEPS...): a static library libatlas/src/NAME/*.cpp with the
+# public headers in libatlas/include/atlas/NAME. Modules are separate targets so
+# that the dependency graph between them stays visible and explicit.
+function(atlas_module name)
+  file(GLOB _srcs CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/src/${name}/*.cpp")
+  if(NOT _srcs)
+    # A module with headers only (or not written yet) is an interface target.
+    add_library(atlas_${name} INTERFACE)
+    add_library(atlas::${name} ALIAS atlas_${name})
+    target_include_directories(atlas_${name} INTERFACE "${CMAKE_CURRENT_SOURCE_DIR}/include")
+    target_link_libraries(atlas_${name} INTERFACE ${ARGN})
+    return()
+  endif()
+  add_library(atlas_${name} STATIC ${_srcs})
+  add_library(atlas::${name} ALIAS atlas_${name})
+  target_include_directories(atlas_${name} PUBLIC "${CMAKE_CURRENT_SOURCE_DIR}/include")
+  target_link_libraries(atlas_${name} PUBLIC ${ARGN} PRIVATE atlas_warnings)
+  set_target_properties(atlas_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+endfunction()
+
+# atlas_test(NAME SOURCES... LIBS ...): one GoogleTest binary registered with ctest.
+function(atlas_test name)
+  cmake_parse_arguments(T "" "" "SOURCES;LIBS" ${ARGN})
+  add_executable(${name} ${T_SOURCES})
+  target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest_main atlas_warnings)
+  target_compile_definitions(${name} PRIVATE
+    ATLAS_SOURCE_DIR="${PROJECT_SOURCE_DIR}" ATLAS_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS unit)
+endfunction()

@@ -1,0 +1,125 @@
+// atlas/core/field.h - dense 2D and 3D grids of float channels over a world box.
+//
+// Layout: channel-planar. channel(c)[index(x, y, z)] with x fastest, then y,
+// then z. Samples are cell-centred: voxel (i, j, k) covers
+// [min + i*voxel, min + (i+1)*voxel) and its value sits at the cell centre.
+// Fields are values: nodes produce them and never mutate a field they were
+// given (they are shared as std::shared_ptr<const Field3D>).
+// A const Field is safe to read from any number of threads.
+#pragma once
+
+#include "atlas/core/math.h"
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace atlas {
+
+class Hasher;
+class MemoryBudget;
+
+// How sampling treats coordinates outside the grid.
+enum class WrapMode {
+    Clamp, // repeat the edge sample
+    Wrap,  // periodic: the grid tiles (used by tileable noise)
+};
+
+namespace detail {
+// Shared by Field2D and Field3D: channels, names, storage.
+class FieldStorage {
+public:
+    int channels() const { return static_cast<int>(data_.size()); }
+    const std::vector<std::string>& channel_names() const { return names_; }
+    const std::string& channel_name(int c) const { return names_[static_cast<size_t>(c)]; }
+    // Index of a named channel, or -1.
+    int find_channel(const std::string& name) const;
+    std::span<float> channel(int c) { return data_[static_cast<size_t>(c)]; }
+    std::span<const float> channel(int c) const { return data_[static_cast<size_t>(c)]; }
+    size_t voxel_count() const { return count_; }
+    uint64_t byte_size() const { return uint64_t(count_) * data_.size() * sizeof(float); }
+    void set_channel_names(std::vector<std::string> names);
+
+protected:
+    FieldStorage(size_t count, int channels, std::vector<std::string> names);
+    void hash_storage(Hasher& h) const;
+    bool same_storage(const FieldStorage& o) const { return names_ == o.names_ && data_ == o.data_; }
+
+    size_t count_ = 0;
+    std::vector<std::vector<float>> data_;
+    std::vector<std::string> names_;
+};
+} // namespace detail
+
+// Bytes a field of this many voxels and channels needs (for budget checks).
+constexpr uint64_t field_bytes(uint64_t voxels, int channels) { return voxels * uint64_t(channels) * sizeof(float); }
+
+class Field2D : public detail::FieldStorage {
+public:
+    // Zero-filled field. Throws atlas::Error on a non-positive resolution,
+    // channel count or an invalid box; checks `budget` when given.
+    Field2D(Vec2i resolution, int channels, Box2d bounds, std::vector<std::string> channel_names = {},
+            const MemoryBudget* budget = nullptr);
+
+    Vec2i resolution() const { return res_; }
+    int width() const { return res_[0]; }
+    int height() const { return res_[1]; }
+    const Box2d& bounds() const { return bounds_; }
+    Vec2d voxel_size() const;
+    size_t index(int x, int y) const { return size_t(y) * size_t(res_[0]) + size_t(x); }
+    float at(int c, int x, int y) const { return channel(c)[index(x, y)]; }
+    float& at(int c, int x, int y) { return channel(c)[index(x, y)]; }
+
+    // World position of the centre of texel (x, y).
+    Vec2d texel_center(int x, int y) const;
+    // Bilinear sample at continuous texel coordinates (texel centres at i+0.5).
+    float sample_texel(int c, double u, double v, WrapMode wrap) const;
+    // Bilinear sample at a world position.
+    float sample_world(int c, Vec2d p, WrapMode wrap) const;
+
+    void hash_into(Hasher& h) const;
+    bool operator==(const Field2D& o) const { return res_ == o.res_ && bounds_ == o.bounds_ && same_storage(o); }
+
+private:
+    Vec2i res_;
+    Box2d bounds_;
+};
+
+class Field3D : public detail::FieldStorage {
+public:
+    Field3D(Vec3i resolution, int channels, Box3d bounds, std::vector<std::string> channel_names = {},
+            const MemoryBudget* budget = nullptr);
+
+    Vec3i resolution() const { return res_; }
+    int nx() const { return res_[0]; }
+    int ny() const { return res_[1]; }
+    int nz() const { return res_[2]; }
+    const Box3d& bounds() const { return bounds_; }
+    Vec3d voxel_size() const;
+    size_t index(int x, int y, int z) const { return (size_t(z) * size_t(res_[1]) + size_t(y)) * size_t(res_[0]) + size_t(x); }
+    float at(int c, int x, int y, int z) const { return channel(c)[index(x, y, z)]; }
+    float& at(int c, int x, int y, int z) { return channel(c)[index(x, y, z)]; }
+
+    Vec3d voxel_center(int x, int y, int z) const;
+    // Trilinear sample at continuous voxel coordinates (voxel centres at i+0.5).
+    float sample_voxel(int c, double u, double v, double w, WrapMode wrap) const;
+    // Trilinear sample at a world position.
+    float sample_world(int c, Vec3d p, WrapMode wrap) const;
+
+    void hash_into(Hasher& h) const;
+    bool operator==(const Field3D& o) const { return res_ == o.res_ && bounds_ == o.bounds_ && same_storage(o); }
+
+private:
+    Vec3i res_;
+    Box3d bounds_;
+};
+
+using Field2DPtr = std::shared_ptr<const Field2D>;
+using Field3DPtr = std::shared_ptr<const Field3D>;
+
+// Default channel names: "r", "g", "b", "a" for up to 4 channels, else "c0".. .
+std::vector<std::string> default_channel_names(int channels);
+
+} // namespace atlas

@@ -1,0 +1,59 @@
+// atlas/core/files.h - atomic file output and output-path safety.
+//
+// A failed write must never leave a partial or corrupted file where a good
+// one is expected. StagedOutputs collects every file of one operation (a cook
+// may write dozens) in a hidden staging directory beside the destination and
+// moves them into place only when all of them were written; if anything
+// fails, or the object is destroyed without commit(), nothing is touched.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace atlas {
+
+namespace fs = std::filesystem;
+
+class StagedOutputs {
+public:
+    // Files will be committed under `root` (created on commit if missing).
+    explicit StagedOutputs(fs::path root);
+    ~StagedOutputs(); // removes the staging directory if not committed
+    StagedOutputs(const StagedOutputs&) = delete;
+    StagedOutputs& operator=(const StagedOutputs&) = delete;
+
+    // A path in the staging area for `relative` (its parent directories are
+    // created). Write the file there; it is moved to root/relative on commit.
+    fs::path stage(const fs::path& relative);
+    // Moves every staged file into place (rename within one file system).
+    // Returns the final paths.
+    std::vector<fs::path> commit();
+    // Every file the writers produced in the staging area, as relative paths.
+    std::vector<fs::path> staged_files() const;
+
+private:
+    fs::path root_;
+    fs::path staging_;
+    bool committed_ = false;
+};
+
+// Writes one file atomically: `write` is called with a temporary path in the
+// same directory, which is renamed over `path` when it returns normally and
+// removed if it throws.
+template <typename WriteFn>
+void write_file_atomic(const fs::path& path, WriteFn&& write) {
+    StagedOutputs out(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+    write(out.stage(path.filename()));
+    out.commit();
+}
+
+// Resolves an output path from a graph against the output directory. Throws
+// atlas::Error when it is absolute or climbs out of `out_dir` (through `..`
+// or a symlink), unless `allow_outside` is true.
+fs::path resolve_output_path(const fs::path& out_dir, const std::string& relative, bool allow_outside);
+
+// Reads a whole file; throws atlas::Error naming the file on failure.
+std::string read_file_bytes(const fs::path& path);
+
+} // namespace atlas

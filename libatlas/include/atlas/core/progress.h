@@ -1,0 +1,31 @@
+// atlas/core/progress.h - progress reporting and cancellation through callbacks.
+//
+// The library never writes to a terminal. Long work reports a fraction done
+// through ProgressSink::on_progress and polls ProgressSink::is_cancelled; a
+// host (the CLI's progress bar, an editor's status bar) supplies both.
+// Callbacks may be invoked from worker threads, so hosts must make them
+// thread-safe; Atlas serialises nothing for them.
+#pragma once
+
+#include <functional>
+#include <string>
+
+namespace atlas {
+
+struct ProgressEvent {
+    std::string task;     // what is running, e.g. "node 'clouds'"
+    double fraction = 0;  // 0..1 within the whole job
+    int done = 0;         // units of work finished (e.g. nodes cooked)
+    int total = 0;        // units of work in the job
+};
+
+struct ProgressSink {
+    std::function<void(const ProgressEvent&)> on_progress; // may be empty
+    std::function<bool()> is_cancelled;                     // may be empty
+
+    bool cancelled() const { return is_cancelled && is_cancelled(); }
+    // Throws CancelledError if the host asked to stop.
+    void poll() const;
+};
+
+} // namespace atlas

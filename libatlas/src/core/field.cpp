@@ -1,0 +1,165 @@
+#include "atlas/core/field.h"
+
+#include "atlas/core/error.h"
+#include "atlas/core/hash.h"
+#include "atlas/core/memory.h"
+
+#include <cmath>
+
+namespace atlas {
+
+std::vector<std::string> default_channel_names(int channels) {
+    static const char* rgba[] = {"r", "g", "b", "a"};
+    std::vector<std::string> names;
+    for (int c = 0; c < channels; ++c) names.push_back(channels <= 4 ? rgba[c] : "c" + std::to_string(c));
+    return names;
+}
+
+namespace detail {
+
+FieldStorage::FieldStorage(size_t count, int channels, std::vector<std::string> names) : count_(count) {
+    if (channels <= 0 || channels > 64) throw Error("field: channel count " + std::to_string(channels) + " out of range (expected 1..64)");
+    if (names.empty()) names = default_channel_names(channels);
+    if (names.size() != size_t(channels))
+        throw Error("field: " + std::to_string(names.size()) + " channel names given for " + std::to_string(channels) + " channels");
+    names_ = std::move(names);
+    data_.assign(size_t(channels), std::vector<float>(count, 0.0f));
+}
+
+int FieldStorage::find_channel(const std::string& name) const {
+    for (size_t i = 0; i < names_.size(); ++i)
+        if (names_[i] == name) return int(i);
+    return -1;
+}
+
+void FieldStorage::set_channel_names(std::vector<std::string> names) {
+    if (names.size() != data_.size()) throw Error("field: channel name count does not match channel count");
+    names_ = std::move(names);
+}
+
+void FieldStorage::hash_storage(Hasher& h) const {
+    h.add(uint64_t(data_.size()));
+    for (size_t c = 0; c < data_.size(); ++c) {
+        h.add(names_[c]);
+        h.add_floats(data_[c]);
+    }
+}
+
+} // namespace detail
+
+namespace {
+template <int N>
+void check_shape(const Vec<int, N>& res, const Box<N>& bounds, const char* what) {
+    for (int i = 0; i < N; ++i)
+        if (res[i] <= 0) throw Error(std::string(what) + ": resolution must be positive in every axis");
+    if (!bounds.valid()) throw Error(std::string(what) + ": bounds must be finite with max > min in every axis");
+}
+
+template <int N>
+size_t checked_count(const Vec<int, N>& res, int channels, const MemoryBudget* budget, const char* what) {
+    uint64_t n = 1;
+    for (int i = 0; i < N; ++i) n *= uint64_t(res[i]);
+    if (budget) {
+        std::string desc = std::string("a ") + what + " of ";
+        for (int i = 0; i < N; ++i) desc += (i ? "x" : "") + std::to_string(res[i]);
+        desc += " voxels x " + std::to_string(channels) + " channels";
+        budget->check(field_bytes(n, channels), desc);
+    }
+    return size_t(n);
+}
+
+// Wraps or clamps an integer index into [0, n).
+inline int fix_index(int i, int n, WrapMode wrap) {
+    if (wrap == WrapMode::Wrap) { i %= n; return i < 0 ? i + n : i; }
+    return i < 0 ? 0 : (i >= n ? n - 1 : i);
+}
+
+// Splits a continuous coordinate (centres at i+0.5) into the two taps and weight.
+inline void taps(double u, int n, WrapMode wrap, int& i0, int& i1, float& t) {
+    double f = u - 0.5;
+    if (!std::isfinite(f)) f = 0.0;
+    double fl = std::floor(f);
+    t = float(f - fl);
+    // Keep the index in int range even for absurd coordinates.
+    if (fl > 1e9) fl = 1e9;
+    if (fl < -1e9) fl = -1e9;
+    int base = int(fl);
+    i0 = fix_index(base, n, wrap);
+    i1 = fix_index(base + 1, n, wrap);
+}
+} // namespace
+
+Field2D::Field2D(Vec2i resolution, int channels, Box2d bounds, std::vector<std::string> channel_names, const MemoryBudget* budget)
+    : FieldStorage((check_shape(resolution, bounds, "Field2D"), checked_count(resolution, channels, budget, "2D field")), channels,
+                   std::move(channel_names)),
+      res_(resolution), bounds_(bounds) {}
+
+Vec2d Field2D::voxel_size() const { return {{bounds_.size()[0] / res_[0], bounds_.size()[1] / res_[1]}}; }
+
+Vec2d Field2D::texel_center(int x, int y) const {
+    Vec2d s = voxel_size();
+    return {{bounds_.min[0] + (x + 0.5) * s[0], bounds_.min[1] + (y + 0.5) * s[1]}};
+}
+
+float Field2D::sample_texel(int c, double u, double v, WrapMode wrap) const {
+    int x0, x1, y0, y1;
+    float tx, ty;
+    taps(u, res_[0], wrap, x0, x1, tx);
+    taps(v, res_[1], wrap, y0, y1, ty);
+    auto ch = channel(c);
+    float a = lerp(ch[index(x0, y0)], ch[index(x1, y0)], tx);
+    float b = lerp(ch[index(x0, y1)], ch[index(x1, y1)], tx);
+    return lerp(a, b, ty);
+}
+
+float Field2D::sample_world(int c, Vec2d p, WrapMode wrap) const {
+    Vec2d s = voxel_size();
+    return sample_texel(c, (p[0] - bounds_.min[0]) / s[0], (p[1] - bounds_.min[1]) / s[1], wrap);
+}
+
+void Field2D::hash_into(Hasher& h) const {
+    h.add("Field2D").add(res_[0]).add(res_[1]);
+    for (int i = 0; i < 2; ++i) h.add(bounds_.min[i]).add(bounds_.max[i]);
+    hash_storage(h);
+}
+
+Field3D::Field3D(Vec3i resolution, int channels, Box3d bounds, std::vector<std::string> channel_names, const MemoryBudget* budget)
+    : FieldStorage((check_shape(resolution, bounds, "Field3D"), checked_count(resolution, channels, budget, "3D field")), channels,
+                   std::move(channel_names)),
+      res_(resolution), bounds_(bounds) {}
+
+Vec3d Field3D::voxel_size() const {
+    Vec3d s = bounds_.size();
+    return {{s[0] / res_[0], s[1] / res_[1], s[2] / res_[2]}};
+}
+
+Vec3d Field3D::voxel_center(int x, int y, int z) const {
+    Vec3d s = voxel_size();
+    return {{bounds_.min[0] + (x + 0.5) * s[0], bounds_.min[1] + (y + 0.5) * s[1], bounds_.min[2] + (z + 0.5) * s[2]}};
+}
+
+float Field3D::sample_voxel(int c, double u, double v, double w, WrapMode wrap) const {
+    int x0, x1, y0, y1, z0, z1;
+    float tx, ty, tz;
+    taps(u, res_[0], wrap, x0, x1, tx);
+    taps(v, res_[1], wrap, y0, y1, ty);
+    taps(w, res_[2], wrap, z0, z1, tz);
+    auto ch = channel(c);
+    auto row = [&](int y, int z) { return lerp(ch[index(x0, y, z)], ch[index(x1, y, z)], tx); };
+    float a = lerp(row(y0, z0), row(y1, z0), ty);
+    float b = lerp(row(y0, z1), row(y1, z1), ty);
+    return lerp(a, b, tz);
+}
+
+float Field3D::sample_world(int c, Vec3d p, WrapMode wrap) const {
+    Vec3d s = voxel_size();
+    return sample_voxel(c, (p[0] - bounds_.min[0]) / s[0], (p[1] - bounds_.min[1]) / s[1], (p[2] - bounds_.min[2]) / s[2], wrap);
+}
+
+void Field3D::hash_into(Hasher& h) const {
+    h.add("Field3D").add(res_[0]).add(res_[1]).add(res_[2]);
+    for (int i = 0; i < 3; ++i) h.add(bounds_.min[i]).add(bounds_.max[i]);
+    hash_storage(h);
+}
+
+} // namespace atlas
