@@ -3,6 +3,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <fstream>
