@@ -43,3 +43,15 @@ function(atlas_test name)
     ATLAS_SOURCE_DIR="${PROJECT_SOURCE_DIR}" ATLAS_BINARY_DIR="${PROJECT_BINARY_DIR}")
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS unit)
 endfunction()
+
+# atlas_benchmark(NAME SOURCES... LIBS ...): a Google Benchmark program. Each
+# is also registered with ctest as a short smoke run (label "bench"), so CI
+# proves it still runs without paying for a full measurement.
+function(atlas_benchmark name)
+  cmake_parse_arguments(B "" "" "SOURCES;LIBS" ${ARGN})
+  add_executable(${name} ${B_SOURCES})
+  target_link_libraries(${name} PRIVATE ${B_LIBS} benchmark::benchmark atlas_warnings)
+  target_compile_definitions(${name} PRIVATE ATLAS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  add_test(NAME ${name}_smoke COMMAND ${name} --benchmark_min_time=0.01 --benchmark_filter=Smoke)
+  set_tests_properties(${name}_smoke PROPERTIES LABELS bench)
+endfunction()
