@@ -10,6 +10,7 @@
 #include <sstream>
 #include <system_error>
 #include <unistd.h>
+#include <vector>
 
 namespace atlas {
 
@@ -102,4 +103,21 @@ std::string read_file_bytes(const fs::path& path) {
     return ss.str();
 }
 
+} // namespace atlas
+
+namespace atlas {
+void hash_file(Hasher& h, const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path.string() + ": cannot open input file (does it exist?)");
+    h.add(path.filename().string());
+    std::vector<char> buf(1 << 20);
+    uint64_t total = 0;
+    while (in) {
+        in.read(buf.data(), std::streamsize(buf.size()));
+        const auto n = size_t(in.gcount());
+        if (n) h.add_bytes(buf.data(), n);
+        total += n;
+    }
+    h.add(total);
+}
 } // namespace atlas

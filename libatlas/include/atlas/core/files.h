@@ -57,3 +57,11 @@ fs::path resolve_output_path(const fs::path& out_dir, const std::string& relativ
 std::string read_file_bytes(const fs::path& path);
 
 } // namespace atlas
+
+namespace atlas {
+class Hasher;
+// Adds a file's size and contents to a hash (import nodes use it so that
+// editing an input file re-cooks what depends on it). Throws atlas::Error
+// naming the file when it cannot be read.
+void hash_file(Hasher& h, const fs::path& path);
+} // namespace atlas

@@ -1,0 +1,96 @@
+#include "cli.h"
+
+#include "atlas/graph/graph.h"
+
+#include <sstream>
+
+namespace atlas::cli {
+
+const std::vector<Command>& commands() {
+    static const std::vector<Command> table = {
+        {"cook", "GRAPH [options]", "cook a graph file and write its outputs",
+         {{"--out", "DIR", "output directory; graph output paths are relative to it (default: .)"},
+          {"--output", "NAME", "cook only this output (file name or node name); repeatable", true},
+          {"--set", "NODE.PARAM=VALUE", "override a parameter; repeatable", true},
+          {"--jobs", "N", "worker threads (default: all cores); output bytes do not depend on it"},
+          {"--cache", "DIR", "on-disk cache of node results (re-cooks only what changed)"},
+          {"--no-cache", "", "do not read or write the on-disk cache"},
+          {"--report", "FILE.json", "write the cook report (per node status, time, bytes, metrics)"},
+          {"--memory-budget", "SIZE", "refuse allocations past this size (default 8GiB)"},
+          {"--checked", "", "re-cook every node and compare with the cache (catches incomplete hashes)"},
+          {"--allow-outside-out", "", "allow output paths that are absolute or leave --out"},
+          {"--quiet", "", "no progress or summary on stderr"}},
+         run_cook},
+        {"validate", "GRAPH [--set NODE.PARAM=VALUE]...", "parse and type-check a graph; cook nothing",
+         {{"--set", "NODE.PARAM=VALUE", "override a parameter; repeatable", true}},
+         run_validate},
+        {"nodes", "[TYPE] [--markdown]", "list node types, or show one node's ports and parameters",
+         {{"--markdown", "", "print the whole reference as Markdown (docs/nodes.md)"}},
+         run_nodes},
+        {"info", "FILE...", "describe EXR, VDB, image or TGA-slice files: size, channels, value statistics", {}, run_info},
+    };
+    return table;
+}
+
+Args parse_args(const Command& cmd, const std::vector<std::string>& argv) {
+    Args a;
+    for (size_t i = 0; i < argv.size(); ++i) {
+        std::string arg = argv[i];
+        if (arg == "-h" || arg == "--help") { a.options["--help"].push_back(""); continue; }
+        if (arg.size() > 1 && arg[0] == '-') {
+            std::string name = arg, value;
+            bool inline_value = false;
+            if (auto eq = arg.find('='); eq != std::string::npos && arg.rfind("--", 0) == 0) {
+                name = arg.substr(0, eq);
+                value = arg.substr(eq + 1);
+                inline_value = true;
+            }
+            if (name == "-o") name = "--out";
+            const OptionDecl* decl = nullptr;
+            std::vector<std::string> names;
+            for (const auto& o : cmd.options) {
+                names.push_back(o.name);
+                if (o.name == name) decl = &o;
+            }
+            if (!decl) {
+                std::string msg = "unknown option '" + name + "' for 'atlas " + cmd.name + "'";
+                if (auto s = closest_match(name, names); !s.empty()) msg += " (did you mean '" + s + "'?)";
+                throw UsageError{msg, cmd.name};
+            }
+            if (!decl->value.empty() && !inline_value) {
+                if (i + 1 >= argv.size()) throw UsageError{"option '" + name + "' expects a value " + decl->value, cmd.name};
+                value = argv[++i];
+            } else if (decl->value.empty() && inline_value) {
+                throw UsageError{"option '" + name + "' takes no value", cmd.name};
+            }
+            if (!decl->repeatable && a.options.count(name)) throw UsageError{"option '" + name + "' given twice", cmd.name};
+            a.options[name].push_back(value);
+        } else {
+            a.positional.push_back(arg);
+        }
+    }
+    return a;
+}
+
+std::string command_help(const Command& cmd) {
+    std::ostringstream out;
+    out << "usage: atlas " << cmd.name << " " << cmd.usage << "\n\n" << cmd.summary << "\n";
+    if (!cmd.options.empty()) out << "\noptions:\n";
+    for (const auto& o : cmd.options) {
+        std::string left = "  " + o.name + (o.value.empty() ? "" : " " + o.value);
+        out << left << std::string(left.size() < 30 ? 30 - left.size() : 1, ' ') << o.doc << "\n";
+    }
+    return out.str();
+}
+
+std::string general_help() {
+    std::ostringstream out;
+    out << "atlas - author volumetric cloud data (noises, NDFs, NVDFs, SDFs, BC textures)\n\n"
+        << "usage: atlas COMMAND [options]\n\ncommands:\n";
+    for (const auto& c : commands()) out << "  " << c.name << std::string(12 - c.name.size(), ' ') << c.summary << "\n";
+    out << "\nrun 'atlas COMMAND --help' for a command's options. Messages and progress go to\n"
+        << "stderr; stdout carries only data. Exit status: 0 ok, 1 error, 2 usage, 130 cancelled.\n";
+    return out.str();
+}
+
+} // namespace atlas::cli

@@ -1,0 +1,63 @@
+// The atlas command line: subcommands declared with their options, so that
+// help and "did you mean" come from one table (in the manner of vdb_tool).
+#pragma once
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace atlas::cli {
+
+struct OptionDecl {
+    std::string name;   // "--out"
+    std::string value;  // "DIR" (empty: a flag)
+    std::string doc;
+    bool repeatable = false;
+};
+
+// Parsed arguments of one subcommand.
+struct Args {
+    std::vector<std::string> positional;
+    std::map<std::string, std::vector<std::string>> options; // name -> values ("" for flags)
+    bool has(const std::string& name) const { return options.count(name) > 0; }
+    std::string get(const std::string& name, const std::string& def = "") const {
+        auto it = options.find(name);
+        return it == options.end() || it->second.empty() ? def : it->second.back();
+    }
+    const std::vector<std::string>& all(const std::string& name) const {
+        static const std::vector<std::string> none;
+        auto it = options.find(name);
+        return it == options.end() ? none : it->second;
+    }
+};
+
+struct Command {
+    std::string name;
+    std::string usage;    // "GRAPH [options]"
+    std::string summary;  // one line
+    std::vector<OptionDecl> options;
+    std::function<int(const Args&)> run;
+};
+
+// Thrown for a bad command line; main prints it with the usage and exits 2.
+struct UsageError {
+    std::string message;
+    std::string command;
+};
+
+const std::vector<Command>& commands();
+Args parse_args(const Command& cmd, const std::vector<std::string>& argv);
+std::string command_help(const Command& cmd);
+std::string general_help();
+
+// Subcommand entry points (one file each).
+int run_cook(const Args&);
+int run_validate(const Args&);
+int run_nodes(const Args&);
+int run_info(const Args&);
+
+// Terminal progress bar on stderr (only when stderr is a terminal).
+class ProgressBar;
+
+} // namespace atlas::cli

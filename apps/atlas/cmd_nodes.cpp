@@ -1,0 +1,33 @@
+// atlas nodes [TYPE] [--markdown]
+#include "cli.h"
+
+#include "atlas/graph/graph.h"
+#include "atlas/graph/node_docs.h"
+
+#include <iostream>
+
+namespace atlas::cli {
+
+int run_nodes(const Args& a) {
+    NodeRegistry reg = builtin_nodes();
+    if (a.has("--markdown")) {
+        std::cout << node_reference_markdown(reg);
+        return 0;
+    }
+    if (a.positional.empty()) {
+        std::cout << node_list_text(reg);
+        return 0;
+    }
+    for (const auto& name : a.positional) {
+        const NodeType* t = reg.find(name);
+        if (!t) {
+            std::string msg = "unknown node type '" + name + "'";
+            if (auto s = closest_match(name, reg.names()); !s.empty()) msg += " (did you mean '" + s + "'?)";
+            throw Error(msg);
+        }
+        std::cout << node_reference_text(*t);
+    }
+    return 0;
+}
+
+} // namespace atlas::cli

@@ -1,0 +1,42 @@
+// atlas: build the command table, run one subcommand, turn errors into an exit status.
+#include "cli.h"
+
+#include "atlas/core/error.h"
+
+#include <iostream>
+
+int main(int argc, char** argv) {
+    using namespace atlas::cli;
+    std::vector<std::string> args(argv + 1, argv + argc);
+    try {
+        if (args.empty() || args[0] == "-h" || args[0] == "--help" || args[0] == "help") {
+            if (args.size() >= 2) {
+                for (const auto& c : commands())
+                    if (c.name == args[1]) { std::cout << command_help(c); return 0; }
+            }
+            std::cout << general_help();
+            return args.empty() ? 2 : 0;
+        }
+        if (args[0] == "--version") { std::cout << "atlas 0.1.0\n"; return 0; }
+        for (const auto& c : commands()) {
+            if (c.name != args[0]) continue;
+            Args parsed = parse_args(c, {args.begin() + 1, args.end()});
+            if (parsed.has("--help")) { std::cout << command_help(c); return 0; }
+            return c.run(parsed);
+        }
+        std::vector<std::string> names;
+        for (const auto& c : commands()) names.push_back(c.name);
+        throw UsageError{"unknown command '" + args[0] + "'", ""};
+    } catch (const UsageError& e) {
+        std::cerr << "atlas: error: " << e.message << "\n";
+        if (!e.command.empty()) std::cerr << "run 'atlas " << e.command << " --help' for its options\n";
+        else std::cerr << "run 'atlas --help' for the list of commands\n";
+        return 2;
+    } catch (const atlas::CancelledError&) {
+        std::cerr << "atlas: cancelled; no output was written\n";
+        return 130;
+    } catch (const std::exception& e) {
+        std::cerr << "atlas: error: " << e.what() << "\n";
+        return 1;
+    }
+}

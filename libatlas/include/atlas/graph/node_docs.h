@@ -1,0 +1,19 @@
+// atlas/graph/node_docs.h - the node reference, generated from declarations.
+// `atlas nodes` prints it and docs/nodes.md is this Markdown, so the docs
+// cannot drift from the code (a test compares them).
+#pragma once
+
+#include "atlas/graph/node.h"
+
+#include <string>
+
+namespace atlas {
+
+// One line per node type: "name  summary".
+std::string node_list_text(const NodeRegistry& registry);
+// Ports and parameters of one node type, as plain text for a terminal.
+std::string node_reference_text(const NodeType& type);
+// The whole reference as Markdown (docs/nodes.md).
+std::string node_reference_markdown(const NodeRegistry& registry);
+
+} // namespace atlas

@@ -1,0 +1,389 @@
+// Graph files: YAML text -> Graph, with every error located at file:line:col.
+#include "atlas/graph/graph.h"
+
+#include "atlas/core/files.h"
+#include "atlas/io/writers.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace atlas {
+
+namespace {
+
+struct Parser {
+    std::string filename;
+
+    SourceLocation at(const YAML::Node& n) const {
+        YAML::Mark m = n.Mark();
+        if (m.is_null()) return {filename, 0, 0};
+        return {filename, m.line + 1, m.column + 1};
+    }
+    [[noreturn]] void fail(const YAML::Node& n, const std::string& msg) const { throw ParseError(at(n), msg); }
+
+    std::string scalar(const YAML::Node& n, const std::string& what) const {
+        if (!n.IsScalar()) fail(n, what + ": expected a string");
+        return n.Scalar();
+    }
+
+    // Rejects keys not in `allowed`, with a did-you-mean.
+    void check_keys(const YAML::Node& map, const std::vector<std::string>& allowed, const std::string& where) const {
+        std::set<std::string> seen;
+        for (auto it = map.begin(); it != map.end(); ++it) {
+            std::string key = scalar(it->first, where + " key");
+            if (!seen.insert(key).second) fail(it->first, where + ": duplicate key '" + key + "'");
+            if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+                std::string msg = where + ": unknown key '" + key + "'";
+                if (auto s = closest_match(key, allowed); !s.empty()) msg += " (did you mean '" + s + "'?)";
+                else {
+                    msg += " (expected one of:";
+                    for (const auto& a : allowed) msg += " " + a;
+                    msg += ")";
+                }
+                fail(it->first, msg);
+            }
+        }
+    }
+};
+
+bool parse_bool(const std::string& s, bool& out) {
+    if (s == "true" || s == "yes" || s == "on") { out = true; return true; }
+    if (s == "false" || s == "no" || s == "off") { out = false; return true; }
+    return false;
+}
+
+bool parse_int(const std::string& s, int64_t& out) {
+    if (s.empty()) return false;
+    size_t used = 0;
+    try {
+        long long v = std::stoll(s, &used, 10);
+        if (used != s.size()) return false;
+        out = v;
+        return true;
+    } catch (...) {
+        return false;
+    }
+}
+
+bool parse_double(const std::string& s, double& out) {
+    if (s.empty()) return false;
+    size_t used = 0;
+    try {
+        double v = std::stod(s, &used);
+        if (used != s.size()) return false;
+        out = v;
+        return true;
+    } catch (...) {
+        return false;
+    }
+}
+
+// Converts a YAML node to the declared type, or returns an error message.
+std::string yaml_to_param(const YAML::Node& n, const ParamDecl& decl, ParamValue& out) {
+    const int comps = param_components(decl.type);
+    if (comps > 1) {
+        if (!n.IsSequence()) return "expected a list of " + std::to_string(comps) + " numbers, e.g. [" + (comps == 2 ? "1, 2" : "1, 2, 3") + "]";
+        std::vector<double> v;
+        for (const auto& e : n) {
+            double d;
+            if (!e.IsScalar() || !parse_double(e.Scalar(), d)) return "expected numbers in the list";
+            v.push_back(d);
+        }
+        out = v;
+        return "";
+    }
+    if (!n.IsScalar()) return "expected a single " + std::string(param_type_name(decl.type)) + " value";
+    const std::string& s = n.Scalar();
+    switch (decl.type) {
+    case ParamType::Float: {
+        double d;
+        if (!parse_double(s, d)) return "expected a number, got '" + s + "'";
+        out = d;
+        return "";
+    }
+    case ParamType::Int: {
+        int64_t i;
+        if (!parse_int(s, i)) return "expected an integer, got '" + s + "'";
+        out = i;
+        return "";
+    }
+    case ParamType::Bool: {
+        bool b;
+        if (!parse_bool(s, b)) return "expected true or false, got '" + s + "'";
+        out = b;
+        return "";
+    }
+    default:
+        out = s;
+        return "";
+    }
+}
+
+void parse_inputs(const Parser& p, const YAML::Node& inputs, GraphNode& node) {
+    if (!inputs.IsMap()) p.fail(inputs, "node '" + node.name + "': 'inputs' must be a map of input port to source node");
+    for (auto it = inputs.begin(); it != inputs.end(); ++it) {
+        std::string port = p.scalar(it->first, "input name");
+        if (node.inputs.count(port)) p.fail(it->first, "node '" + node.name + "': input '" + port + "' given twice");
+        InputBinding b;
+        b.where = p.at(it->second);
+        if (it->second.IsScalar()) {
+            // "source" or "source.port"
+            std::string s = it->second.Scalar();
+            auto dot = s.find('.');
+            b.node = s.substr(0, dot);
+            if (dot != std::string::npos) b.port = s.substr(dot + 1);
+        } else if (it->second.IsMap()) {
+            p.check_keys(it->second, {"node", "port"}, "input '" + port + "'");
+            if (!it->second["node"]) p.fail(it->second, "input '" + port + "': expected 'node'");
+            b.node = p.scalar(it->second["node"], "input node");
+            if (it->second["port"]) b.port = p.scalar(it->second["port"], "input port");
+        } else {
+            p.fail(it->second, "node '" + node.name + "': input '" + port + "' must name a node ('source' or 'source.port')");
+        }
+        if (b.node.empty()) p.fail(it->second, "node '" + node.name + "': input '" + port + "' names no node");
+        node.inputs[port] = b;
+    }
+}
+
+// The output's format exists, accepts what the port produces, and knows its options.
+void check_output_request(PortType produced, const std::string& format, const std::map<std::string, std::string>& options) {
+    const io::OutputFormat* fmt = nullptr;
+    std::vector<std::string> names;
+    for (const auto& f : io::output_formats()) {
+        names.push_back(f.name);
+        if (f.name == format) fmt = &f;
+    }
+    if (!fmt) {
+        std::string msg = "unknown format '" + format + "'";
+        if (auto s = closest_match(format, names); !s.empty()) msg += " (did you mean '" + s + "'?)";
+        else {
+            msg += " (known:";
+            for (const auto& n : names) msg += " " + n;
+            msg += ")";
+        }
+        throw Error(msg);
+    }
+    bool ok = false;
+    for (PortType t : fmt->accepts) ok = ok || port_accepts(t, produced) || port_accepts(produced, t);
+    if (!ok) {
+        std::string acc;
+        for (PortType t : fmt->accepts) acc += (acc.empty() ? "" : " or ") + std::string(port_type_name(t));
+        throw Error("format '" + format + "' writes " + acc + ", but the port produces a " + std::string(port_type_name(produced)));
+    }
+    std::vector<std::string> known;
+    for (const auto& o : fmt->options) known.push_back(o.first);
+    for (const auto& kv : options) {
+        if (std::find(known.begin(), known.end(), kv.first) != known.end()) continue;
+        std::string msg = "unknown option '" + kv.first + "' for format '" + format + "'";
+        if (auto s = closest_match(kv.first, known); !s.empty()) msg += " (did you mean '" + s + "'?)";
+        else {
+            msg += " (known:";
+            for (const auto& k : known) msg += " " + k;
+            msg += ")";
+        }
+        throw Error(msg);
+    }
+}
+
+} // namespace
+
+std::string closest_match(const std::string& word, const std::vector<std::string>& candidates) {
+    auto distance = [](const std::string& a, const std::string& b) {
+        std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
+        for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+        for (size_t i = 1; i <= a.size(); ++i) {
+            cur[0] = i;
+            for (size_t j = 1; j <= b.size(); ++j)
+                cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            std::swap(prev, cur);
+        }
+        return prev[b.size()];
+    };
+    std::string best;
+    size_t best_d = std::max<size_t>(2, word.size() / 3) + 1;
+    for (const auto& c : candidates) {
+        size_t d = distance(word, c);
+        // Also accept a candidate whose last path component matches ("perlin" -> "noise/perlin").
+        auto slash = c.rfind('/');
+        if (slash != std::string::npos) d = std::min(d, distance(word, c.substr(slash + 1)) + 1);
+        if (d < best_d) { best_d = d; best = c; }
+    }
+    return best;
+}
+
+const GraphNode* Graph::find(const std::string& name) const {
+    for (const auto& n : nodes) if (n.name == name) return &n;
+    return nullptr;
+}
+GraphNode* Graph::find(const std::string& name) {
+    for (auto& n : nodes) if (n.name == name) return &n;
+    return nullptr;
+}
+
+Graph parse_graph(const std::string& text, const std::string& filename, const std::filesystem::path& base_dir,
+                  const NodeRegistry& registry) {
+    Parser p{filename};
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::Exception& e) {
+        throw ParseError({filename, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1},
+                         "invalid YAML: " + e.msg);
+    }
+    if (!root || root.IsNull()) throw ParseError({filename, 1, 1}, "empty graph file: expected 'atlas: 1', 'nodes' and 'outputs'");
+    if (!root.IsMap()) p.fail(root, "a graph file is a map with 'atlas', 'nodes' and 'outputs'");
+    p.check_keys(root, {"atlas", "description", "nodes", "outputs"}, "graph");
+
+    Graph g;
+    g.base_dir = base_dir;
+    if (!root["atlas"]) p.fail(root, "missing 'atlas: " + std::to_string(kGraphFormatVersion) + "' version line");
+    {
+        int64_t v = 0;
+        const YAML::Node vn = root["atlas"];
+        if (!vn.IsScalar() || !parse_int(vn.Scalar(), v)) p.fail(vn, "'atlas' must be the format version number, e.g. atlas: 1");
+        if (v != kGraphFormatVersion)
+            p.fail(vn, "unsupported graph format version " + std::to_string(v) + " (this Atlas reads version " +
+                           std::to_string(kGraphFormatVersion) + ")");
+        g.version = int(v);
+    }
+
+    const YAML::Node nodes = root["nodes"];
+    if (!nodes) p.fail(root, "missing 'nodes' map");
+    if (!nodes.IsMap()) p.fail(nodes, "'nodes' must be a map of node name to node");
+    const auto type_names = registry.names();
+    for (auto it = nodes.begin(); it != nodes.end(); ++it) {
+        GraphNode n;
+        n.name = p.scalar(it->first, "node name");
+        n.where = p.at(it->first);
+        if (n.name.empty() || n.name.find_first_of(". \t") != std::string::npos)
+            p.fail(it->first, "node name '" + n.name + "' may not be empty or contain '.' or spaces");
+        if (g.find(n.name)) p.fail(it->first, "duplicate node name '" + n.name + "'");
+        const YAML::Node body = it->second;
+        if (!body.IsMap()) p.fail(body, "node '" + n.name + "': expected a map with 'type', 'params' and 'inputs'");
+        p.check_keys(body, {"type", "params", "inputs", "doc"}, "node '" + n.name + "'");
+        if (!body["type"]) p.fail(body, "node '" + n.name + "': missing 'type'");
+        n.type = p.scalar(body["type"], "node type");
+        const NodeType* type = registry.find(n.type);
+        if (!type) {
+            std::string msg = "node '" + n.name + "': unknown node type '" + n.type + "'";
+            if (auto s = closest_match(n.type, type_names); !s.empty()) msg += " (did you mean '" + s + "'?)";
+            else msg += " (run 'atlas nodes' for the list)";
+            p.fail(body["type"], msg);
+        }
+        if (const YAML::Node params = body["params"]) {
+            if (!params.IsMap()) p.fail(params, "node '" + n.name + "': 'params' must be a map");
+            std::vector<std::string> known;
+            for (const auto& d : type->decl.params()) known.push_back(d.name);
+            for (auto pit = params.begin(); pit != params.end(); ++pit) {
+                std::string pname = p.scalar(pit->first, "parameter name");
+                const ParamDecl* decl = type->decl.find_param(pname);
+                if (!decl) {
+                    std::string msg = "node '" + n.name + "': unknown parameter '" + pname + "'";
+                    if (auto s = closest_match(pname, known); !s.empty()) {
+                        msg += " (did you mean '" + s + "'?)";
+                    } else {
+                        msg += " (" + n.type + " has: ";
+                        for (size_t i = 0; i < known.size(); ++i) msg += (i ? ", " : "") + known[i];
+                        msg += known.empty() ? "no parameters)" : ")";
+                    }
+                    p.fail(pit->first, msg);
+                }
+                if (n.params.count(pname)) p.fail(pit->first, "node '" + n.name + "': parameter '" + pname + "' given twice");
+                ParamValue v;
+                std::string err = yaml_to_param(pit->second, *decl, v);
+                if (err.empty()) err = decl->check(v);
+                if (!err.empty())
+                    p.fail(pit->second, "node '" + n.name + "': parameter '" + pname + "' (" +
+                                            std::string(param_type_name(decl->type)) + "): " + err);
+                n.params[pname] = {v, p.at(pit->second)};
+            }
+        }
+        if (const YAML::Node inputs = body["inputs"]) parse_inputs(p, inputs, n);
+        g.nodes.push_back(std::move(n));
+    }
+
+    const YAML::Node outputs = root["outputs"];
+    if (!outputs) p.fail(root, "missing 'outputs' list (what the graph writes)");
+    if (!outputs.IsSequence()) p.fail(outputs, "'outputs' must be a list of {node, port, file, format}");
+    for (const auto& o : outputs) {
+        if (!o.IsMap()) p.fail(o, "an output is a map with 'node', 'file' and optionally 'port', 'format', 'options'");
+        p.check_keys(o, {"node", "port", "file", "format", "options"}, "output");
+        GraphOutput out;
+        out.where = p.at(o);
+        if (!o["node"]) p.fail(o, "output: missing 'node'");
+        if (!o["file"]) p.fail(o, "output: missing 'file'");
+        out.node = p.scalar(o["node"], "output node");
+        out.file = p.scalar(o["file"], "output file");
+        if (o["port"]) out.port = p.scalar(o["port"], "output port");
+        if (o["format"]) out.format = p.scalar(o["format"], "output format");
+        if (const YAML::Node opts = o["options"]) {
+            if (!opts.IsMap()) p.fail(opts, "output '" + out.file + "': 'options' must be a map");
+            for (auto it = opts.begin(); it != opts.end(); ++it) {
+                std::string v;
+                if (it->second.IsSequence()) {
+                    for (const auto& e : it->second) v += (v.empty() ? "" : ",") + p.scalar(e, "option value");
+                } else {
+                    v = p.scalar(it->second, "option value");
+                }
+                out.options[p.scalar(it->first, "option name")] = v;
+            }
+        }
+        // Output-level checks that need the source location.
+        const GraphNode* src = g.find(out.node);
+        if (!src) {
+            std::vector<std::string> names;
+            for (const auto& n : g.nodes) names.push_back(n.name);
+            std::string msg = "output '" + out.file + "': unknown node '" + out.node + "'";
+            if (auto s = closest_match(out.node, names); !s.empty()) msg += " (did you mean '" + s + "'?)";
+            p.fail(o["node"], msg);
+        }
+        const NodeType* st = registry.find(src->type);
+        if (out.port.empty()) {
+            if (st->decl.outputs().size() != 1) {
+                std::string list;
+                for (const auto& po : st->decl.outputs()) list += (list.empty() ? "" : ", ") + po.name;
+                p.fail(o, "output '" + out.file + "': node '" + out.node + "' has several outputs (" + list + "); say which with 'port'");
+            }
+            out.port = st->decl.outputs().front().name;
+        }
+        const PortDecl* port = st->decl.find_output(out.port);
+        if (!port) {
+            std::vector<std::string> names;
+            for (const auto& po : st->decl.outputs()) names.push_back(po.name);
+            std::string msg = "output '" + out.file + "': node '" + out.node + "' (" + src->type + ") has no output port '" + out.port + "'";
+            if (auto s = closest_match(out.port, names); !s.empty()) msg += " (did you mean '" + s + "'?)";
+            p.fail(o["port"] ? o["port"] : o, msg);
+        }
+        try {
+            if (out.format.empty()) out.format = io::output_format_for_path(out.file);
+            check_output_request(port->type, out.format, out.options);
+        } catch (const ParseError&) {
+            throw;
+        } catch (const Error& e) {
+            p.fail(o, "output '" + out.file + "': " + e.what());
+        }
+        for (const auto& prev : g.outputs)
+            if (prev.file == out.file) p.fail(o, "output file '" + out.file + "' is written twice");
+        g.outputs.push_back(std::move(out));
+    }
+
+    validate_graph(g, registry);
+    return g;
+}
+
+Graph load_graph(const std::filesystem::path& file, const NodeRegistry& registry) {
+    std::string text;
+    try {
+        text = read_file_bytes(file);
+    } catch (const Error&) {
+        throw Error(file.string() + ": cannot read graph file (does it exist?)");
+    }
+    Graph g = parse_graph(text, file.string(), file.parent_path().empty() ? std::filesystem::path(".") : file.parent_path(), registry);
+    g.file = file;
+    return g;
+}
+
+} // namespace atlas

@@ -1,0 +1,185 @@
+// Graph validation (connections, types, cycles) and parameter overrides.
+#include "atlas/graph/graph.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <functional>
+
+namespace atlas {
+
+namespace {
+// Ports are compatible when some concrete type satisfies both sides.
+bool ports_compatible(PortType accepted, PortType produced) {
+    return port_accepts(accepted, produced) || (produced == PortType::Field && port_accepts(PortType::Field, accepted));
+}
+
+std::vector<std::string> port_names(const std::deque<PortDecl>& ports) {
+    std::vector<std::string> v;
+    for (const auto& p : ports) v.push_back(p.name);
+    return v;
+}
+
+std::string with_hint(std::string msg, const std::string& word, const std::vector<std::string>& candidates) {
+    if (auto s = closest_match(word, candidates); !s.empty()) return msg + " (did you mean '" + s + "'?)";
+    if (candidates.empty()) return msg;
+    msg += " (expected one of:";
+    for (const auto& c : candidates) msg += " " + c;
+    return msg + ")";
+}
+} // namespace
+
+void validate_graph(const Graph& graph, const NodeRegistry& registry) {
+    std::vector<std::string> node_names;
+    for (const auto& n : graph.nodes) node_names.push_back(n.name);
+
+    for (const auto& n : graph.nodes) {
+        const NodeType* type = registry.find(n.type);
+        if (!type) throw ParseError(n.where, "node '" + n.name + "': unknown node type '" + n.type + "'");
+        for (const auto& [port, b] : n.inputs) {
+            const PortDecl* in = type->decl.find_input(port);
+            if (!in)
+                throw ParseError(b.where, with_hint("node '" + n.name + "' (" + n.type + "): unknown input '" + port + "'", port,
+                                                    port_names(type->decl.inputs())));
+            const GraphNode* src = graph.find(b.node);
+            if (!src)
+                throw ParseError(b.where, with_hint("node '" + n.name + "': input '" + port + "' names unknown node '" + b.node + "'",
+                                                    b.node, node_names));
+            const NodeType* st = registry.find(src->type);
+            std::string sport = b.port;
+            if (sport.empty()) {
+                if (st->decl.outputs().size() != 1)
+                    throw ParseError(b.where, "node '" + n.name + "': input '" + port + "': node '" + b.node +
+                                                  "' has several outputs; write '" + b.node + "." + st->decl.outputs().front().name + "'");
+                sport = st->decl.outputs().front().name;
+            }
+            const PortDecl* out = st->decl.find_output(sport);
+            if (!out)
+                throw ParseError(b.where, with_hint("node '" + n.name + "': input '" + port + "': node '" + b.node + "' (" + src->type +
+                                                        ") has no output '" + sport + "'",
+                                                    sport, port_names(st->decl.outputs())));
+            if (!ports_compatible(in->type, out->type))
+                throw ParseError(b.where, "node '" + n.name + "': type mismatch: input '" + port + "' expects a " +
+                                              std::string(port_type_name(in->type)) + " but '" + b.node + "." + sport + "' produces a " +
+                                              std::string(port_type_name(out->type)));
+        }
+        for (const auto& in : type->decl.inputs())
+            if (!in.optional && !n.inputs.count(in.name))
+                throw ParseError(n.where, "node '" + n.name + "' (" + n.type + "): missing input '" + in.name + "' (" +
+                                              std::string(port_type_name(in.type)) + ": " + in.doc + ")");
+        for (const auto& [pname, setting] : n.params) {
+            const ParamDecl* d = type->decl.find_param(pname);
+            if (!d) throw ParseError(setting.where, "node '" + n.name + "': unknown parameter '" + pname + "'");
+            if (auto err = d->check(setting.value); !err.empty())
+                throw ParseError(setting.where, "node '" + n.name + "': parameter '" + pname + "': " + err);
+        }
+    }
+
+    // Cycles: depth-first search with colours; report the cycle's path.
+    std::map<std::string, int> colour; // 0 white, 1 grey, 2 black
+    std::vector<std::string> stack;
+    std::function<void(const GraphNode&)> visit = [&](const GraphNode& n) {
+        colour[n.name] = 1;
+        stack.push_back(n.name);
+        for (const auto& [port, b] : n.inputs) {
+            const GraphNode* src = graph.find(b.node);
+            int c = colour[src->name];
+            if (c == 1) {
+                std::string path;
+                auto it = std::find(stack.begin(), stack.end(), src->name);
+                for (; it != stack.end(); ++it) path += *it + " -> ";
+                path += src->name;
+                throw ParseError(b.where, "cycle in the graph: " + path + " (a node cannot depend on its own output)");
+            }
+            if (c == 0) visit(*src);
+        }
+        stack.pop_back();
+        colour[n.name] = 2;
+    };
+    for (const auto& n : graph.nodes)
+        if (colour[n.name] == 0) visit(n);
+}
+
+std::map<std::string, ParamValue> resolved_params(const GraphNode& node, const NodeType& type) {
+    std::map<std::string, ParamValue> values;
+    for (const auto& d : type.decl.params()) values[d.name] = d.default_value;
+    for (const auto& [name, setting] : node.params) values[name] = setting.value;
+    return values;
+}
+
+namespace {
+const ParamDecl& find_override_target(Graph& graph, const NodeRegistry& registry, const std::string& node, const std::string& param,
+                                      GraphNode*& gn) {
+    gn = graph.find(node);
+    if (!gn) {
+        std::vector<std::string> names;
+        for (const auto& n : graph.nodes) names.push_back(n.name);
+        throw Error(with_hint("unknown node '" + node + "'", node, names));
+    }
+    const NodeType* type = registry.find(gn->type);
+    const ParamDecl* d = type->decl.find_param(param);
+    if (!d) {
+        std::vector<std::string> names;
+        for (const auto& p : type->decl.params()) names.push_back(p.name);
+        throw Error(with_hint("node '" + node + "' (" + gn->type + "): unknown parameter '" + param + "'", param, names));
+    }
+    return *d;
+}
+} // namespace
+
+void set_param(Graph& graph, const NodeRegistry& registry, const std::string& node, const std::string& param, const ParamValue& value) {
+    GraphNode* gn = nullptr;
+    const ParamDecl& d = find_override_target(graph, registry, node, param, gn);
+    ParamValue v = value;
+    // Hosts may pass an integer where a float is declared.
+    if (d.type == ParamType::Float && std::holds_alternative<int64_t>(v)) v = double(std::get<int64_t>(v));
+    if (auto err = d.check(v); !err.empty()) throw Error("node '" + node + "': parameter '" + param + "': " + err);
+    gn->params[param] = {v, SourceLocation{"<host>", 0, 0}};
+}
+
+void set_param_text(Graph& graph, const NodeRegistry& registry, const std::string& node, const std::string& param,
+                    const std::string& value_text, const std::string& origin) {
+    GraphNode* gn = nullptr;
+    const ParamDecl* d = nullptr;
+    try {
+        d = &find_override_target(graph, registry, node, param, gn);
+    } catch (const Error& e) {
+        throw Error(origin + ": " + e.what());
+    }
+    // Parse the text as a YAML flow value so '--set a.b=[1,2,3]' works.
+    YAML::Node n;
+    try {
+        n = YAML::Load(value_text);
+    } catch (const YAML::Exception& e) {
+        throw Error(origin + ": cannot read value '" + value_text + "': " + e.msg);
+    }
+    ParamValue v;
+    std::string err;
+    const int comps = param_components(d->type);
+    if (comps > 1) {
+        if (!n.IsSequence()) err = "expected a list of " + std::to_string(comps) + " numbers, e.g. [1, 2" + (comps == 3 ? ", 3]" : "]");
+        else {
+            std::vector<double> xs;
+            for (const auto& e : n) {
+                try { xs.push_back(std::stod(e.Scalar())); } catch (...) { err = "expected numbers in the list"; }
+            }
+            v = xs;
+        }
+    } else if (d->type == ParamType::Float) {
+        try { size_t used; v = std::stod(value_text, &used); if (used != value_text.size()) err = "expected a number"; } catch (...) { err = "expected a number"; }
+    } else if (d->type == ParamType::Int) {
+        try { size_t used; v = int64_t(std::stoll(value_text, &used)); if (used != value_text.size()) err = "expected an integer"; } catch (...) { err = "expected an integer"; }
+    } else if (d->type == ParamType::Bool) {
+        if (value_text == "true" || value_text == "1" || value_text == "yes" || value_text == "on") v = true;
+        else if (value_text == "false" || value_text == "0" || value_text == "no" || value_text == "off") v = false;
+        else err = "expected true or false";
+    } else {
+        v = value_text;
+    }
+    if (err.empty()) err = d->check(v);
+    if (!err.empty())
+        throw Error(origin + ": node '" + node + "': parameter '" + param + "' (" + std::string(param_type_name(d->type)) + "): " + err);
+    gn->params[param] = {v, SourceLocation{origin, 0, 0}};
+}
+
+} // namespace atlas

@@ -1,0 +1,93 @@
+#include "atlas/graph/node_docs.h"
+
+#include <sstream>
+
+namespace atlas {
+
+namespace {
+std::string first_sentence(const std::string& doc) {
+    auto dot = doc.find(". ");
+    return dot == std::string::npos ? doc : doc.substr(0, dot + 1);
+}
+
+std::string range_text(const ParamDecl& p) {
+    if (p.type == ParamType::Enum) {
+        std::string s;
+        for (const auto& c : p.choices) s += (s.empty() ? "" : " | ") + c;
+        return s;
+    }
+    auto num = [](double d) { return format_param_value(ParamValue(d)); };
+    if (p.min && p.max) return "[" + num(*p.min) + ", " + num(*p.max) + "]";
+    if (p.min) return ">= " + num(*p.min);
+    if (p.max) return "<= " + num(*p.max);
+    return "";
+}
+
+std::string port_line(const PortDecl& p) {
+    return std::string(port_type_name(p.type)) + (p.optional ? ", optional" : "");
+}
+} // namespace
+
+std::string node_list_text(const NodeRegistry& registry) {
+    std::ostringstream out;
+    size_t w = 0;
+    for (const NodeType* t : registry.all()) w = std::max(w, t->name.size());
+    for (const NodeType* t : registry.all())
+        out << t->name << std::string(w + 2 - t->name.size(), ' ') << first_sentence(t->decl.doc()) << "\n";
+    return out.str();
+}
+
+std::string node_reference_text(const NodeType& t) {
+    std::ostringstream out;
+    out << t.name << " (version " << t.version << ")\n  " << t.decl.doc() << "\n";
+    if (!t.decl.inputs().empty()) {
+        out << "\ninputs:\n";
+        for (const auto& p : t.decl.inputs()) out << "  " << p.name << " (" << port_line(p) << "): " << p.doc << "\n";
+    }
+    out << "\noutputs:\n";
+    for (const auto& p : t.decl.outputs()) out << "  " << p.name << " (" << port_line(p) << "): " << p.doc << "\n";
+    if (!t.decl.params().empty()) {
+        out << "\nparameters:\n";
+        for (const auto& p : t.decl.params()) {
+            out << "  " << p.name << " (" << param_type_name(p.type);
+            if (!p.unit.empty()) out << ", " << p.unit;
+            out << ") = " << format_param_value(p.default_value);
+            if (auto r = range_text(p); !r.empty()) out << "  " << r;
+            out << "\n      " << p.doc << "\n";
+        }
+    }
+    return out.str();
+}
+
+std::string node_reference_markdown(const NodeRegistry& registry) {
+    std::ostringstream out;
+    out << "# Node reference\n\n"
+        << "Generated from the node declarations by `atlas nodes --markdown`; do not edit by hand\n"
+        << "(a test fails when this file is stale: regenerate it with\n"
+        << "`build/apps/atlas nodes --markdown > docs/nodes.md`).\n\n";
+    for (const NodeType* t : registry.all()) out << "- [`" << t->name << "`](#" << [&] {
+            std::string a;
+            for (char c : t->name) if (c != '/') a += c;
+            return a;
+        }() << ")\n";
+    for (const NodeType* t : registry.all()) {
+        out << "\n## " << t->name << "\n\n" << t->decl.doc() << " (version " << t->version << ")\n\n";
+        if (!t->decl.inputs().empty()) {
+            out << "| input | type | description |\n|---|---|---|\n";
+            for (const auto& p : t->decl.inputs()) out << "| `" << p.name << "` | " << port_line(p) << " | " << p.doc << " |\n";
+            out << "\n";
+        }
+        out << "| output | type | description |\n|---|---|---|\n";
+        for (const auto& p : t->decl.outputs()) out << "| `" << p.name << "` | " << port_line(p) << " | " << p.doc << " |\n";
+        out << "\n";
+        if (!t->decl.params().empty()) {
+            out << "| parameter | type | default | range | unit | description |\n|---|---|---|---|---|---|\n";
+            for (const auto& p : t->decl.params())
+                out << "| `" << p.name << "` | " << param_type_name(p.type) << " | `" << format_param_value(p.default_value) << "` | "
+                    << range_text(p) << " | " << p.unit << " | " << p.doc << " |\n";
+        }
+    }
+    return out.str();
+}
+
+} // namespace atlas

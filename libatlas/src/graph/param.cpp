@@ -1,0 +1,131 @@
+#include "atlas/graph/param.h"
+
+#include "atlas/core/hash.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace atlas {
+
+std::string_view param_type_name(ParamType t) {
+    switch (t) {
+    case ParamType::Float: return "float";
+    case ParamType::Int: return "int";
+    case ParamType::Bool: return "bool";
+    case ParamType::String: return "string";
+    case ParamType::Enum: return "enum";
+    case ParamType::Path: return "path";
+    case ParamType::Float2: return "float2";
+    case ParamType::Float3: return "float3";
+    case ParamType::Int2: return "int2";
+    case ParamType::Int3: return "int3";
+    }
+    return "?";
+}
+
+int param_components(ParamType t) {
+    switch (t) {
+    case ParamType::Float2:
+    case ParamType::Int2: return 2;
+    case ParamType::Float3:
+    case ParamType::Int3: return 3;
+    default: return 1;
+    }
+}
+
+namespace {
+std::string format_number(double d) {
+    std::ostringstream ss;
+    ss.precision(17);
+    ss << d;
+    std::string s = ss.str();
+    // Prefer the shortest spelling that round-trips.
+    for (int p = 1; p <= 17; ++p) {
+        std::ostringstream t;
+        t.precision(p);
+        t << d;
+        if (std::stod(t.str()) == d) return t.str();
+    }
+    return s;
+}
+} // namespace
+
+std::string format_param_value(const ParamValue& v) {
+    struct Visitor {
+        std::string operator()(bool b) const { return b ? "true" : "false"; }
+        std::string operator()(int64_t i) const { return std::to_string(i); }
+        std::string operator()(double d) const { return format_number(d); }
+        std::string operator()(const std::string& s) const { return "'" + s + "'"; }
+        std::string operator()(const std::vector<double>& v) const {
+            std::string s = "[";
+            for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + format_number(v[i]);
+            return s + "]";
+        }
+    };
+    return std::visit(Visitor{}, v);
+}
+
+void hash_param_value(Hasher& h, const ParamValue& v) {
+    h.add(uint64_t(v.index()));
+    std::visit([&](const auto& x) {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, std::vector<double>>) {
+            h.add(uint64_t(x.size()));
+            for (double d : x) h.add(d);
+        } else {
+            h.add(x);
+        }
+    }, v);
+}
+
+std::string ParamDecl::check(const ParamValue& v) const {
+    auto in_range = [&](double d) -> std::string {
+        if (!std::isfinite(d)) return "must be a finite number";
+        if (min && max && (d < *min || d > *max))
+            return "value " + format_number(d) + " is out of range [" + format_number(*min) + ", " + format_number(*max) + "]";
+        if (min && d < *min) return "value " + format_number(d) + " is below the minimum " + format_number(*min);
+        if (max && d > *max) return "value " + format_number(d) + " is above the maximum " + format_number(*max);
+        return "";
+    };
+    switch (type) {
+    case ParamType::Float:
+        if (!std::holds_alternative<double>(v)) return "expected a number";
+        return in_range(std::get<double>(v));
+    case ParamType::Int:
+        if (!std::holds_alternative<int64_t>(v)) return "expected an integer";
+        return in_range(double(std::get<int64_t>(v)));
+    case ParamType::Bool:
+        return std::holds_alternative<bool>(v) ? "" : "expected true or false";
+    case ParamType::String:
+    case ParamType::Path:
+        return std::holds_alternative<std::string>(v) ? "" : "expected a string";
+    case ParamType::Enum: {
+        if (!std::holds_alternative<std::string>(v)) return "expected one of the names listed for it";
+        const auto& s = std::get<std::string>(v);
+        if (std::find(choices.begin(), choices.end(), s) != choices.end()) return "";
+        std::string list;
+        for (const auto& c : choices) list += (list.empty() ? "" : ", ") + c;
+        return "'" + s + "' is not one of: " + list;
+    }
+    case ParamType::Float2:
+    case ParamType::Float3:
+    case ParamType::Int2:
+    case ParamType::Int3: {
+        const int n = param_components(type);
+        const bool integral = type == ParamType::Int2 || type == ParamType::Int3;
+        std::string expect = "expected a list of " + std::to_string(n) + (integral ? " integers" : " numbers");
+        if (!std::holds_alternative<std::vector<double>>(v)) return expect;
+        const auto& xs = std::get<std::vector<double>>(v);
+        if (int(xs.size()) != n) return expect + ", got " + std::to_string(xs.size());
+        for (double d : xs) {
+            if (integral && std::isfinite(d) && d != std::floor(d)) return expect + ", got " + format_number(d);
+            if (auto e = in_range(d); !e.empty()) return e;
+        }
+        return "";
+    }
+    }
+    return "unknown parameter type";
+}
+
+} // namespace atlas

@@ -1,0 +1,29 @@
+// field/constant: a field filled with one value per channel.
+#include "atlas/graph/node.h"
+
+namespace {
+using namespace atlas;
+
+void declare(NodeDeclaration& d) {
+    d.doc("A 3D field of the given resolution and world bounds, every voxel set to `value`.");
+    d.output("out", PortType::Field3D, "the constant field");
+    d.param_int3("resolution", {{64, 64, 16}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z");
+    d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");
+    d.param_float3("bounds_max", {{4096, 4096, 512}}).with_unit("m").describe("world-space maximum corner");
+    d.param_int("channels", 1).range(1, 16).describe("number of channels");
+    d.param_float("value", 0.0).describe("value of every voxel in every channel");
+}
+
+void cook(CookContext& ctx) {
+    Box3d box{ctx.get_float3("bounds_min"), ctx.get_float3("bounds_max")};
+    if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in every axis");
+    auto f = ctx.make_field3d(ctx.get_int3("resolution"), int(ctx.get_int("channels")), box);
+    const float v = float(ctx.get_float("value"));
+    for (int c = 0; c < f->channels(); ++c) std::fill(f->channel(c).begin(), f->channel(c).end(), v);
+    ctx.set_output("out", Field3DPtr(f));
+}
+} // namespace
+
+ATLAS_REGISTER_NODE(registry) {
+    registry.add({.name = "field/constant", .version = 1, .declare = declare, .cook = cook});
+}

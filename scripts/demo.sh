@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds, cooks examples/quickstart.yaml and says
+# where the outputs are.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+bash scripts/build.sh
+OUT="${1:-demo-out}"
+mkdir -p "$OUT"
+echo "cooking examples/quickstart.yaml into $OUT/ ..." >&2
+build/bin/atlas cook examples/quickstart.yaml --out "$OUT" --report "$OUT/report.json"
+echo >&2
+echo "outputs are in $(cd "$OUT" && pwd):" >&2
+ls -1 "$OUT" | sed 's/^/  /' >&2
+echo "the cook report (per node time, status, metrics) is $OUT/report.json" >&2
