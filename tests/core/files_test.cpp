@@ -1,0 +1,84 @@
+#include "atlas/core/error.h"
+#include "atlas/core/files.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+using namespace atlas;
+
+namespace {
+fs::path temp_dir(const std::string& name) {
+    fs::path d = fs::temp_directory_path() / ("atlas_files_" + name);
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+void write(const fs::path& p, const std::string& s) { std::ofstream(p) << s; }
+} // namespace
+
+TEST(StagedOutputs, CommitMovesEverythingIntoPlace) {
+    fs::path d = temp_dir("commit");
+    {
+        StagedOutputs s(d);
+        write(s.stage("a.txt"), "A");
+        write(s.stage("sub/b.txt"), "B");
+        EXPECT_FALSE(fs::exists(d / "a.txt"));
+        auto files = s.commit();
+        EXPECT_EQ(files.size(), 2u);
+    }
+    EXPECT_EQ(read_file_bytes(d / "a.txt"), "A");
+    EXPECT_EQ(read_file_bytes(d / "sub" / "b.txt"), "B");
+    for (const auto& e : fs::directory_iterator(d)) EXPECT_EQ(e.path().filename().string().find(".atlas-staging"), std::string::npos);
+    fs::remove_all(d);
+}
+
+TEST(StagedOutputs, WithoutCommitNothingChanges) {
+    fs::path d = temp_dir("abort");
+    write(d / "a.txt", "old");
+    {
+        StagedOutputs s(d);
+        write(s.stage("a.txt"), "new");
+        write(s.stage("b.txt"), "new");
+    }
+    EXPECT_EQ(read_file_bytes(d / "a.txt"), "old");
+    EXPECT_FALSE(fs::exists(d / "b.txt"));
+    EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator()), 1);
+    fs::remove_all(d);
+}
+
+TEST(WriteFileAtomic, ThrowingWriterLeavesTheOldFile) {
+    fs::path d = temp_dir("atomic");
+    write(d / "x", "old");
+    EXPECT_THROW(write_file_atomic(d / "x", [](const fs::path& tmp) {
+        write(tmp, "half");
+        throw Error("disk full");
+    }), Error);
+    EXPECT_EQ(read_file_bytes(d / "x"), "old");
+    write_file_atomic(d / "x", [](const fs::path& tmp) { write(tmp, "new"); });
+    EXPECT_EQ(read_file_bytes(d / "x"), "new");
+    fs::remove_all(d);
+}
+
+TEST(ResolveOutputPath, RefusesEscapes) {
+    fs::path d = temp_dir("resolve");
+    EXPECT_EQ(resolve_output_path(d, "a/b.exr", false), (d / "a/b.exr").lexically_normal());
+    EXPECT_EQ(resolve_output_path(d, "a/../b.exr", false), (d / "b.exr").lexically_normal());
+    EXPECT_THROW(resolve_output_path(d, "../b.exr", false), Error);
+    EXPECT_THROW(resolve_output_path(d, "/etc/passwd", false), Error);
+    EXPECT_THROW(resolve_output_path(d, "", false), Error);
+    EXPECT_NO_THROW(resolve_output_path(d, "../b.exr", true));
+    fs::create_directories(d / "out");
+    fs::create_directory_symlink(fs::temp_directory_path(), d / "out" / "tmp");
+    EXPECT_THROW(resolve_output_path(d / "out", "tmp/x.exr", false), Error);
+    fs::remove_all(d);
+}
+
+TEST(ReadFile, NamesTheMissingFile) {
+    try {
+        read_file_bytes("/nonexistent/dir/f.yaml");
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/f.yaml"), std::string::npos);
+    }
+}
