@@ -1,0 +1,64 @@
+// atlas info FILE...: what a file holds (size, channels, value statistics), on stdout.
+#include "cli.h"
+
+#include "atlas/core/error.h"
+#include "atlas/core/field_math.h"
+#include "atlas/io/exr.h"
+#include "atlas/io/image.h"
+#include "atlas/io/vdb.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+
+namespace atlas::cli {
+
+namespace {
+void print_channels(const detail::FieldStorage& f) {
+    for (int c = 0; c < f.channels(); ++c) {
+        ChannelStats s = channel_stats(f.channel(c));
+        std::printf("  channel %-20s min %-12g max %-12g mean %-12g", f.channel_name(c).c_str(), s.min, s.max, s.mean);
+        if (s.nan_count || s.inf_count) std::printf("  NaN %llu  Inf %llu", (unsigned long long)s.nan_count, (unsigned long long)s.inf_count);
+        std::printf("\n");
+    }
+}
+
+void describe(const Value& v) {
+    if (auto f3 = std::get_if<Field3DPtr>(&v)) {
+        const auto& f = **f3;
+        std::printf("  3D field %dx%dx%d, %d channels, bounds [%g %g %g] - [%g %g %g] m, voxel %g x %g x %g m\n", f.nx(), f.ny(), f.nz(),
+                    f.channels(), f.bounds().min[0], f.bounds().min[1], f.bounds().min[2], f.bounds().max[0], f.bounds().max[1],
+                    f.bounds().max[2], f.voxel_size()[0], f.voxel_size()[1], f.voxel_size()[2]);
+        print_channels(f);
+    } else if (auto f2 = std::get_if<Field2DPtr>(&v)) {
+        const auto& f = **f2;
+        std::printf("  2D field %dx%d, %d channels, bounds [%g %g] - [%g %g]\n", f.width(), f.height(), f.channels(), f.bounds().min[0],
+                    f.bounds().min[1], f.bounds().max[0], f.bounds().max[1]);
+        print_channels(f);
+    }
+}
+} // namespace
+
+int run_info(const Args& a) {
+    if (a.positional.empty()) throw UsageError{"expected at least one file", "info"};
+    for (const auto& file : a.positional) {
+        std::string ext = std::filesystem::path(file).extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+        std::printf("%s\n", file.c_str());
+        if (ext == ".exr") {
+            describe(io::read_exr(file));
+        } else if (ext == ".vdb") {
+            std::printf("  grids:");
+            for (const auto& g : io::list_vdb_grids(file)) std::printf(" %s", g.c_str());
+            std::printf("\n");
+            describe(Field3DPtr(std::make_shared<Field3D>(io::read_vdb(file))));
+        } else if (ext == ".png" || ext == ".tga" || ext == ".jpg" || ext == ".tif" || ext == ".tiff") {
+            describe(Field2DPtr(std::make_shared<Field2D>(io::read_image(file))));
+        } else {
+            throw Error(file + ": unknown file type '" + ext + "' (atlas info reads .exr, .vdb, .png, .tga, .tif)");
+        }
+    }
+    return 0;
+}
+
+} // namespace atlas::cli

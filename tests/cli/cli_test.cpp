@@ -1,0 +1,128 @@
+// The atlas program as users and scripts see it: exit status, stdout for data,
+// stderr for messages, located errors, and the generated node reference.
+#include "atlas/graph/node.h"
+#include "atlas/graph/node_docs.h"
+#include "atlas/core/files.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+    int status = -1;
+    std::string out, err;
+};
+
+Run run(const std::string& args) {
+    fs::path dir = fs::temp_directory_path() / "atlas_cli_test";
+    fs::create_directories(dir);
+    std::string cmd = std::string(ATLAS_BINARY_DIR) + "/bin/atlas " + args + " 2>" + (dir / "err").string();
+    Run r;
+    FILE* p = popen(cmd.c_str(), "r");
+    std::array<char, 4096> buf;
+    size_t n;
+    while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
+    int st = pclose(p);
+    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    r.err = atlas::read_file_bytes(dir / "err");
+    return r;
+}
+
+fs::path write_graph(const std::string& name, const std::string& text) {
+    fs::path dir = fs::temp_directory_path() / "atlas_cli_graphs";
+    fs::create_directories(dir);
+    std::ofstream(dir / name) << text;
+    return dir / name;
+}
+
+} // namespace
+
+TEST(Cli, NodesListGoesToStdout) {
+    Run r = run("nodes");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.out.find("noise/value"), std::string::npos);
+    EXPECT_NE(r.out.find("math/remap"), std::string::npos);
+    EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(Cli, NodeReferenceShowsParameters) {
+    Run r = run("nodes math/remap");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.out.find("in_min (float) = 0"), std::string::npos) << r.out;
+    Run bad = run("nodes math/remapp");
+    EXPECT_EQ(bad.status, 1);
+    EXPECT_NE(bad.err.find("did you mean 'math/remap'?"), std::string::npos) << bad.err;
+}
+
+TEST(Cli, DocsNodesMdIsUpToDate) {
+    std::string expected = atlas::node_reference_markdown(atlas::builtin_nodes());
+    std::string actual;
+    ASSERT_NO_THROW(actual = atlas::read_file_bytes(std::string(ATLAS_SOURCE_DIR) + "/docs/nodes.md"));
+    EXPECT_TRUE(actual == expected)
+        << "docs/nodes.md is stale: regenerate it with 'build/bin/atlas nodes --markdown > docs/nodes.md'";
+}
+
+TEST(Cli, ValidateReportsLocatedErrors) {
+    auto g = write_graph("typo.yaml", "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params:\n      octavs: 3\noutputs: []\n");
+    Run r = run("validate " + g.string());
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find(g.string() + ":6:7: error: node 'n': unknown parameter 'octavs' (did you mean 'octaves'?)"), std::string::npos)
+        << r.err;
+    EXPECT_TRUE(r.out.empty());
+}
+
+TEST(Cli, UsageErrorsExitTwo) {
+    Run r = run("cook --jbos 2 x.yaml");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("unknown option '--jbos' for 'atlas cook' (did you mean '--jobs'?)"), std::string::npos) << r.err;
+    EXPECT_EQ(run("frobnicate").status, 2);
+    EXPECT_EQ(run("cook").status, 2);
+}
+
+TEST(Cli, MissingGraphFileIsNamed) {
+    Run r = run("cook /nonexistent/graph.yaml");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("/nonexistent/graph.yaml: cannot read graph file"), std::string::npos) << r.err;
+}
+
+TEST(Cli, CookWritesSummaryAndFilesAndReport) {
+    auto g = write_graph("small.yaml", R"(atlas: 1
+nodes:
+  n:
+    type: noise/value
+    params: {resolution: [16, 16, 4]}
+  unused:
+    type: noise/value
+outputs:
+  - {node: n, file: n.exr}
+  - {node: n, file: n.png, options: {slice: 1}}
+)");
+    fs::path out = fs::temp_directory_path() / "atlas_cli_out";
+    fs::remove_all(out);
+    Run r = run("cook " + g.string() + " --out " + out.string() + " --report " + (out / "r.json").string() + " --quiet --jobs 2");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("cooked 1, cached 0, skipped 1 nodes"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find((out / "n.exr").string()), std::string::npos) << r.out;
+    EXPECT_TRUE(fs::exists(out / "n.exr"));
+    EXPECT_TRUE(fs::exists(out / "n.png"));
+    EXPECT_TRUE(fs::exists(out / "r.json"));
+    EXPECT_TRUE(r.err.empty()) << r.err;
+
+    Run info = run("info " + (out / "n.exr").string());
+    EXPECT_EQ(info.status, 0) << info.err;
+    EXPECT_NE(info.out.find("3D field 16x16x4"), std::string::npos) << info.out;
+
+    Run set = run("cook " + g.string() + " --out " + out.string() + " --set n.octaves=99 --quiet");
+    EXPECT_EQ(set.status, 1);
+    EXPECT_NE(set.err.find("--set n.octaves=99: node 'n': parameter 'octaves' (int): value 99 is out of range [1, 16]"),
+              std::string::npos) << set.err;
+    fs::remove_all(out);
+}
