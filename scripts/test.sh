@@ -1,10 +1,28 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs the whole test suite (ctest).
+# First the engine's own suites (core, graph) are built with AddressSanitizer
+# and UndefinedBehaviorSanitizer and run (skip: ATLAS_SKIP_SANITIZERS=1); then
+# the Release build runs everything, so ctest's summary is the last word.
 # Usage: scripts/test.sh [ctest arguments], e.g. scripts/test.sh -R graph
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
+
+if [ "${ATLAS_SKIP_SANITIZERS:-0}" != "1" ] && [ $# -eq 0 ]; then
+  echo "== sanitizer run (ASan + UBSan): core and graph suites" >&2
+  SAN_DIR="${ATLAS_SANITIZER_BUILD_DIR:-build-asan}"
+  cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DATLAS_SANITIZE=ON \
+        -DATLAS_BUILD_BENCHMARKS=OFF >/dev/null
+  cmake --build "$SAN_DIR" -j "$(nproc)" --target core_test graph_test >&2
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    "$SAN_DIR/tests/core_test" --gtest_brief=1 >&2
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    "$SAN_DIR/tests/graph_test" --gtest_brief=1 >&2
+  echo "== sanitizer run passed" >&2
+fi
+
+echo "== Release build and full test suite" >&2
 bash scripts/build.sh
 BUILD_DIR="${ATLAS_BUILD_DIR:-build}"
 cd "$BUILD_DIR"
-ctest --output-on-failure -j "$(nproc)" --timeout 600 "$@"
+ctest --output-on-failure -j "$(nproc)" --timeout 900 "$@"
