@@ -3,8 +3,8 @@
 #include "atlas/core/hash.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <sstream>
 
 namespace atlas {
 
@@ -35,19 +35,11 @@ int param_components(ParamType t) {
 }
 
 namespace {
+// Shortest spelling that reads back to the same double ("1000", "0.1", "1e+21").
 std::string format_number(double d) {
-    std::ostringstream ss;
-    ss.precision(17);
-    ss << d;
-    std::string s = ss.str();
-    // Prefer the shortest spelling that round-trips.
-    for (int p = 1; p <= 17; ++p) {
-        std::ostringstream t;
-        t.precision(p);
-        t << d;
-        if (std::stod(t.str()) == d) return t.str();
-    }
-    return s;
+    char buf[64];
+    auto r = std::to_chars(buf, buf + sizeof buf, d);
+    return std::string(buf, r.ptr);
 }
 } // namespace
 
