@@ -1,0 +1,143 @@
+// Exact EDT to sub-voxel crossing points.
+//
+// The crossing points lie on grid edges, so each has exactly one fractional
+// coordinate. Points whose fractional coordinate is along axis a ("family a")
+// are handled by an exact separable transform: a 1D nearest-point pass along
+// a (fractional positions), then Felzenszwalb-Huttenlocher lower envelopes of
+// parabolas along the two other axes (integer sites). The squared distance to
+// all crossings is the minimum over the three families.
+#include "atlas/core/memory.h"
+#include "atlas/core/progress.h"
+#include "atlas/volume/sdf.h"
+#include "line_passes.h"
+#include "surface_crossings.h"
+
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <chrono>
+#include <limits>
+#include <vector>
+
+namespace atlas::volume {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// 1D pass along the family axis: squared distance (in units of h^2) from each
+// sample to the nearest crossing on its line. Returns crossings found.
+struct NearestCrossing {
+    float iso;
+    bool border;
+    uint64_t operator()(const float* d, float* out, int n, std::vector<double>& seeds) const {
+        seeds.clear();
+        if (border && detail::is_inside(d[0], iso)) seeds.push_back(-0.5);
+        for (int i = 0; i + 1 < n; ++i)
+            if (detail::is_inside(d[i], iso) != detail::is_inside(d[i + 1], iso))
+                seeds.push_back(i + detail::crossing_t(d[i], d[i + 1], iso));
+        if (border && detail::is_inside(d[n - 1], iso)) seeds.push_back(n - 0.5);
+        if (seeds.empty()) {
+            std::fill(out, out + n, kInf);
+            return 0;
+        }
+        size_t j = 0;
+        for (int i = 0; i < n; ++i) {
+            while (j + 1 < seeds.size() && std::abs(i - seeds[j + 1]) <= std::abs(i - seeds[j])) ++j;
+            const double e = i - seeds[j];
+            out[i] = float(e * e);
+        }
+        return seeds.size();
+    }
+};
+
+// Lower envelope of parabolas (p - q)^2 * h2 + f(q) over integer sites q.
+// f may be +inf (no site). Scratch: v (sites), z (boundaries).
+void envelope(const float* f, float* out, int n, double h2, std::vector<int>& v, std::vector<double>& z) {
+    v.resize(size_t(n));
+    z.resize(size_t(n) + 1);
+    int k = -1;
+    for (int q = 0; q < n; ++q) {
+        if (f[q] == kInf) continue;
+        const double fq = double(f[q]) / h2 + double(q) * q;
+        double s = 0;
+        while (k >= 0) {
+            const int p = v[size_t(k)];
+            s = (fq - (double(f[p]) / h2 + double(p) * p)) / (2.0 * (q - p));
+            if (s <= z[size_t(k)]) --k;
+            else break;
+        }
+        ++k;
+        v[size_t(k)] = q;
+        z[size_t(k)] = k == 0 ? -std::numeric_limits<double>::infinity() : s;
+        z[size_t(k) + 1] = std::numeric_limits<double>::infinity();
+    }
+    if (k < 0) {
+        std::fill(out, out + n, kInf);
+        return;
+    }
+    int j = 0;
+    for (int q = 0; q < n; ++q) {
+        while (z[size_t(j) + 1] < q) ++j;
+        const int p = v[size_t(j)];
+        const double e = double(q - p);
+        out[q] = float(e * e * h2 + double(f[p]));
+    }
+}
+
+} // namespace
+
+Field3D sdf_from_density_edt(const Field3D& density, const SdfOptions& o, const MemoryBudget* budget, SdfStats* stats,
+                             const ProgressSink* progress) {
+    const auto t0 = std::chrono::steady_clock::now();
+    detail::check_density(density, o, "sdf (edt)");
+    const Vec3i res = density.resolution();
+    const size_t count = density.voxel_count();
+    if (budget) budget->check(field_bytes(count, 3), "sdf (edt): output and two scratch grids");
+    Field3D out(res, 1, density.bounds(), {"sdf"}, budget);
+    const Vec3d h = density.voxel_size();
+    const float iso = float(o.iso);
+    const float* dens = density.channel(o.channel).data();
+
+    std::vector<float> work(count), best(count, kInf);
+    std::atomic<uint64_t> crossings{0};
+    for (int a = 0; a < 3; ++a) {
+        if (progress) progress->poll();
+        const NearestCrossing nearest{iso, o.border_is_outside};
+        const double ha2 = h[a] * h[a];
+        detail::for_each_line(res, a, dens, work.data(), [&](const float* d, float* w, int n) {
+            thread_local std::vector<double> seeds;
+            const uint64_t c = nearest(d, w, n, seeds);
+            if (c) crossings.fetch_add(c, std::memory_order_relaxed);
+            for (int i = 0; i < n; ++i) w[i] = w[i] == kInf ? kInf : float(double(w[i]) * ha2);
+        });
+        for (int b = 0; b < 3; ++b) {
+            if (b == a) continue;
+            const double hb2 = h[b] * h[b];
+            detail::for_each_line(res, b, work.data(), work.data(), [&](const float* f, float* w, int n) {
+                thread_local std::vector<int> v;
+                thread_local std::vector<double> z;
+                envelope(f, w, n, hb2, v, z);
+            });
+        }
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) best[i] = std::min(best[i], work[i]);
+        });
+    }
+    // Border seeds were counted once per line that sees them; fine as a statistic.
+    const float far = float(detail::far_value(density, o));
+    auto sdf = out.channel(0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+            const bool in = detail::is_inside(dens[i], iso);
+            const float d = best[i] == kInf ? far : std::sqrt(best[i]);
+            sdf[i] = in ? -d : d;
+        }
+    });
+    if (stats) {
+        stats->crossings = crossings.load();
+        stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    return out;
+}
+
+} // namespace atlas::volume
