@@ -95,8 +95,8 @@ TEST(SdfFastSweeping, SignExactErrorBounded) {
         const SdfError err = compare_sdf(f, b);
         EXPECT_EQ(err.sign_mismatches, 0u);
         // Fast sweeping is first order (no sub-voxel seeds): documented bound
-        // 1 voxel on these small grids (measured 0.6-0.75).
-        EXPECT_LT(err.max_abs_voxels, 1.0) << "seed " << seed;
+        // 2 voxels (measured 0.6-0.75 here, 1.6 on the 512x512x64 bench grid).
+        EXPECT_LT(err.max_abs_voxels, 2.0) << "seed " << seed;
         EXPECT_LT(err.rms_voxels, 0.5) << "seed " << seed;
         expect_all_finite(f);
     }

@@ -15,7 +15,8 @@
 namespace atlas::volume::detail {
 
 // op(const float* in, float* out, int n): in and out are contiguous copies of
-// one line of `src` / `dst` (out holds dst's old values on entry).
+// one line of `src` / `dst` (out's contents on entry are unspecified; op
+// must write all n values).
 // src and dst may be the same array.
 template <typename Op>
 void for_each_line(Vec3i res, int axis, const float* src, float* dst, Op op) {
@@ -28,7 +29,6 @@ void for_each_line(Vec3i res, int axis, const float* src, float* dst, Op op) {
                 for (int y = 0; y < res[1]; ++y) {
                     const size_t base = size_t(z) * stride[2] + size_t(y) * stride[1];
                     std::copy(src + base, src + base + size_t(n), in.begin());
-                    std::copy(dst + base, dst + base + size_t(n), out.begin());
                     op(in.data(), out.data(), n);
                     std::copy(out.begin(), out.end(), dst + base);
                 }
@@ -50,14 +50,10 @@ void for_each_line(Vec3i res, int axis, const float* src, float* dst, Op op) {
                     const size_t o = base + size_t(i) * stride[axis];
                     for (int k = 0; k < bw; ++k) {
                         bin[size_t(i) * kBlock + size_t(k)] = src[o + size_t(k)];
-                        bout[size_t(i) * kBlock + size_t(k)] = dst[o + size_t(k)];
                     }
                 }
                 for (int k = 0; k < bw; ++k) {
-                    for (int i = 0; i < n; ++i) {
-                        in[size_t(i)] = bin[size_t(i) * kBlock + size_t(k)];
-                        out[size_t(i)] = bout[size_t(i) * kBlock + size_t(k)];
-                    }
+                    for (int i = 0; i < n; ++i) in[size_t(i)] = bin[size_t(i) * kBlock + size_t(k)];
                     op(in.data(), out.data(), n);
                     for (int i = 0; i < n; ++i) bout[size_t(i) * kBlock + size_t(k)] = out[size_t(i)];
                 }
