@@ -14,9 +14,10 @@
 
 namespace atlas::volume::detail {
 
-// op(const float* in, float* out, int n): in and out are contiguous copies of
+// op(const float* in, float* out, int n, size_t base): in and out are contiguous copies of
 // one line of `src` / `dst` (out's contents on entry are unspecified; op
 // must write all n values).
+// base is the flat grid index of the line's first sample.
 // src and dst may be the same array.
 template <typename Op>
 void for_each_line(Vec3i res, int axis, const float* src, float* dst, Op op) {
@@ -29,7 +30,7 @@ void for_each_line(Vec3i res, int axis, const float* src, float* dst, Op op) {
                 for (int y = 0; y < res[1]; ++y) {
                     const size_t base = size_t(z) * stride[2] + size_t(y) * stride[1];
                     std::copy(src + base, src + base + size_t(n), in.begin());
-                    op(in.data(), out.data(), n);
+                    op(in.data(), out.data(), n, base);
                     std::copy(out.begin(), out.end(), dst + base);
                 }
         });
@@ -54,7 +55,7 @@ void for_each_line(Vec3i res, int axis, const float* src, float* dst, Op op) {
                 }
                 for (int k = 0; k < bw; ++k) {
                     for (int i = 0; i < n; ++i) in[size_t(i)] = bin[size_t(i) * kBlock + size_t(k)];
-                    op(in.data(), out.data(), n);
+                    op(in.data(), out.data(), n, base + size_t(k));
                     for (int i = 0; i < n; ++i) bout[size_t(i) * kBlock + size_t(k)] = out[size_t(i)];
                 }
                 for (int i = 0; i < n; ++i) {

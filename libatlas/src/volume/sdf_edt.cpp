@@ -10,6 +10,7 @@
 #include "atlas/core/progress.h"
 #include "atlas/volume/sdf.h"
 #include "line_passes.h"
+#include "edt_core.h"
 #include "surface_crossings.h"
 
 #include <tbb/parallel_for.h>
@@ -23,32 +24,6 @@ namespace atlas::volume {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-
-// 1D pass along the family axis: squared distance (in units of h^2) from each
-// sample to the nearest crossing on its line. Returns crossings found.
-struct NearestCrossing {
-    float iso;
-    bool border;
-    uint64_t operator()(const float* d, float* out, int n, std::vector<double>& seeds) const {
-        seeds.clear();
-        if (border && detail::is_inside(d[0], iso)) seeds.push_back(-0.5);
-        for (int i = 0; i + 1 < n; ++i)
-            if (detail::is_inside(d[i], iso) != detail::is_inside(d[i + 1], iso))
-                seeds.push_back(i + detail::crossing_t(d[i], d[i + 1], iso));
-        if (border && detail::is_inside(d[n - 1], iso)) seeds.push_back(n - 0.5);
-        if (seeds.empty()) {
-            std::fill(out, out + n, kInf);
-            return 0;
-        }
-        size_t j = 0;
-        for (int i = 0; i < n; ++i) {
-            while (j + 1 < seeds.size() && std::abs(i - seeds[j + 1]) <= std::abs(i - seeds[j])) ++j;
-            const double e = i - seeds[j];
-            out[i] = float(e * e);
-        }
-        return seeds.size();
-    }
-};
 
 // Lower envelope of parabolas (p - q)^2 * h2 + f(q) over integer sites q.
 // f may be +inf (no site). Scratch: v (sites), z (boundaries).
@@ -86,34 +61,35 @@ void envelope(const float* f, float* out, int n, double h2, std::vector<int>& v,
 
 } // namespace
 
-Field3D sdf_from_density_edt(const Field3D& density, const SdfOptions& o, const MemoryBudget* budget, SdfStats* stats,
-                             const ProgressSink* progress) {
-    const auto t0 = std::chrono::steady_clock::now();
-    detail::check_density(density, o, "sdf (edt)");
-    const Vec3i res = density.resolution();
-    const size_t count = density.voxel_count();
-    if (budget) budget->check(field_bytes(count, 3), "sdf (edt): output and two scratch grids");
-    Field3D out(res, 1, density.bounds(), {"sdf"}, budget);
-    const Vec3d h = density.voxel_size();
-    const float iso = float(o.iso);
-    const float* dens = density.channel(o.channel).data();
+namespace detail {
 
+std::vector<float> squared_distance_to_line_seeds(Vec3i res, Vec3d h, const LineSeedFn& seed_fn, unsigned long long* seed_count) {
+    const size_t count = size_t(res[0]) * size_t(res[1]) * size_t(res[2]);
     std::vector<float> work(count), best(count, kInf);
-    std::atomic<uint64_t> crossings{0};
+    std::atomic<unsigned long long> crossings{0};
     for (int a = 0; a < 3; ++a) {
-        if (progress) progress->poll();
-        const NearestCrossing nearest{iso, o.border_is_outside};
         const double ha2 = h[a] * h[a];
-        detail::for_each_line(res, a, dens, work.data(), [&](const float* d, float* w, int n) {
+        // 1D pass along the family axis: nearest seed on the line.
+        detail::for_each_line(res, a, work.data(), work.data(), [&](const float*, float* w, int n, size_t base) {
             thread_local std::vector<double> seeds;
-            const uint64_t c = nearest(d, w, n, seeds);
-            if (c) crossings.fetch_add(c, std::memory_order_relaxed);
-            for (int i = 0; i < n; ++i) w[i] = w[i] == kInf ? kInf : float(double(w[i]) * ha2);
+            seeds.clear();
+            seed_fn(a, base, n, seeds);
+            if (seeds.empty()) {
+                std::fill(w, w + n, kInf);
+                return;
+            }
+            crossings.fetch_add(seeds.size(), std::memory_order_relaxed);
+            size_t j = 0;
+            for (int i = 0; i < n; ++i) {
+                while (j + 1 < seeds.size() && std::abs(i - seeds[j + 1]) <= std::abs(i - seeds[j])) ++j;
+                const double e = i - seeds[j];
+                w[i] = float(e * e * ha2);
+            }
         });
         for (int b = 0; b < 3; ++b) {
             if (b == a) continue;
             const double hb2 = h[b] * h[b];
-            detail::for_each_line(res, b, work.data(), work.data(), [&](const float* f, float* w, int n) {
+            detail::for_each_line(res, b, work.data(), work.data(), [&](const float* f, float* w, int n, size_t) {
                 thread_local std::vector<int> v;
                 thread_local std::vector<double> z;
                 envelope(f, w, n, hb2, v, z);
@@ -123,7 +99,40 @@ Field3D sdf_from_density_edt(const Field3D& density, const SdfOptions& o, const 
             for (size_t i = r.begin(); i < r.end(); ++i) best[i] = std::min(best[i], work[i]);
         });
     }
-    // Border seeds were counted once per line that sees them; fine as a statistic.
+    if (seed_count) *seed_count = crossings.load();
+    return best;
+}
+
+} // namespace detail
+
+Field3D sdf_from_density_edt(const Field3D& density, const SdfOptions& o, const MemoryBudget* budget, SdfStats* stats,
+                             const ProgressSink* progress) {
+    const auto t0 = std::chrono::steady_clock::now();
+    detail::check_density(density, o, "sdf (edt)");
+    const Vec3i res = density.resolution();
+    const size_t count = density.voxel_count();
+    if (budget) budget->check(field_bytes(count, 3), "sdf (edt): output and two scratch grids");
+    if (progress) progress->poll();
+    Field3D out(res, 1, density.bounds(), {"sdf"}, budget);
+    const float iso = float(o.iso);
+    const float* dens = density.channel(o.channel).data();
+    const size_t stride[3] = {1, size_t(res[0]), size_t(res[0]) * size_t(res[1])};
+    const bool border = o.border_is_outside;
+    auto seeds = [&](int a, size_t base, int n, std::vector<double>& out_seeds) {
+        const size_t st = stride[a];
+        auto d = [&](int i) { return dens[base + size_t(i) * st]; };
+        if (border && detail::is_inside(d(0), iso)) out_seeds.push_back(-0.5);
+        bool prev = detail::is_inside(d(0), iso);
+        for (int i = 0; i + 1 < n; ++i) {
+            const bool next = detail::is_inside(d(i + 1), iso);
+            if (prev != next) out_seeds.push_back(i + detail::crossing_t(d(i), d(i + 1), iso));
+            prev = next;
+        }
+        if (border && detail::is_inside(d(n - 1), iso)) out_seeds.push_back(n - 0.5);
+    };
+    unsigned long long crossings = 0;
+    std::vector<float> best = detail::squared_distance_to_line_seeds(res, density.voxel_size(), seeds, &crossings);
+    if (progress) progress->poll();
     const float far = float(detail::far_value(density, o));
     auto sdf = out.channel(0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
@@ -134,7 +143,7 @@ Field3D sdf_from_density_edt(const Field3D& density, const SdfOptions& o, const 
         }
     });
     if (stats) {
-        stats->crossings = crossings.load();
+        stats->crossings = crossings;
         stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     return out;
