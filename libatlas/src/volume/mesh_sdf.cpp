@@ -1,0 +1,148 @@
+// Mesh inside test and signed distance over a grid.
+#include "atlas/core/error.h"
+#include "atlas/core/memory.h"
+#include "atlas/volume/mesh_io.h"
+#include "atlas/volume/mesh_voxelize.h"
+#include "edt_core.h"
+#include "mesh_line_hits.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace atlas::volume {
+namespace {
+
+Vec3d to_d(const Vec3f& v) { return {{v[0], v[1], v[2]}}; }
+
+// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection 5.1.5).
+Vec3d closest_on_triangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+    const Vec3d ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    if (d1 <= 0 && d2 <= 0) return a;
+    const Vec3d bp = p - b;
+    const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return b;
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+    const Vec3d cp = p - c;
+    const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return c;
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    const double den = va + vb + vc;
+    if (!(den > 0)) return a; // degenerate (zero-area) triangle: fall back to a corner
+    return a + ab * (vb / den) + ac * (vc / den);
+}
+
+double diagonal(const Box3d& b) { return length(b.size()); }
+
+} // namespace
+
+double winding_number(const Mesh& m, Vec3d p) {
+    validate_mesh(m, "winding_number");
+    // Van Oosterom & Strackee: tan(omega/2) = det / (|a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|).
+    double sum = 0;
+    for (const auto& t : m.triangles) {
+        const Vec3d a = to_d(m.vertices[t[0]]) - p, b = to_d(m.vertices[t[1]]) - p, c = to_d(m.vertices[t[2]]) - p;
+        const double la = length(a), lb = length(b), lc = length(c);
+        const double det = dot(a, cross(b, c));
+        const double den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+        sum += 2 * std::atan2(det, den);
+    }
+    return sum / (4 * std::numbers::pi);
+}
+
+Field3D mesh_winding_field(const Mesh& m, Vec3i res, Box3d bounds, const MemoryBudget* budget) {
+    if (budget) budget->check(field_bytes(uint64_t(res[0]) * res[1] * res[2], 2), "mesh winding field");
+    const detail::MeshLineHits hits = detail::mesh_line_hits(m, res, bounds);
+    Field3D out(res, 1, bounds, {"winding"}, budget);
+    const std::vector<float> w = detail::ray_winding_vote(hits, res, m, bounds);
+    std::copy(w.begin(), w.end(), out.channel(0).begin());
+    return out;
+}
+
+Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions& o, const MemoryBudget* budget, MeshSdfStats* stats) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!(o.exact_band_voxels >= 0) || !std::isfinite(o.exact_band_voxels))
+        throw Error("mesh_to_sdf: exact_band_voxels must be finite and >= 0");
+    if (!std::isfinite(o.far_distance)) throw Error("mesh_to_sdf: far_distance must be finite");
+    const uint64_t count = uint64_t(res[0]) * res[1] * res[2];
+    if (budget) budget->check(field_bytes(count, 5), "mesh_to_sdf: output, winding, band and two EDT grids");
+    const detail::MeshLineHits hits = detail::mesh_line_hits(m, res, bounds);
+    Field3D out(res, 1, bounds, {"sdf"}, budget);
+    const Vec3d h = out.voxel_size();
+    const size_t stride[3] = {1, size_t(res[0]), size_t(res[0]) * size_t(res[1])};
+
+    // Far field: exact EDT to the crossing points on the grid lines.
+    auto seeds = [&](int a, size_t base, int, std::vector<double>& s) {
+        int b, c;
+        detail::other_axes(a, b, c);
+        const size_t ib = (base / stride[b]) % size_t(res[b]), ic = (base / stride[c]) % size_t(res[c]);
+        const uint32_t l = uint32_t(ib) + uint32_t(ic) * uint32_t(res[b]);
+        const auto& ah = hits.axis[a];
+        s.assign(ah.t.begin() + ah.offsets[l], ah.t.begin() + ah.offsets[l + 1]);
+    };
+    std::vector<float> d2 = detail::squared_distance_to_line_seeds(res, h, seeds);
+
+    // Near field: exact point-triangle distances within the band (serial over
+    // triangles, min is order-independent).
+    const double vmin = std::min({h[0], h[1], h[2]});
+    const double band = o.exact_band_voxels * vmin;
+    if (band > 0) {
+        for (const auto& t : m.triangles) {
+            const Vec3d a = to_d(m.vertices[t[0]]), b = to_d(m.vertices[t[1]]), c = to_d(m.vertices[t[2]]);
+            int lo[3], hi[3];
+            bool empty = false;
+            for (int k = 0; k < 3; ++k) {
+                const double mn = std::min({a[k], b[k], c[k]}) - band, mx = std::max({a[k], b[k], c[k]}) + band;
+                lo[k] = std::max(0, int(std::ceil((mn - bounds.min[k]) / h[k] - 0.5)));
+                hi[k] = std::min(res[k] - 1, int(std::floor((mx - bounds.min[k]) / h[k] - 0.5)));
+                empty |= lo[k] > hi[k];
+            }
+            if (empty) continue;
+            for (int z = lo[2]; z <= hi[2]; ++z)
+                for (int y = lo[1]; y <= hi[1]; ++y)
+                    for (int x = lo[0]; x <= hi[0]; ++x) {
+                        const Vec3d p = out.voxel_center(x, y, z);
+                        const Vec3d q = closest_on_triangle(p, a, b, c) - p;
+                        const float e = float(dot(q, q));
+                        float& cur = d2[out.index(x, y, z)];
+                        if (e < cur) cur = e;
+                    }
+        }
+    }
+    const std::vector<float> vote = detail::ray_winding_vote(hits, res, m, bounds);
+    const float far = float(o.far_distance > 0 ? o.far_distance : diagonal(bounds));
+    auto sdf = out.channel(0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(count), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+            const float d = std::isinf(d2[i]) ? far : std::sqrt(d2[i]);
+            sdf[i] = vote[i] > 0.5f ? -d : d;
+        }
+    });
+    if (stats) {
+        stats->line_hits = hits.total;
+        stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    return out;
+}
+
+Field3D density_from_sdf(const Field3D& sdf, int channel) {
+    if (channel < 0 || channel >= sdf.channels()) throw Error("density_from_sdf: channel " + std::to_string(channel) + " does not exist");
+    const Vec3d h = sdf.voxel_size();
+    const double vmin = std::min({h[0], h[1], h[2]});
+    Field3D out(sdf.resolution(), 1, sdf.bounds(), {"density"});
+    auto s = sdf.channel(channel);
+    auto d = out.channel(0);
+    for (size_t i = 0; i < s.size(); ++i) d[i] = float(std::clamp(0.5 - double(s[i]) / vmin, 0.0, 1.0));
+    return out;
+}
+
+} // namespace atlas::volume
