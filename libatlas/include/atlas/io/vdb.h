@@ -1,0 +1,40 @@
+// atlas/io/vdb.h - OpenVDB files: dense Field3D <-> sparse float/vector grids.
+//
+// Field voxel (i, j, k) is VDB voxel (i, j, k); the grid transform is linear
+// (scale by the voxel size per axis, translate by bounds.min + half a voxel),
+// so voxel centres coincide. The field's bounds are also stored as grid
+// metadata (atlas_bounds_min / atlas_bounds_max) so a round trip restores
+// them exactly even when the border is empty.
+// Output bytes are deterministic: the archive's random UUID is replaced by
+// one derived from the grids' content.
+#pragma once
+
+#include "atlas/core/field.h"
+#include "atlas/core/memory.h"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace atlas::io {
+
+namespace fs = std::filesystem;
+
+struct VdbOptions {
+    std::vector<std::string> grid_names; // default: the field's channel names
+    float tolerance = 0.0f;              // |v - 0| <= tolerance is left inactive (background 0)
+    bool vector3 = false;                // write 3 channels as one Vec3f grid
+};
+
+void write_vdb(const Field3D& field, const fs::path& path, const VdbOptions& options = {});
+
+// Names of the grids in a file (any type).
+std::vector<std::string> list_vdb_grids(const fs::path& path);
+
+// Reads the named float grids (or every float grid when empty; a Vec3f grid
+// becomes 3 channels "name.x/.y/.z") densified over the union of their
+// active bounding boxes, or the atlas bounds metadata when present. Grids
+// must share one transform. Throws atlas::Error naming the file and grid.
+Field3D read_vdb(const fs::path& path, const std::vector<std::string>& grid_names = {}, const MemoryBudget* budget = nullptr);
+
+} // namespace atlas::io

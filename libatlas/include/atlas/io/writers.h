@@ -1,0 +1,45 @@
+// atlas/io/writers.h - the output formats a graph (or the CLI) can write.
+//
+// The table of formats is the single source for validation (graph outputs
+// are checked against it before anything cooks), for docs, and for dispatch.
+// Writers write straight to the path given; atomicity is the caller's job
+// (core/files.h StagedOutputs).
+#pragma once
+
+#include "atlas/core/value.h"
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace atlas::io {
+
+namespace fs = std::filesystem;
+
+// Option name -> value text, as given in a graph output's `options` map.
+using OutputOptions = std::map<std::string, std::string>;
+
+struct OutputFormat {
+    std::string name;                                          // "exr"
+    std::vector<std::string> extensions;                       // {".exr"}
+    std::vector<PortType> accepts;                             // value types it writes
+    std::string doc;                                           // one line
+    std::vector<std::pair<std::string, std::string>> options;  // option name, doc
+};
+
+// Every output format, in a fixed order.
+const std::vector<OutputFormat>& output_formats();
+
+// The format for a file name's extension; throws atlas::Error listing the
+// known extensions when there is none.
+std::string output_format_for_path(const fs::path& path);
+
+// Writes `value` in `format` to `path` and returns the files written (several
+// for "tga-slices", where `path` is DIR/STEM and files are DIR/STEM.001.tga...).
+// Throws atlas::Error on a value the format cannot write, an unknown option
+// or a bad option value (naming the option and what it expects).
+std::vector<fs::path> write_value(const Value& value, const fs::path& path, const std::string& format, const OutputOptions& options);
+
+} // namespace atlas::io
