@@ -1,0 +1,55 @@
+// Value erosion by fractal value noise (the Nubis remap erosion).
+#include "atlas/core/error.h"
+#include "atlas/core/memory.h"
+#include "atlas/noise/value_noise.h"
+#include "atlas/volume/edit.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace atlas::volume {
+
+Field3D erode_by_noise(const Field3D& density, const ErosionOptions& o, const MemoryBudget* budget) {
+    if (o.channel < 0 || o.channel >= density.channels()) throw Error("erode_by_noise: channel " + std::to_string(o.channel) + " does not exist");
+    if (!(o.amount >= 0 && o.amount <= 1)) throw Error("erode_by_noise: amount must be in [0, 1]");
+    if (!(o.frequency > 0) || !std::isfinite(o.frequency)) throw Error("erode_by_noise: frequency must be finite and > 0 (cells per metre)");
+    if (o.octaves < 1 || o.octaves > 12) throw Error("erode_by_noise: octaves must be in [1, 12]");
+    if (budget) budget->check(density.byte_size(), "erode_by_noise: the density copy");
+    const Box3d& b = density.bounds();
+    const Vec3d h = density.voxel_size();
+    const Vec3d ext = b.size();
+    for (int a = 0; a < 3; ++a)
+        if (ext[a] * o.frequency * std::ldexp(1.0, o.octaves - 1) > 1e7)
+            throw Error("erode_by_noise: frequency x extent is too large (over 1e7 noise cells per axis)");
+    Field3D out = density;
+    double norm = 0;
+    for (int k = 0; k < o.octaves; ++k) norm += std::ldexp(1.0, -k);
+    tbb::parallel_for(0, density.nz(), [&](int z) {
+        std::vector<float> row(size_t(density.nx())), acc(size_t(density.nx()));
+        for (int y = 0; y < density.ny(); ++y) {
+            std::fill(acc.begin(), acc.end(), 0.0f);
+            for (int k = 0; k < o.octaves; ++k) {
+                const double f = o.frequency * std::ldexp(1.0, k);
+                // Period in cells: the extent, so the noise tiles on the bounds
+                // when frequency * extent is an integer.
+                const Vec3i period{{std::max(1, int(std::lround(ext[0] * f))), std::max(1, int(std::lround(ext[1] * f))),
+                                    std::max(1, int(std::lround(ext[2] * f)))}};
+                noise::value_noise_row(row, 0.5 * h[0] * f, h[0] * f, (y + 0.5) * h[1] * f, (z + 0.5) * h[2] * f, period,
+                                       o.seed + uint32_t(k) * 0x9E3779B9u);
+                const float w = float(std::ldexp(1.0, -k) / norm);
+                for (size_t i = 0; i < row.size(); ++i) acc[i] += w * row[i];
+            }
+            for (int x = 0; x < density.nx(); ++x) {
+                const double e = o.amount * std::clamp(double(acc[size_t(x)]), 0.0, 1.0);
+                float& d = out.at(o.channel, x, y, z);
+                d = e >= 1 ? 0.0f : float(std::clamp((double(d) - e) / (1 - e), 0.0, 1.0));
+            }
+        }
+    });
+    return out;
+}
+
+} // namespace atlas::volume
