@@ -16,16 +16,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
+struct CliRun {
     int status = -1;
     std::string out, err;
 };
 
-Run run(const std::string& args) {
+CliRun run(const std::string& args) {
     fs::path dir = fs::temp_directory_path() / "atlas_cli_test";
     fs::create_directories(dir);
     std::string cmd = std::string(ATLAS_BINARY_DIR) + "/bin/atlas " + args + " 2>" + (dir / "err").string();
-    Run r;
+    CliRun r;
     FILE* p = popen(cmd.c_str(), "r");
     std::array<char, 4096> buf;
     size_t n;
@@ -46,7 +46,7 @@ fs::path write_graph(const std::string& name, const std::string& text) {
 } // namespace
 
 TEST(Cli, NodesListGoesToStdout) {
-    Run r = run("nodes");
+    CliRun r = run("nodes");
     EXPECT_EQ(r.status, 0);
     EXPECT_NE(r.out.find("noise/value"), std::string::npos);
     EXPECT_NE(r.out.find("math/remap"), std::string::npos);
@@ -54,10 +54,10 @@ TEST(Cli, NodesListGoesToStdout) {
 }
 
 TEST(Cli, NodeReferenceShowsParameters) {
-    Run r = run("nodes math/remap");
+    CliRun r = run("nodes math/remap");
     EXPECT_EQ(r.status, 0);
     EXPECT_NE(r.out.find("in_min (float) = 0"), std::string::npos) << r.out;
-    Run bad = run("nodes math/remapp");
+    CliRun bad = run("nodes math/remapp");
     EXPECT_EQ(bad.status, 1);
     EXPECT_NE(bad.err.find("did you mean 'math/remap'?"), std::string::npos) << bad.err;
 }
@@ -72,7 +72,7 @@ TEST(Cli, DocsNodesMdIsUpToDate) {
 
 TEST(Cli, ValidateReportsLocatedErrors) {
     auto g = write_graph("typo.yaml", "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params:\n      octavs: 3\noutputs: []\n");
-    Run r = run("validate " + g.string());
+    CliRun r = run("validate " + g.string());
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find(g.string() + ":6:7: error: node 'n': unknown parameter 'octavs' (did you mean 'octaves'?)"), std::string::npos)
         << r.err;
@@ -80,7 +80,7 @@ TEST(Cli, ValidateReportsLocatedErrors) {
 }
 
 TEST(Cli, UsageErrorsExitTwo) {
-    Run r = run("cook --jbos 2 x.yaml");
+    CliRun r = run("cook --jbos 2 x.yaml");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("unknown option '--jbos' for 'atlas cook' (did you mean '--jobs'?)"), std::string::npos) << r.err;
     EXPECT_EQ(run("frobnicate").status, 2);
@@ -88,7 +88,7 @@ TEST(Cli, UsageErrorsExitTwo) {
 }
 
 TEST(Cli, MissingGraphFileIsNamed) {
-    Run r = run("cook /nonexistent/graph.yaml");
+    CliRun r = run("cook /nonexistent/graph.yaml");
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find("/nonexistent/graph.yaml: cannot read graph file"), std::string::npos) << r.err;
 }
@@ -107,7 +107,7 @@ outputs:
 )");
     fs::path out = fs::temp_directory_path() / "atlas_cli_out";
     fs::remove_all(out);
-    Run r = run("cook " + g.string() + " --out " + out.string() + " --report " + (out / "r.json").string() + " --quiet --jobs 2");
+    CliRun r = run("cook " + g.string() + " --out " + out.string() + " --report " + (out / "r.json").string() + " --quiet --jobs 2");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("cooked 1, cached 0, skipped 1 nodes"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find((out / "n.exr").string()), std::string::npos) << r.out;
@@ -116,11 +116,11 @@ outputs:
     EXPECT_TRUE(fs::exists(out / "r.json"));
     EXPECT_TRUE(r.err.empty()) << r.err;
 
-    Run info = run("info " + (out / "n.exr").string());
+    CliRun info = run("info " + (out / "n.exr").string());
     EXPECT_EQ(info.status, 0) << info.err;
     EXPECT_NE(info.out.find("3D field 16x16x4"), std::string::npos) << info.out;
 
-    Run set = run("cook " + g.string() + " --out " + out.string() + " --set n.octaves=99 --quiet");
+    CliRun set = run("cook " + g.string() + " --out " + out.string() + " --set n.octaves=99 --quiet");
     EXPECT_EQ(set.status, 1);
     EXPECT_NE(set.err.find("--set n.octaves=99: node 'n': parameter 'octaves' (int): value 99 is out of range [1, 16]"),
               std::string::npos) << set.err;
