@@ -1,0 +1,66 @@
+// Dimensional profile, field-data encoding and the NVDF channel set.
+#include "atlas/volume/nvdf.h"
+
+#include "atlas/core/error.h"
+#include "atlas/core/memory.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace atlas::volume {
+namespace {
+void check_channel(const Field3D& f, int c, const char* who) {
+    if (c < 0 || c >= f.channels()) throw Error(std::string(who) + ": channel " + std::to_string(c) + " does not exist");
+}
+void check_range(double lo, double hi, const char* who) {
+    if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo))
+        throw Error(std::string(who) + ": range_max must be greater than range_min (both finite), got [" + std::to_string(lo) + ", " +
+                    std::to_string(hi) + "]");
+}
+} // namespace
+
+Field3D dimensional_profile(const Field3D& sdf, const DimensionalProfileOptions& o, const MemoryBudget* budget) {
+    check_channel(sdf, o.channel, "dimensional_profile");
+    if (!(o.depth > 0) || !std::isfinite(o.depth)) throw Error("dimensional_profile: depth must be finite and > 0 metres");
+    if (!(o.exponent > 0) || !std::isfinite(o.exponent)) throw Error("dimensional_profile: exponent must be finite and > 0");
+    Field3D out(sdf.resolution(), 1, sdf.bounds(), {"dimensional_profile"}, budget);
+    auto s = sdf.channel(o.channel);
+    auto d = out.channel(0);
+    for (size_t i = 0; i < s.size(); ++i) {
+        const double t = std::clamp(-double(s[i]) / o.depth, 0.0, 1.0);
+        d[i] = float(o.exponent == 1 ? t : std::pow(t, o.exponent));
+    }
+    return out;
+}
+
+Field3D encode_field_data(const Field3D& sdf, double lo, double hi, int channel, const MemoryBudget* budget) {
+    check_channel(sdf, channel, "encode_field_data");
+    check_range(lo, hi, "encode_field_data");
+    Field3D out(sdf.resolution(), 1, sdf.bounds(), {"field_data"}, budget);
+    auto s = sdf.channel(channel);
+    auto d = out.channel(0);
+    for (size_t i = 0; i < s.size(); ++i) d[i] = float(std::clamp((double(s[i]) - lo) / (hi - lo), 0.0, 1.0));
+    return out;
+}
+
+Field3D decode_field_data(const Field3D& enc, double lo, double hi, int channel, const MemoryBudget* budget) {
+    check_channel(enc, channel, "decode_field_data");
+    check_range(lo, hi, "decode_field_data");
+    Field3D out(enc.resolution(), 1, enc.bounds(), {"sdf"}, budget);
+    auto s = enc.channel(channel);
+    auto d = out.channel(0);
+    for (size_t i = 0; i < s.size(); ++i) d[i] = float(lo + double(s[i]) * (hi - lo));
+    return out;
+}
+
+Field3D assemble_modeling_nvdf(const Field3D& dp, const Field3D& dt, const Field3D& ds, const MemoryBudget* budget) {
+    for (const Field3D* f : {&dt, &ds})
+        if (f->resolution() != dp.resolution() || !(f->bounds() == dp.bounds()))
+            throw Error("modeling NVDF: detail_type and density_scale must have the dimensional profile's resolution and bounds");
+    Field3D out(dp.resolution(), 3, dp.bounds(), {"dimensional_profile", "detail_type", "density_scale"}, budget);
+    const Field3D* src[3] = {&dp, &dt, &ds};
+    for (int c = 0; c < 3; ++c) std::copy(src[c]->channel(0).begin(), src[c]->channel(0).end(), out.channel(c).begin());
+    return out;
+}
+
+} // namespace atlas::volume

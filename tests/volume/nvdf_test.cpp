@@ -1,0 +1,127 @@
+#include "atlas/core/error.h"
+#include "atlas/io/tga_slices.h"
+#include "atlas/volume/nvdf.h"
+#include "atlas/volume/shapes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <vector>
+
+using namespace atlas;
+using namespace atlas::volume;
+
+namespace {
+const Box3d kBox{{{0, 0, 0}}, {{256, 192, 64}}};
+Field3D sphere_sdf() {
+    Shape s;
+    s.a = {{128, 96, 32}};
+    s.radius = 40;
+    return shape_sdf(s, {{32, 24, 8}}, kBox);
+}
+struct TempDir {
+    std::filesystem::path path = std::filesystem::temp_directory_path() / ("atlas_nvdf_" + std::to_string(::getpid()));
+    bool keep = std::getenv("ATLAS_KEEP_TMP") != nullptr;
+    TempDir() { std::filesystem::create_directories(path); }
+    ~TempDir() { if (!keep) std::filesystem::remove_all(path); }
+};
+} // namespace
+
+TEST(Nvdf, DimensionalProfileDefinition) {
+    const Field3D sdf = sphere_sdf();
+    DimensionalProfileOptions o;
+    o.depth = 24;
+    o.exponent = 2;
+    const Field3D dp = dimensional_profile(sdf, o);
+    for (size_t i = 0; i < sdf.voxel_count(); ++i) {
+        const double s = sdf.channel(0)[i];
+        const double e = s >= 0 ? 0 : std::pow(std::min(1.0, -s / 24), 2);
+        ASSERT_NEAR(dp.channel(0)[i], e, 1e-6);
+    }
+    o.depth = 0;
+    EXPECT_THROW(dimensional_profile(sdf, o), Error);
+}
+
+TEST(Nvdf, FieldDataEncodeDecode) {
+    const Field3D sdf = sphere_sdf();
+    const Field3D enc = encode_field_data(sdf);
+    const Field3D dec = decode_field_data(enc);
+    for (size_t i = 0; i < sdf.voxel_count(); ++i) {
+        ASSERT_NEAR(enc.channel(0)[i], (sdf.channel(0)[i] + 256.0) / 4352.0, 1e-6);
+        ASSERT_NEAR(dec.channel(0)[i], sdf.channel(0)[i], 1e-3);
+    }
+    EXPECT_THROW(encode_field_data(sdf, 10, 10), Error);
+}
+
+TEST(Nvdf, PackTgaLayoutsRoundTrip) {
+    TempDir dir;
+    const Field3D sdf = sphere_sdf();
+    const Field3D dp = dimensional_profile(sdf);
+    Field3D dt(sdf.resolution(), 1, kBox), ds(sdf.resolution(), 1, kBox);
+    for (size_t i = 0; i < sdf.voxel_count(); ++i) {
+        dt.channel(0)[i] = float(i % 7) / 6.0f;
+        ds.channel(0)[i] = 0.25f + float(i % 3) / 4.0f;
+    }
+    const Field3D nvdf = assemble_modeling_nvdf(dp, dt, ds);
+    const auto files = write_nubis_modeling_tga(nvdf, dir.path, "modeling");
+    ASSERT_EQ(files.size(), 8u);
+    // Raw layout, from the file's bytes: BGRA pixels after an 18-byte header, A = 0.
+    {
+        std::ifstream in(files[0], std::ios::binary);
+        std::vector<unsigned char> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        ASSERT_EQ(b.size(), 18u + 32u * 24u * 4u + (b.size() - 18u - 32u * 24u * 4u)); // footer allowed
+        ASSERT_EQ(b[2], 2);  // uncompressed true colour
+        ASSERT_EQ(b[16], 32);
+        const bool top_down = b[17] & 0x20;
+        for (int y = 0; y < 24; ++y)
+            for (int x = 0; x < 32; ++x) {
+                const int row = top_down ? 23 - y : y;
+                const unsigned char* p = &b[18 + (size_t(row) * 32 + size_t(x)) * 4];
+                ASSERT_EQ(p[2], std::lround(double(nvdf.at(0, x, y, 0)) * 255.0)); // R
+                ASSERT_EQ(p[1], std::lround(double(nvdf.at(1, x, y, 0)) * 255.0)); // G
+                ASSERT_EQ(p[0], std::lround(double(nvdf.at(2, x, y, 0)) * 255.0)); // B
+                ASSERT_EQ(p[3], 0);                                       // A
+            }
+    }
+    const Field3D back = read_nubis_modeling_tga(files[0], kBox);
+    EXPECT_EQ(back.channel_names(), nvdf.channel_names());
+    for (size_t i = 0; i < back.voxel_count(); ++i)
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(back.channel(c)[i], nvdf.channel(c)[i], 0.5 / 255 + 1e-6);
+
+    const auto fd = write_nubis_field_data_tga(sdf, dir.path, "field");
+    const Field3D fraw = io::read_tga_slices(fd[0], kBox, 4);
+    const Field3D fback = read_nubis_field_data_tga(fd[0], kBox);
+    for (size_t i = 0; i < fraw.voxel_count(); ++i) {
+        // d = R/255 * 4352 - 256 with R the byte; G = B = 0, A = 255.
+        const double r_byte = std::round(fraw.channel(0)[i] * 255.0);
+        ASSERT_NEAR(r_byte / 255 * 4352 - 256, sdf.channel(0)[i], 4352.0 / 255 / 2 + 1e-3);
+        ASSERT_NEAR(fback.channel(0)[i], r_byte / 255 * 4352 - 256, 1e-2);
+        ASSERT_EQ(fraw.channel(1)[i], 0.0f);
+        ASSERT_EQ(fraw.channel(2)[i], 0.0f);
+        ASSERT_EQ(fraw.channel(3)[i], 1.0f);
+    }
+}
+
+TEST(Nvdf, PackVdbRoundTrip) {
+    TempDir dir;
+    const Field3D sdf = sphere_sdf();
+    const Field3D dp = dimensional_profile(sdf);
+    Field3D dt(sdf.resolution(), 1, kBox), ds(sdf.resolution(), 1, kBox);
+    std::fill(ds.channel(0).begin(), ds.channel(0).end(), 1.0f);
+    const Field3D nvdf = assemble_modeling_nvdf(dp, dt, ds);
+    write_nubis_vdb(nvdf, sdf, dir.path / "cloud.vdb");
+    const Field3D back = read_nubis_vdb(dir.path / "cloud.vdb");
+    ASSERT_EQ(back.channels(), 4);
+    EXPECT_EQ(back.channel_name(3), "sdf");
+    ASSERT_EQ(back.resolution(), sdf.resolution());
+    for (size_t i = 0; i < sdf.voxel_count(); ++i) {
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(back.channel(c)[i], nvdf.channel(c)[i]);
+        ASSERT_EQ(back.channel(3)[i], sdf.channel(0)[i]);
+    }
+    Field3D wrong({{4, 4, 4}}, 1, kBox);
+    EXPECT_THROW(assemble_modeling_nvdf(dp, wrong, ds), Error);
+}
