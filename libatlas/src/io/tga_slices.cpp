@@ -6,7 +6,6 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
-#include <regex>
 
 namespace atlas::io {
 
@@ -62,13 +61,19 @@ std::vector<fs::path> write_tga_slices(const Field3D& f, const fs::path& dir, co
 }
 
 std::vector<fs::path> find_tga_slices(const fs::path& first) {
-    static const std::regex pattern(R"((.*)\.(0*1)\.tga)", std::regex::icase);
-    std::smatch m;
+    // STEM.<digits ending in 1, otherwise zeros>.tga, e.g. clouds.001.tga
     const std::string name = first.filename().string();
-    if (!std::regex_match(name, m, pattern))
-        throw Error(first.string() + ": expected the first slice of a stack, named STEM.001.tga");
-    const std::string stem = m[1];
-    const int digits = int(m[2].length());
+    std::string lower = name;
+    for (auto& ch : lower) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    const auto bad_name = [&] { return Error(first.string() + ": expected the first slice of a stack, named STEM.001.tga"); };
+    if (lower.size() < 6 || lower.compare(lower.size() - 4, 4, ".tga") != 0) throw bad_name();
+    const std::string base = name.substr(0, name.size() - 4);
+    const auto dot = base.rfind('.');
+    if (dot == std::string::npos || dot == 0) throw bad_name();
+    const std::string number = base.substr(dot + 1);
+    if (number.empty() || number.back() != '1' || number.find_first_not_of('0') != number.size() - 1) throw bad_name();
+    const std::string stem = base.substr(0, dot);
+    const int digits = int(number.size());
     std::vector<fs::path> files;
     for (int i = 1;; ++i) {
         fs::path p = first.parent_path() / slice_name(stem, i, digits);
