@@ -1,6 +1,8 @@
+// EXR reading and writing through OpenEXR (see exr.h for the layout).
 #include "atlas/io/exr.h"
 
 #include "atlas/core/error.h"
+#include "io_common.h"
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
@@ -8,10 +10,13 @@
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfOutputFile.h>
-#include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
+#include <ImfStringVectorAttribute.h>
 #include <ImfVecAttribute.h>
+#include <Imath/half.h>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace atlas::io {
@@ -19,128 +24,212 @@ namespace atlas::io {
 namespace {
 
 constexpr int kExrLayoutVersion = 1;
+// Largest finite half; beyond it a half EXR would silently store infinity.
+constexpr float kHalfMax = 65504.0f;
 
-// Writes `channels` planar buffers (each width*height, file row order) to an EXR.
-void write_planes(const fs::path& path, int width, int height, const std::vector<std::string>& names,
-                  const std::vector<std::vector<float>>& planes, bool half, Imf::Header header) {
-    header.compression() = Imf::ZIP_COMPRESSION;
+// Planar float buffers in file row order (row 0 = top of the image).
+struct Planes {
+    int width = 0, height = 0;
+    std::vector<std::vector<float>> data;
+};
+
+void check_channel_names(const std::vector<std::string>& names, const fs::path& path) {
+    for (size_t i = 0; i < names.size(); ++i) {
+        if (names[i].empty()) throw Error(path.string() + ": cannot write EXR: channel " + std::to_string(i) + " has an empty name");
+        for (size_t j = i + 1; j < names.size(); ++j)
+            if (names[i] == names[j]) throw Error(path.string() + ": cannot write EXR: duplicate channel name '" + names[i] + "'");
+    }
+}
+
+// Half storage rounds; it must not turn finite values into infinities.
+void check_half_range(const atlas::detail::FieldStorage& f, const fs::path& path) {
+    for (int c = 0; c < f.channels(); ++c)
+        for (size_t i = 0; i < f.voxel_count(); ++i) {
+            const float v = f.channel(c)[i];
+            if (std::isfinite(v) && std::fabs(v) > kHalfMax)
+                throw Error(path.string() + ": cannot write EXR as half: channel '" + f.channel_name(c) + "' holds " + std::to_string(v) +
+                            " (element " + std::to_string(i) + "), beyond the half range +-65504; write 32-bit float instead");
+        }
+}
+
+Imf::Header base_header(int width, int height, const std::vector<std::string>& names, const std::string& meaning) {
+    Imf::Header h(width, height);
+    h.compression() = Imf::ZIP_COMPRESSION;
+    h.insert("atlas:version", Imf::IntAttribute(kExrLayoutVersion));
+    h.insert("atlas:channel_meaning", Imf::StringAttribute(meaning));
+    // EXR lists channels alphabetically; this keeps the field's order.
+    h.insert("atlas:channels", Imf::StringVectorAttribute(names));
+    return h;
+}
+
+void write_planes(const fs::path& path, const Planes& p, const std::vector<std::string>& names, bool half, Imf::Header header) {
     for (const auto& n : names) header.channels().insert(n, Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
+    // OpenEXR converts pixel types when reading, not when writing: half
+    // channels need half buffers (rounded to nearest even by Imath).
+    std::vector<std::vector<::half>> halves(half ? names.size() : 0);
     Imf::FrameBuffer fb;
-    for (size_t c = 0; c < names.size(); ++c)
-        fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)planes[c].data(), sizeof(float), sizeof(float) * size_t(width)));
+    for (size_t c = 0; c < names.size(); ++c) {
+        if (half) {
+            halves[c].assign(p.data[c].begin(), p.data[c].end());
+            fb.insert(names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves[c].data()), sizeof(::half), sizeof(::half) * size_t(p.width)));
+        } else {
+            fb.insert(names[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(p.data[c].data())), sizeof(float),
+                                           sizeof(float) * size_t(p.width)));
+        }
+    }
     try {
+        // One thread: OpenEXR's output is the same bytes either way, and the
+        // caller decides the parallelism.
         Imf::OutputFile file(path.string().c_str(), header, 1);
         file.setFrameBuffer(fb);
-        file.writePixels(height);
+        file.writePixels(p.height);
     } catch (const std::exception& e) {
         throw Error(path.string() + ": cannot write EXR: " + e.what());
     }
 }
 
-Imf::Header base_header(int width, int height, const std::string& meaning) {
-    Imf::Header h(width, height);
-    h.insert("atlas:version", Imf::IntAttribute(kExrLayoutVersion));
-    if (!meaning.empty()) h.insert("atlas:channel_meaning", Imf::StringAttribute(meaning));
-    return h;
+// Channel order: the atlas:channels attribute when it names exactly the file's
+// channels, else the file's (alphabetical) order.
+std::vector<std::string> channel_order(const Imf::Header& hd) {
+    std::vector<std::string> names;
+    for (auto it = hd.channels().begin(); it != hd.channels().end(); ++it) names.emplace_back(it.name());
+    if (const auto* order = hd.findTypedAttribute<Imf::StringVectorAttribute>("atlas:channels")) {
+        std::vector<std::string> a = order->value(), b = names;
+        std::sort(a.begin(), a.end());
+        std::sort(b.begin(), b.end());
+        if (a == b && std::adjacent_find(a.begin(), a.end()) == a.end()) return order->value();
+    }
+    return names;
 }
 
-void check_channel_names(const std::vector<std::string>& names, const fs::path& path) {
-    for (size_t i = 0; i < names.size(); ++i)
-        for (size_t j = i + 1; j < names.size(); ++j)
-            if (names[i] == names[j]) throw Error(path.string() + ": cannot write EXR: duplicate channel name '" + names[i] + "'");
+// Reads every channel as float planes (file row order), checking the size first.
+Planes read_planes(Imf::InputFile& file, const std::vector<std::string>& names, const MemoryBudget& budget) {
+    const Imf::Header& hd = file.header();
+    const Imath::Box2i dw = hd.dataWindow();
+    const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
+    if (w <= 0 || h <= 0 || w > (1 << 30) || h > (1 << 30)) throw Error("data window is empty or absurd");
+    if (names.empty()) throw Error("the image has no channels");
+    if (names.size() > 64) throw Error("the image has " + std::to_string(names.size()) + " channels; at most 64 are supported");
+    for (const auto& n : names) {
+        const Imf::Channel* ch = hd.channels().findChannel(n);
+        if (ch->xSampling != 1 || ch->ySampling != 1)
+            throw Error("channel '" + n + "' is subsampled (luminance/chroma image); only full-resolution channels are supported");
+    }
+    // The planes plus the field built from them.
+    budget.check(field_bytes(uint64_t(w) * uint64_t(h), int(names.size())) * 2,
+                 "a " + std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(names.size()) + " EXR image");
+    Planes p;
+    p.width = int(w);
+    p.height = int(h);
+    p.data.assign(names.size(), std::vector<float>(size_t(w) * size_t(h)));
+    Imf::FrameBuffer fb;
+    for (size_t c = 0; c < names.size(); ++c)
+        fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, p.data[c].data(), dw, sizeof(float), sizeof(float) * size_t(w)));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return p;
+}
+
+template <typename Attr, typename Fn>
+void if_attr(const Imf::Header& hd, const char* name, Fn&& fn) {
+    if (const auto* a = hd.findTypedAttribute<Attr>(name)) fn(a->value());
+}
+
+Value make_field3d(const Imf::Header& hd, const Planes& p, const std::vector<std::string>& names, Imath::V3i r, const MemoryBudget& budget) {
+    if (r.x <= 0 || r.y <= 0 || r.z <= 0 || r.x != p.width || int64_t(r.y) * r.z != p.height)
+        throw Error("atlas:resolution " + std::to_string(r.x) + "x" + std::to_string(r.y) + "x" + std::to_string(r.z) +
+                    " does not match the image size " + std::to_string(p.width) + "x" + std::to_string(p.height) + " (expected nx by ny*nz)");
+    Box3d b{{{0, 0, 0}}, {{double(r.x), double(r.y), double(r.z)}}};
+    const auto* bmin = hd.findTypedAttribute<Imf::V3dAttribute>("atlas:bounds_min");
+    const auto* bmax = hd.findTypedAttribute<Imf::V3dAttribute>("atlas:bounds_max");
+    if (bmin && bmax) {
+        b.min = {{bmin->value().x, bmin->value().y, bmin->value().z}};
+        b.max = {{bmax->value().x, bmax->value().y, bmax->value().z}};
+    }
+    auto f = std::make_shared<Field3D>(Vec3i{{r.x, r.y, r.z}}, int(names.size()), b, names, &budget);
+    for (size_t c = 0; c < names.size(); ++c)
+        for (int z = 0; z < r.z; ++z)
+            for (int y = 0; y < r.y; ++y)
+                std::copy_n(p.data[c].data() + (size_t(z) * size_t(r.y) + size_t(r.y - 1 - y)) * size_t(r.x), size_t(r.x),
+                            f->channel(int(c)).data() + f->index(0, y, z));
+    return Field3DPtr(f);
+}
+
+Value make_field2d(const Imf::Header& hd, const Planes& p, const std::vector<std::string>& names, const MemoryBudget& budget) {
+    Box2d b{{{0, 0}}, {{double(p.width), double(p.height)}}};
+    const auto* bmin = hd.findTypedAttribute<Imf::V2dAttribute>("atlas:bounds_min");
+    const auto* bmax = hd.findTypedAttribute<Imf::V2dAttribute>("atlas:bounds_max");
+    if (bmin && bmax) {
+        b.min = {{bmin->value().x, bmin->value().y}};
+        b.max = {{bmax->value().x, bmax->value().y}};
+    }
+    auto f = std::make_shared<Field2D>(Vec2i{{p.width, p.height}}, int(names.size()), b, names, &budget);
+    for (size_t c = 0; c < names.size(); ++c)
+        for (int y = 0; y < p.height; ++y)
+            std::copy_n(p.data[c].data() + size_t(p.height - 1 - y) * size_t(p.width), size_t(p.width), f->channel(int(c)).data() + f->index(0, y));
+    return Field2DPtr(f);
 }
 
 } // namespace
 
 void write_exr(const Field2D& f, const fs::path& path, const ExrOptions& o) {
     check_channel_names(f.channel_names(), path);
-    const int w = f.width(), h = f.height();
-    std::vector<std::vector<float>> planes(size_t(f.channels()), std::vector<float>(f.voxel_count()));
+    if (o.half) check_half_range(f, path);
+    Planes p;
+    p.width = f.width();
+    p.height = f.height();
+    p.data.assign(size_t(f.channels()), std::vector<float>(f.voxel_count()));
     for (int c = 0; c < f.channels(); ++c)
-        for (int y = 0; y < h; ++y)
-            std::copy_n(f.channel(c).data() + f.index(0, y), w, planes[size_t(c)].data() + size_t(h - 1 - y) * size_t(w));
-    Imf::Header hd = base_header(w, h, o.channel_meaning);
-    hd.insert("atlas:bounds_min", Imf::V2dAttribute(Imath::V2d(f.bounds().min[0], f.bounds().min[1])));
-    hd.insert("atlas:bounds_max", Imf::V2dAttribute(Imath::V2d(f.bounds().max[0], f.bounds().max[1])));
-    hd.insert("atlas:voxel_size", Imf::V2dAttribute(Imath::V2d(f.voxel_size()[0], f.voxel_size()[1])));
-    write_planes(path, w, h, f.channel_names(), planes, o.half, hd);
+        for (int y = 0; y < p.height; ++y)
+            std::copy_n(f.channel(c).data() + f.index(0, y), size_t(p.width), p.data[size_t(c)].data() + size_t(p.height - 1 - y) * size_t(p.width));
+    Imf::Header hd = base_header(p.width, p.height, f.channel_names(), o.channel_meaning);
+    const auto& b = f.bounds();
+    const Vec2d v = f.voxel_size();
+    hd.insert("atlas:bounds_min", Imf::V2dAttribute(Imath::V2d(b.min[0], b.min[1])));
+    hd.insert("atlas:bounds_max", Imf::V2dAttribute(Imath::V2d(b.max[0], b.max[1])));
+    hd.insert("atlas:voxel_size", Imf::V2dAttribute(Imath::V2d(v[0], v[1])));
+    write_planes(path, p, f.channel_names(), o.half, hd);
 }
 
 void write_exr(const Field3D& f, const fs::path& path, const ExrOptions& o) {
     check_channel_names(f.channel_names(), path);
+    if (o.half) check_half_range(f, path);
     const int nx = f.nx(), ny = f.ny(), nz = f.nz();
-    if (int64_t(ny) * nz > (1 << 30)) throw Error(path.string() + ": field too tall for the EXR slice layout");
-    std::vector<std::vector<float>> planes(size_t(f.channels()), std::vector<float>(f.voxel_count()));
+    // EXR coordinates are int; the stacked image must fit.
+    if (int64_t(ny) * nz > (int64_t(1) << 30))
+        throw Error(path.string() + ": cannot write EXR: " + std::to_string(ny) + "x" + std::to_string(nz) + " rows are too many for one image");
+    Planes p;
+    p.width = nx;
+    p.height = ny * nz;
+    p.data.assign(size_t(f.channels()), std::vector<float>(f.voxel_count()));
     for (int c = 0; c < f.channels(); ++c)
         for (int z = 0; z < nz; ++z)
             for (int y = 0; y < ny; ++y)
-                std::copy_n(f.channel(c).data() + f.index(0, y, z), nx,
-                            planes[size_t(c)].data() + (size_t(z) * size_t(ny) + size_t(ny - 1 - y)) * size_t(nx));
-    Imf::Header hd = base_header(nx, ny * nz, o.channel_meaning);
+                std::copy_n(f.channel(c).data() + f.index(0, y, z), size_t(nx),
+                            p.data[size_t(c)].data() + (size_t(z) * size_t(ny) + size_t(ny - 1 - y)) * size_t(nx));
+    Imf::Header hd = base_header(p.width, p.height, f.channel_names(), o.channel_meaning);
     const auto& b = f.bounds();
+    const Vec3d v = f.voxel_size();
     hd.insert("atlas:bounds_min", Imf::V3dAttribute(Imath::V3d(b.min[0], b.min[1], b.min[2])));
     hd.insert("atlas:bounds_max", Imf::V3dAttribute(Imath::V3d(b.max[0], b.max[1], b.max[2])));
-    hd.insert("atlas:voxel_size", Imf::V3dAttribute(Imath::V3d(f.voxel_size()[0], f.voxel_size()[1], f.voxel_size()[2])));
+    hd.insert("atlas:voxel_size", Imf::V3dAttribute(Imath::V3d(v[0], v[1], v[2])));
     hd.insert("atlas:resolution", Imf::V3iAttribute(Imath::V3i(nx, ny, nz)));
-    write_planes(path, nx, ny * nz, f.channel_names(), planes, o.half, hd);
+    write_planes(path, p, f.channel_names(), o.half, hd);
 }
 
 Value read_exr(const fs::path& path, const MemoryBudget* budget) {
-    if (!fs::exists(path)) throw Error(path.string() + ": cannot open EXR file (no such file)");
+    detail::require_regular_file(path, "EXR");
+    const MemoryBudget fallback;
+    const MemoryBudget& bud = detail::budget_or_default(budget, fallback);
     try {
         Imf::InputFile file(path.string().c_str(), 1);
         const Imf::Header& hd = file.header();
-        const Imath::Box2i dw = hd.dataWindow();
-        const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
-        std::vector<std::string> names;
-        for (auto it = hd.channels().begin(); it != hd.channels().end(); ++it) names.emplace_back(it.name());
-        if (names.empty()) throw Error("no channels");
-        if (names.size() > 64) throw Error("more than 64 channels");
-        if (budget) budget->check(uint64_t(w) * uint64_t(h) * names.size() * 4 * 2, path.string() + ": reading the EXR");
-        std::vector<std::vector<float>> planes(names.size(), std::vector<float>(size_t(w) * size_t(h)));
-        Imf::FrameBuffer fb;
-        for (size_t c = 0; c < names.size(); ++c) {
-            // Base pointer shifted so that data-window origin maps to element 0.
-            char* base = (char*)(planes[c].data() - int64_t(dw.min.x) - int64_t(dw.min.y) * w);
-            fb.insert(names[c], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(w), 1, 1, 0.0));
-        }
-        file.setFrameBuffer(fb);
-        file.readPixels(dw.min.y, dw.max.y);
-
-        if (const auto* res = hd.findTypedAttribute<Imf::V3iAttribute>("atlas:resolution")) {
-            const Imath::V3i r = res->value();
-            if (r.x != w || int64_t(r.y) * r.z != h || r.x <= 0 || r.y <= 0 || r.z <= 0)
-                throw Error("atlas:resolution " + std::to_string(r.x) + "x" + std::to_string(r.y) + "x" + std::to_string(r.z) +
-                            " does not match the image size " + std::to_string(w) + "x" + std::to_string(h));
-            Box3d b{{{0, 0, 0}}, {{double(r.x), double(r.y), double(r.z)}}};
-            const auto* bmin = hd.findTypedAttribute<Imf::V3dAttribute>("atlas:bounds_min");
-            const auto* bmax = hd.findTypedAttribute<Imf::V3dAttribute>("atlas:bounds_max");
-            if (bmin && bmax) {
-                b.min = {{bmin->value().x, bmin->value().y, bmin->value().z}};
-                b.max = {{bmax->value().x, bmax->value().y, bmax->value().z}};
-            }
-            auto f = std::make_shared<Field3D>(Vec3i{{r.x, r.y, r.z}}, int(names.size()), b, names, budget);
-            for (size_t c = 0; c < names.size(); ++c)
-                for (int z = 0; z < r.z; ++z)
-                    for (int y = 0; y < r.y; ++y)
-                        std::copy_n(planes[c].data() + (size_t(z) * size_t(r.y) + size_t(r.y - 1 - y)) * size_t(w), w,
-                                    f->channel(int(c)).data() + f->index(0, y, z));
-            return Field3DPtr(f);
-        }
-        Box2d b{{{0, 0}}, {{double(w), double(h)}}};
-        const auto* bmin = hd.findTypedAttribute<Imf::V2dAttribute>("atlas:bounds_min");
-        const auto* bmax = hd.findTypedAttribute<Imf::V2dAttribute>("atlas:bounds_max");
-        if (bmin && bmax) {
-            b.min = {{bmin->value().x, bmin->value().y}};
-            b.max = {{bmax->value().x, bmax->value().y}};
-        }
-        auto f = std::make_shared<Field2D>(Vec2i{{w, h}}, int(names.size()), b, names, budget);
-        for (size_t c = 0; c < names.size(); ++c)
-            for (int y = 0; y < h; ++y)
-                std::copy_n(planes[c].data() + size_t(h - 1 - y) * size_t(w), w, f->channel(int(c)).data() + f->index(0, y));
-        return Field2DPtr(f);
-    } catch (const MemoryBudgetError&) {
-        throw;
+        const std::vector<std::string> names = channel_order(hd);
+        const Planes p = read_planes(file, names, bud);
+        if (const auto* res = hd.findTypedAttribute<Imf::V3iAttribute>("atlas:resolution")) return make_field3d(hd, p, names, res->value(), bud);
+        return make_field2d(hd, p, names, bud);
+    } catch (const MemoryBudgetError& e) {
+        throw MemoryBudgetError(path.string() + ": " + e.what());
     } catch (const std::exception& e) {
         throw Error(path.string() + ": cannot read EXR: " + e.what());
     }

@@ -1,12 +1,13 @@
+// OpenVDB files: dense Field3D <-> sparse float / vec3s grids (see vdb.h).
 #include "atlas/io/vdb.h"
 
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
+#include "io_common.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 
-#include <cstdio>
 #include <fstream>
 #include <mutex>
 
@@ -15,13 +16,16 @@ namespace atlas::io {
 namespace {
 
 void init_openvdb() {
-    static std::once_flag once; // openvdb::initialize() is idempotent; this just avoids repeated locking inside it
+    // openvdb::initialize() is idempotent and thread-safe; call_once only
+    // spares its internal lock on every read and write.
+    static std::once_flag once;
     std::call_once(once, [] { openvdb::initialize(); });
 }
 
+// Index (i,j,k) -> world min + (i + 0.5) * voxel: the field's voxel centres.
 openvdb::math::Transform::Ptr field_transform(const Field3D& f) {
     const Vec3d v = f.voxel_size();
-    openvdb::math::Mat4d m;
+    openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
     m.setToScale(openvdb::Vec3d(v[0], v[1], v[2]));
     m.setTranslation(openvdb::Vec3d(f.bounds().min[0] + 0.5 * v[0], f.bounds().min[1] + 0.5 * v[1], f.bounds().min[2] + 0.5 * v[2]));
     return openvdb::math::Transform::createLinearTransform(m);
@@ -34,56 +38,114 @@ void add_atlas_meta(openvdb::GridBase& g, const Field3D& f) {
     g.insertMeta("atlas_resolution", openvdb::Vec3IMetadata(openvdb::Vec3i(f.nx(), f.ny(), f.nz())));
 }
 
+// The name of a vector grid: the channels' shared "NAME." prefix (vel.x,
+// vel.y, vel.z -> vel), else "vector".
+std::string vector_grid_name(const Field3D& f) {
+    const std::string& a = f.channel_name(0);
+    const size_t dot = a.rfind('.');
+    if (dot != std::string::npos && dot > 0) {
+        const std::string prefix = a.substr(0, dot + 1);
+        if (f.channel_name(1).rfind(prefix, 0) == 0 && f.channel_name(2).rfind(prefix, 0) == 0) return a.substr(0, dot);
+    }
+    return "vector";
+}
+
 // OpenVDB writes a random UUID into every archive header. Replace it with one
-// derived from the file's content so the same field gives the same bytes.
-void make_uuid_deterministic(const fs::path& path) {
+// derived from what was written, so the same field gives the same bytes.
+void make_uuid_deterministic(const fs::path& path, const Hash128& content) {
+    // Header: magic (8), file version (4), library version (4 + 4), grid offsets flag (1), UUID text (36).
+    constexpr size_t at = 21, len = 36;
     std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
-    std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-    // Header: magic (8), file version (4), library version (4 + 4), offsets flag (1), UUID text (36).
-    const size_t at = 21, len = 36;
-    if (bytes.size() < at + len) return;
-    const std::string uuid = bytes.substr(at, len);
-    if (uuid[8] != '-' || uuid[13] != '-' || uuid[18] != '-' || uuid[23] != '-') return; // unknown layout: leave it
-    std::string rest = bytes.substr(0, at) + bytes.substr(at + len);
-    Hash128 h = Hasher().add(rest).finish();
-    std::string hex = h.hex();
-    std::string det = hex.substr(0, 8) + "-" + hex.substr(8, 4) + "-" + hex.substr(12, 4) + "-" + hex.substr(16, 4) + "-" + hex.substr(20, 12);
-    file.clear();
+    std::string head(at + len, '\0');
+    file.read(head.data(), std::streamsize(head.size()));
+    if (!file) throw Error(path.string() + ": cannot finish the VDB header (file too short)");
+    const std::string uuid = head.substr(at, len);
+    // An unknown header layout is left alone rather than damaged.
+    if (uuid[8] != '-' || uuid[13] != '-' || uuid[18] != '-' || uuid[23] != '-') return;
+    const std::string hex = content.hex();
+    const std::string det = hex.substr(0, 8) + "-" + hex.substr(8, 4) + "-" + hex.substr(12, 4) + "-" + hex.substr(16, 4) + "-" + hex.substr(20, 12);
     file.seekp(std::streamoff(at));
     file.write(det.data(), std::streamsize(len));
-    if (!file) throw Error(path.string() + ": cannot finish VDB header");
+    file.flush();
+    if (!file) throw Error(path.string() + ": cannot finish the VDB header");
+}
+
+std::string list_names(const std::vector<std::string>& names) {
+    std::string s;
+    for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+    return s;
+}
+
+// Axis-aligned with positive scale: scale + translation only.
+bool axis_aligned(const openvdb::math::Transform& xf) {
+    if (!xf.isLinear()) return false;
+    const openvdb::Mat4d m = xf.baseMap()->getAffineMap()->getMat4();
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            const double v = m(i, j);
+            if (i == j ? !(v > 0) : std::fabs(v) > 1e-12 * std::fabs(m(i, i)) + 0.0) return false;
+        }
+    return true;
+}
+
+// The atlas metadata describes exactly this transform (not one edited since).
+bool meta_matches(const openvdb::math::Transform& xf, const Box3d& b, const openvdb::Vec3i& r) {
+    for (int k = 0; k < 3; ++k)
+        if (r[k] <= 0) return false;
+    if (!b.valid()) return false;
+    const openvdb::Vec3d o = xf.indexToWorld(openvdb::Vec3d(0, 0, 0));
+    const openvdb::Vec3d e = xf.indexToWorld(openvdb::Vec3d(r.x(), r.y(), r.z()));
+    for (int k = 0; k < 3; ++k) {
+        const double v = (b.max[k] - b.min[k]) / r[k];
+        const double tol = 1e-6 * v;
+        if (std::fabs(o[k] - (b.min[k] + 0.5 * v)) > tol || std::fabs(e[k] - (b.max[k] + 0.5 * v)) > tol) return false;
+    }
+    return true;
 }
 
 } // namespace
 
 void write_vdb(const Field3D& f, const fs::path& path, const VdbOptions& o) {
     init_openvdb();
-    std::vector<std::string> names = o.grid_names.empty() ? f.channel_names() : o.grid_names;
+    const std::string where = path.string() + ": cannot write VDB: ";
+    if (!(o.tolerance >= 0) || !std::isfinite(o.tolerance)) throw Error(where + "tolerance must be a finite number >= 0, got " + std::to_string(o.tolerance));
+    const size_t grid_count = o.vector3 ? 1 : size_t(f.channels());
+    if (o.vector3 && f.channels() != 3) throw Error(where + "vector3 needs a 3-channel field, the field has " + std::to_string(f.channels()));
+    std::vector<std::string> names = o.grid_names;
+    if (names.empty()) names = o.vector3 ? std::vector<std::string>{vector_grid_name(f)} : f.channel_names();
+    if (names.size() != grid_count)
+        throw Error(where + std::to_string(names.size()) + " grid names given for " + std::to_string(grid_count) + " grid(s)");
+    for (size_t i = 0; i < names.size(); ++i) {
+        if (names[i].empty()) throw Error(where + "grid name " + std::to_string(i) + " is empty");
+        for (size_t j = i + 1; j < names.size(); ++j)
+            if (names[i] == names[j]) throw Error(where + "grid name '" + names[i] + "' is used twice");
+    }
+
     openvdb::GridPtrVec grids;
     const openvdb::CoordBBox bbox(openvdb::Coord(0, 0, 0), openvdb::Coord(f.nx() - 1, f.ny() - 1, f.nz() - 1));
-    auto xf = field_transform(f);
+    const auto xf = field_transform(f);
     if (o.vector3) {
-        if (f.channels() != 3) throw Error(path.string() + ": vector3 needs a 3-channel field, got " + std::to_string(f.channels()));
         auto g = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
         auto acc = g->getAccessor();
         for (int z = 0; z < f.nz(); ++z)
             for (int y = 0; y < f.ny(); ++y)
                 for (int x = 0; x < f.nx(); ++x) {
-                    openvdb::Vec3s v(f.at(0, x, y, z), f.at(1, x, y, z), f.at(2, x, y, z));
-                    if (std::fabs(v[0]) > o.tolerance || std::fabs(v[1]) > o.tolerance || std::fabs(v[2]) > o.tolerance)
+                    const openvdb::Vec3s v(f.at(0, x, y, z), f.at(1, x, y, z), f.at(2, x, y, z));
+                    // Inactive only when every component is within tolerance of 0 (NaN stays active).
+                    if (!(std::fabs(v[0]) <= o.tolerance && std::fabs(v[1]) <= o.tolerance && std::fabs(v[2]) <= o.tolerance))
                         acc.setValue(openvdb::Coord(x, y, z), v);
                 }
-        g->setName(o.grid_names.empty() ? std::string("vector") : o.grid_names[0]);
+        g->setName(names[0]);
         g->setTransform(xf);
         g->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+        g->setGridClass(openvdb::GRID_FOG_VOLUME);
         add_atlas_meta(*g, f);
         grids.push_back(g);
     } else {
-        if (names.size() != size_t(f.channels()))
-            throw Error(path.string() + ": " + std::to_string(names.size()) + " grid names for " + std::to_string(f.channels()) + " channels");
         for (int c = 0; c < f.channels(); ++c) {
             auto g = openvdb::FloatGrid::create(0.0f);
-            // copyFromDense builds the tree in parallel; the result depends only on the values.
+            // |v - 0| <= tolerance stays inactive. copyFromDense is parallel, but
+            // the tree it builds depends only on the values.
             openvdb::tools::Dense<const float, openvdb::tools::LayoutXYZ> dense(bbox, f.channel(c).data());
             openvdb::tools::copyFromDense(dense, *g, o.tolerance);
             g->setName(names[size_t(c)]);
@@ -98,14 +160,18 @@ void write_vdb(const Field3D& f, const fs::path& path, const VdbOptions& o) {
         file.write(grids);
         file.close();
     } catch (const std::exception& e) {
-        throw Error(path.string() + ": cannot write VDB: " + e.what());
+        throw Error(where + e.what());
     }
-    make_uuid_deterministic(path);
+    Hasher h;
+    f.hash_into(h);
+    h.add(o.tolerance).add(o.vector3);
+    for (const auto& n : names) h.add(n);
+    make_uuid_deterministic(path, h.finish());
 }
 
 std::vector<std::string> list_vdb_grids(const fs::path& path) {
     init_openvdb();
-    if (!fs::exists(path)) throw Error(path.string() + ": cannot open VDB file (no such file)");
+    detail::require_regular_file(path, "VDB");
     try {
         openvdb::io::File file(path.string());
         file.open(false);
@@ -120,7 +186,10 @@ std::vector<std::string> list_vdb_grids(const fs::path& path) {
 
 Field3D read_vdb(const fs::path& path, const std::vector<std::string>& wanted, const MemoryBudget* budget) {
     init_openvdb();
-    if (!fs::exists(path)) throw Error(path.string() + ": cannot open VDB file (no such file)");
+    detail::require_regular_file(path, "VDB");
+    const MemoryBudget fallback;
+    const MemoryBudget& bud = detail::budget_or_default(budget, fallback);
+    const std::string where = path.string() + ": ";
     openvdb::GridPtrVecPtr all;
     try {
         openvdb::io::File file(path.string());
@@ -128,57 +197,74 @@ Field3D read_vdb(const fs::path& path, const std::vector<std::string>& wanted, c
         all = file.getGrids();
         file.close();
     } catch (const std::exception& e) {
-        throw Error(path.string() + ": cannot read VDB: " + e.what());
+        throw Error(where + "cannot read VDB: " + e.what());
     }
+    if (!all || all->empty()) throw Error(where + "the VDB file holds no grids");
+    std::vector<std::string> present;
+    for (const auto& g : *all) present.push_back("'" + g->getName() + "' (" + g->valueType() + ")");
+
+    // 1. Which grids.
     std::vector<openvdb::GridBase::Ptr> grids;
-    std::string present;
-    for (const auto& g : *all) present += (present.empty() ? "" : ", ") + g->getName() + " (" + g->valueType() + ")";
     if (wanted.empty()) {
         for (const auto& g : *all)
             if (g->isType<openvdb::FloatGrid>() || g->isType<openvdb::Vec3SGrid>()) grids.push_back(g);
-        if (grids.empty()) throw Error(path.string() + ": no float or vec3s grid in the file (it has: " + present + ")");
+        if (grids.empty()) throw Error(where + "no float or vec3s grid in the file (it has " + list_names(present) + ")");
     } else {
-        for (const auto& name : wanted) {
+        for (size_t i = 0; i < wanted.size(); ++i) {
+            for (size_t j = 0; j < i; ++j)
+                if (wanted[i] == wanted[j]) throw Error(where + "grid '" + wanted[i] + "' is asked for twice");
             openvdb::GridBase::Ptr found;
             for (const auto& g : *all)
-                if (g->getName() == name) found = g;
-            if (!found) throw Error(path.string() + ": no grid named '" + name + "' (the file has: " + present + ")");
+                if (!found && g->getName() == wanted[i]) found = g;
+            if (!found) throw Error(where + "no grid named '" + wanted[i] + "' (the file has " + list_names(present) + ")");
             if (!found->isType<openvdb::FloatGrid>() && !found->isType<openvdb::Vec3SGrid>())
-                throw Error(path.string() + ": grid '" + name + "' holds " + found->valueType() + "; expected float or vec3s");
+                throw Error(where + "grid '" + wanted[i] + "' holds " + found->valueType() + " values; expected float (or vec3s)");
             grids.push_back(found);
         }
     }
-    // One transform for all, axis-aligned (a scale and a translation).
+
+    // 2. One shared, axis-aligned transform.
     const auto& xf = grids[0]->transform();
     for (const auto& g : grids)
-        if (g->transform() != xf) throw Error(path.string() + ": grids '" + grids[0]->getName() + "' and '" + g->getName() + "' have different transforms");
-    if (!xf.isLinear()) throw Error(path.string() + ": grid '" + grids[0]->getName() + "' has a non-linear transform (frustum); resample it first");
-    const openvdb::Vec3d vs = xf.voxelSize();
-    const openvdb::Vec3d o0 = xf.indexToWorld(openvdb::Vec3d(0, 0, 0));
-    const openvdb::Vec3d ox = xf.indexToWorld(openvdb::Vec3d(1, 0, 0)) - o0;
-    if (std::fabs(ox.y()) > 1e-9 * vs.x() || std::fabs(ox.z()) > 1e-9 * vs.x())
-        throw Error(path.string() + ": grid '" + grids[0]->getName() + "' is rotated; only axis-aligned grids are supported");
+        if (g->transform() != xf)
+            throw Error(where + "grids '" + grids[0]->getName() + "' and '" + g->getName() +
+                        "' have different transforms; read them separately (or resample one onto the other)");
+    if (!axis_aligned(xf))
+        throw Error(where + "grid '" + grids[0]->getName() +
+                    "' has a rotated, flipped or non-linear transform; only axis-aligned grids with positive voxel sizes can become a field");
 
-    // The index box: atlas metadata when present, else the union of active boxes.
+    // 3. The index box: the atlas metadata when it still matches the
+    //    transform, else the union of the active bounding boxes.
     openvdb::CoordBBox bbox;
     Box3d bounds;
     const auto meta_min = grids[0]->getMetadata<openvdb::Vec3DMetadata>("atlas_bounds_min");
     const auto meta_max = grids[0]->getMetadata<openvdb::Vec3DMetadata>("atlas_bounds_max");
     const auto meta_res = grids[0]->getMetadata<openvdb::Vec3IMetadata>("atlas_resolution");
+    bool from_meta = false;
     if (meta_min && meta_max && meta_res) {
         const auto r = meta_res->value();
-        bbox = openvdb::CoordBBox(openvdb::Coord(0, 0, 0), openvdb::Coord(r.x() - 1, r.y() - 1, r.z() - 1));
-        bounds = {{{meta_min->value().x(), meta_min->value().y(), meta_min->value().z()}},
-                  {{meta_max->value().x(), meta_max->value().y(), meta_max->value().z()}}};
-    } else {
-        for (const auto& g : grids) bbox.expand(g->evalActiveVoxelBoundingBox());
-        if (bbox.empty()) throw Error(path.string() + ": grid '" + grids[0]->getName() + "' has no active voxels");
+        const Box3d b{{{meta_min->value().x(), meta_min->value().y(), meta_min->value().z()}},
+                      {{meta_max->value().x(), meta_max->value().y(), meta_max->value().z()}}};
+        if (meta_matches(xf, b, r)) {
+            bbox = openvdb::CoordBBox(openvdb::Coord(0, 0, 0), openvdb::Coord(r.x() - 1, r.y() - 1, r.z() - 1));
+            bounds = b;
+            from_meta = true;
+        }
+    }
+    if (!from_meta) {
+        std::vector<std::string> names;
+        for (const auto& g : grids) {
+            bbox.expand(g->evalActiveVoxelBoundingBox());
+            names.push_back("'" + g->getName() + "'");
+        }
+        if (bbox.empty()) throw Error(where + "grid " + list_names(names) + " has no active voxels (nothing to densify)");
         const openvdb::Vec3d lo = xf.indexToWorld(openvdb::Vec3d(bbox.min().x() - 0.5, bbox.min().y() - 0.5, bbox.min().z() - 0.5));
         const openvdb::Vec3d hi = xf.indexToWorld(openvdb::Vec3d(bbox.max().x() + 0.5, bbox.max().y() + 0.5, bbox.max().z() + 0.5));
-        bounds = {{{std::min(lo.x(), hi.x()), std::min(lo.y(), hi.y()), std::min(lo.z(), hi.z())}},
-                  {{std::max(lo.x(), hi.x()), std::max(lo.y(), hi.y()), std::max(lo.z(), hi.z())}}};
+        bounds = {{{lo.x(), lo.y(), lo.z()}}, {{hi.x(), hi.y(), hi.z()}}};
     }
     const openvdb::Coord dim = bbox.dim();
+
+    // 4. Densify.
     std::vector<std::string> names;
     for (const auto& g : grids) {
         if (g->isType<openvdb::Vec3SGrid>()) {
@@ -187,25 +273,32 @@ Field3D read_vdb(const fs::path& path, const std::vector<std::string>& wanted, c
             names.push_back(g->getName());
         }
     }
-    Field3D f({{dim.x(), dim.y(), dim.z()}}, int(names.size()), bounds, names, budget);
-    int c = 0;
-    for (const auto& g : grids) {
-        if (auto fg = openvdb::gridPtrCast<openvdb::FloatGrid>(g)) {
-            openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(bbox, f.channel(c).data());
-            openvdb::tools::copyToDense(*fg, dense);
-            ++c;
-        } else if (auto vg = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g)) {
-            auto acc = vg->getConstAccessor();
-            for (int z = 0; z < dim.z(); ++z)
-                for (int y = 0; y < dim.y(); ++y)
-                    for (int x = 0; x < dim.x(); ++x) {
-                        const openvdb::Vec3s v = acc.getValue(bbox.min().offsetBy(x, y, z));
-                        for (int k = 0; k < 3; ++k) f.at(c + k, x, y, z) = v[k];
-                    }
-            c += 3;
+    if (names.size() > 64) throw Error(where + std::to_string(names.size()) + " channels; a field holds at most 64");
+    try {
+        Field3D f({{dim.x(), dim.y(), dim.z()}}, int(names.size()), bounds, names, &bud);
+        int c = 0;
+        for (const auto& g : grids) {
+            if (auto fg = openvdb::gridPtrCast<openvdb::FloatGrid>(g)) {
+                openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(bbox, f.channel(c).data());
+                openvdb::tools::copyToDense(*fg, dense);
+                ++c;
+            } else if (auto vg = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g)) {
+                auto acc = vg->getConstAccessor();
+                for (int z = 0; z < dim.z(); ++z)
+                    for (int y = 0; y < dim.y(); ++y)
+                        for (int x = 0; x < dim.x(); ++x) {
+                            const openvdb::Vec3s v = acc.getValue(bbox.min().offsetBy(x, y, z));
+                            for (int k = 0; k < 3; ++k) f.at(c + k, x, y, z) = v[k];
+                        }
+                c += 3;
+            }
         }
+        return f;
+    } catch (const MemoryBudgetError& e) {
+        throw MemoryBudgetError(where + e.what());
+    } catch (const Error& e) {
+        throw Error(where + e.what());
     }
-    return f;
 }
 
 } // namespace atlas::io

@@ -1,0 +1,31 @@
+// Private: the table behind output_formats() and write_value().
+//
+// Adding a format (e.g. DDS) = one writer function in its own .cpp file,
+// declared here, plus one entry appended in format_table.cpp. write_value()
+// checks the value type against `accepts` and the option names against
+// `options` before calling the writer, so a writer only parses values
+// (through OptionReader) and writes.
+#pragma once
+
+#include "atlas/io/writers.h"
+
+namespace atlas::io::detail {
+
+// Writes `value` (of a type the format accepts) to `path`; returns the files written.
+using FormatWriter = std::vector<fs::path> (*)(const Value& value, const fs::path& path, const OutputOptions& options);
+
+struct FormatEntry {
+    OutputFormat format;
+    FormatWriter write;
+};
+
+// In a fixed order: the order of output_formats().
+const std::vector<FormatEntry>& format_table();
+
+// The writers (format_writers.cpp).
+std::vector<fs::path> write_exr_output(const Value&, const fs::path&, const OutputOptions&);
+std::vector<fs::path> write_image_output(const Value&, const fs::path&, const OutputOptions&);
+std::vector<fs::path> write_vdb_output(const Value&, const fs::path&, const OutputOptions&);
+std::vector<fs::path> write_tga_slices_output(const Value&, const fs::path&, const OutputOptions&);
+
+} // namespace atlas::io::detail

@@ -1,0 +1,145 @@
+// Readers on bad input: missing, empty, random, truncated and mislabelled
+// files must throw atlas::Error naming the file - never crash.
+#include "atlas/io/exr.h"
+#include "atlas/io/image.h"
+#include "atlas/io/tga_slices.h"
+#include "atlas/io/vdb.h"
+
+#include "io_test_util.h"
+
+#include <functional>
+
+using namespace atlas;
+using namespace atlas::io;
+using namespace atlas::io::test;
+
+namespace {
+
+using Reader = std::function<void(const fs::path&)>;
+
+struct Format {
+    std::string ext;
+    std::function<void(const fs::path&)> write_valid;
+    Reader read;
+    // Listing VDB grid names reads only the grid descriptors, so a file cut
+    // inside the last grid's voxel data may still list: no crash is required.
+    bool must_fail_when_truncated = true;
+};
+
+std::vector<Format> formats() {
+    auto f3 = std::make_shared<Field3D>(make_field3d({{16, 12, 6}}, Box3d{{{0, 0, 0}}, {{1, 1, 1}}}, {"a", "b"},
+                                                     [](int x, int y, int z, int c) { return unit_float(41, x, y, z, c); }));
+    auto f2 = std::make_shared<Field2D>(make_field2d({{32, 24}}, Box2d{{{0, 0}}, {{1, 1}}}, {"r", "g", "b", "a"},
+                                                     [](int x, int y, int z, int c) { return unit_float(42, x, y, z, c); }));
+    return {
+        {".exr", [=](const fs::path& p) { write_exr(*f3, p); }, [](const fs::path& p) { read_exr(p); }},
+        {".png", [=](const fs::path& p) { write_image(*f2, p); }, [](const fs::path& p) { read_image(p); }},
+        {".tga", [=](const fs::path& p) { write_image(*f2, p); }, [](const fs::path& p) { read_image(p); }},
+        {".vdb", [=](const fs::path& p) { write_vdb(*f3, p); }, [](const fs::path& p) { read_vdb(p); }},
+        {".vdb", [=](const fs::path& p) { write_vdb(*f3, p); }, [](const fs::path& p) { list_vdb_grids(p); }, false},
+    };
+}
+
+std::string random_bytes(uint32_t seed, size_t n) {
+    std::string s(n, '\0');
+    for (size_t i = 0; i < n; ++i) s[i] = char(hash_coords(seed, int(i)) & 0xff);
+    return s;
+}
+
+} // namespace
+
+TEST(BadInput, MissingFileNamesTheFile) {
+    TempDir dir;
+    for (const auto& f : formats()) {
+        const fs::path p = dir / ("missing" + f.ext);
+        expect_error_containing([&] { f.read(p); }, {p.string(), "no such file"});
+    }
+    expect_error_containing([&] { read_tga_slices(dir / "missing.001.tga", Box3d{{{0, 0, 0}}, {{1, 1, 1}}}); }, {"missing.001.tga"});
+}
+
+TEST(BadInput, EmptyAndRandomFilesAreErrors) {
+    TempDir dir;
+    int n = 0;
+    for (const auto& f : formats()) {
+        for (size_t size : {size_t(0), size_t(1), size_t(7), size_t(64), size_t(4096)}) {
+            const fs::path p = dir / ("junk" + std::to_string(n++) + f.ext);
+            write_bytes(p, random_bytes(uint32_t(n), size));
+            expect_error_containing([&] { f.read(p); }, {p.filename().string()});
+        }
+    }
+}
+
+// Valid magic number, garbage after it.
+TEST(BadInput, ValidHeaderFollowedByGarbage) {
+    TempDir dir;
+    int n = 0;
+    for (const auto& f : formats()) {
+        const fs::path good = dir / ("good" + std::to_string(n) + f.ext);
+        f.write_valid(good);
+        std::string bytes = read_bytes(good);
+        for (size_t keep : {size_t(4), size_t(16), size_t(40)}) {
+            if (keep >= bytes.size()) continue;
+            const fs::path p = dir / ("hdr" + std::to_string(n++) + f.ext);
+            write_bytes(p, bytes.substr(0, keep) + random_bytes(uint32_t(n + 100), bytes.size() - keep));
+            // Garbage may still decode to *something* for a few formats; what matters
+            // is no crash and, on failure, a message that names the file.
+            try {
+                f.read(p);
+            } catch (const Error& e) {
+                EXPECT_NE(std::string(e.what()).find(p.filename().string()), std::string::npos) << e.what();
+            }
+        }
+    }
+}
+
+TEST(BadInput, TruncatedFilesAreErrors) {
+    TempDir dir;
+    int n = 0;
+    for (const auto& f : formats()) {
+        const fs::path good = dir / ("good" + std::to_string(n) + f.ext);
+        f.write_valid(good);
+        ASSERT_NO_THROW(f.read(good)) << good;
+        const std::string bytes = read_bytes(good);
+        // Strictly shorter than the pixel data needs: must fail.
+        for (double frac : {0.1, 0.5, 0.8}) {
+            const fs::path p = dir / ("cut" + std::to_string(n++) + f.ext);
+            write_bytes(p, bytes.substr(0, size_t(double(bytes.size()) * frac)));
+            SCOPED_TRACE(p.filename().string() + " truncated to " + std::to_string(frac));
+            if (f.must_fail_when_truncated) {
+                expect_error_containing([&] { f.read(p); }, {p.filename().string()});
+            } else {
+                try {
+                    f.read(p);
+                } catch (const Error& e) {
+                    EXPECT_NE(std::string(e.what()).find(p.filename().string()), std::string::npos) << e.what();
+                }
+            }
+        }
+    }
+}
+
+TEST(BadInput, WrongFormatBehindTheExtension) {
+    TempDir dir;
+    Field2D f({{4, 4}}, 1, Box2d{{{0, 0}}, {{1, 1}}});
+    write_image(f, dir / "real.png");
+    fs::copy_file(dir / "real.png", dir / "fake.exr");
+    fs::copy_file(dir / "real.png", dir / "fake.vdb");
+    expect_error_containing([&] { read_exr(dir / "fake.exr"); }, {"fake.exr", "EXR"});
+    expect_error_containing([&] { read_vdb(dir / "fake.vdb"); }, {"fake.vdb", "VDB"});
+    // A directory is not a file.
+    fs::create_directories(dir / "adir.exr");
+    expect_error_containing([&] { read_exr(dir / "adir.exr"); }, {"adir.exr"});
+    fs::create_directories(dir / "adir.png");
+    expect_error_containing([&] { read_image(dir / "adir.png"); }, {"adir.png"});
+}
+
+TEST(BadInput, ImageWithTooManyChannelsForSlicesIsNamed) {
+    TempDir dir;
+    // A 2x2 RGBA slice stack where one slice is a 1-channel image: still read
+    // (missing channels fill), but a different size is an error naming it.
+    Field2D one({{2, 2}}, 1, Box2d{{{0, 0}}, {{1, 1}}});
+    Field2D big({{4, 2}}, 1, Box2d{{{0, 0}}, {{1, 1}}});
+    write_image(one, dir / "s.001.tga");
+    write_image(big, dir / "s.002.tga");
+    expect_error_containing([&] { read_tga_slices(dir / "s.001.tga", Box3d{{{0, 0, 0}}, {{1, 1, 1}}}); }, {"s.002.tga", "4x2"});
+}
