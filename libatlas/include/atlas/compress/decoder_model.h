@@ -1,0 +1,43 @@
+// atlas/compress/decoder_model.h - the BC1/BC4 decoders an encoder guarantees its bounds for.
+//
+// The D3D specification defines BC1 and BC4 decoding with a tolerance, and real
+// decoders differ in how they round the interpolated palette entries. Atlas models
+// each of them exactly (see docs/compression.md for the formulas and sources):
+//   Reference   exact float interpolation of the UNORM/SNORM endpoints (D3D reference)
+//   Nvidia      NVIDIA's published BC1 interpolation (5-bit R/B, 8-bit G fixed point)
+//   Amd         AMD's published BC1 interpolation ((43*c0 + 21*c1 + 32) / 64 on 8 bits)
+//   Tool8       8-bit integer tool decoders (squish, OpenImageIO 2.4, bcdec): endpoints
+//               expanded to 8 bits, interpolation truncated to 8 bits
+//   Conformant  any decoder within the tolerance Atlas assumes the spec allows:
+//               +-1/255 of full range around the Reference value for every palette entry
+// For BC4, Nvidia and Amd interpolate with >= 16 bits and are modelled as Reference.
+// A guarantee "under a DecoderSet" holds for every decoder model in the set.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace atlas::compress {
+
+enum class Decoder : uint8_t { Reference = 0, Nvidia = 1, Amd = 2, Tool8 = 3, Conformant = 4 };
+constexpr int kDecoderCount = 5;
+
+// Bit set of Decoder values (bit i = Decoder i).
+using DecoderSet = uint32_t;
+constexpr DecoderSet decoder_bit(Decoder d) { return DecoderSet(1) << static_cast<int>(d); }
+// Every modelled decoder: the strongest guarantee.
+constexpr DecoderSet kAllDecoders = (DecoderSet(1) << kDecoderCount) - 1;
+constexpr DecoderSet kReferenceOnly = decoder_bit(Decoder::Reference);
+
+// The tolerance (fraction of full range) the Conformant model allows around Reference.
+constexpr float kConformantTolerance = 1.0f / 255.0f;
+
+// "reference", "nvidia", "amd", "tool8", "conformant".
+const char* decoder_name(Decoder d);
+// Parses a name above; throws atlas::Error naming the accepted values.
+Decoder parse_decoder(const std::string& name);
+// The decoders in a set, in enum order.
+std::vector<Decoder> decoders_in(DecoderSet set);
+
+} // namespace atlas::compress

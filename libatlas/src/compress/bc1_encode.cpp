@@ -1,0 +1,155 @@
+// BC1 RGB encoder: principal-axis endpoints, then +-1 hill climbing on the 565
+// endpoints under the decoder-set objective (max error, then squared error).
+#include "atlas/compress/bc1.h"
+
+#include "bc1_palette.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace atlas::compress {
+
+namespace {
+
+struct Rgb565 { int c[3]; };
+
+uint16_t pack(const Rgb565& e) { return uint16_t((e.c[0] << 11) | (e.c[1] << 5) | e.c[2]); }
+
+Rgb565 quantize(const double v[3]) {
+    Rgb565 e;
+    const int m[3] = {31, 63, 31};
+    for (int c = 0; c < 3; ++c) e.c[c] = std::clamp(int(std::lround(std::clamp(v[c], 0.0, 1.0) * m[c])), 0, m[c]);
+    return e;
+}
+
+struct Candidate {
+    uint16_t c0 = 0, c1 = 0;
+    detail::Selection sel;
+    bool valid = false;
+};
+
+class Search {
+public:
+    Search(const float* src, const BlockOptions& o) : src_(src), o_(o) {}
+
+    // Evaluates the ordered pair (c0, c1); keeps it when better.
+    void try_pair(uint16_t c0, uint16_t c1) {
+        detail::Palette<3> p;
+        detail::bc1_interval_palette(c0, c1, o_.decoders, p);
+        detail::Selection s = detail::select_indices(p, src_, o_.one_sided_below, best.valid ? best.sel.max_err : INFINITY);
+        if (!std::isfinite(s.max_err)) return;
+        if (!best.valid || detail::better(s, best.sel)) { best.c0 = c0; best.c1 = c1; best.sel = s; best.valid = true; }
+    }
+    // Both modes of an unordered pair.
+    void try_both(uint16_t a, uint16_t b) {
+        try_pair(std::max(a, b), std::min(a, b)); // 4 colours (3 when equal)
+        try_pair(std::min(a, b), std::max(a, b)); // 3 colours + black
+    }
+    // Rounds of +-1 moves on each channel of each endpoint, keeping the mode.
+    void refine(int rounds) {
+        for (int r = 0; r < rounds && best.valid; ++r) {
+            const uint16_t b0 = best.c0, b1 = best.c1;
+            const uint32_t before_key = (uint32_t(b0) << 16) | b1;
+            for (int end = 0; end < 2; ++end)
+                for (int ch = 0; ch < 3; ++ch)
+                    for (int dir = -1; dir <= 1; dir += 2) {
+                        uint16_t e[2] = {b0, b1};
+                        const int shift = ch == 0 ? 11 : ch == 1 ? 5 : 0, m = ch == 1 ? 63 : 31;
+                        int v = (e[end] >> shift) & m;
+                        v += dir;
+                        if (v < 0 || v > m) continue;
+                        e[end] = uint16_t((e[end] & ~(m << shift)) | (v << shift));
+                        try_both(e[0], e[1]);
+                    }
+            if (((uint32_t(best.c0) << 16) | best.c1) == before_key) break; // local optimum
+        }
+    }
+
+    Candidate best;
+
+private:
+    const float* src_;
+    const BlockOptions& o_;
+};
+
+} // namespace
+
+BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, uint8_t out[8]) {
+    double mean[3] = {0, 0, 0}, lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
+    for (int t = 0; t < 16; ++t)
+        for (int c = 0; c < 3; ++c) {
+            mean[c] += rgb[3 * t + c] / 16.0;
+            lo[c] = std::min(lo[c], double(rgb[3 * t + c]));
+            hi[c] = std::max(hi[c], double(rgb[3 * t + c]));
+        }
+    double cov[3][3] = {};
+    for (int t = 0; t < 16; ++t)
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b) cov[a][b] += (rgb[3 * t + a] - mean[a]) * (rgb[3 * t + b] - mean[b]);
+    double axis[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    if (axis[0] + axis[1] + axis[2] <= 0) axis[0] = axis[1] = axis[2] = 1;
+    for (int it = 0; it < 8; ++it) { // power iteration, deterministic start
+        double n[3];
+        for (int a = 0; a < 3; ++a) n[a] = cov[a][0] * axis[0] + cov[a][1] * axis[1] + cov[a][2] * axis[2];
+        double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(len > 1e-12)) break;
+        for (int a = 0; a < 3; ++a) axis[a] = n[a] / len;
+    }
+    double len = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+    for (double& a : axis) a /= len;
+    double tmin = 1e30, tmax = -1e30;
+    for (int t = 0; t < 16; ++t) {
+        double p = 0;
+        for (int c = 0; c < 3; ++c) p += (rgb[3 * t + c] - mean[c]) * axis[c];
+        tmin = std::min(tmin, p);
+        tmax = std::max(tmax, p);
+    }
+    double e0[3], e1[3];
+    for (int c = 0; c < 3; ++c) { e0[c] = mean[c] + tmax * axis[c]; e1[c] = mean[c] + tmin * axis[c]; }
+
+    Search s(rgb, options);
+    s.try_both(pack(quantize(e0)), pack(quantize(e1)));
+    if (options.quality != Quality::Fast) {
+        s.try_both(pack(quantize(hi)), pack(quantize(lo))); // box diagonal
+        s.refine(3);
+    }
+    const bool missed = !s.best.valid || (options.max_error >= 0 && s.best.sel.max_err > options.max_error);
+    if (options.quality == Quality::Best || missed) {
+        // More starts: the other box diagonals, inset principal endpoints, then long refinement.
+        for (int corner = 1; corner < 4; ++corner) {
+            double a[3], b[3];
+            for (int c = 0; c < 3; ++c) {
+                const bool flip = c < 2 && ((corner >> c) & 1);
+                a[c] = flip ? lo[c] : hi[c];
+                b[c] = flip ? hi[c] : lo[c];
+            }
+            s.try_both(pack(quantize(a)), pack(quantize(b)));
+        }
+        for (double f : {0.0625, 0.125, 0.25}) {
+            double a[3], b[3];
+            for (int c = 0; c < 3; ++c) { a[c] = e0[c] + (e1[c] - e0[c]) * f; b[c] = e1[c] + (e0[c] - e1[c]) * f; }
+            s.try_both(pack(quantize(a)), pack(quantize(b)));
+        }
+        s.refine(32);
+    }
+    if (!s.best.valid) {
+        // One-sided with no feasible candidate: all-black (0 is below any source >= 0).
+        uint8_t idx[16];
+        std::memset(idx, 3, sizeof idx);
+        detail::write_bc1_block(0, 0, idx, out);
+        detail::Palette<3> p;
+        detail::bc1_interval_palette(0, 0, options.decoders, p);
+        detail::Selection sel = detail::select_indices(p, rgb, options.one_sided_below);
+        if (std::isfinite(sel.max_err)) {
+            detail::write_bc1_block(0, 0, sel.idx, out);
+            return {sel.max_err, sel.sum_sq, true};
+        }
+        detail::Selection any = detail::select_indices(p, rgb, false);
+        return {any.max_err, any.sum_sq, false};
+    }
+    detail::write_bc1_block(s.best.c0, s.best.c1, s.best.sel.idx, out);
+    return {s.best.sel.max_err, s.best.sel.sum_sq, true};
+}
+
+} // namespace atlas::compress

@@ -1,0 +1,117 @@
+// BC1 palette decoding under each decoder model.
+// Formulas: Reference = D3D float interpolation of c/31, c/63. Tool8 = squish /
+// OpenImageIO 2.4 (8-bit expansion, truncating (2a+b)/3). Nvidia and Amd = the
+// published models (as in rgbcx / Giesen, "GPU BCn decoding", 2021).
+#include "atlas/compress/bc1.h"
+
+#include "bc1_palette.h"
+
+#include <algorithm>
+
+namespace atlas::compress {
+
+namespace {
+
+int expand5(int v) { return (v << 3) | (v >> 2); }
+int expand6(int v) { return (v << 2) | (v >> 4); }
+
+int nv_interp5(int a, int b) { return ((2 * a + b) * 22) / 8; }
+int nv_interp6(int c0, int c1) { int g = c1 - c0; return (256 * c0 + g / 4 + 128 + g * 80) / 256; }
+int nv_half5(int a, int b) { return ((a + b) * 33) / 8; }
+int nv_half6(int c0, int c1) { int g = c1 - c0; return (256 * c0 + g / 4 + 128 + g * 128) / 256; }
+int amd_interp(int c0, int c1) { return (c0 * 43 + c1 * 21 + 32) / 64; }
+int amd_half(int c0, int c1) { return (c0 + c1 + 1) >> 1; }
+
+} // namespace
+
+void bc1_palette(uint16_t c0, uint16_t c1, Decoder d, float out[4][3]) {
+    const bool four = c0 > c1;
+    const int raw0[3] = {(c0 >> 11) & 31, (c0 >> 5) & 63, c0 & 31};
+    const int raw1[3] = {(c1 >> 11) & 31, (c1 >> 5) & 63, c1 & 31};
+    for (int ch = 0; ch < 3; ++ch) {
+        const bool six = ch == 1;
+        const int a = raw0[ch], b = raw1[ch];
+        if (d == Decoder::Reference || d == Decoder::Conformant) {
+            const float m = six ? 63.0f : 31.0f;
+            out[0][ch] = float(a) / m;
+            out[1][ch] = float(b) / m;
+            if (four) {
+                out[2][ch] = float(2 * a + b) / (3.0f * m);
+                out[3][ch] = float(a + 2 * b) / (3.0f * m);
+            } else {
+                out[2][ch] = float(a + b) / (2.0f * m);
+                out[3][ch] = 0.0f;
+            }
+            continue;
+        }
+        const int A = six ? expand6(a) : expand5(a), B = six ? expand6(b) : expand5(b);
+        int v2 = 0, v3 = 0;
+        switch (d) {
+        case Decoder::Tool8:
+            if (four) { v2 = (2 * A + B) / 3; v3 = (A + 2 * B) / 3; }
+            else v2 = (A + B) / 2;
+            break;
+        case Decoder::Nvidia:
+            if (four) {
+                v2 = six ? nv_interp6(A, B) : nv_interp5(a, b);
+                v3 = six ? nv_interp6(B, A) : nv_interp5(b, a);
+            } else v2 = six ? nv_half6(A, B) : nv_half5(a, b);
+            break;
+        case Decoder::Amd:
+            if (four) { v2 = amd_interp(A, B); v3 = amd_interp(B, A); }
+            else v2 = amd_half(A, B);
+            break;
+        default: break;
+        }
+        out[0][ch] = float(A) / 255.0f;
+        out[1][ch] = float(B) / 255.0f;
+        out[2][ch] = float(v2) / 255.0f;
+        out[3][ch] = float(v3) / 255.0f;
+    }
+}
+
+void decode_bc1_block(const uint8_t block[8], Decoder d, float rgb[48]) {
+    const uint16_t c0 = uint16_t(block[0] | (block[1] << 8)), c1 = uint16_t(block[2] | (block[3] << 8));
+    float pal[4][3];
+    bc1_palette(c0, c1, d, pal);
+    const uint32_t bits = uint32_t(block[4]) | (uint32_t(block[5]) << 8) | (uint32_t(block[6]) << 16) | (uint32_t(block[7]) << 24);
+    for (int t = 0; t < 16; ++t) {
+        const int i = int((bits >> (2 * t)) & 3);
+        for (int c = 0; c < 3; ++c) rgb[3 * t + c] = pal[i][c];
+    }
+}
+
+namespace detail {
+
+void bc1_interval_palette(uint16_t c0, uint16_t c1, DecoderSet set, Palette<3>& p) {
+    p.n = 4;
+    float ref[4][3];
+    bc1_palette(c0, c1, Decoder::Reference, ref);
+    bool any = false;
+    auto merge = [&](int i, int c, float lo, float hi) {
+        if (!any) { p.lo[i][c] = lo; p.hi[i][c] = hi; }
+        else { p.lo[i][c] = std::min(p.lo[i][c], lo); p.hi[i][c] = std::max(p.hi[i][c], hi); }
+    };
+    for (int i = 0; i < 4; ++i)
+        for (int c = 0; c < 3; ++c) { p.ref[i][c] = ref[i][c]; p.lo[i][c] = p.hi[i][c] = ref[i][c]; }
+    const bool four = c0 > c1;
+    for (Decoder d : decoders_in(set == 0 ? kReferenceOnly : set)) {
+        float v[4][3];
+        if (d == Decoder::Conformant) {
+            for (int i = 0; i < 4; ++i)
+                for (int c = 0; c < 3; ++c) {
+                    const float t = (!four && i == 3) ? 0.0f : kConformantTolerance; // black is exact
+                    merge(i, c, ref[i][c] - t, ref[i][c] + t);
+                }
+            any = true;
+            continue;
+        }
+        bc1_palette(c0, c1, d, v);
+        for (int i = 0; i < 4; ++i)
+            for (int c = 0; c < 3; ++c) merge(i, c, v[i][c], v[i][c]);
+        any = true;
+    }
+}
+
+} // namespace detail
+} // namespace atlas::compress

@@ -1,0 +1,22 @@
+// Internal: BC1 palettes as decoder-set intervals (shared by bc1 and bc1-scalar).
+#pragma once
+
+#include "atlas/compress/decoder_model.h"
+#include "palette_search.h"
+
+#include <cstdint>
+
+namespace atlas::compress::detail {
+
+// Per-channel interval palette of (c0, c1) over a decoder set.
+void bc1_interval_palette(uint16_t c0, uint16_t c1, DecoderSet set, Palette<3>& p);
+
+inline void write_bc1_block(uint16_t c0, uint16_t c1, const uint8_t idx[16], uint8_t out[8]) {
+    out[0] = uint8_t(c0); out[1] = uint8_t(c0 >> 8);
+    out[2] = uint8_t(c1); out[3] = uint8_t(c1 >> 8);
+    uint32_t bits = 0;
+    for (int t = 0; t < 16; ++t) bits |= uint32_t(idx[t] & 3) << (2 * t);
+    for (int i = 0; i < 4; ++i) out[4 + i] = uint8_t(bits >> (8 * i));
+}
+
+} // namespace atlas::compress::detail

@@ -1,0 +1,177 @@
+// bc1-scalar: weights from the decoder models, greedy round-down endpoints and a
+// candidate search over the block's own values (Nubis: "adjust the high endpoint
+// down to improve average error").
+#include "atlas/compress/bc1_scalar.h"
+
+#include "atlas/compress/bc1.h"
+#include "atlas/core/error.h"
+#include "bc1_palette.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace atlas::compress {
+
+namespace {
+
+// Decoded value of channel level i (bits = 5 or 6) under a decoder's endpoint rule.
+float level_value(int i, int bits, Decoder d) {
+    const int m = (1 << bits) - 1;
+    if (d == Decoder::Reference || d == Decoder::Conformant) return float(i) / float(m);
+    const int e = bits == 5 ? ((i << 3) | (i >> 2)) : ((i << 2) | (i >> 4));
+    return float(e) / 255.0f;
+}
+
+struct Levels {
+    float hi5[32], hi6[64]; // largest value of each level over the decoders (round-down safety)
+    float ref5[32], ref6[64];
+};
+
+Levels make_levels(DecoderSet set) {
+    Levels L;
+    for (int i = 0; i < 32; ++i) { L.ref5[i] = level_value(i, 5, Decoder::Reference); L.hi5[i] = L.ref5[i]; }
+    for (int i = 0; i < 64; ++i) { L.ref6[i] = level_value(i, 6, Decoder::Reference); L.hi6[i] = L.ref6[i]; }
+    for (Decoder d : decoders_in(set)) {
+        for (int i = 0; i < 32; ++i) L.hi5[i] = std::max(L.hi5[i], level_value(i, 5, d));
+        for (int i = 0; i < 64; ++i) L.hi6[i] = std::max(L.hi6[i], level_value(i, 6, d));
+    }
+    return L;
+}
+
+// Largest level index whose (weighted) value is <= v, or 0.
+int floor_level(const float* table, int n, float w, float v) {
+    int best = 0;
+    for (int i = 0; i < n; ++i)
+        if (table[i] * w <= v) best = i;
+    return best;
+}
+
+// Greedy split of v into R, G, B; `nearest_last` rounds the B digit to nearest.
+uint16_t split(float v, const ScalarUnpack& u, const float* t5, const float* t6, bool nearest_last) {
+    const int r = floor_level(t5, 32, u.weights[0], v);
+    float rest = v - t5[r] * u.weights[0];
+    const int g = floor_level(t6, 64, u.weights[1], rest);
+    rest -= t6[g] * u.weights[1];
+    int b = floor_level(t5, 32, u.weights[2], rest);
+    if (nearest_last && b < 31 && std::fabs(t5[b + 1] * u.weights[2] - rest) < std::fabs(t5[b] * u.weights[2] - rest)) ++b;
+    return uint16_t((r << 11) | (g << 5) | b);
+}
+
+void scalar_palette(uint16_t c0, uint16_t c1, const ScalarUnpack& u, detail::Palette<1>& p) {
+    p.n = 4;
+    auto dotw = [&](const float* rgb) { return rgb[0] * u.weights[0] + rgb[1] * u.weights[1] + rgb[2] * u.weights[2]; };
+    float ref[4][3];
+    bc1_palette(c0, c1, Decoder::Reference, ref);
+    for (int i = 0; i < 4; ++i) { p.ref[i][0] = dotw(ref[i]); p.lo[i][0] = p.hi[i][0] = p.ref[i][0]; }
+    bool any = false;
+    const bool four = c0 > c1;
+    for (Decoder d : decoders_in(u.decoders)) {
+        float v[4][3];
+        bc1_palette(c0, c1, d, v);
+        for (int i = 0; i < 4; ++i) {
+            float x = dotw(v[i]);
+            float lo = x, hi = x;
+            if (d == Decoder::Conformant && (four || i != 3)) { // per-channel tolerance through the weights
+                const float t = kConformantTolerance * u.max_value;
+                lo -= t;
+                hi += t;
+            }
+            if (!any) { p.lo[i][0] = lo; p.hi[i][0] = hi; }
+            else { p.lo[i][0] = std::min(p.lo[i][0], lo); p.hi[i][0] = std::max(p.hi[i][0], hi); }
+        }
+        any = true;
+    }
+}
+
+} // namespace
+
+ScalarUnpack bc1_scalar_unpack(DecoderSet decoders) {
+    if (decoders == 0) decoders = kReferenceOnly;
+    ScalarUnpack u;
+    u.decoders = decoders;
+    float step5 = 0, step6 = 0;
+    for (Decoder d : decoders_in(decoders)) {
+        for (int i = 0; i < 31; ++i) step5 = std::max(step5, level_value(i + 1, 5, d) - level_value(i, 5, d));
+        for (int i = 0; i < 63; ++i) step6 = std::max(step6, level_value(i + 1, 6, d) - level_value(i, 6, d));
+    }
+    u.weights = {1.0f, step5, step5 * step6};
+    u.max_value = u.weights[0] + u.weights[1] + u.weights[2];
+    u.endpoint_step = u.weights[2] * step5;
+    return u;
+}
+
+void decode_bc1_scalar_block(const uint8_t block[8], Decoder d, const ScalarUnpack& u, float out[16]) {
+    float rgb[48];
+    decode_bc1_block(block, d, rgb);
+    for (int t = 0; t < 16; ++t)
+        out[t] = rgb[3 * t] * u.weights[0] + rgb[3 * t + 1] * u.weights[1] + rgb[3 * t + 2] * u.weights[2];
+}
+
+BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, const BlockOptions& options,
+                                    uint8_t out[8]) {
+    if (options.decoders != u.decoders && !(options.decoders == 0 && u.decoders == kReferenceOnly))
+        throw Error("encode_bc1_scalar_block: options.decoders differs from the unpack weights' decoder set");
+    // Round-down against the largest decoded level keeps endpoints below the source
+    // for every decoder; the reference table gives the nearest alternatives.
+    const Levels L = make_levels(u.decoders);
+    float smin = src[0], smax = src[0];
+    for (int t = 1; t < 16; ++t) { smin = std::min(smin, src[t]); smax = std::max(smax, src[t]); }
+    std::vector<uint16_t> lows = {split(smin, u, L.hi5, L.hi6, false)};
+    std::vector<uint16_t> highs = {split(smax, u, L.hi5, L.hi6, false)};
+    if (!options.one_sided_below || options.quality != Quality::Fast) {
+        lows.push_back(split(smin, u, L.ref5, L.ref6, true));
+        highs.push_back(split(smax, u, L.ref5, L.ref6, true));
+    }
+    if (options.quality != Quality::Fast)
+        for (int t = 0; t < 16; ++t) highs.push_back(split(src[t], u, L.hi5, L.hi6, false));
+    std::sort(highs.begin(), highs.end());
+    highs.erase(std::unique(highs.begin(), highs.end()), highs.end());
+    std::sort(lows.begin(), lows.end());
+    lows.erase(std::unique(lows.begin(), lows.end()), lows.end());
+
+    detail::Selection best;
+    uint16_t b0 = 0, b1 = 0;
+    bool have = false;
+    auto consider = [&](uint16_t c0, uint16_t c1) {
+        detail::Palette<1> p;
+        scalar_palette(c0, c1, u, p);
+        detail::Selection s = detail::select_indices(p, src, options.one_sided_below, have ? best.max_err : INFINITY);
+        if (!std::isfinite(s.max_err)) return;
+        if (!have || detail::better(s, best)) { best = s; b0 = c0; b1 = c1; have = true; }
+    };
+    auto both = [&](uint16_t a, uint16_t b) {
+        consider(std::max(a, b), std::min(a, b));
+        consider(std::min(a, b), std::max(a, b));
+    };
+    for (uint16_t h : highs)
+        for (uint16_t l : lows) both(h, l);
+    const bool missed = !have || (options.max_error >= 0 && best.max_err > options.max_error);
+    if (options.quality == Quality::Best || missed) {
+        // Nudge both endpoint codes by a few units (neighbouring codes are neighbouring values).
+        for (int round = 0; round < 4 && have; ++round) {
+            const uint16_t k0 = b0, k1 = b1;
+            for (int d0 = -3; d0 <= 3; ++d0)
+                for (int d1 = -3; d1 <= 3; ++d1) {
+                    const int a = int(k0) + d0, b = int(k1) + d1;
+                    if (a < 0 || b < 0 || a > 65535 || b > 65535) continue;
+                    both(uint16_t(a), uint16_t(b));
+                }
+            if (k0 == b0 && k1 == b1) break;
+        }
+    }
+    if (!have) { // unreachable for sources >= 0: (0,0) gives the exact black entry
+        both(0, 0);
+        if (!have) {
+            detail::Palette<1> p;
+            scalar_palette(0, 0, u, p);
+            detail::Selection s = detail::select_indices(p, src, false);
+            detail::write_bc1_block(0, 0, s.idx, out);
+            return {s.max_err, s.sum_sq, false};
+        }
+    }
+    detail::write_bc1_block(b0, b1, best.idx, out);
+    return {best.max_err, best.sum_sq, true};
+}
+
+} // namespace atlas::compress
