@@ -1,0 +1,185 @@
+// BC4: bounds hold under every decoder model, one-sided holds, exhaustive search is optimal.
+#include "atlas/compress/bc4.h"
+
+#include "test_blocks.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace atlas::compress {
+namespace {
+
+using test::kRandomBlocks;
+using test::scalar_block;
+
+// Independent check of one encoded block: decode with each model, compare to the source.
+struct Check {
+    float max_err = 0;      // max over decoders (Conformant: reference +- tolerance on interpolants)
+    float max_over = -1e9f; // max over decoders of decoded - source
+    double ref_sq = 0;
+};
+
+Check check_block(const uint8_t blk[8], bool snorm, DecoderSet set, const float src[16]) {
+    Check c;
+    for (Decoder d : decoders_in(set)) {
+        float v[16];
+        decode_bc4_block(blk, snorm, d, v);
+        const bool eight = snorm ? int8_t(blk[0]) > int8_t(blk[1]) : blk[0] > blk[1];
+        uint64_t bits = 0;
+        for (int i = 0; i < 6; ++i) bits |= uint64_t(blk[2 + i]) << (8 * i);
+        for (int t = 0; t < 16; ++t) {
+            const int idx = int((bits >> (3 * t)) & 7);
+            const bool interp = idx >= 2 && idx < (eight ? 8 : 6);
+            const float tol = (d == Decoder::Conformant && interp) ? kConformantTolerance : 0.0f;
+            c.max_err = std::max(c.max_err, std::fabs(v[t] - src[t]) + tol);
+            c.max_over = std::max(c.max_over, v[t] + tol - src[t]);
+            if (d == Decoder::Reference) c.ref_sq += double(v[t] - src[t]) * double(v[t] - src[t]);
+        }
+    }
+    return c;
+}
+
+void run_random(bool snorm, bool one_sided, Quality q, DecoderSet set, int blocks) {
+    BlockOptions o;
+    o.quality = q;
+    o.one_sided_below = one_sided;
+    o.decoders = set;
+    Bc4Encoder enc(snorm, o);
+    double under = 0;
+    for (int k = 0; k < blocks; ++k) {
+        float src[16];
+        scalar_block(uint64_t(k) + (snorm ? 77777 : 0), snorm ? -1.0f : 0.0f, 1.0f, src);
+        uint8_t blk[8];
+        BlockResult r = enc.encode(src, blk);
+        Check c = check_block(blk, snorm, set | kReferenceOnly, src);
+        ASSERT_LE(c.max_err, r.max_error + 1e-6f) << "block " << k;
+        ASSERT_NEAR(c.ref_sq, r.sum_sq, 1e-6 + 1e-6 * r.sum_sq) << "block " << k;
+        if (one_sided) { ASSERT_LE(c.max_over, 0.0f) << "block " << k; }
+        under += r.sum_sq;
+    }
+    (void)under;
+}
+
+TEST(Bc4, RandomBlocksUnormAllDecoders) { run_random(false, false, Quality::Normal, kAllDecoders, kRandomBlocks); }
+TEST(Bc4, RandomBlocksSnormAllDecoders) { run_random(true, false, Quality::Normal, kAllDecoders, kRandomBlocks); }
+TEST(Bc4, RandomBlocksOneSidedEveryDecoder) { run_random(false, true, Quality::Normal, kAllDecoders, kRandomBlocks); }
+TEST(Bc4, RandomBlocksOneSidedFast) { run_random(false, true, Quality::Fast, kAllDecoders, kRandomBlocks / 4); }
+
+TEST(Bc4, MaxErrorIsMetOrProvablyUnreachable) {
+    BlockOptions o;
+    o.max_error = 1.0f / 255.0f;
+    o.decoders = kAllDecoders;
+    Bc4Encoder enc(false, o);
+    BlockOptions ob = o;
+    ob.quality = Quality::Best;
+    Bc4Encoder best(false, ob);
+    int missed = 0;
+    for (int k = 0; k < 2000; ++k) {
+        float src[16];
+        scalar_block(uint64_t(k) + 5, 0, 1, src);
+        uint8_t a[8], b[8];
+        BlockResult r = enc.encode(src, a);
+        if (r.max_error > o.max_error) {
+            ++missed;
+            BlockResult rb = best.encode(src, b);
+            EXPECT_EQ(rb.max_error, r.max_error) << "a missed block must be the exhaustive optimum";
+        }
+    }
+    EXPECT_GT(missed, 0); // noise blocks cannot reach 1/255 under every decoder
+}
+
+// Naive optimum with the Reference decoder only: all pairs, best index per texel.
+float naive_best(const float src[16], bool one_sided) {
+    float best = INFINITY;
+    for (int k = 0; k < 65536; ++k) {
+        uint8_t blk[8] = {uint8_t(k >> 8), uint8_t(k & 255), 0, 0, 0, 0, 0, 0};
+        float pal[8];
+        for (int i = 0; i < 8; ++i) { // decode each index through the public decoder
+            uint64_t bits = 0;
+            for (int t = 0; t < 16; ++t) bits |= uint64_t(i) << (3 * t);
+            for (int j = 0; j < 6; ++j) blk[2 + j] = uint8_t(bits >> (8 * j));
+            float v[16];
+            decode_bc4_block(blk, false, Decoder::Reference, v);
+            pal[i] = v[0];
+        }
+        float worst = 0;
+        for (int t = 0; t < 16 && worst < best; ++t) {
+            float e = INFINITY;
+            for (float p : pal)
+                if (!one_sided || p <= src[t]) e = std::min(e, std::fabs(p - src[t]));
+            worst = std::max(worst, e);
+        }
+        best = std::min(best, worst);
+    }
+    return best;
+}
+
+TEST(Bc4, BestIsOptimalAgainstNaiveSearch) {
+    for (bool os : {false, true}) {
+        BlockOptions o;
+        o.quality = Quality::Best;
+        o.decoders = kReferenceOnly;
+        o.one_sided_below = os;
+        Bc4Encoder enc(false, o);
+        for (int k = 0; k < 6; ++k) {
+            float src[16];
+            scalar_block(uint64_t(k) * 7 + 3, 0, 1, src);
+            uint8_t blk[8];
+            BlockResult r = enc.encode(src, blk);
+            EXPECT_FLOAT_EQ(r.max_error, naive_best(src, os)) << "block " << k << " one-sided " << os;
+        }
+    }
+}
+
+TEST(Bc4, NormalNeverBeatsBest) {
+    BlockOptions o;
+    Bc4Encoder normal(false, o);
+    o.quality = Quality::Best;
+    Bc4Encoder best(false, o);
+    for (int k = 0; k < 300; ++k) {
+        float src[16];
+        scalar_block(uint64_t(k) + 900, 0, 1, src);
+        uint8_t a[8], b[8];
+        EXPECT_LE(best.encode(src, b).max_error, normal.encode(src, a).max_error);
+    }
+}
+
+TEST(Bc4, ConstantAndExtremeBlocksAreExact) {
+    BlockOptions o;
+    o.decoders = kAllDecoders;
+    Bc4Encoder enc(false, o);
+    for (float v : {0.0f, 1.0f, 128.0f / 255.0f}) {
+        float src[16];
+        std::fill(src, src + 16, v);
+        uint8_t blk[8];
+        EXPECT_EQ(enc.encode(src, blk).max_error, 0.0f) << v;
+    }
+    float two[16];
+    for (int t = 0; t < 16; ++t) two[t] = (t & 1) ? 1.0f : 0.0f;
+    uint8_t blk[8];
+    EXPECT_EQ(enc.encode(two, blk).max_error, 0.0f);
+}
+
+TEST(Bc4, SnormMinus128ReadsAsMinus127) {
+    uint8_t a[8] = {0x80, 0, 0, 0, 0, 0, 0, 0}, b[8] = {0x81, 0, 0, 0, 0, 0, 0, 0};
+    float va[16], vb[16];
+    decode_bc4_block(a, true, Decoder::Reference, va);
+    decode_bc4_block(b, true, Decoder::Reference, vb);
+    EXPECT_EQ(va[0], -1.0f);
+    EXPECT_EQ(vb[0], -1.0f);
+}
+
+TEST(Bc4, Tool8TruncatesWhereReferenceDoesNot) {
+    // e0 = 255, e1 = 0 (8-value mode), index 2 = 6/7 * 255 = 218.57: tool decoders give 218.
+    uint8_t blk[8] = {255, 0, 2, 0, 0, 0, 0, 0};
+    float ref[16], tool[16];
+    decode_bc4_block(blk, false, Decoder::Reference, ref);
+    decode_bc4_block(blk, false, Decoder::Tool8, tool);
+    EXPECT_FLOAT_EQ(ref[0], 6.0f / 7.0f);
+    EXPECT_FLOAT_EQ(tool[0], 218.0f / 255.0f);
+}
+
+} // namespace
+} // namespace atlas::compress
