@@ -123,7 +123,14 @@ void write_vdb(const Field3D& f, const fs::path& path, const VdbOptions& o) {
 
     openvdb::GridPtrVec grids;
     const openvdb::CoordBBox bbox(openvdb::Coord(0, 0, 0), openvdb::Coord(f.nx() - 1, f.ny() - 1, f.nz() - 1));
-    const auto xf = field_transform(f);
+    openvdb::math::Transform::Ptr xf;
+    try {
+        xf = field_transform(f);
+    } catch (const std::exception& e) {
+        const Vec3d v = f.voxel_size();
+        throw Error(where + "OpenVDB cannot represent voxel size " + std::to_string(v[0]) + " x " + std::to_string(v[1]) + " x " +
+                    std::to_string(v[2]) + " (" + e.what() + "); scale the bounds to larger units");
+    }
     if (o.vector3) {
         auto g = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
         auto acc = g->getAccessor();
@@ -298,6 +305,8 @@ Field3D read_vdb(const fs::path& path, const std::vector<std::string>& wanted, c
         throw MemoryBudgetError(where + e.what());
     } catch (const Error& e) {
         throw Error(where + e.what());
+    } catch (const std::exception& e) {
+        throw Error(where + "cannot read VDB: " + e.what());
     }
 }
 
