@@ -100,7 +100,7 @@ void bc1_interval_palette(uint16_t c0, uint16_t c1, DecoderSet set, Palette<3>& 
         if (d == Decoder::Conformant) {
             for (int i = 0; i < 4; ++i)
                 for (int c = 0; c < 3; ++c) {
-                    const float t = (!four && i == 3) ? 0.0f : kConformantTolerance; // black is exact
+                    const float t = (!four && i == 3) ? 0.0f : bc1_conformant_tolerance(ref[0][c], ref[1][c]); // black is exact
                     merge(i, c, ref[i][c] - t, ref[i][c] + t);
                 }
             any = true;

@@ -73,7 +73,8 @@ void scalar_palette(uint16_t c0, uint16_t c1, const ScalarUnpack& u, detail::Pal
             float x = dotw(v[i]);
             float lo = x, hi = x;
             if (d == Decoder::Conformant && (four || i != 3)) { // per-channel tolerance through the weights
-                const float t = kConformantTolerance * u.max_value;
+                float t = 0;
+                for (int c = 0; c < 3; ++c) t += u.weights[size_t(c)] * bc1_conformant_tolerance(ref[0][c], ref[1][c]);
                 lo -= t;
                 hi += t;
             }

@@ -1,0 +1,202 @@
+// BC1 RGB and bc1-scalar: bounds under every decoder model, one-sided, decoder models.
+#include "atlas/compress/bc1.h"
+#include "atlas/compress/bc1_scalar.h"
+
+#include "test_blocks.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace atlas::compress {
+namespace {
+
+using test::kRandomBlocks;
+using test::scalar_block;
+using test::unit;
+
+// Worst |decoded - source| and decoded - source over the decoders (Conformant: +-tol
+// except the 3-colour black).
+void check_rgb(const uint8_t blk[8], DecoderSet set, const float src[48], float& max_err, float& max_over, double& ref_sq) {
+    max_err = 0; max_over = -1e9f; ref_sq = 0;
+    const uint16_t c0 = uint16_t(blk[0] | (blk[1] << 8)), c1 = uint16_t(blk[2] | (blk[3] << 8));
+    const uint32_t bits = uint32_t(blk[4]) | (uint32_t(blk[5]) << 8) | (uint32_t(blk[6]) << 16) | (uint32_t(blk[7]) << 24);
+    for (Decoder d : decoders_in(set)) {
+        float v[48];
+        decode_bc1_block(blk, d, v);
+        for (int t = 0; t < 16; ++t) {
+            const int idx = int((bits >> (2 * t)) & 3);
+            float ep[4][3];
+            bc1_palette(c0, c1, Decoder::Reference, ep);
+            for (int c = 0; c < 3; ++c) {
+                const float tol = (d == Decoder::Conformant && !(c0 <= c1 && idx == 3)) ? bc1_conformant_tolerance(ep[0][c], ep[1][c]) : 0.0f;
+                max_err = std::max(max_err, std::fabs(v[3 * t + c] - src[3 * t + c]) + tol);
+                max_over = std::max(max_over, v[3 * t + c] + tol - src[3 * t + c]);
+                if (d == Decoder::Reference) ref_sq += double(v[3 * t + c] - src[3 * t + c]) * double(v[3 * t + c] - src[3 * t + c]);
+            }
+        }
+    }
+}
+
+void rgb_block(uint64_t k, float out[48]) {
+    float r[16], g[16], b[16];
+    scalar_block(k, 0, 1, r);
+    scalar_block(k + 1000003, 0, 1, g);
+    scalar_block(k + 2000003, 0, 1, b);
+    for (int t = 0; t < 16; ++t) { out[3 * t] = r[t]; out[3 * t + 1] = g[t]; out[3 * t + 2] = b[t]; }
+}
+
+TEST(Bc1, RandomBlocksReportedErrorBoundsEveryDecoder) {
+    BlockOptions o;
+    o.quality = Quality::Fast;
+    o.decoders = kAllDecoders;
+    for (int k = 0; k < kRandomBlocks; ++k) {
+        float src[48];
+        rgb_block(uint64_t(k), src);
+        uint8_t blk[8];
+        BlockResult r = encode_bc1_block(src, o, blk);
+        float e, over;
+        double sq;
+        check_rgb(blk, kAllDecoders, src, e, over, sq);
+        ASSERT_LE(e, r.max_error + 1e-6f) << k;
+        ASSERT_NEAR(sq, r.sum_sq, 1e-6 + 1e-6 * r.sum_sq) << k;
+    }
+}
+
+TEST(Bc1, NormalImprovesOnFastAndBestOnNormal) {
+    BlockOptions f, n, b;
+    f.quality = Quality::Fast; n.quality = Quality::Normal; b.quality = Quality::Best;
+    double ef = 0, en = 0, eb = 0;
+    for (int k = 0; k < 2000; ++k) {
+        float src[48];
+        rgb_block(uint64_t(k) * 3 + 1, src);
+        uint8_t blk[8];
+        const float a = encode_bc1_block(src, f, blk).max_error;
+        const float c = encode_bc1_block(src, n, blk).max_error;
+        const float d = encode_bc1_block(src, b, blk).max_error;
+        EXPECT_LE(c, a);
+        EXPECT_LE(d, c);
+        ef += a; en += c; eb += d;
+    }
+    EXPECT_LT(en, ef);
+}
+
+TEST(Bc1, OneSidedHoldsForEveryDecoderOnSmoothBlocks) {
+    BlockOptions o;
+    o.one_sided_below = true;
+    o.decoders = kAllDecoders;
+    int ok = 0;
+    for (int k = 0; k < kRandomBlocks / 10; ++k) {
+        float src[48];
+        rgb_block(uint64_t(k) * 7, src);
+        uint8_t blk[8];
+        BlockResult r = encode_bc1_block(src, o, blk);
+        float e, over;
+        double sq;
+        check_rgb(blk, kAllDecoders, src, e, over, sq);
+        if (r.one_sided_ok) { ASSERT_LE(over, 0.0f) << k; ++ok; }
+    }
+    EXPECT_GT(ok, kRandomBlocks / 20);
+}
+
+TEST(Bc1, DecoderModelsStayWithinConformantTolerance) {
+    for (int k = 0; k < 20000; ++k) {
+        const uint16_t c0 = uint16_t(unit(k, 1) * 65536), c1 = uint16_t(unit(k, 2) * 65536);
+        float ref[4][3];
+        bc1_palette(c0, c1, Decoder::Reference, ref);
+        for (Decoder d : {Decoder::Nvidia, Decoder::Amd, Decoder::Tool8}) {
+            float v[4][3];
+            bc1_palette(c0, c1, d, v);
+            for (int i = 0; i < 4; ++i)
+                for (int c = 0; c < 3; ++c) ASSERT_LE(std::fabs(v[i][c] - ref[i][c]), bc1_conformant_tolerance(ref[0][c], ref[1][c]) + 1e-6f) << decoder_name(d) << " " << c0 << " " << c1;
+        }
+    }
+}
+
+TEST(Bc1, PublishedInterpolationValues) {
+    // White (0xFFFF) and black (0x0000), 4-colour mode: index 2 = 2/3 white.
+    float n[4][3], a[4][3], t[4][3], r[4][3];
+    bc1_palette(0xFFFF, 0x0000, Decoder::Nvidia, n);
+    bc1_palette(0xFFFF, 0x0000, Decoder::Amd, a);
+    bc1_palette(0xFFFF, 0x0000, Decoder::Tool8, t);
+    bc1_palette(0xFFFF, 0x0000, Decoder::Reference, r);
+    EXPECT_FLOAT_EQ(r[2][0], 2.0f / 3.0f);
+    EXPECT_FLOAT_EQ(t[2][0], 170.0f / 255.0f);           // (2*255)/3
+    EXPECT_FLOAT_EQ(a[2][0], 171.0f / 255.0f);           // (255*43 + 32)/64
+    EXPECT_FLOAT_EQ(n[2][0], float((62 * 22) / 8) / 255.0f); // ((2*31)*22)/8 = 170
+    EXPECT_FLOAT_EQ(n[2][1], float((256 * 255 - 255 / 4 + 128 - 255 * 80) / 256) / 255.0f);
+}
+
+TEST(Bc1Scalar, WeightsReproduceNubisConstantsForEightBitDecoders) {
+    ScalarUnpack u = bc1_scalar_unpack(kAllDecoders);
+    EXPECT_FLOAT_EQ(u.weights[0], 1.0f);
+    EXPECT_NEAR(u.weights[1], 0.03529415f, 1e-7f);
+    EXPECT_NEAR(u.weights[2], 0.00069204f, 1e-8f);
+    ScalarUnpack ref = bc1_scalar_unpack(kReferenceOnly);
+    EXPECT_NEAR(ref.weights[1], 1.0f / 31.0f, 1e-7f); // largest float step between levels
+    EXPECT_NEAR(ref.weights[2], 1.0f / 31.0f / 63.0f, 1e-8f);
+    EXPECT_LT(ref.endpoint_step, 1.0f / 60000.0f); // ~16-bit endpoint precision
+}
+
+void run_scalar(DecoderSet set, bool one_sided, Quality q, int blocks, double* mean_under) {
+    ScalarUnpack u = bc1_scalar_unpack(set);
+    BlockOptions o;
+    o.decoders = set;
+    o.one_sided_below = one_sided;
+    o.quality = q;
+    double under = 0;
+    for (int k = 0; k < blocks; ++k) {
+        float src[16];
+        scalar_block(uint64_t(k) + 31, 0, 1, src);
+        uint8_t blk[8];
+        BlockResult r = encode_bc1_scalar_block(src, u, o, blk);
+        ASSERT_TRUE(r.one_sided_ok);
+        for (Decoder d : decoders_in(set)) {
+            float v[16];
+            decode_bc1_scalar_block(blk, d, u, v);
+            const bool black3 = (blk[0] | (blk[1] << 8)) <= (blk[2] | (blk[3] << 8));
+            for (int t = 0; t < 16; ++t) {
+                const int idx = (blk[4 + t / 4] >> (2 * (t % 4))) & 3;
+                float tol = 0;
+                if (d == Decoder::Conformant && !(black3 && idx == 3)) {
+                    float ep[4][3];
+                    bc1_palette(uint16_t(blk[0] | (blk[1] << 8)), uint16_t(blk[2] | (blk[3] << 8)), Decoder::Reference, ep);
+                    for (int c = 0; c < 3; ++c) tol += u.weights[size_t(c)] * bc1_conformant_tolerance(ep[0][c], ep[1][c]);
+                }
+                ASSERT_LE(std::fabs(v[t] - src[t]) + tol, r.max_error + 1e-6f) << k << " " << decoder_name(d);
+                if (one_sided) { ASSERT_LE(v[t] + tol, src[t]) << k << " " << decoder_name(d); }
+                if (d == Decoder::Reference) under += src[t] - v[t];
+            }
+        }
+    }
+    if (mean_under) *mean_under = under / (16.0 * blocks);
+}
+
+TEST(Bc1Scalar, RandomBlocksAllDecoders) { run_scalar(kAllDecoders, false, Quality::Normal, kRandomBlocks, nullptr); }
+TEST(Bc1Scalar, RandomBlocksOneSidedAllDecoders) {
+    double under = 0;
+    run_scalar(kAllDecoders, true, Quality::Normal, kRandomBlocks / 2, &under);
+    RecordProperty("mean_under_estimate", std::to_string(under));
+    std::printf("bc1-scalar one-sided (all decoders), mixed blocks: mean under-estimate %.6f\n", under);
+}
+TEST(Bc1Scalar, RandomBlocksOneSidedReferenceOnly) { run_scalar(kReferenceOnly, true, Quality::Best, kRandomBlocks / 20, nullptr); }
+
+TEST(Bc1Scalar, ConstantBlockReachesEndpointPrecision) {
+    for (DecoderSet set : {kReferenceOnly, kAllDecoders}) {
+        ScalarUnpack u = bc1_scalar_unpack(set);
+        BlockOptions o;
+        o.decoders = set;
+        o.one_sided_below = true;
+        for (int k = 0; k < 500; ++k) {
+            float src[16];
+            std::fill(src, src + 16, float(unit(k, 9)));
+            uint8_t blk[8];
+            BlockResult r = encode_bc1_scalar_block(src, u, o, blk);
+            if (set == kReferenceOnly) { ASSERT_LE(r.max_error, u.endpoint_step * 1.001f + 1e-7f) << src[0]; }
+        }
+    }
+}
+
+} // namespace
+} // namespace atlas::compress
