@@ -1,11 +1,16 @@
 // Volume benchmarks: whole-grid SDF (exact EDT vs OpenVDB fast sweeping) and
 // mesh to SDF. Error columns: the fast-sweeping result against the EDT (exact
 // with respect to the crossing points), in voxels.
+#include "atlas/volume/mesh_io.h"
+#include "atlas/volume/mesh_primitives.h"
+#include "atlas/volume/mesh_voxelize.h"
 #include "atlas/volume/sdf.h"
 
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <random>
 
 namespace {
@@ -61,8 +66,53 @@ void BM_SdfFastSweeping_512x512x64(benchmark::State& s) { run_sdf(s, {{512, 512,
 void BM_SdfEdt_Smoke(benchmark::State& s) { run_sdf(s, {{32, 32, 8}}, false); }
 void BM_SdfFastSweeping_Smoke(benchmark::State& s) { run_sdf(s, {{32, 32, 8}}, true); }
 
+// A bumpy sphere (cauliflower-like cloud shape) of about `triangles` triangles.
+Mesh bumpy_sphere(int triangles) {
+    const int slices = int(std::sqrt(triangles)), stacks = std::max(2, slices / 2);
+    Mesh m = make_sphere_mesh({{128, 128, 128}}, 90, stacks, slices);
+    for (auto& v : m.vertices) {
+        const double x = v[0] - 128, y = v[1] - 128, z = v[2] - 128;
+        const double r = std::sqrt(x * x + y * y + z * z);
+        const double k = 1 + 0.12 * std::sin(x * 0.09) * std::sin(y * 0.08) * std::sin(z * 0.07 + 1);
+        v = {{float(128 + x * k), float(128 + y * k), float(128 + z * k)}};
+        (void)r;
+    }
+    return m;
+}
+
+void run_mesh_sdf(benchmark::State& state, int triangles, int res, bool openvdb) {
+    const Mesh m = bumpy_sphere(triangles);
+    if (const char* dir = std::getenv("ATLAS_BENCH_MESH_DIR"))
+        write_mesh(std::filesystem::path(dir) / ("bench_mesh_" + std::to_string(m.triangles.size()) + ".obj"), m);
+    const Box3d box{{{0, 0, 0}}, {{256, 256, 256}}};
+    const Vec3i r{{res, res, res}};
+    MeshSdfStats st;
+    Field3D out = openvdb ? mesh_to_sdf_openvdb(m, r, box, nullptr, &st) : mesh_to_sdf(m, r, box, {}, nullptr, &st);
+    for (auto _ : state) {
+        out = openvdb ? mesh_to_sdf_openvdb(m, r, box, nullptr, &st) : mesh_to_sdf(m, r, box, {}, nullptr, &st);
+        benchmark::DoNotOptimize(out.channel(0).data());
+    }
+    if (openvdb) {
+        const SdfError e = compare_sdf(out, mesh_to_sdf(m, r, box));
+        state.counters["max_diff_vs_edt_vox"] = e.max_abs_voxels;
+        state.counters["rms_diff_vs_edt_vox"] = e.rms_voxels;
+        state.counters["sign_diff"] = double(e.sign_mismatches);
+    }
+    state.counters["triangles"] = double(m.triangles.size());
+    state.counters["line_hits"] = double(st.line_hits);
+}
+
+void BM_MeshSdfEdt_100k_256(benchmark::State& s) { run_mesh_sdf(s, 100000, 256, false); }
+void BM_MeshSdfOpenVdb_100k_256(benchmark::State& s) { run_mesh_sdf(s, 100000, 256, true); }
+void BM_MeshSdfEdt_Smoke(benchmark::State& s) { run_mesh_sdf(s, 2000, 32, false); }
+void BM_MeshSdfOpenVdb_Smoke(benchmark::State& s) { run_mesh_sdf(s, 2000, 32, true); }
+
 } // namespace
 
+BENCHMARK(BM_MeshSdfEdt_100k_256)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MeshSdfOpenVdb_100k_256)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MeshSdfEdt_Smoke)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MeshSdfOpenVdb_Smoke)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SdfEdt_512x512x64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SdfFastSweeping_512x512x64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SdfEdt_Smoke)->Unit(benchmark::kMillisecond)->UseRealTime();
