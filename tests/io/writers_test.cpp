@@ -182,6 +182,25 @@ TEST(Writers, WrongValueKindNamesFormatAndWhatItAccepts) {
     expect_error_containing([&] { write_value(MeshPtr(std::make_shared<Mesh>()), dir / "x.exr", "exr", {}); }, {"x.exr", "exr", "mesh"});
     expect_error_containing([&] { write_value(Value{}, dir / "x.exr", "exr", {}); }, {"x.exr", "empty"});
     expect_error_containing([&] { write_value(image2d(), dir / "x.exr", "jpeg", {}); }, {"x.exr", "'jpeg'", "exr", "tga-slices"});
+    // tga-slices takes DIR/STEM, not a file name.
+    expect_error_containing([&] { write_value(volume(), dir / "x.tga", "tga-slices", {}); }, {"x.tga", "DIR/STEM"});
+    EXPECT_FALSE(fs::exists(dir / "x.tga.001.tga"));
+}
+
+TEST(Writers, OptionMessagesAreReadable) {
+    TempDir dir;
+    try {
+        write_value(volume(), dir / "x.vdb", "vdb", {{"tolerance", "-0.5"}});
+        ADD_FAILURE() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), "output 'x.vdb': option 'tolerance': expected a finite number >= 0, got '-0.5'");
+    }
+    try {
+        write_value(image2d(), dir / "x.png", "png", {{"bits", "12"}});
+        ADD_FAILURE() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), "output 'x.png': option 'bits': expected 8 or 16, got '12'");
+    }
 }
 
 TEST(Writers, FormatForPathAgreesWithTheTable) {

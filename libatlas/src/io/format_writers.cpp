@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace atlas::io::detail {
 
@@ -59,22 +60,22 @@ Field2D montage(const Field3D& f) {
 }
 
 // A 2D picture of a value: the field itself, one z slice, or a montage.
-Field2D picture(const Value& v, const OptionReader& o) {
+Field2DPtr picture(const Value& v, const OptionReader& o) {
     if (auto f2 = std::get_if<Field2DPtr>(&v)) {
         if (o.has("slice")) o.bad("slice", "no slice option for a 2D field");
         if (o.has("montage")) o.bad("montage", "no montage option for a 2D field");
-        return **f2;
+        return *f2;
     }
     const Field3D& f = *std::get<Field3DPtr>(v);
     if (o.flag("montage")) {
         if (o.has("slice")) throw Error(o.prefix() + "options 'montage' and 'slice' exclude each other");
-        return montage(f);
+        return std::make_shared<Field2D>(montage(f));
     }
     const int z = o.integer("slice", f.nz() / 2, 0, f.nz() - 1);
     const Box2d b2{{{f.bounds().min[0], f.bounds().min[1]}}, {{f.bounds().max[0], f.bounds().max[1]}}};
-    Field2D out({{f.nx(), f.ny()}}, f.channels(), b2, f.channel_names());
+    auto out = std::make_shared<Field2D>(Vec2i{{f.nx(), f.ny()}}, f.channels(), b2, f.channel_names());
     const size_t n = size_t(f.nx()) * size_t(f.ny());
-    for (int c = 0; c < f.channels(); ++c) std::copy_n(f.channel(c).data() + f.index(0, 0, z), n, out.channel(c).data());
+    for (int c = 0; c < f.channels(); ++c) std::copy_n(f.channel(c).data() + f.index(0, 0, z), n, out->channel(c).data());
     return out;
 }
 
@@ -104,22 +105,19 @@ std::vector<fs::path> write_image_output(const Value& v, const fs::path& p, cons
     io.bits = o.integer("bits", 8, 0, 64);
     if (tga ? io.bits != 8 : (io.bits != 8 && io.bits != 16)) o.bad("bits", tga ? "8 (TGA holds 8 bits per channel)" : "8 or 16");
     std::tie(io.range_min, io.range_max) = o.range("range", 0.0f, 1.0f);
-    // Options are parsed (and checked) before any pixel is copied.
-    const bool has_montage = o.flag("montage");
-    (void)has_montage;
     const Value s = selected(v, o);
     const int channels = std::holds_alternative<Field2DPtr>(s) ? std::get<Field2DPtr>(s)->channels() : std::get<Field3DPtr>(s)->channels();
     if (channels > 4 || (tga && channels == 2))
         throw Error(o.prefix() + (tga ? "a TGA holds 1, 3 or 4 channels" : "an image holds 1 to 4 channels") + ", the value has " +
                     std::to_string(channels) + "; choose some with option 'channels'");
-    write_image(picture(s, o), p, io);
+    write_image(*picture(s, o), p, io);
     return {p};
 }
 
 std::vector<fs::path> write_vdb_output(const Value& v, const fs::path& p, const OutputOptions& opts) {
     const OptionReader o(opts, p);
     VdbOptions vo;
-    vo.tolerance = o.number("tolerance", 0.0f, 0.0f, std::numeric_limits<float>::max());
+    vo.tolerance = o.number("tolerance", 0.0f, 0.0f, std::numeric_limits<float>::infinity());
     vo.vector3 = o.flag("vector3");
     vo.grid_names = o.list("grids");
     write_vdb(*std::get<Field3DPtr>(selected(v, o)), p, vo);
@@ -128,6 +126,8 @@ std::vector<fs::path> write_vdb_output(const Value& v, const fs::path& p, const 
 
 std::vector<fs::path> write_tga_slices_output(const Value& v, const fs::path& p, const OutputOptions& opts) {
     const OptionReader o(opts, p);
+    if (lower_extension(p) == ".tga")
+        throw Error(o.prefix() + "format 'tga-slices' takes DIR/STEM (it writes STEM.001.tga, STEM.002.tga, ...), not a .tga file name");
     SliceOptions so;
     std::tie(so.range_min, so.range_max) = o.range("range", 0.0f, 1.0f);
     so.default_alpha = uint8_t(o.integer("alpha", 255, 0, 255));

@@ -25,6 +25,12 @@ bool parse_float(const std::string& text, float& out) {
     return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(out);
 }
 
+std::string shortest(float v) {
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    return std::string(buf, r.ptr);
+}
+
 } // namespace
 
 OptionReader::OptionReader(const std::map<std::string, std::string>& options, const std::filesystem::path& output)
@@ -56,8 +62,8 @@ float OptionReader::number(const std::string& key, float fallback, float lo, flo
     if (!has(key)) return fallback;
     float v = 0;
     if (!parse_float(text(key), v) || v < lo || v > hi) {
-        std::string lo_s = std::to_string(lo), hi_s = std::to_string(hi);
-        bad(key, "a number in [" + lo_s + ", " + hi_s + "]");
+        if (std::isinf(hi)) bad(key, "a finite number >= " + shortest(lo));
+        bad(key, "a number in [" + shortest(lo) + ", " + shortest(hi) + "]");
     }
     return v;
 }

@@ -34,7 +34,7 @@ public:
     int integer(const std::string& key, int fallback, int lo, int hi) const;
     // true/1/yes/on or false/0/no/off; false when absent.
     bool flag(const std::string& key) const;
-    // Finite number in [lo, hi]; `fallback` when absent.
+    // Finite number in [lo, hi] (hi may be +infinity: no upper limit); `fallback` when absent.
     float number(const std::string& key, float fallback, float lo, float hi) const;
     // "lo,hi" with finite lo < hi; {lo, hi} defaults when absent.
     std::pair<float, float> range(const std::string& key, float lo, float hi) const;
