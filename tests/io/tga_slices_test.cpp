@@ -140,6 +140,11 @@ TEST(TgaSlices, PatternsFindTheSameStack) {
         EXPECT_EQ(g.at(0, 1, 1, 2), 1.0f) << p;
     }
     expect_error_containing([&] { find_tga_slices(dir / "st.002.tga"); }, {"st.002.tga", "001"});
+    expect_error_containing([&] { find_tga_slices(dir / "st.tga"); }, {"st.tga", "001"});
+    // Stems may contain dots.
+    write_tga_slices(f, dir.path(), "cloud.v2");
+    EXPECT_EQ(find_tga_slices(dir / "cloud.v2").size(), 3u);
+    EXPECT_EQ(find_tga_slices(dir / "cloud.v2.001.tga").size(), 3u);
     expect_error_containing([&] { find_tga_slices(dir / "other.001.tga"); }, {"other.001.tga"});
 }
 

@@ -57,8 +57,8 @@ StackName parse_stack_name(const std::string& name) {
         if (all_digits(index)) return {stem, index.substr(std::min(index.find_first_not_of('0'), index.size())) == "1"};
         return {};
     }
-    // A bare stem (DIR/STEM, as write_value takes it).
-    if (!name.empty() && name.find('.') == std::string::npos) return {name, true};
+    // A bare stem (DIR/STEM, as write_value takes it; it may contain dots).
+    if (!name.empty() && !(name.size() >= 4 && iequals(name.substr(name.size() - 4), ".tga"))) return {name, true};
     return {};
 }
 
