@@ -53,9 +53,7 @@ Args parse_args(const Command& cmd, const std::vector<std::string>& argv) {
                 if (o.name == name) decl = &o;
             }
             if (!decl) {
-                std::string msg = "unknown option '" + name + "' for 'atlas " + cmd.name + "'";
-                if (auto s = closest_match(name, names); !s.empty()) msg += " (did you mean '" + s + "'?)";
-                throw UsageError{msg, cmd.name};
+                throw UsageError{"unknown option '" + name + "' for 'atlas " + cmd.name + "'" + name_hint(name, names, "options"), cmd.name};
             }
             if (!decl->value.empty() && !inline_value) {
                 if (i + 1 >= argv.size()) throw UsageError{"option '" + name + "' expects a value " + decl->value, cmd.name};

@@ -21,9 +21,7 @@ int run_nodes(const Args& a) {
     for (const auto& name : a.positional) {
         const NodeType* t = reg.find(name);
         if (!t) {
-            std::string msg = "unknown node type '" + name + "'";
-            if (auto s = closest_match(name, reg.names()); !s.empty()) msg += " (did you mean '" + s + "'?)";
-            throw Error(msg);
+            throw Error("unknown node type '" + name + "'" + name_hint(name, reg.names(), "known types"));
         }
         std::cout << node_reference_text(*t);
     }

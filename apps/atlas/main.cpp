@@ -2,6 +2,7 @@
 #include "cli.h"
 
 #include "atlas/core/error.h"
+#include "atlas/graph/graph.h"
 
 #include <iostream>
 
@@ -26,7 +27,7 @@ int main(int argc, char** argv) {
         }
         std::vector<std::string> names;
         for (const auto& c : commands()) names.push_back(c.name);
-        throw UsageError{"unknown command '" + args[0] + "'", ""};
+        throw UsageError{"unknown command '" + args[0] + "'" + atlas::name_hint(args[0], names, "commands"), ""};
     } catch (const UsageError& e) {
         std::cerr << "atlas: error: " << e.message << "\n";
         if (!e.command.empty()) std::cerr << "run 'atlas " << e.command << " --help' for its options\n";

@@ -194,14 +194,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             if (matched.count(r)) continue;
             std::vector<std::string> names;
             for (const auto& o : g.outputs) names.push_back(o.file);
-            std::string msg = "unknown output '" + r + "'";
-            if (auto s = closest_match(r, names); !s.empty()) msg += " (did you mean '" + s + "'?)";
-            else {
-                msg += " (the graph writes:";
-                for (const auto& n : names) msg += " " + n;
-                msg += ")";
-            }
-            throw Error(msg);
+            throw Error("unknown output '" + r + "'" + name_hint(r, names, "the graph writes"));
         }
     }
 

@@ -36,14 +36,7 @@ struct Parser {
             std::string key = scalar(it->first, where + " key");
             if (!seen.insert(key).second) fail(it->first, where + ": duplicate key '" + key + "'");
             if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-                std::string msg = where + ": unknown key '" + key + "'";
-                if (auto s = closest_match(key, allowed); !s.empty()) msg += " (did you mean '" + s + "'?)";
-                else {
-                    msg += " (expected one of:";
-                    for (const auto& a : allowed) msg += " " + a;
-                    msg += ")";
-                }
-                fail(it->first, msg);
+                fail(it->first, where + ": unknown key '" + key + "'" + name_hint(key, allowed));
             }
         }
     }
@@ -157,14 +150,7 @@ void check_output_request(PortType produced, const std::string& format, const st
         if (f.name == format) fmt = &f;
     }
     if (!fmt) {
-        std::string msg = "unknown format '" + format + "'";
-        if (auto s = closest_match(format, names); !s.empty()) msg += " (did you mean '" + s + "'?)";
-        else {
-            msg += " (known:";
-            for (const auto& n : names) msg += " " + n;
-            msg += ")";
-        }
-        throw Error(msg);
+        throw Error("unknown format '" + format + "'" + name_hint(format, names, "known"));
     }
     bool ok = false;
     for (PortType t : fmt->accepts) ok = ok || port_accepts(t, produced) || port_accepts(produced, t);
@@ -177,14 +163,7 @@ void check_output_request(PortType produced, const std::string& format, const st
     for (const auto& o : fmt->options) known.push_back(o.first);
     for (const auto& kv : options) {
         if (std::find(known.begin(), known.end(), kv.first) != known.end()) continue;
-        std::string msg = "unknown option '" + kv.first + "' for format '" + format + "'";
-        if (auto s = closest_match(kv.first, known); !s.empty()) msg += " (did you mean '" + s + "'?)";
-        else {
-            msg += " (known:";
-            for (const auto& k : known) msg += " " + k;
-            msg += ")";
-        }
-        throw Error(msg);
+        throw Error("unknown option '" + kv.first + "' for format '" + format + "'" + name_hint(kv.first, known, "known"));
     }
 }
 
@@ -212,6 +191,14 @@ std::string closest_match(const std::string& word, const std::vector<std::string
         if (d < best_d) { best_d = d; best = c; }
     }
     return best;
+}
+
+std::string name_hint(const std::string& word, const std::vector<std::string>& candidates, const std::string& intro) {
+    if (auto s = closest_match(word, candidates); !s.empty()) return " (did you mean '" + s + "'?)";
+    if (candidates.empty()) return "";
+    std::string list;
+    for (const auto& c : candidates) list += (list.empty() ? "" : ", ") + c;
+    return " (" + intro + ": " + list + ")";
 }
 
 const GraphNode* Graph::find(const std::string& name) const {
@@ -268,10 +255,9 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
         n.type = p.scalar(body["type"], "node type");
         const NodeType* type = registry.find(n.type);
         if (!type) {
-            std::string msg = "node '" + n.name + "': unknown node type '" + n.type + "'";
-            if (auto s = closest_match(n.type, type_names); !s.empty()) msg += " (did you mean '" + s + "'?)";
-            else msg += " (run 'atlas nodes' for the list)";
-            p.fail(body["type"], msg);
+            std::string hint = closest_match(n.type, type_names);
+            p.fail(body["type"], "node '" + n.name + "': unknown node type '" + n.type + "'" +
+                                     (hint.empty() ? " (run 'atlas nodes' for the list)" : " (did you mean '" + hint + "'?)"));
         }
         if (const YAML::Node params = body["params"]) {
             if (!params.IsMap()) p.fail(params, "node '" + n.name + "': 'params' must be a map");
@@ -281,15 +267,8 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
                 std::string pname = p.scalar(pit->first, "parameter name");
                 const ParamDecl* decl = type->decl.find_param(pname);
                 if (!decl) {
-                    std::string msg = "node '" + n.name + "': unknown parameter '" + pname + "'";
-                    if (auto s = closest_match(pname, known); !s.empty()) {
-                        msg += " (did you mean '" + s + "'?)";
-                    } else {
-                        msg += " (" + n.type + " has: ";
-                        for (size_t i = 0; i < known.size(); ++i) msg += (i ? ", " : "") + known[i];
-                        msg += known.empty() ? "no parameters)" : ")";
-                    }
-                    p.fail(pit->first, msg);
+                    p.fail(pit->first, "node '" + n.name + "': unknown parameter '" + pname + "'" +
+                                           (known.empty() ? " (" + n.type + " has no parameters)" : name_hint(pname, known, n.type + " has")));
                 }
                 if (n.params.count(pname)) p.fail(pit->first, "node '" + n.name + "': parameter '" + pname + "' given twice");
                 ParamValue v;
@@ -336,9 +315,7 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
         if (!src) {
             std::vector<std::string> names;
             for (const auto& n : g.nodes) names.push_back(n.name);
-            std::string msg = "output '" + out.file + "': unknown node '" + out.node + "'";
-            if (auto s = closest_match(out.node, names); !s.empty()) msg += " (did you mean '" + s + "'?)";
-            p.fail(o["node"], msg);
+            p.fail(o["node"], "output '" + out.file + "': unknown node '" + out.node + "'" + name_hint(out.node, names, "nodes"));
         }
         const NodeType* st = registry.find(src->type);
         if (out.port.empty()) {
@@ -353,9 +330,8 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
         if (!port) {
             std::vector<std::string> names;
             for (const auto& po : st->decl.outputs()) names.push_back(po.name);
-            std::string msg = "output '" + out.file + "': node '" + out.node + "' (" + src->type + ") has no output port '" + out.port + "'";
-            if (auto s = closest_match(out.port, names); !s.empty()) msg += " (did you mean '" + s + "'?)";
-            p.fail(o["port"] ? o["port"] : o, msg);
+            p.fail(o["port"] ? o["port"] : o, "output '" + out.file + "': node '" + out.node + "' (" + src->type +
+                                                  ") has no output port '" + out.port + "'" + name_hint(out.port, names, "it has"));
         }
         try {
             if (out.format.empty()) out.format = io::output_format_for_path(out.file);

@@ -20,12 +20,8 @@ std::vector<std::string> port_names(const std::deque<PortDecl>& ports) {
     return v;
 }
 
-std::string with_hint(std::string msg, const std::string& word, const std::vector<std::string>& candidates) {
-    if (auto s = closest_match(word, candidates); !s.empty()) return msg + " (did you mean '" + s + "'?)";
-    if (candidates.empty()) return msg;
-    msg += " (expected one of:";
-    for (const auto& c : candidates) msg += " " + c;
-    return msg + ")";
+std::string with_hint(const std::string& msg, const std::string& word, const std::vector<std::string>& candidates) {
+    return msg + name_hint(word, candidates);
 }
 } // namespace
 

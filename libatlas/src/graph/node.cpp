@@ -158,24 +158,25 @@ void CookContext::set_output(const std::string& port, Value v) {
     outputs_[port] = std::move(v);
 }
 
-std::shared_ptr<Field2D> CookContext::make_field2d(Vec2i res, int channels, Box2d bounds, std::vector<std::string> names) const {
+// Creates a field, naming this node in budget and shape errors.
+template <typename F, typename Res, typename Box>
+std::shared_ptr<F> make_named_field(const CookContext& ctx, const MemoryBudget& budget, Res res, int channels, Box bounds,
+                                    std::vector<std::string> names) {
     try {
-        return std::make_shared<Field2D>(res, channels, bounds, std::move(names), &budget_);
+        return std::make_shared<F>(res, channels, bounds, std::move(names), &budget);
     } catch (const MemoryBudgetError& e) {
-        throw MemoryBudgetError("node '" + name_ + "': " + e.what());
+        throw MemoryBudgetError("node '" + ctx.node_name() + "': " + e.what());
     } catch (const Error& e) {
-        fail(e.what());
+        ctx.fail(e.what());
     }
 }
 
+std::shared_ptr<Field2D> CookContext::make_field2d(Vec2i res, int channels, Box2d bounds, std::vector<std::string> names) const {
+    return make_named_field<Field2D>(*this, budget_, res, channels, bounds, std::move(names));
+}
+
 std::shared_ptr<Field3D> CookContext::make_field3d(Vec3i res, int channels, Box3d bounds, std::vector<std::string> names) const {
-    try {
-        return std::make_shared<Field3D>(res, channels, bounds, std::move(names), &budget_);
-    } catch (const MemoryBudgetError& e) {
-        throw MemoryBudgetError("node '" + name_ + "': " + e.what());
-    } catch (const Error& e) {
-        fail(e.what());
-    }
+    return make_named_field<Field3D>(*this, budget_, res, channels, bounds, std::move(names));
 }
 
 void CookContext::check_memory(uint64_t bytes, std::string_view what) const {

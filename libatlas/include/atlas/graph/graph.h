@@ -87,4 +87,8 @@ std::map<std::string, ParamValue> resolved_params(const GraphNode& node, const N
 // distance, or "".
 std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
 
+// The tail of an "unknown name" message: " (did you mean 'x'?)" when a
+// candidate is close, else " (<intro>: a, b, c)", or "" with no candidates.
+std::string name_hint(const std::string& word, const std::vector<std::string>& candidates, const std::string& intro = "expected one of");
+
 } // namespace atlas
