@@ -6,6 +6,9 @@ cd "$(dirname "$0")/.."
 BUILD_DIR="${ATLAS_BUILD_DIR:-build}"
 JOBS="${ATLAS_BUILD_JOBS:-$(nproc)}"
 export CCACHE_DIR="${CCACHE_DIR:-$HOME/.cache/ccache}"
+# Paths relative to the checkout, so a fresh clone elsewhere still hits the cache.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(pwd)}"
+export CCACHE_NOHASHDIR=1
 if [ ! -f "$BUILD_DIR/build.ninja" ] || [ $# -gt 0 ]; then
   cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE="${ATLAS_BUILD_TYPE:-Release}" "$@" >&2
 fi

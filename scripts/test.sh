@@ -11,6 +11,7 @@ bash scripts/setup.sh
 if [ "${ATLAS_SKIP_SANITIZERS:-0}" != "1" ] && [ $# -eq 0 ]; then
   echo "== sanitizer run (ASan + UBSan): core and graph suites" >&2
   SAN_DIR="${ATLAS_SANITIZER_BUILD_DIR:-build-asan}"
+  export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(pwd)}" CCACHE_NOHASHDIR=1
   cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DATLAS_SANITIZE=ON \
         -DATLAS_BUILD_BENCHMARKS=OFF >/dev/null
   cmake --build "$SAN_DIR" -j "$(nproc)" --target core_test graph_test >&2
