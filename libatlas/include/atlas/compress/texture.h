@@ -1,0 +1,179 @@
+// atlas/compress/texture.h - fields to DDS textures with error bounds, and back.
+//
+// This is the API the CLI (`atlas compress / decompress / info`) and the graph
+// writer nodes call. Values are mapped from the source range [lo, hi] to the
+// format's normalized range (UNORM [0,1], SNORM [-1,1]; float formats are stored
+// as is); every error below is in SOURCE units unless it says otherwise.
+// Determinism: the written bytes depend only on the field and the options, never
+// on the thread count (blocks are encoded independently, reductions are ordered).
+// Thread-safety: the functions are reentrant; they use TBB internally.
+#pragma once
+
+#include "atlas/compress/block.h"
+#include "atlas/compress/dds.h"
+#include "atlas/core/error.h"
+#include "atlas/core/field.h"
+#include "atlas/core/progress.h"
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace atlas::compress {
+
+namespace fs = std::filesystem;
+
+enum class Format {
+    Bc1,       // RGB, 4 bpp
+    Bc1Scalar, // one channel across RGB565 (Nubis field data), 4 bpp
+    Bc4,       // one channel UNORM, 4 bpp
+    Bc4Snorm,  // one channel SNORM, 4 bpp
+    Bc6hUf16,  // not implemented yet: throws atlas::Error
+    Bc6hSf16,  // not implemented yet: throws atlas::Error
+    R8, R16, R16F, R32F, Rgba8, Rgba16F, Rgba4,
+};
+// "bc1", "bc1-scalar", "bc4", "bc4-snorm", "bc6h", "bc6h-sf16", "r8", "r16", "r16f",
+// "r32f", "rgba8", "rgba16f", "rgba4".
+const char* format_name(Format f);
+Format parse_format(const std::string& name); // throws atlas::Error listing the names
+DxgiFormat dxgi_format(Format f);
+
+struct CompressOptions {
+    Format format = Format::Bc4;
+    Quality quality = Quality::Normal;
+    // Guarantee |decoded - source| <= max_error (source units) for every texel of
+    // every mip level under every decoder in `decoders`; blocks that cannot meet it
+    // are listed in the report and make compress_to_dds throw BoundError unless
+    // allow_over_bound.
+    std::optional<float> max_error;
+    // Guarantee decoded <= source for every texel under every decoder in `decoders`
+    // (bc4, bc1-scalar, uncompressed formats; BC1 RGB per channel when reachable).
+    // Mips are then min-reduced so every mip texel is <= the level-0 texels it covers.
+    bool one_sided_below = false;
+    bool allow_over_bound = false;
+    // 1 = no mips, 0 = full chain, n = n levels. Volumes get 3D mips (2x2x2).
+    int mip_levels = 1;
+    DecoderSet decoders = kAllDecoders;
+    // Source range mapped to the normalized range; empty = the data's min and max.
+    std::optional<std::pair<float, float>> value_range;
+    // Field channels to store (empty = the first ones the format needs; missing
+    // colour channels are 0, missing alpha is 1).
+    std::vector<int> channels;
+    // A Field3D with nz > 1 becomes a 2D array instead of a volume texture.
+    bool as_array = false;
+    // Free text for the manifest's channel meanings (default: the field's names).
+    std::vector<std::string> channel_meanings;
+};
+
+// One 4x4 block (per slice) that misses the bound: its texel origin and the best
+// error the encoder reached (source units).
+struct BlockMiss {
+    int x = 0, y = 0, z = 0, array_index = 0, mip = 0;
+    float best_error = 0;
+    bool one_sided_failed = false;
+};
+
+// Errors of the level-0 data under one decoder model.
+struct DecoderStats {
+    Decoder decoder = Decoder::Reference;
+    std::vector<double> max_error;     // per stored channel (worst case inside Conformant's interval)
+    double max_over = 0;               // max(decoded - source) over texels and channels (<= 0: one-sided holds)
+    uint64_t one_sided_violations = 0; // texel-channels with decoded > source
+    double mean_under = 0;             // mean(source - decoded)
+};
+
+struct CompressReport {
+    std::string format;
+    std::string file;
+    int width = 0, height = 0, depth = 1, array_size = 1, mip_levels = 1, channels = 1;
+    std::pair<float, float> value_range{0.0f, 1.0f};
+    // Level 0, Reference decoder, per stored channel, source units.
+    std::vector<double> max_error, rmse, psnr;
+    double bound_max_error = 0; // max over decoders and channels (the guaranteed figure)
+    std::optional<float> requested_max_error;
+    bool one_sided_below = false;
+    std::vector<BlockMiss> blocks_over_bound;
+    std::vector<DecoderStats> per_decoder;
+    double encode_seconds = 0;
+    double texels_per_second = 0;
+    uint64_t texels = 0;
+    uint64_t bytes = 0;
+    // Keys as named above; stable for --report.
+    std::string to_json() const;
+};
+
+// Thrown when blocks miss the bound and allow_over_bound is false; carries the report.
+class BoundError : public Error {
+public:
+    BoundError(const std::string& message, CompressReport report) : Error(message), report_(std::move(report)) {}
+    const CompressReport& report() const { return report_; }
+
+private:
+    CompressReport report_;
+};
+
+// The sidecar manifest OUT.dds.json an engine importer reads.
+struct TextureManifest {
+    std::string encoding;  // format_name()
+    std::string dxgi_format;
+    int width = 0, height = 0, depth = 1, array_size = 1, mip_levels = 1;
+    bool volume = false;
+    std::vector<std::string> channel_meanings;
+    // value = lo + n * (hi - lo) for UNORM n, lo + (n + 1) / 2 * (hi - lo) for SNORM n,
+    // value = n for float formats ("identity").
+    std::string mapping;
+    float range_lo = 0, range_hi = 1;
+    std::optional<float> max_error; // source units, as guaranteed
+    bool one_sided_below = false;
+    std::vector<std::string> decoders;
+    std::string mip_filter; // "box" or "min"
+    std::array<float, 3> unpack_weights{1, 0, 0}; // bc1-scalar: n = dot(rgb, weights)
+    std::string to_json() const;
+    static TextureManifest from_json(const std::string& text, const std::string& what);
+};
+
+// Encodes a field (2D, or 3D as a volume or an array) to a DDS file and writes
+// OUT.dds.json beside it; both appear atomically or not at all. Throws
+// atlas::Error on NaN / Inf input (naming the texel and channel), bad options,
+// an unimplemented format, and BoundError as described above.
+CompressReport compress_to_dds(const Field3D& field, const fs::path& out, const CompressOptions& options,
+                               const ProgressSink* progress = nullptr);
+CompressReport compress_to_dds(const Field2D& field, const fs::path& out, const CompressOptions& options,
+                               const ProgressSink* progress = nullptr);
+
+// Encodes without writing: the DDS texture, its manifest and the report.
+struct EncodedTexture {
+    DdsTexture dds;
+    TextureManifest manifest;
+    CompressReport report;
+};
+EncodedTexture encode_texture(const Field3D& field, const CompressOptions& options, const ProgressSink* progress = nullptr);
+
+// Decodes level 0 of every slice / array element to float in source units (the
+// manifest's mapping if OUT.dds.json exists, else the normalized values; a
+// bc1-scalar file without manifest decodes as RGB). Arrays stack along z.
+Field3D read_dds(const fs::path& dds, Decoder decoder = Decoder::Reference);
+Field3D decode_texture(const DdsTexture& dds, const TextureManifest* manifest, Decoder decoder = Decoder::Reference);
+
+// Decodes level 0 with every decoder in `decoders` and compares to `source`
+// (whose stored channels are taken as in `options.channels`): max error and
+// one-sided error per model. Uses the manifest next to the file for the mapping.
+CompressReport verify_dds(const fs::path& dds, const Field3D& source, DecoderSet decoders = kAllDecoders,
+                          const std::vector<int>& channels = {});
+
+// verify_dds on an in-memory texture; `manifest` may be null (values compared as stored).
+CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* manifest, const Field3D& source,
+                              DecoderSet decoders = kAllDecoders, const std::vector<int>& channels = {},
+                              const std::string& what = "texture");
+
+// Encodes at each quality level (no file written): error versus time.
+struct SweepRow {
+    Quality quality;
+    double max_error = 0, rmse = 0, seconds = 0;
+};
+std::vector<SweepRow> sweep(const Field3D& field, const CompressOptions& options);
+
+} // namespace atlas::compress

@@ -1,0 +1,424 @@
+// Field -> DDS texture: mapping, validation, mips, parallel block encoding, bound
+// accounting, manifest, atomic write.
+#include "atlas/compress/bc1.h"
+#include "atlas/compress/bc1_scalar.h"
+#include "atlas/compress/bc4.h"
+#include "atlas/core/error.h"
+#include "atlas/core/files.h"
+#include "half.h"
+#include "mips.h"
+#include "texture_internal.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace atlas::compress {
+
+namespace {
+
+using detail::LevelData;
+using detail::MapKind;
+
+struct BlockOutcome {
+    float err = 0; // normalized
+    bool one_sided_ok = true;
+};
+
+std::string texel_name(const Field3D& f, int c, size_t i) {
+    const size_t x = i % size_t(f.nx()), y = (i / size_t(f.nx())) % size_t(f.ny()), z = i / (size_t(f.nx()) * size_t(f.ny()));
+    return "texel (" + std::to_string(x) + ", " + std::to_string(y) + ", " + std::to_string(z) + ") channel '" + f.channel_name(c) + "'";
+}
+
+// Quantizes one normalized value for an uncompressed format channel; returns the
+// stored code and writes the decoded value. one_sided: the largest code <= n.
+uint32_t quantize_unorm(float n, int levels, bool one_sided, float& decoded) {
+    const float m = float(levels);
+    int q = int(one_sided ? std::floor(n * m) : std::nearbyint(n * m));
+    q = std::clamp(q, 0, levels);
+    if (one_sided)
+        while (q > 0 && float(q) / m > n) --q;
+    decoded = float(q) / m;
+    return uint32_t(q);
+}
+
+uint16_t quantize_half(float n, bool one_sided, float& decoded) {
+    const uint16_t h = one_sided ? detail::float_to_half_down(n) : detail::float_to_half(n);
+    decoded = detail::half_to_float(h);
+    return h;
+}
+
+// Encodes one level of an uncompressed format; per-block (4x4 per slice) max errors.
+void encode_plain(const LevelData& L, int layer, DxgiFormat f, bool one_sided, uint8_t* out, std::vector<BlockOutcome>& blocks,
+                  int bw, int bh) {
+    const size_t n = size_t(L.w) * size_t(L.h) * size_t(L.d);
+    const int unit = format_unit_bytes(f);
+    const auto& P = L.planes[size_t(layer)];
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            uint8_t* p = out + i * size_t(unit);
+            float dec[4] = {0, 0, 0, 0};
+            auto put16 = [&](int k, uint16_t v) { p[2 * k] = uint8_t(v); p[2 * k + 1] = uint8_t(v >> 8); };
+            switch (f) {
+            case DxgiFormat::R8_UNORM: p[0] = uint8_t(quantize_unorm(P[0][i], 255, one_sided, dec[0])); break;
+            case DxgiFormat::R16_UNORM: put16(0, uint16_t(quantize_unorm(P[0][i], 65535, one_sided, dec[0]))); break;
+            case DxgiFormat::R16_FLOAT: put16(0, quantize_half(P[0][i], one_sided, dec[0])); break;
+            case DxgiFormat::R32_FLOAT: std::memcpy(p, &P[0][i], 4); dec[0] = P[0][i]; break;
+            case DxgiFormat::R8G8B8A8_UNORM:
+                for (int c = 0; c < 4; ++c) p[c] = uint8_t(quantize_unorm(P[size_t(c)][i], 255, one_sided, dec[c]));
+                break;
+            case DxgiFormat::R16G16B16A16_FLOAT:
+                for (int c = 0; c < 4; ++c) put16(c, quantize_half(P[size_t(c)][i], one_sided, dec[c]));
+                break;
+            case DxgiFormat::B4G4R4A4_UNORM: {
+                uint32_t q[4];
+                for (int c = 0; c < 4; ++c) q[c] = quantize_unorm(P[size_t(c)][i], 15, one_sided, dec[c]);
+                put16(0, uint16_t(q[2] | (q[1] << 4) | (q[0] << 8) | (q[3] << 12)));
+                break;
+            }
+            default: break;
+            }
+            (void)dec;
+        }
+    });
+    // Per-block max error, in a fixed order.
+    for (size_t i = 0; i < n; ++i) {
+        const int x = int(i % size_t(L.w)), y = int((i / size_t(L.w)) % size_t(L.h)), z = int(i / (size_t(L.w) * size_t(L.h)));
+        BlockOutcome& b = blocks[(size_t(z) * size_t(bh) + size_t(y / 4)) * size_t(bw) + size_t(x / 4)];
+        for (size_t c = 0; c < P.size(); ++c) {
+            float d = 0;
+            switch (f) {
+            case DxgiFormat::R8_UNORM: case DxgiFormat::R8G8B8A8_UNORM: quantize_unorm(P[c][i], 255, one_sided, d); break;
+            case DxgiFormat::R16_UNORM: quantize_unorm(P[c][i], 65535, one_sided, d); break;
+            case DxgiFormat::B4G4R4A4_UNORM: quantize_unorm(P[c][i], 15, one_sided, d); break;
+            case DxgiFormat::R16_FLOAT: case DxgiFormat::R16G16B16A16_FLOAT: quantize_half(P[c][i], one_sided, d); break;
+            default: d = P[c][i]; break;
+            }
+            b.err = std::max(b.err, std::fabs(d - P[c][i]));
+            if (d > P[c][i]) b.one_sided_ok = false;
+        }
+    }
+}
+
+// Encodes one BC level of one layer.
+void encode_bc(const LevelData& L, int layer, Format fmt, const BlockOptions& bo, const Bc4Encoder* bc4,
+               const ScalarUnpack& unpack, uint8_t* out, std::vector<BlockOutcome>& blocks, int bw, int bh,
+               const ProgressSink* progress) {
+    const auto& P = L.planes[size_t(layer)];
+    const size_t nblocks = size_t(bw) * size_t(bh) * size_t(L.d);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nblocks, 64), [&](const tbb::blocked_range<size_t>& r) {
+        if (progress) progress->poll();
+        for (size_t b = r.begin(); b != r.end(); ++b) {
+            const int bx = int(b % size_t(bw)), by = int((b / size_t(bw)) % size_t(bh)), z = int(b / (size_t(bw) * size_t(bh)));
+            float src[48];
+            const int ch = fmt == Format::Bc1 ? 3 : 1;
+            for (int t = 0; t < 16; ++t) {
+                const int x = std::min(bx * 4 + t % 4, L.w - 1), y = std::min(by * 4 + t / 4, L.h - 1); // edge replicate
+                const size_t at = (size_t(z) * size_t(L.h) + size_t(y)) * size_t(L.w) + size_t(x);
+                for (int c = 0; c < ch; ++c) src[ch * t + c] = P[size_t(c)][at];
+            }
+            BlockResult res;
+            uint8_t* dst = out + b * 8;
+            if (fmt == Format::Bc1) res = encode_bc1_block(src, bo, dst);
+            else if (fmt == Format::Bc1Scalar) res = encode_bc1_scalar_block(src, unpack, bo, dst);
+            else res = bc4->encode(src, dst);
+            blocks[b] = {res.max_error, res.one_sided_ok};
+        }
+    });
+}
+
+} // namespace
+
+EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, const ProgressSink* progress) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (o.format == Format::Bc6hUf16 || o.format == Format::Bc6hSf16)
+        throw Error(std::string("compress: format '") + format_name(o.format) + "' is not implemented yet (use rgba16f)");
+    const DxgiFormat dx = dxgi_format(o.format);
+    const bool scalar = o.format == Format::Bc1Scalar;
+    const int stored = scalar ? 1 : format_channels(dx);
+    std::vector<int> chans = o.channels;
+    if (chans.empty())
+        for (int c = 0; c < std::min(stored, field.channels()); ++c) chans.push_back(c);
+    if (int(chans.size()) > stored)
+        throw Error(std::string("compress: format '") + format_name(o.format) + "' stores " + std::to_string(stored) +
+                    " channel(s), " + std::to_string(chans.size()) + " were selected");
+    for (int c : chans)
+        if (c < 0 || c >= field.channels())
+            throw Error("compress: channel index " + std::to_string(c) + " out of range (the field has " + std::to_string(field.channels()) + ")");
+    if (o.mip_levels < 0) throw Error("compress: mip_levels must be >= 0 (0 = full chain), got " + std::to_string(o.mip_levels));
+    if (o.max_error && !(*o.max_error >= 0 && std::isfinite(*o.max_error)))
+        throw Error("compress: max_error must be a finite value >= 0");
+    if ((o.format == Format::Bc1Scalar) && o.decoders == 0) throw Error("compress: the decoder set is empty");
+
+    // NaN / Inf are errors naming the texel.
+    for (int c : chans) {
+        auto s = field.channel(c);
+        for (size_t i = 0; i < s.size(); ++i)
+            if (!std::isfinite(s[i]))
+                throw Error("compress: source " + texel_name(field, c, i) + " is " + (std::isnan(s[i]) ? "NaN" : "infinite") +
+                            " (clean the field before encoding)");
+    }
+
+    detail::Mapping map;
+    map.kind = detail::map_kind(dx);
+    if (map.kind != MapKind::Float) {
+        if (o.value_range) {
+            map.lo = o.value_range->first;
+            map.hi = o.value_range->second;
+            if (!(map.hi > map.lo) || !std::isfinite(map.lo) || !std::isfinite(map.hi))
+                throw Error("compress: value_range must be finite with lo < hi");
+        } else {
+            float lo = INFINITY, hi = -INFINITY;
+            for (int c : chans)
+                for (float v : field.channel(c)) { lo = std::min(lo, v); hi = std::max(hi, v); }
+            if (chans.empty()) { lo = 0; hi = 1; }
+            if (!(hi > lo)) hi = lo + 1.0f;
+            map.lo = lo;
+            map.hi = hi;
+        }
+    } else if (dx == DxgiFormat::R16_FLOAT || dx == DxgiFormat::R16G16B16A16_FLOAT) {
+        for (int c : chans)
+            for (size_t i = 0; i < field.channel(c).size(); ++i)
+                if (std::fabs(field.channel(c)[i]) > 65504.0f)
+                    throw Error("compress: source " + texel_name(field, c, i) + " exceeds the half-float range (65504)");
+    }
+    const float nmin = map.kind == MapKind::Snorm ? -1.0f : 0.0f;
+
+    const bool volume = field.nz() > 1 && !o.as_array;
+    const int layers = volume ? 1 : field.nz();
+    LevelData L0;
+    L0.w = field.nx();
+    L0.h = field.ny();
+    L0.d = volume ? field.nz() : 1;
+    const size_t slice = size_t(L0.w) * size_t(L0.h) * size_t(L0.d);
+    L0.planes.assign(size_t(layers), std::vector<std::vector<float>>(size_t(stored), std::vector<float>(slice, 0.0f)));
+    for (int l = 0; l < layers; ++l)
+        for (int c = 0; c < stored; ++c) {
+            auto& dst = L0.planes[size_t(l)][size_t(c)];
+            if (c >= int(chans.size())) { // missing channels: colour 0, alpha 1
+                std::fill(dst.begin(), dst.end(), (c == 3) ? 1.0f : 0.0f);
+                continue;
+            }
+            auto s = field.channel(chans[size_t(c)]);
+            for (size_t i = 0; i < slice; ++i) {
+                const float v = s[size_t(l) * slice + i];
+                float n = map.to_norm(v);
+                if (map.kind != MapKind::Float) {
+                    if (n < nmin - 1e-6f || n > 1.0f + 1e-6f)
+                        throw Error("compress: source " + texel_name(field, chans[size_t(c)], size_t(l) * slice + i) + " = " +
+                                    std::to_string(v) + " lies outside value_range [" + std::to_string(map.lo) + ", " +
+                                    std::to_string(map.hi) + "]");
+                    n = std::clamp(n, nmin, 1.0f);
+                }
+                // One-sided: the normalized source must map back to <= the source.
+                if (o.one_sided_below)
+                    while (n > nmin && map.to_src(n) > v) n = std::nextafter(n, -INFINITY);
+                dst[i] = n;
+            }
+        }
+
+    int full = 1;
+    for (int s = std::max({L0.w, L0.h, L0.d}); s > 1; s >>= 1) ++full;
+    const int mips = o.mip_levels == 0 ? full : std::min(o.mip_levels, full);
+    std::vector<LevelData> levels;
+    levels.push_back(std::move(L0));
+    for (int m = 1; m < mips; ++m) levels.push_back(detail::reduce_level(levels.back(), volume, o.one_sided_below));
+
+    EncodedTexture out;
+    DdsTexture& tex = out.dds;
+    tex.format = dx;
+    tex.width = field.nx();
+    tex.height = field.ny();
+    tex.depth = volume ? field.nz() : 1;
+    tex.volume = volume;
+    tex.array_size = layers;
+    tex.mip_levels = mips;
+    tex.data.assign(tex.total_bytes(), 0);
+
+    BlockOptions bo;
+    bo.quality = o.quality;
+    bo.one_sided_below = o.one_sided_below;
+    bo.decoders = o.decoders == 0 ? kReferenceOnly : o.decoders;
+    const double scale = map.scale();
+    bo.max_error = o.max_error ? float(*o.max_error / scale) : -1.0f;
+    std::unique_ptr<Bc4Encoder> bc4;
+    if (o.format == Format::Bc4 || o.format == Format::Bc4Snorm) bc4 = std::make_unique<Bc4Encoder>(o.format == Format::Bc4Snorm, bo);
+    const ScalarUnpack unpack = bc1_scalar_unpack(bo.decoders);
+
+    CompressReport& rep = out.report;
+    for (int l = 0; l < layers; ++l)
+        for (int m = 0; m < mips; ++m) {
+            const LevelData& L = levels[size_t(m)];
+            const int bw = std::max(1, (L.w + 3) / 4), bh = std::max(1, (L.h + 3) / 4);
+            std::vector<BlockOutcome> blocks(size_t(bw) * size_t(bh) * size_t(L.d));
+            uint8_t* dst = tex.data.data() + tex.offset(l, m);
+            if (is_block_compressed(dx)) encode_bc(L, l, o.format, bo, bc4.get(), unpack, dst, blocks, bw, bh, progress);
+            else encode_plain(L, l, dx, o.one_sided_below, dst, blocks, bw, bh);
+            for (size_t b = 0; b < blocks.size(); ++b) {
+                const bool over = (o.max_error && double(blocks[b].err) * scale > double(*o.max_error)) ||
+                                  (o.one_sided_below && !blocks[b].one_sided_ok);
+                if (!over) continue;
+                BlockMiss miss;
+                miss.x = int(b % size_t(bw)) * 4;
+                miss.y = int((b / size_t(bw)) % size_t(bh)) * 4;
+                miss.z = int(b / (size_t(bw) * size_t(bh)));
+                miss.array_index = l;
+                miss.mip = m;
+                miss.best_error = float(double(blocks[b].err) * scale);
+                miss.one_sided_failed = o.one_sided_below && !blocks[b].one_sided_ok;
+                rep.blocks_over_bound.push_back(miss);
+            }
+            if (progress && progress->on_progress) {
+                ProgressEvent ev;
+                ev.task = "compress";
+                ev.done = l * mips + m + 1;
+                ev.total = layers * mips;
+                ev.fraction = double(ev.done) / ev.total;
+                progress->on_progress(ev);
+            }
+        }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    TextureManifest& man = out.manifest;
+    man.encoding = format_name(o.format);
+    man.dxgi_format = dxgi_format_name(dx);
+    man.width = tex.width;
+    man.height = tex.height;
+    man.depth = tex.depth;
+    man.array_size = tex.array_size;
+    man.mip_levels = mips;
+    man.volume = volume;
+    for (int c = 0; c < stored; ++c) {
+        if (c < int(o.channel_meanings.size())) man.channel_meanings.push_back(o.channel_meanings[size_t(c)]);
+        else if (c < int(chans.size())) man.channel_meanings.push_back(field.channel_name(chans[size_t(c)]));
+        else man.channel_meanings.push_back(c == 3 ? "alpha (constant 1)" : "unused (constant 0)");
+    }
+    man.mapping = map.kind == MapKind::Float ? "identity" : map.kind == MapKind::Snorm ? "snorm: value = lo + (n + 1) / 2 * (hi - lo)"
+                                                                                        : "unorm: value = lo + n * (hi - lo)";
+    if (scalar) man.mapping = "bc1-scalar: n = dot(rgb, unpack_weights); value = lo + n * (hi - lo)";
+    man.range_lo = map.kind == MapKind::Float ? 0.0f : map.lo;
+    man.range_hi = map.kind == MapKind::Float ? 1.0f : map.hi;
+    man.max_error = o.max_error;
+    man.one_sided_below = o.one_sided_below;
+    for (Decoder d : decoders_in(bo.decoders)) man.decoders.push_back(decoder_name(d));
+    man.mip_filter = o.one_sided_below ? "min" : "box";
+    man.unpack_weights = unpack.weights;
+
+    // Level-0 errors under every decoder, from the encoded bytes.
+    CompressReport v = verify_texture(tex, &man, field, bo.decoders, chans, "encoded texture");
+    v.blocks_over_bound = std::move(rep.blocks_over_bound);
+    rep = std::move(v);
+    rep.format = man.encoding;
+    rep.requested_max_error = o.max_error;
+    rep.one_sided_below = o.one_sided_below;
+    rep.value_range = {man.range_lo, man.range_hi};
+    rep.encode_seconds = seconds;
+    rep.texels = uint64_t(field.nx()) * uint64_t(field.ny()) * uint64_t(field.nz());
+    rep.texels_per_second = seconds > 0 ? double(rep.texels) / seconds : 0;
+    rep.bytes = tex.data.size();
+    return out;
+}
+
+CompressReport compress_to_dds(const Field3D& field, const fs::path& path, const CompressOptions& o, const ProgressSink* progress) {
+    EncodedTexture enc = encode_texture(field, o, progress);
+    enc.report.file = path.string();
+    if (!enc.report.blocks_over_bound.empty() && !o.allow_over_bound) {
+        std::ostringstream msg;
+        msg << "compress: " << enc.report.blocks_over_bound.size() << " block(s) cannot meet the bound";
+        if (o.max_error) msg << " max_error " << *o.max_error;
+        if (o.one_sided_below) msg << (o.max_error ? " with" : "") << " one-sided below";
+        msg << " for format '" << format_name(o.format) << "'; first:";
+        for (size_t i = 0; i < std::min<size_t>(5, enc.report.blocks_over_bound.size()); ++i) {
+            const BlockMiss& b = enc.report.blocks_over_bound[i];
+            msg << " [mip " << b.mip << " layer " << b.array_index << " block at (" << b.x << ", " << b.y << ", " << b.z
+                << ") best error " << b.best_error << (b.one_sided_failed ? ", one-sided failed" : "") << "]";
+        }
+        msg << " (allow_over_bound writes the file anyway)";
+        throw BoundError(msg.str(), enc.report);
+    }
+    const std::vector<uint8_t> bytes = encode_dds(enc.dds);
+    const std::string manifest = enc.manifest.to_json();
+    StagedOutputs staged(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+    {
+        std::ofstream f(staged.stage(path.filename()), std::ios::binary);
+        f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        if (!f) throw Error("compress: cannot write " + path.string());
+    }
+    {
+        fs::path side = path.filename();
+        side += ".json";
+        std::ofstream f(staged.stage(side), std::ios::binary);
+        f << manifest;
+        if (!f) throw Error("compress: cannot write the manifest of " + path.string());
+    }
+    staged.commit();
+    return enc.report;
+}
+
+CompressReport compress_to_dds(const Field2D& field, const fs::path& path, const CompressOptions& o, const ProgressSink* progress) {
+    Field3D f3(Vec3i{{field.width(), field.height(), 1}}, field.channels(),
+               Box3d{{{field.bounds().min[0], field.bounds().min[1], 0}}, {{field.bounds().max[0], field.bounds().max[1], 1}}},
+               field.channel_names());
+    for (int c = 0; c < field.channels(); ++c) std::copy(field.channel(c).begin(), field.channel(c).end(), f3.channel(c).begin());
+    return compress_to_dds(f3, path, o, progress);
+}
+
+std::vector<SweepRow> sweep(const Field3D& field, const CompressOptions& options) {
+    std::vector<SweepRow> rows;
+    for (Quality q : {Quality::Fast, Quality::Normal, Quality::Best}) {
+        CompressOptions o = options;
+        o.quality = q;
+        EncodedTexture e = encode_texture(field, o);
+        SweepRow r;
+        r.quality = q;
+        r.max_error = e.report.bound_max_error;
+        for (double x : e.report.rmse) r.rmse = std::max(r.rmse, x);
+        r.seconds = e.report.encode_seconds;
+        rows.push_back(r);
+    }
+    return rows;
+}
+
+std::string CompressReport::to_json() const {
+    std::ostringstream s;
+    s.precision(9);
+    auto arr = [&](const std::vector<double>& v) {
+        s << "[";
+        for (size_t i = 0; i < v.size(); ++i) {
+            if (i) s << ", ";
+            if (std::isfinite(v[i])) s << v[i]; else s << "null";
+        }
+        s << "]";
+    };
+    s << "{\n  \"format\": \"" << format << "\",\n  \"file\": \"";
+    for (char c : file) { if (c == '"' || c == '\\') s << '\\'; s << c; }
+    s << "\",\n  \"width\": " << width << ", \"height\": " << height << ", \"depth\": " << depth << ", \"array_size\": " << array_size
+      << ", \"mip_levels\": " << mip_levels << ", \"channels\": " << channels << ",\n";
+    s << "  \"value_range\": [" << value_range.first << ", " << value_range.second << "],\n";
+    s << "  \"max_error\": "; arr(max_error); s << ",\n  \"rmse\": "; arr(rmse); s << ",\n  \"psnr\": "; arr(psnr);
+    s << ",\n  \"bound_max_error\": " << bound_max_error << ",\n  \"requested_max_error\": ";
+    if (requested_max_error) s << *requested_max_error; else s << "null";
+    s << ",\n  \"one_sided\": \"" << (one_sided_below ? "below" : "none") << "\",\n  \"blocks_over_bound\": [";
+    for (size_t i = 0; i < blocks_over_bound.size(); ++i) {
+        const BlockMiss& b = blocks_over_bound[i];
+        s << (i ? ", " : "") << "{\"x\": " << b.x << ", \"y\": " << b.y << ", \"z\": " << b.z << ", \"array_index\": " << b.array_index
+          << ", \"mip\": " << b.mip << ", \"best_error\": " << b.best_error << ", \"one_sided_failed\": " << (b.one_sided_failed ? "true" : "false") << "}";
+    }
+    s << "],\n  \"decoders\": [";
+    for (size_t i = 0; i < per_decoder.size(); ++i) {
+        const DecoderStats& d = per_decoder[i];
+        s << (i ? ", " : "") << "\n    {\"decoder\": \"" << decoder_name(d.decoder) << "\", \"max_error\": ";
+        arr(d.max_error);
+        s << ", \"max_over\": " << d.max_over << ", \"one_sided_violations\": " << d.one_sided_violations << ", \"mean_under\": " << d.mean_under << "}";
+    }
+    s << "],\n  \"encode_seconds\": " << encode_seconds << ",\n  \"texels\": " << texels << ",\n  \"texels_per_second\": " << texels_per_second
+      << ",\n  \"bytes\": " << bytes << "\n}\n";
+    return s.str();
+}
+
+} // namespace atlas::compress

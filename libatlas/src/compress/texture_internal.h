@@ -1,0 +1,41 @@
+// Internal: value mapping and level decoding shared by encode, verify and read.
+#pragma once
+
+#include "atlas/compress/bc1_scalar.h"
+#include "atlas/compress/texture.h"
+
+#include <vector>
+
+namespace atlas::compress::detail {
+
+enum class MapKind { Unorm, Snorm, Float };
+
+struct Mapping {
+    MapKind kind = MapKind::Unorm;
+    float lo = 0, hi = 1;
+    double scale() const { return kind == MapKind::Float ? 1.0 : kind == MapKind::Snorm ? (double(hi) - lo) / 2.0 : double(hi) - lo; }
+    float to_norm(float v) const {
+        if (kind == MapKind::Float) return v;
+        const float u = (v - lo) / (hi - lo);
+        return kind == MapKind::Snorm ? u * 2.0f - 1.0f : u;
+    }
+    float to_src(float n) const {
+        if (kind == MapKind::Float) return n;
+        const float u = kind == MapKind::Snorm ? (n + 1.0f) * 0.5f : n;
+        return lo + u * (hi - lo);
+    }
+};
+
+MapKind map_kind(DxgiFormat f);
+
+// Level `mip` of array element `layer`, decoded to normalized channel planes
+// (x fastest, then y, then z); lo/hi give the decoder's interval (equal except
+// for the Conformant model).
+struct DecodedLevel {
+    int w = 0, h = 0, d = 0, channels = 0;
+    std::vector<std::vector<float>> lo, hi;
+};
+DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder decoder, bool bc1_scalar,
+                          const ScalarUnpack& unpack);
+
+} // namespace atlas::compress::detail
