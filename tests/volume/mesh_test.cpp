@@ -194,7 +194,8 @@ TEST(MeshSdf, OpenVdbVariantSignAndError) {
     const Field3D ours2 = mesh_to_sdf(m, {{24, 24, 24}}, grid_box(48));
     for (size_t i = 0; i < vdb.voxel_count(); ++i) {
         ASSERT_EQ(vdb.channel(0)[i] < 0, ours2.channel(0)[i] < 0) << i;
-        ASSERT_NEAR(vdb.channel(0)[i], ours2.channel(0)[i], 1.0) << i; // half a voxel each way
+        // Exact band, then first-order fast sweeping: within one voxel (2 m) here.
+        ASSERT_NEAR(vdb.channel(0)[i], ours2.channel(0)[i], 2.0) << i;
     }
     (void)ours;
 }

@@ -7,6 +7,7 @@
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
+#include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/MeshToVolume.h>
 
 #include <chrono>
@@ -33,15 +34,35 @@ Field3D mesh_to_sdf_openvdb(const Mesh& m, Vec3i res, Box3d bounds, const Memory
     tris.reserve(m.triangles.size());
     for (const auto& t : m.triangles) tris.emplace_back(t[0], t[1], t[2]);
     std::vector<openvdb::Vec4I> quads;
-    // Band wide enough to cover the whole grid.
-    const float bandwidth = float(std::max({res[0], res[1], res[2]})) * 1.75f;
+    // Exact unsigned distances in a narrow band (3 voxels), signed by the
+    // ray-winding vote (OpenVDB's own sign needs a watertight mesh), then
+    // extended over the whole grid by OpenVDB's fast sweeping (maskSdf).
+    const float bandwidth = 3.0f;
     auto grid = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xf, pts, tris, quads, bandwidth);
-    const openvdb::CoordBBox box(openvdb::Coord(0, 0, 0), openvdb::Coord(res[0] - 1, res[1] - 1, res[2] - 1));
-    openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dst(box, out.channel(0).data());
-    openvdb::tools::copyToDense(*grid, dst);
     const std::vector<float> vote = detail::ray_winding_vote(hits, res, m, bounds);
+    const openvdb::CoordBBox box(openvdb::Coord(0, 0, 0), openvdb::Coord(res[0] - 1, res[1] - 1, res[2] - 1));
+    for (auto it = grid->beginValueOn(); it; ++it) {
+        const openvdb::Coord c = it.getCoord();
+        if (!box.isInside(c)) {
+            it.setValueOff(); // beyond the grid: no vote there
+            continue;
+        }
+        if (vote[out.index(c.x(), c.y(), c.z())] > 0.5f) it.setValue(-std::abs(*it));
+    }
+    grid->setGridClass(openvdb::GRID_LEVEL_SET);
     auto s = out.channel(0);
-    for (size_t i = 0; i < s.size(); ++i) s[i] = vote[i] > 0.5f ? -std::abs(s[i]) : std::abs(s[i]);
+    if (grid->activeVoxelCount() == 0) {
+        const float far = float(length(bounds.size()));
+        for (size_t i = 0; i < s.size(); ++i) s[i] = vote[i] > 0.5f ? -far : far;
+    } else {
+        openvdb::MaskGrid mask(false);
+        mask.setTransform(xf);
+        mask.tree().denseFill(box, true, true);
+        auto full = openvdb::tools::maskSdf(*grid, mask);
+        openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dst(box, s.data());
+        openvdb::tools::copyToDense(*full, dst);
+        for (size_t i = 0; i < s.size(); ++i) s[i] = vote[i] > 0.5f ? -std::abs(s[i]) : std::abs(s[i]);
+    }
     if (stats) {
         stats->line_hits = hits.total;
         stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -63,8 +63,9 @@ Field3D mesh_to_sdf(const Mesh& mesh, Vec3i res, Box3d bounds, const MeshSdfOpti
 // `voxel` is the smallest voxel edge of the field. Channel "density".
 Field3D density_from_sdf(const Field3D& sdf, int channel = 0);
 
-// OpenVDB meshToUnsignedDistanceField over the whole grid with the ray-winding
-// sign, for comparison (cubic voxels only; throws otherwise).
+// OpenVDB pipeline, for comparison: meshToUnsignedDistanceField in a 3-voxel
+// band, signed by the ray-winding vote, extended over the whole grid by
+// OpenVDB fast sweeping (tools::maskSdf; first order). Cubic voxels only.
 Field3D mesh_to_sdf_openvdb(const Mesh& mesh, Vec3i res, Box3d bounds, const MemoryBudget* budget = nullptr,
                             MeshSdfStats* stats = nullptr);
 
