@@ -120,6 +120,20 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
     for (int t = 1; t < 16; ++t) { smin = std::min(smin, src[t]); smax = std::max(smax, src[t]); }
     std::vector<uint16_t> lows = {split(smin, u, L.hi5, L.hi6, false)};
     std::vector<uint16_t> highs = {split(smax, u, L.hi5, L.hi6, false)};
+    // The Conformant model moves even the endpoints by its base tolerance: one-sided
+    // endpoints must then sit that far below the values they stand for.
+    const float margin = (u.decoders & decoder_bit(Decoder::Conformant)) ? kBc1ConformantBase * u.max_value * 1.0001f : 0.0f;
+    if (margin > 0) {
+        // Its relative term (3% of each channel's endpoint difference) is bounded by the
+        // block's range in R plus one R level, and the full G and B ranges.
+        const float rel = kConformantRelative * (u.weights[0] * (smax - smin + 2.0f / 31.0f) + u.weights[1] + u.weights[2]);
+        for (float m : {margin, margin + rel}) {
+            lows.push_back(split(smin - m, u, L.hi5, L.hi6, false));
+            highs.push_back(split(smax - m, u, L.hi5, L.hi6, false));
+            if (options.quality != Quality::Fast)
+                for (int t = 0; t < 16; ++t) highs.push_back(split(src[t] - m, u, L.hi5, L.hi6, false));
+        }
+    }
     if (!options.one_sided_below || options.quality != Quality::Fast) {
         lows.push_back(split(smin, u, L.ref5, L.ref6, true));
         highs.push_back(split(smax, u, L.ref5, L.ref6, true));

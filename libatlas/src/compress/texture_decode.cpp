@@ -218,7 +218,7 @@ CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* mani
             for (int c = 0; c < r.channels; ++c) {
                 const int sc = src_channel(c);
                 for (size_t i = 0; i < L.lo[size_t(c)].size(); ++i) {
-                    const float s = sc >= 0 ? source.channel(sc)[size_t(layer) * slice + i] : (c == 3 ? 1.0f : 0.0f);
+                    const float s = sc >= 0 ? source.channel(sc)[size_t(layer) * slice + i] : map.to_src(c == 3 ? 1.0f : 0.0f); // missing: stored constants
                     const double lo = map.to_src(L.lo[size_t(c)][i]), hi = map.to_src(L.hi[size_t(c)][i]);
                     st.max_error[size_t(c)] = std::max(st.max_error[size_t(c)], std::max(hi - s, s - lo));
                     st.max_over = std::max(st.max_over, hi - s);
