@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -22,7 +23,8 @@ struct CliRun {
 };
 
 CliRun run(const std::string& args) {
-    fs::path dir = fs::temp_directory_path() / "atlas_cli_test";
+    // ctest runs the tests of this file as parallel processes: one directory each.
+    fs::path dir = fs::temp_directory_path() / ("atlas_cli_test_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     std::string cmd = std::string(ATLAS_BINARY_DIR) + "/bin/atlas " + args + " 2>" + (dir / "err").string();
     CliRun r;
@@ -37,7 +39,7 @@ CliRun run(const std::string& args) {
 }
 
 fs::path write_graph(const std::string& name, const std::string& text) {
-    fs::path dir = fs::temp_directory_path() / "atlas_cli_graphs";
+    fs::path dir = fs::temp_directory_path() / ("atlas_cli_graphs_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     std::ofstream(dir / name) << text;
     return dir / name;
@@ -105,7 +107,7 @@ outputs:
   - {node: n, file: n.exr}
   - {node: n, file: n.png, options: {slice: 1}}
 )");
-    fs::path out = fs::temp_directory_path() / "atlas_cli_out";
+    fs::path out = fs::temp_directory_path() / ("atlas_cli_out_" + std::to_string(::getpid()));
     fs::remove_all(out);
     CliRun r = run("cook " + g.string() + " --out " + out.string() + " --report " + (out / "r.json").string() + " --quiet --jobs 2");
     ASSERT_EQ(r.status, 0) << r.err;
