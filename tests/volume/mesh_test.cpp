@@ -4,6 +4,7 @@
 #include "volume_test_util.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <filesystem>
 #include <limits>
@@ -254,4 +255,14 @@ TEST(MeshIo, RoundTripEveryFormat) {
     { std::FILE* f = std::fopen(junk.c_str(), "w"); std::fputs("OFF\n3 1 0\n0 0 0\n1 0 nan\n", f); std::fclose(f); }
     EXPECT_THROW(read_mesh(junk), Error);
     std::filesystem::remove_all(dir);
+}
+
+TEST(MeshSdf, SameBytesForAnyThreadCount) {
+    Mesh m = uv_sphere({{16.3, 15.2, 16.8}}, 9, 16, 32);
+    m.triangles.erase(m.triangles.begin() + 40, m.triangles.begin() + 46); // a hole: exercises the exact-winding fallback
+    const Field3D many = mesh_to_sdf(m, {{32, 32, 32}}, grid_box(32));
+    const Field3D many_w = mesh_winding_field(m, {{32, 32, 32}}, grid_box(32));
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_TRUE(mesh_to_sdf(m, {{32, 32, 32}}, grid_box(32)) == many);
+    EXPECT_TRUE(mesh_winding_field(m, {{32, 32, 32}}, grid_box(32)) == many_w);
 }
