@@ -105,7 +105,7 @@ TEST(Bc1, DecoderModelsStayWithinConformantTolerance) {
         const uint16_t c0 = uint16_t(unit(k, 1) * 65536), c1 = uint16_t(unit(k, 2) * 65536);
         float ref[4][3];
         bc1_palette(c0, c1, Decoder::Reference, ref);
-        for (Decoder d : {Decoder::Nvidia, Decoder::Amd, Decoder::Tool8}) {
+        for (Decoder d : {Decoder::Nvidia, Decoder::Amd, Decoder::Tool8, Decoder::Tool8Round}) {
             float v[4][3];
             bc1_palette(c0, c1, d, v);
             for (int i = 0; i < 4; ++i)

@@ -51,6 +51,10 @@ void bc1_palette(uint16_t c0, uint16_t c1, Decoder d, float out[4][3]) {
             if (four) { v2 = (2 * A + B) / 3; v3 = (A + 2 * B) / 3; }
             else v2 = (A + B) / 2;
             break;
+        case Decoder::Tool8Round:
+            if (four) { v2 = (2 * A + B + 1) / 3; v3 = (A + 2 * B + 1) / 3; }
+            else v2 = (A + B + 1) / 2;
+            break;
         case Decoder::Nvidia:
             if (four) {
                 v2 = six ? nv_interp6(A, B) : nv_interp5(a, b);

@@ -24,7 +24,8 @@ void palette_values(uint8_t b0, uint8_t b1, bool snorm, Decoder d, float v[8]) {
     const int e0 = level(b0, snorm), e1 = level(b1, snorm);
     const float scale = snorm ? 127.0f : 255.0f;
     const bool eight = snorm ? (static_cast<int8_t>(b0) > static_cast<int8_t>(b1)) : (b0 > b1);
-    const bool integer = (d == Decoder::Tool8);
+    const bool integer = (d == Decoder::Tool8 || d == Decoder::Tool8Round);
+    const bool round = d == Decoder::Tool8Round;
     v[0] = float(e0) / scale;
     v[1] = float(e1) / scale;
     const int steps = eight ? 7 : 5;
@@ -32,7 +33,9 @@ void palette_values(uint8_t b0, uint8_t b1, bool snorm, Decoder d, float v[8]) {
     for (int k = 0; k < count; ++k) {
         const int num = (steps - 1 - k) * e0 + (k + 1) * e1;
         // Tool decoders truncate toward zero in integer arithmetic (squish, bcdec).
-        v[2 + k] = integer ? float(num / steps) / scale : float(num) / float(steps) / scale;
+        // Rounding tools add half the divisor (toward zero for negative SNORM sums).
+        const int rounded = round ? (num >= 0 ? (num + steps / 2) / steps : (num - steps / 2) / steps) : num / steps;
+        v[2 + k] = integer ? float(rounded) / scale : float(num) / float(steps) / scale;
     }
     if (!eight) {
         v[6] = snorm ? -1.0f : 0.0f;

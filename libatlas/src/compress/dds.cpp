@@ -136,9 +136,15 @@ std::vector<uint8_t> encode_dds(const DdsTexture& t) {
     put32(b, uint32_t(t.mip_levels));
     for (int i = 0; i < 11; ++i) put32(b, 0);
     // DDS_PIXELFORMAT: FourCC "DX10", the real format is in the extended header.
+    uint32_t legacy = 0;
+    if (t.legacy_header && t.array_size == 1) {
+        if (t.format == DxgiFormat::BC1_UNORM) legacy = fourcc('D', 'X', 'T', '1');
+        if (t.format == DxgiFormat::BC4_UNORM) legacy = fourcc('A', 'T', 'I', '1');
+        if (t.format == DxgiFormat::BC4_SNORM) legacy = fourcc('B', 'C', '4', 'S');
+    }
     put32(b, 32);
     put32(b, DDPF_FOURCC);
-    put32(b, fourcc('D', 'X', '1', '0'));
+    put32(b, legacy ? legacy : fourcc('D', 'X', '1', '0'));
     for (int i = 0; i < 5; ++i) put32(b, 0);
     uint32_t caps = DDSCAPS_TEXTURE;
     if (t.mip_levels > 1) caps |= DDSCAPS_MIPMAP | DDSCAPS_COMPLEX;
@@ -148,6 +154,10 @@ std::vector<uint8_t> encode_dds(const DdsTexture& t) {
     put32(b, 0);
     put32(b, 0);
     put32(b, 0);
+    if (legacy) {
+        b.insert(b.end(), t.data.begin(), t.data.end());
+        return b;
+    }
     // DDS_HEADER_DXT10
     put32(b, uint32_t(t.format));
     put32(b, t.volume ? kDim3D : kDim2D);
@@ -186,6 +196,7 @@ DdsTexture decode_dds(const std::vector<uint8_t>& b, const std::string& what) {
     else if (four == fourcc('A', 'T', 'I', '1') || four == fourcc('B', 'C', '4', 'U')) t.format = DxgiFormat::BC4_UNORM;
     else if (four == fourcc('B', 'C', '4', 'S')) t.format = DxgiFormat::BC4_SNORM;
     else throw Error(what + ": unsupported FourCC");
+    t.legacy_header = data_at == 128;
     if (caps2 & DDSCAPS2_VOLUME) t.volume = true;
     t.depth = t.volume ? int(std::max<uint32_t>(1, depth)) : 1;
     validate(t, what);

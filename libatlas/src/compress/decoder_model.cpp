@@ -11,6 +11,7 @@ const char* decoder_name(Decoder d) {
     case Decoder::Amd: return "amd";
     case Decoder::Tool8: return "tool8";
     case Decoder::Conformant: return "conformant";
+    case Decoder::Tool8Round: return "tool8-round";
     }
     return "?";
 }
@@ -18,7 +19,7 @@ const char* decoder_name(Decoder d) {
 Decoder parse_decoder(const std::string& name) {
     for (int i = 0; i < kDecoderCount; ++i)
         if (name == decoder_name(static_cast<Decoder>(i))) return static_cast<Decoder>(i);
-    throw Error("unknown decoder model '" + name + "' (expected reference, nvidia, amd, tool8 or conformant)");
+    throw Error("unknown decoder model '" + name + "' (expected reference, nvidia, amd, tool8, tool8-round or conformant)");
 }
 
 std::vector<Decoder> decoders_in(DecoderSet set) {

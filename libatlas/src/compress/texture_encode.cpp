@@ -238,6 +238,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     tex.volume = volume;
     tex.array_size = layers;
     tex.mip_levels = mips;
+    tex.legacy_header = o.legacy_bc1_header && dx == DxgiFormat::BC1_UNORM;
     tex.data.assign(tex.total_bytes(), 0);
 
     BlockOptions bo;

@@ -53,6 +53,10 @@ struct DdsTexture {
     int array_size = 1; // 2D arrays (volumes have 1)
     int mip_levels = 1;
     std::vector<uint8_t> data; // every subresource, in DDS order
+    // Write the legacy FourCC header ("DXT1" / "ATI1") instead of DX10 when the
+    // format has one and the texture is not an array (old readers such as
+    // OpenImageIO 2.4 only know these for BC1). Reading accepts both.
+    bool legacy_header = false;
 
     int level_width(int mip) const { return std::max(1, width >> mip); }
     int level_height(int mip) const { return std::max(1, height >> mip); }

@@ -8,6 +8,9 @@
 //   Amd         AMD's published BC1 interpolation ((43*c0 + 21*c1 + 32) / 64 on 8 bits)
 //   Tool8       8-bit integer tool decoders (squish, OpenImageIO 2.4, bcdec): endpoints
 //               expanded to 8 bits, interpolation truncated to 8 bits
+//   Tool8Round  8-bit decoders that round the interpolation to nearest instead
+//               (OpenImageIO 2.4's DDS reader, Compressonator's BC4 "+3"): BC1
+//               (2a+b+1)/3, (a+b+1)/2 on expanded endpoints; BC4 (num + k/2) / k
 //   Conformant  any decoder within the tolerance Atlas assumes for conforming hardware
 //               (Atlas's model, not spec text): BC4 interpolants +-1/255; BC1 entries
 //               +-(2/255 + 3% of the endpoints' per-channel difference). It contains
@@ -22,8 +25,8 @@
 
 namespace atlas::compress {
 
-enum class Decoder : uint8_t { Reference = 0, Nvidia = 1, Amd = 2, Tool8 = 3, Conformant = 4 };
-constexpr int kDecoderCount = 5;
+enum class Decoder : uint8_t { Reference = 0, Nvidia = 1, Amd = 2, Tool8 = 3, Conformant = 4, Tool8Round = 5 };
+constexpr int kDecoderCount = 6;
 
 // Bit set of Decoder values (bit i = Decoder i).
 using DecoderSet = uint32_t;
@@ -46,7 +49,7 @@ inline float bc1_conformant_tolerance(float ref0, float ref1) {
     return kBc1ConformantBase + kConformantRelative * d;
 }
 
-// "reference", "nvidia", "amd", "tool8", "conformant".
+// "reference", "nvidia", "amd", "tool8", "conformant", "tool8-round".
 const char* decoder_name(Decoder d);
 // Parses a name above; throws atlas::Error naming the accepted values.
 Decoder parse_decoder(const std::string& name);

@@ -64,6 +64,9 @@ struct CompressOptions {
     std::vector<int> channels;
     // A Field3D with nz > 1 becomes a 2D array instead of a volume texture.
     bool as_array = false;
+    // BC1 textures that are not arrays get the legacy "DXT1" FourCC header instead
+    // of DX10 (same data; OpenImageIO 2.4 reads only that for BC1).
+    bool legacy_bc1_header = true;
     // Free text for the manifest's channel meanings (default: the field's names).
     std::vector<std::string> channel_meanings;
 };
