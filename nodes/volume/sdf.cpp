@@ -18,6 +18,7 @@ void declare(NodeDeclaration& d) {
     d.param_float("far_distance", 0).at_least(0).with_unit("m").describe("distance where the grid has no surface (0: the grid diagonal)");
     d.param_bool("border_is_outside", false).describe("treat beyond the grid as empty (edt; fast_sweeping always does)");
     d.param_int("sweeps", 1).range(1, 16).describe("fogToSdf iterations (fast_sweeping)");
+    d.param_bool("check_error", false).describe("also compute the brute-force reference (small grids only) and report max/rms error in voxels");
 }
 
 void cook(CookContext& ctx) {
@@ -33,6 +34,15 @@ void cook(CookContext& ctx) {
                       : volume::sdf_from_density_fast_sweeping(*in, o, int(ctx.get_int("sweeps")), &ctx.budget(), &st);
     ctx.metric("seconds", st.seconds);
     ctx.metric("crossings", double(st.crossings));
+    if (ctx.get_bool("check_error")) {
+        // fast_sweeping sees beyond the grid as empty: compare like with like.
+        volume::SdfOptions ro = o;
+        ro.border_is_outside = o.border_is_outside || ctx.get_string("method") == "fast_sweeping";
+        const volume::SdfError e = volume::compare_sdf(out, volume::sdf_brute_force(*in, ro));
+        ctx.metric("max_error_voxels", e.max_abs_voxels);
+        ctx.metric("rms_error_voxels", e.rms_voxels);
+        ctx.metric("sign_errors", double(e.sign_mismatches));
+    }
     ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(std::move(out))));
 }
 } // namespace

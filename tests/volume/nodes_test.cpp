@@ -37,6 +37,10 @@ nodes:
   sdf:
     type: volume/sdf
     inputs: {in: cut}
+  swept:
+    type: volume/sdf
+    inputs: {in: cut}
+    params: {method: fast_sweeping, check_error: true}
   nvdf:
     type: volume/nvdf
     inputs: {sdf: sdf}
@@ -54,6 +58,7 @@ nodes:
     params: {resolution: [32, 32, 8], bounds_max: [256, 256, 64]}
 outputs:
   - {node: nvdf, port: vdb_set, file: set.vdb}
+  - {node: swept, file: swept.vdb}
 )";
 
 template <typename T>
@@ -95,6 +100,11 @@ TEST(VolumeNodes, GraphMatchesLibrary) {
     }
     auto fd = as<Field3D>(s.get("nvdf", "field_data", co));
     EXPECT_TRUE(*fd == volume::encode_field_data(sdf));
+    const CookResult r = s.cook([&] { CookOptions c = co; c.outputs = {"swept.vdb"}; return c; }());
+    const auto& m = r.nodes.at("swept").metrics;
+    ASSERT_TRUE(m.count("max_error_voxels"));
+    EXPECT_LT(m.at("max_error_voxels"), 2.0);
+    EXPECT_EQ(m.at("sign_errors"), 0.0);
     auto pts = as<Points>(s.get("fill", "out", co));
     EXPECT_GT(pts->positions.size(), 10u);
     EXPECT_EQ(pts->attributes.at("radius").size(), pts->positions.size());
