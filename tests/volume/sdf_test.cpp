@@ -217,3 +217,21 @@ TEST(SdfEdt, SameBytesForAnyThreadCount) {
     Field3D many = sdf_from_density_edt(d, {});
     EXPECT_TRUE(one == many);
 }
+
+// Grids one voxel thin in some axes (2D and 1D slabs) and a single voxel.
+TEST(SdfDegenerate, ThinGrids) {
+    for (Vec3i res : {Vec3i{{1, 1, 1}}, Vec3i{{7, 1, 1}}, Vec3i{{1, 9, 1}}, Vec3i{{6, 5, 1}}, Vec3i{{1, 4, 6}}}) {
+        Field3D d = random_blobs(res, {{2, 2, 2}}, 5, 3);
+        for (bool border : {false, true}) {
+            SdfOptions o;
+            o.iso = 0.3;
+            o.border_is_outside = border;
+            const Field3D e = sdf_from_density_edt(d, o);
+            const Field3D b = sdf_brute_force(d, o);
+            const SdfError err = compare_sdf(e, b);
+            EXPECT_EQ(err.sign_mismatches, 0u);
+            EXPECT_LT(err.max_abs_voxels, 1e-4) << res[0] << "x" << res[1] << "x" << res[2];
+            expect_all_finite(e);
+        }
+    }
+}
