@@ -6,9 +6,11 @@
 // - The surface is the iso-crossing of the density, linearly interpolated along
 //   the grid edges between neighbouring voxel centres ("crossing points"). The
 //   exact-EDT method returns, for every voxel, the exact Euclidean distance from
-//   its centre to the nearest crossing point (float rounding only); the distance
-//   to the interpolated surface between crossing points is within 0.5 voxel of
-//   that (docs/volumes.md, measured bound in tests/volume/sdf_test.cpp).
+//   its centre to the nearest crossing point (float rounding only). Against the
+//   interpolated surface between crossing points it overestimates by less than
+//   sqrt(3) voxels in the worst case (a crossing lies on an edge of the cell
+//   that holds the nearest surface point); measured < 0.5 voxel on spheres,
+//   shrinking with distance (docs/volumes.md, tests/volume/sdf_test.cpp).
 // - The whole grid is filled (no narrow band): the renderer needs far distances.
 // - A grid without any crossing (empty or full) gets +far_distance (all outside)
 //   or -far_distance (all inside) everywhere, unless border_is_outside puts a
