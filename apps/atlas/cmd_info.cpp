@@ -1,15 +1,14 @@
-// atlas info FILE...: what a file holds (size, channels, value statistics), on stdout.
+// atlas info FILE...: what a file holds (size, format, channels, value statistics), on stdout.
 #include "cli.h"
 
+#include "atlas/compress/texture.h"
 #include "atlas/core/error.h"
 #include "atlas/core/field_math.h"
-#include "atlas/io/exr.h"
-#include "atlas/io/image.h"
+#include "atlas/io/readers.h"
 #include "atlas/io/vdb.h"
 
 #include <algorithm>
 #include <cstdio>
-#include <iostream>
 
 namespace atlas::cli {
 
@@ -45,18 +44,20 @@ int run_info(const Args& a) {
         std::string ext = std::filesystem::path(file).extension().string();
         std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
         std::printf("%s\n", file.c_str());
-        if (ext == ".exr") {
-            describe(io::read_exr(file));
-        } else if (ext == ".vdb") {
+        if (ext == ".dds") {
+            const compress::DdsTexture t = compress::read_dds_file(file);
+            std::printf("  DDS %s %dx%dx%d%s, %d array element(s), %d mip level(s), %zu bytes of data\n",
+                        compress::dxgi_format_name(t.format), t.width, t.height, t.depth, t.volume ? " (volume)" : "", t.array_size,
+                        t.mip_levels, t.data.size());
+            describe(Field3DPtr(std::make_shared<Field3D>(compress::read_dds(file))));
+            continue;
+        }
+        if (ext == ".vdb") {
             std::printf("  grids:");
             for (const auto& g : io::list_vdb_grids(file)) std::printf(" %s", g.c_str());
             std::printf("\n");
-            describe(Field3DPtr(std::make_shared<Field3D>(io::read_vdb(file))));
-        } else if (ext == ".png" || ext == ".tga" || ext == ".jpg" || ext == ".tif" || ext == ".tiff") {
-            describe(Field2DPtr(std::make_shared<Field2D>(io::read_image(file))));
-        } else {
-            throw Error(file + ": unknown file type '" + ext + "' (atlas info reads .exr, .vdb, .png, .tga, .tif)");
         }
+        describe(io::read_field_file(file));
     }
     return 0;
 }

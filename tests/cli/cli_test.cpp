@@ -128,3 +128,34 @@ outputs:
               std::string::npos) << set.err;
     fs::remove_all(out);
 }
+
+TEST(Cli, CompressInfoDecompressRoundTrip) {
+    auto g = write_graph("tex.yaml", R"(atlas: 1
+nodes:
+  n:
+    type: noise/value
+    params: {resolution: [16, 16, 2], octaves: 2}
+outputs:
+  - {node: n, file: n.exr}
+)");
+    fs::path out = fs::temp_directory_path() / ("atlas_cli_tex_" + std::to_string(::getpid()));
+    fs::remove_all(out);
+    ASSERT_EQ(run("cook " + g.string() + " --out " + out.string() + " --quiet").status, 0);
+    CliRun c = run("compress " + (out / "n.exr").string() + " --format bc4 --one-sided below -o " + (out / "n.dds").string() +
+                   " --quiet --report " + (out / "n.json").string());
+    ASSERT_EQ(c.status, 0) << c.err;
+    EXPECT_NE(c.out.find("bc4 16x16x2"), std::string::npos) << c.out;
+    EXPECT_NE(c.out.find("verify"), std::string::npos) << "a bounded encode verifies by default\n" << c.out;
+    EXPECT_TRUE(fs::exists(out / "n.dds.json"));
+    EXPECT_TRUE(fs::exists(out / "n.json"));
+    CliRun i = run("info " + (out / "n.dds").string());
+    EXPECT_EQ(i.status, 0) << i.err;
+    EXPECT_NE(i.out.find("3D field 16x16x2"), std::string::npos) << i.out;
+    CliRun d = run("decompress " + (out / "n.dds").string() + " -o " + (out / "back.exr").string());
+    EXPECT_EQ(d.status, 0) << d.err;
+    EXPECT_TRUE(fs::exists(out / "back.exr"));
+    CliRun bad = run("compress " + (out / "n.exr").string() + " --format bc9 -o " + (out / "x.dds").string());
+    EXPECT_EQ(bad.status, 1);
+    EXPECT_FALSE(fs::exists(out / "x.dds"));
+    fs::remove_all(out);
+}

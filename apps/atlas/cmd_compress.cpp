@@ -1,0 +1,170 @@
+// atlas compress / atlas decompress: fields to BC / uncompressed DDS textures and back.
+#include "cli.h"
+#include "progress_bar.h"
+
+#include "atlas/compress/texture.h"
+#include "atlas/core/files.h"
+#include "atlas/io/readers.h"
+#include "atlas/io/writers.h"
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace atlas::cli {
+
+namespace {
+
+std::vector<std::string> split(const std::string& s, char sep) {
+    std::vector<std::string> v;
+    std::stringstream ss(s);
+    for (std::string item; std::getline(ss, item, sep);)
+        if (!item.empty()) v.push_back(item);
+    return v;
+}
+
+float parse_float(const std::string& text, const std::string& option) {
+    try {
+        size_t used = 0;
+        float v = std::stof(text, &used);
+        if (used == text.size()) return v;
+    } catch (...) {
+    }
+    throw UsageError{option + " expects a number, got '" + text + "'", "compress"};
+}
+
+compress::CompressOptions parse_compress_options(const Args& a, const Field3D& field) {
+    compress::CompressOptions o;
+    if (!a.has("--format")) throw UsageError{"--format is required (bc1, bc1-scalar, bc4, bc4-snorm, bc6h, r8, r16, r16f, r32f, rgba8, rgba16f, rgba4)", "compress"};
+    o.format = compress::parse_format(a.get("--format"));
+    if (a.has("--quality")) o.quality = compress::parse_quality(a.get("--quality").c_str());
+    if (a.has("--max-error")) {
+        o.max_error = parse_float(a.get("--max-error"), "--max-error");
+        if (!(*o.max_error >= 0)) throw UsageError{"--max-error must be >= 0", "compress"};
+    }
+    if (a.has("--one-sided")) {
+        if (a.get("--one-sided") != "below") throw UsageError{"--one-sided accepts 'below' (decoded <= source), got '" + a.get("--one-sided") + "'", "compress"};
+        o.one_sided_below = true;
+    }
+    o.allow_over_bound = a.has("--allow-over-bound");
+    if (a.has("--mips")) {
+        const std::string m = a.get("--mips");
+        o.mip_levels = m == "full" ? 0 : int(parse_float(m, "--mips"));
+        if (o.mip_levels < 0) throw UsageError{"--mips expects a level count >= 1 or 'full'", "compress"};
+    }
+    if (a.has("--range")) {
+        auto parts = split(a.get("--range"), ',');
+        if (parts.size() != 2) throw UsageError{"--range expects LO,HI", "compress"};
+        o.value_range = std::make_pair(parse_float(parts[0], "--range"), parse_float(parts[1], "--range"));
+    }
+    if (a.has("--channels")) {
+        for (const auto& name : split(a.get("--channels"), ',')) {
+            int c = field.find_channel(name);
+            if (c < 0) throw Error("--channels: the input has no channel '" + name + "'");
+            o.channels.push_back(c);
+        }
+    }
+    if (a.has("--decoders")) {
+        o.decoders = 0;
+        for (const auto& d : split(a.get("--decoders"), ',')) o.decoders |= compress::decoder_bit(compress::parse_decoder(d));
+    }
+    o.as_array = a.has("--array");
+    return o;
+}
+
+void print_report(const compress::CompressReport& r) {
+    std::printf("%s: %s %dx%dx%d%s, %d mip level(s), value range [%g, %g]\n", r.file.c_str(), r.format.c_str(), r.width, r.height, r.depth,
+                r.array_size > 1 ? (" x" + std::to_string(r.array_size)).c_str() : "", r.mip_levels, r.value_range.first, r.value_range.second);
+    for (size_t c = 0; c < r.max_error.size(); ++c)
+        std::printf("  channel %zu: max error %.6g  RMSE %.6g  PSNR %.2f dB\n", c, r.max_error[c], r.rmse[c], r.psnr[c]);
+    std::printf("  guaranteed max error over all decoders: %.6g%s\n", r.bound_max_error,
+                r.requested_max_error ? (" (requested " + std::to_string(*r.requested_max_error) + ")").c_str() : "");
+    std::printf("  blocks over the bound: %zu\n", r.blocks_over_bound.size());
+    for (size_t i = 0; i < r.blocks_over_bound.size() && i < 20; ++i) {
+        const auto& b = r.blocks_over_bound[i];
+        std::printf("    block at (%d, %d, %d) mip %d: best error %.6g%s\n", b.x, b.y, b.z, b.mip, b.best_error,
+                    b.one_sided_failed ? " (one-sided not met)" : "");
+    }
+    std::printf("  encode %.3f s, %.3g texels/s, %llu bytes\n", r.encode_seconds, r.texels_per_second, (unsigned long long)r.bytes);
+}
+
+void print_verify(const compress::CompressReport& v) {
+    std::printf("  verify (decoded file against the source):\n");
+    for (const auto& d : v.per_decoder) {
+        double worst = 0;
+        for (double e : d.max_error) worst = std::max(worst, e);
+        std::printf("    %-11s max error %.6g  max over source %.6g  one-sided violations %llu  mean under %.6g\n",
+                    compress::decoder_name(d.decoder), worst, d.max_over, (unsigned long long)d.one_sided_violations, d.mean_under);
+    }
+}
+
+} // namespace
+
+int run_compress(const Args& a) {
+    if (a.positional.size() != 1) throw UsageError{"expected one input file", "compress"};
+    const std::string in = a.positional[0];
+    const MemoryBudget budget(a.has("--memory-budget") ? parse_byte_size(a.get("--memory-budget")) : MemoryBudget::kDefaultLimit);
+    Field3DPtr field = io::as_field3d(io::read_field_file(in, &budget));
+    compress::CompressOptions o = parse_compress_options(a, *field);
+
+    if (a.has("--sweep")) {
+        auto rows = compress::sweep(*field, o);
+        std::printf("quality,max_error,rmse,seconds\n");
+        for (const auto& r : rows) std::printf("%s,%.8g,%.8g,%.6f\n", compress::quality_name(r.quality), r.max_error, r.rmse, r.seconds);
+        if (a.has("--csv")) {
+            write_file_atomic(a.get("--csv"), [&](const fs::path& tmp) {
+                std::ofstream f(tmp);
+                f << "quality,max_error,rmse,seconds\n";
+                for (const auto& r : rows) f << compress::quality_name(r.quality) << "," << r.max_error << "," << r.rmse << "," << r.seconds << "\n";
+            });
+        }
+        return 0;
+    }
+    if (!a.has("--out")) throw UsageError{"-o OUT.dds is required", "compress"};
+    const std::string out = a.get("--out");
+    ProgressBar bar(!a.has("--quiet"));
+    ProgressSink sink = bar.sink();
+    compress::CompressReport r;
+    try {
+        r = compress::compress_to_dds(*field, out, o, &sink);
+    } catch (const compress::BoundError& e) {
+        bar.finish();
+        print_report(e.report());
+        throw;
+    }
+    bar.finish();
+    print_report(r);
+    const bool bounded = o.max_error || o.one_sided_below;
+    if ((bounded && !a.has("--no-verify")) || a.has("--verify")) print_verify(compress::verify_dds(out, *field, o.decoders, o.channels));
+    if (a.has("--report")) {
+        std::string json = r.to_json();
+        write_file_atomic(a.get("--report"), [&](const fs::path& tmp) {
+            std::ofstream f(tmp);
+            f << json;
+        });
+    }
+    return 0;
+}
+
+int run_decompress(const Args& a) {
+    if (a.positional.size() != 1) throw UsageError{"expected one input .dds file", "decompress"};
+    if (!a.has("--out")) throw UsageError{"-o OUT.exr is required", "decompress"};
+    const compress::Decoder decoder = a.has("--decoder") ? compress::parse_decoder(a.get("--decoder")) : compress::Decoder::Reference;
+    auto field = std::make_shared<Field3D>(compress::read_dds(a.positional[0], decoder));
+    const fs::path out = a.get("--out");
+    Value v = Field3DPtr(field);
+    if (field->nz() == 1) {
+        auto f2 = std::make_shared<Field2D>(Vec2i{{field->nx(), field->ny()}}, field->channels(),
+                                            Box2d{{{field->bounds().min[0], field->bounds().min[1]}}, {{field->bounds().max[0], field->bounds().max[1]}}},
+                                            field->channel_names());
+        for (int c = 0; c < field->channels(); ++c) std::copy(field->channel(c).begin(), field->channel(c).end(), f2->channel(c).begin());
+        v = Field2DPtr(f2);
+    }
+    const std::string format = io::output_format_for_path(out);
+    write_file_atomic(out, [&](const fs::path& tmp) { io::write_value(v, tmp, format, {}); });
+    std::printf("%s\n", out.string().c_str());
+    return 0;
+}
+
+} // namespace atlas::cli
