@@ -1,0 +1,89 @@
+// atlas/sim/mac_grid.h - the staggered (MAC) grid the cloud solver works on.
+//
+// Cells are cubes of edge `dx` metres; z is up (gravity along -z). A 2D run is
+// a one-cell slab: ny == 1 (x-z plane) or nx == 1. Scalars (theta', qv, qc, qr)
+// sit at cell centres; velocity components sit on the faces normal to them:
+// u at (i, j+1/2, k+1/2) with i in [0, nx], v at j in [0, ny], w at k in [0, nz].
+// Storage is x fastest, then y, then z, like Field3D.
+// A MacGrid is a plain value; reading it from many threads is safe.
+#pragma once
+
+#include "atlas/core/memory.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace atlas::sim {
+
+// What happens at one face of the domain.
+//   Closed: a free-slip wall; normal velocity 0, pressure gradient 0 (Neumann).
+//   Open:   an outflow/inflow face held at ambient pressure (Dirichlet p' = 0);
+//           the normal velocity there is whatever the projection makes it.
+enum class Boundary { Closed, Open };
+
+// Faces in the order x-, x+, y-, y+, z-, z+.
+using BoundarySet = std::array<Boundary, 6>;
+constexpr BoundarySet all_closed() { return {Boundary::Closed, Boundary::Closed, Boundary::Closed, Boundary::Closed, Boundary::Closed, Boundary::Closed}; }
+constexpr BoundarySet all_open() { return {Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open}; }
+
+// Size and spacing of a simulation grid.
+//   nx, ny, nz: cells, each in [1, 4096], at least 2 along two axes.
+//   dx: cell edge in metres, in [1e-3, 1e5].
+// A direction with a single cell is always treated as closed (a 2D slab).
+struct GridSpec {
+    int nx = 0, ny = 0, nz = 0;
+    double dx = 1.0;
+    BoundarySet boundary = all_closed();
+
+    size_t cells() const { return size_t(nx) * size_t(ny) * size_t(nz); }
+    // Throws atlas::Error naming the bad member when the spec is out of range.
+    void validate() const;
+    // The boundary actually used: single-cell directions are forced closed.
+    Boundary face(int f) const;
+};
+
+// Bytes per cell of a whole Simulation (state, advection scratch, pressure
+// solver with its multigrid hierarchy); the estimate used before allocating.
+// 4-byte floats: u, v, w, theta', qv, qc, qr, two advection scratch copies of
+// each (3 x 7 = 21 floats = 84 B); pressure solver: 6 doubles (48 B) plus about
+// 1/7 of that for coarse levels (8 B): 140 B per cell.
+constexpr uint64_t kSimBytesPerCell = 140;
+uint64_t simulation_bytes(const GridSpec& spec);
+
+// Velocity on a MAC grid, in m/s.
+struct MacVelocity {
+    GridSpec spec;
+    std::vector<float> u, v, w;
+
+    MacVelocity() = default;
+    // Zero velocity. Validates `spec`; checks `budget` (3 face arrays) when given.
+    explicit MacVelocity(const GridSpec& spec, const MemoryBudget* budget = nullptr);
+
+    size_t iu(int i, int j, int k) const { return (size_t(k) * size_t(spec.ny) + size_t(j)) * size_t(spec.nx + 1) + size_t(i); }
+    size_t iv(int i, int j, int k) const { return (size_t(k) * size_t(spec.ny + 1) + size_t(j)) * size_t(spec.nx) + size_t(i); }
+    size_t iw(int i, int j, int k) const { return (size_t(k) * size_t(spec.ny) + size_t(j)) * size_t(spec.nx) + size_t(i); }
+    size_t ic(int i, int j, int k) const { return (size_t(k) * size_t(spec.ny) + size_t(j)) * size_t(spec.nx) + size_t(i); }
+
+    // Sets the normal velocity on closed faces (and in single-cell directions) to 0.
+    void enforce_walls();
+    // Largest |component| in m/s (NaN if any component is NaN).
+    double max_abs() const;
+};
+
+// Divergence statistics over all cells, in 1/s: root-mean-square and max |div u|.
+// `face_weight_z(k)`-free form: plain (Boussinesq) divergence.
+struct DivergenceStats {
+    double l2 = 0;  // sqrt(mean of div^2)
+    double max = 0; // max |div|
+};
+DivergenceStats divergence_stats(const MacVelocity& vel);
+
+// The same with the anelastic weight: div(rho0 u) / rho0(cell), where rho_cell
+// has nz entries (cell centres) and rho_face nz + 1 (w faces).
+DivergenceStats divergence_stats(const MacVelocity& vel, const std::vector<double>& rho_cell,
+                                 const std::vector<double>& rho_face);
+
+} // namespace atlas::sim

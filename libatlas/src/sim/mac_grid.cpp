@@ -1,0 +1,89 @@
+#include "atlas/sim/mac_grid.h"
+
+#include "atlas/core/error.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace atlas::sim {
+
+void GridSpec::validate() const {
+    auto dim = [](int n, const char* name) {
+        if (n < 1 || n > 4096)
+            throw Error(std::string("sim grid: ") + name + " = " + std::to_string(n) + ", expected 1..4096 cells");
+    };
+    dim(nx, "nx");
+    dim(ny, "ny");
+    dim(nz, "nz");
+    int big = (nx >= 2) + (ny >= 2) + (nz >= 2);
+    if (big < 2) throw Error("sim grid: at least two of nx, ny, nz must be >= 2");
+    if (!(dx >= 1e-3 && dx <= 1e5)) throw Error("sim grid: dx = " + std::to_string(dx) + ", expected 1e-3..1e5 m");
+}
+
+Boundary GridSpec::face(int f) const {
+    int n = f < 2 ? nx : f < 4 ? ny : nz;
+    return n == 1 ? Boundary::Closed : boundary[size_t(f)];
+}
+
+uint64_t simulation_bytes(const GridSpec& spec) { return uint64_t(spec.cells()) * kSimBytesPerCell; }
+
+MacVelocity::MacVelocity(const GridSpec& s, const MemoryBudget* budget) : spec(s) {
+    spec.validate();
+    size_t nu = size_t(s.nx + 1) * s.ny * s.nz, nv = size_t(s.nx) * (s.ny + 1) * s.nz, nw = size_t(s.nx) * s.ny * (s.nz + 1);
+    if (budget) budget->check((nu + nv + nw) * sizeof(float), "sim: MAC velocity");
+    u.assign(nu, 0.f);
+    v.assign(nv, 0.f);
+    w.assign(nw, 0.f);
+}
+
+void MacVelocity::enforce_walls() {
+    const int nx = spec.nx, ny = spec.ny, nz = spec.nz;
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j) {
+            if (spec.face(0) == Boundary::Closed) u[iu(0, j, k)] = 0;
+            if (spec.face(1) == Boundary::Closed) u[iu(nx, j, k)] = 0;
+        }
+    for (int k = 0; k < nz; ++k)
+        for (int i = 0; i < nx; ++i) {
+            if (spec.face(2) == Boundary::Closed) v[iv(i, 0, k)] = 0;
+            if (spec.face(3) == Boundary::Closed) v[iv(i, ny, k)] = 0;
+        }
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            if (spec.face(4) == Boundary::Closed) w[iw(i, j, 0)] = 0;
+            if (spec.face(5) == Boundary::Closed) w[iw(i, j, nz)] = 0;
+        }
+}
+
+double MacVelocity::max_abs() const {
+    double m = 0;
+    for (const auto* a : {&u, &v, &w})
+        for (float x : *a) {
+            if (std::isnan(x)) return x;
+            m = std::max(m, double(std::fabs(x)));
+        }
+    return m;
+}
+
+DivergenceStats divergence_stats(const MacVelocity& vel, const std::vector<double>& rho_cell,
+                                 const std::vector<double>& rho_face) {
+    const auto& s = vel.spec;
+    double sum2 = 0, mx = 0;
+    for (int k = 0; k < s.nz; ++k)
+        for (int j = 0; j < s.ny; ++j)
+            for (int i = 0; i < s.nx; ++i) {
+                double rc = rho_cell.empty() ? 1.0 : rho_cell[size_t(k)];
+                double rlo = rho_face.empty() ? 1.0 : rho_face[size_t(k)], rhi = rho_face.empty() ? 1.0 : rho_face[size_t(k + 1)];
+                double d = rc * (double(vel.u[vel.iu(i + 1, j, k)]) - vel.u[vel.iu(i, j, k)]) +
+                           rc * (double(vel.v[vel.iv(i, j + 1, k)]) - vel.v[vel.iv(i, j, k)]) +
+                           (rhi * vel.w[vel.iw(i, j, k + 1)] - rlo * double(vel.w[vel.iw(i, j, k)]));
+                d /= rc * s.dx;
+                sum2 += d * d;
+                mx = std::max(mx, std::fabs(d));
+            }
+    return {std::sqrt(sum2 / double(s.cells())), mx};
+}
+
+DivergenceStats divergence_stats(const MacVelocity& vel) { return divergence_stats(vel, {}, {}); }
+
+} // namespace atlas::sim
