@@ -1,0 +1,60 @@
+// atlas/render/scene.h - what the preview renderer draws: an NVDF set, its
+// signed distance field and the up-rez noise, viewed by a camera under a sun.
+//
+// Units: world metres (the fields' bounds), directions are unit vectors in
+// world space (z up), colours are linear RGB radiance (arbitrary scale; the
+// PNG tone map exposes for 1.0 = white). All types are plain values; a const
+// scene may be rendered from any number of threads.
+#pragma once
+
+#include "atlas/core/field.h"
+
+#include <string>
+
+namespace atlas::render {
+
+// The voxel cloud: Nubis modeling NVDF plus field data (docs/volumes.md).
+//   modeling  channels dimensional_profile, detail_type, density_scale
+//             (found by name, else channels 0, 1, 2), values nominally [0, 1]
+//   sdf       signed distance in metres (negative inside), channel "sdf" or 0;
+//             must share modeling's resolution and bounds
+//   noise     optional Nubis noise volume, 4 channels (r, g = low/high
+//             frequency wispy, b, a = low/high frequency billowy) in [0, 1],
+//             tiling every noise_tile metres; fewer channels repeat the
+//             last one. Null: no up-rez (density = dimensional profile).
+struct CloudScene {
+    Field3DPtr modeling;
+    Field3DPtr sdf;
+    Field3DPtr noise;
+    double noise_tile = 256; // metres per noise period, > 0
+};
+
+// A scene from one 4-channel "vdb_set" field (volume/nvdf's output, or
+// volume::read_nubis_vdb): channels dimensional_profile, detail_type,
+// density_scale, sdf. Throws atlas::Error naming a missing channel.
+CloudScene scene_from_nvdf_set(Field3DPtr vdb_set, Field3DPtr noise = nullptr, double noise_tile = 256);
+
+// Checks the scene (non-null fields, matching grids, >= 3 modeling
+// channels, finite noise_tile > 0); throws atlas::Error naming the problem.
+void validate_scene(const CloudScene& scene);
+
+// Pinhole camera. fov_deg is the vertical field of view in degrees (0, 180);
+// up is the world up hint (must not be parallel to look_at - position).
+struct Camera {
+    Vec3d position{{0, 0, 0}};
+    Vec3d look_at{{0, 1, 0}};
+    Vec3d up{{0, 0, 1}};
+    double fov_deg = 50;
+};
+
+// A camera that frames `bounds` from outside: looking at its centre from the
+// south-west-above at `elevation_deg`, `azimuth_deg` (0 = from -y, growing
+// counter-clockwise seen from above), far enough that the whole box fits a
+// `fov_deg` vertical field of view for the given aspect (width / height).
+Camera framing_camera(const Box3d& bounds, double aspect, double azimuth_deg = 30, double elevation_deg = 20, double fov_deg = 50);
+
+// Unit direction toward the sun from azimuth and elevation in degrees
+// (elevation 0 = horizon, negative = below).
+Vec3d sun_direction(double azimuth_deg, double elevation_deg);
+
+} // namespace atlas::render

@@ -1,0 +1,154 @@
+#include "cloud_sampler.h"
+
+#include "atlas/core/error.h"
+
+#include <algorithm>
+
+namespace atlas::render::detail {
+
+namespace {
+
+int channel_or(const Field3D& f, const char* name, int fallback) {
+    int c = f.find_channel(name);
+    return c >= 0 ? c : fallback;
+}
+
+// Trilinear weights for continuous voxel coordinate u (centres at i + 0.5),
+// clamped to the grid.
+inline void axis(double u, int n, int& i0, int& i1, float& t) {
+    u -= 0.5;
+    if (u <= 0) { i0 = i1 = 0; t = 0; return; }
+    if (u >= n - 1) { i0 = i1 = n - 1; t = 0; return; }
+    i0 = static_cast<int>(u);
+    i1 = i0 + 1;
+    t = static_cast<float>(u - i0);
+}
+
+inline void axis_wrap(double u, int n, int& i0, int& i1, float& t) {
+    u -= 0.5;
+    double f = std::floor(u);
+    t = static_cast<float>(u - f);
+    long long i = static_cast<long long>(f) % n;
+    if (i < 0) i += n;
+    i0 = static_cast<int>(i);
+    i1 = i0 + 1 == n ? 0 : i0 + 1;
+}
+
+} // namespace
+
+CloudSampler::CloudSampler(const CloudScene& scene) {
+    validate_scene(scene);
+    const Field3D& m = *scene.modeling;
+    const Field3D& s = *scene.sdf;
+    int cp = channel_or(m, "dimensional_profile", 0);
+    int ct = channel_or(m, "detail_type", 1);
+    int cs = channel_or(m, "density_scale", 2);
+    int cd = channel_or(s, "sdf", 0);
+    grid_.ch = {m.channel(cp).data(), m.channel(ct).data(), m.channel(cs).data(), s.channel(cd).data()};
+    grid_.nx = m.nx();
+    grid_.ny = m.ny();
+    grid_.nz = m.nz();
+    bounds_ = m.bounds();
+    voxel_ = m.voxel_size();
+    for (int a = 0; a < 3; ++a) {
+        grid_.min[a] = bounds_.min[a];
+        grid_.inv_voxel[a] = 1.0 / voxel_[a];
+    }
+    // Billowy branch only when some voxel asks for it.
+    auto type = m.channel(ct);
+    billowy_ = std::any_of(type.begin(), type.end(), [](float v) { return v > 0.0f; });
+    if (scene.noise) {
+        const Field3D& n = *scene.noise;
+        for (int c = 0; c < 4; ++c) noise_.ch[size_t(c)] = n.channel(std::min(c, n.channels() - 1)).data();
+        noise_.nx = n.nx();
+        noise_.ny = n.ny();
+        noise_.nz = n.nz();
+        noise_.scale[0] = n.nx() / scene.noise_tile;
+        noise_.scale[1] = n.ny() / scene.noise_tile;
+        noise_.scale[2] = n.nz() / scene.noise_tile;
+    }
+}
+
+VoxelSample CloudSampler::voxel(double x, double y, double z) const {
+    int x0, x1, y0, y1, z0, z1;
+    float tx, ty, tz;
+    axis((x - grid_.min[0]) * grid_.inv_voxel[0], grid_.nx, x0, x1, tx);
+    axis((y - grid_.min[1]) * grid_.inv_voxel[1], grid_.ny, y0, y1, ty);
+    axis((z - grid_.min[2]) * grid_.inv_voxel[2], grid_.nz, z0, z1, tz);
+    const size_t sx = 1, sy = size_t(grid_.nx), sz = size_t(grid_.nx) * size_t(grid_.ny);
+    const size_t i000 = size_t(z0) * sz + size_t(y0) * sy + size_t(x0) * sx;
+    const size_t dx = size_t(x1 - x0), dy = size_t(y1 - y0) * sy, dz = size_t(z1 - z0) * sz;
+    float out[4];
+    for (int c = 0; c < 4; ++c) {
+        const float* p = grid_.ch[size_t(c)];
+        float a = p[i000] + (p[i000 + dx] - p[i000]) * tx;
+        float b = p[i000 + dy] + (p[i000 + dy + dx] - p[i000 + dy]) * tx;
+        float cc = p[i000 + dz] + (p[i000 + dz + dx] - p[i000 + dz]) * tx;
+        float d = p[i000 + dz + dy] + (p[i000 + dz + dy + dx] - p[i000 + dz + dy]) * tx;
+        float ab = a + (b - a) * ty;
+        float cd = cc + (d - cc) * ty;
+        out[c] = ab + (cd - ab) * tz;
+    }
+    return {out[0], out[1], out[2], out[3]};
+}
+
+std::array<float, 4> CloudSampler::noise(double x, double y, double z) const {
+    int x0, x1, y0, y1, z0, z1;
+    float tx, ty, tz;
+    axis_wrap(x * noise_.scale[0], noise_.nx, x0, x1, tx);
+    axis_wrap(y * noise_.scale[1], noise_.ny, y0, y1, ty);
+    axis_wrap(z * noise_.scale[2], noise_.nz, z0, z1, tz);
+    const size_t sy = size_t(noise_.nx), sz = size_t(noise_.nx) * size_t(noise_.ny);
+    const size_t r0 = size_t(z0) * sz + size_t(y0) * sy, r1 = size_t(z0) * sz + size_t(y1) * sy;
+    const size_t r2 = size_t(z1) * sz + size_t(y0) * sy, r3 = size_t(z1) * sz + size_t(y1) * sy;
+    std::array<float, 4> out{};
+    for (int c = 0; c < 4; ++c) {
+        const float* p = noise_.ch[size_t(c)];
+        float a = p[r0 + size_t(x0)] + (p[r0 + size_t(x1)] - p[r0 + size_t(x0)]) * tx;
+        float b = p[r1 + size_t(x0)] + (p[r1 + size_t(x1)] - p[r1 + size_t(x0)]) * tx;
+        float cc = p[r2 + size_t(x0)] + (p[r2 + size_t(x1)] - p[r2 + size_t(x0)]) * tx;
+        float d = p[r3 + size_t(x0)] + (p[r3 + size_t(x1)] - p[r3 + size_t(x0)]) * tx;
+        float ab = a + (b - a) * ty;
+        float cd = cc + (d - cc) * ty;
+        out[size_t(c)] = ab + (cd - ab) * tz;
+    }
+    return out;
+}
+
+float CloudSampler::density(const VoxelSample& v, double x, double y, double z, double camera_distance) const {
+    if (!(v.sdf < 0)) return 0.0f;
+    const double dp = saturate(v.profile);
+    const double type = saturate(v.type);
+    double eroded = dp;
+    if (has_noise()) {
+        const auto n = noise(x, y, z);
+        // Nubis³ up-rez: wispy low->high frequency over the profile ...
+        double composite = n[0] + (n[1] - n[0]) * dp;
+        if (billowy_ && type > 0) {
+            // ... billowy high->low frequency toward the core, scaled down ...
+            const double g = std::pow(dp, 0.25);
+            const double billowy = 0.3 * (n[3] + (n[2] - n[3]) * g);
+            composite += (billowy - composite) * type;
+        }
+        if (camera_distance < 198.0) {
+            // ... twice-folded noise ("hhf") blended in near the camera.
+            auto fold2 = [](double a) { return std::fabs(std::fabs(a * 2.0 - 1.0) * 2.0 - 1.0); };
+            double hf = 1.0 - std::pow(fold2(n[1]), 4.0);
+            if (billowy_ && type > 0) hf += (std::pow(fold2(n[3]), 2.0) - hf) * type;
+            const double blend = 0.9 + 0.1 * saturate((camera_distance - 58.0) / 140.0);
+            composite = saturate(hf + (composite - hf) * blend);
+        }
+        composite = saturate(composite);
+        // Value erosion: remap the profile from [noise, 1] to [0, 1].
+        eroded = composite >= 1.0 ? 0.0 : saturate((dp - composite) / (1.0 - composite));
+    }
+    const double scale = std::isfinite(v.scale) ? std::max(0.0f, v.scale) : 0.0;
+    double d = eroded * scale;
+    if (d <= 0) return 0.0f;
+    // Sharpening power: stronger (lower exponent) where the scale is low.
+    const double p4 = std::pow(saturate(scale), 4.0);
+    d = std::pow(d, 0.3 + 0.3 * std::max(1e-6, p4));
+    return static_cast<float>(d);
+}
+
+} // namespace atlas::render::detail

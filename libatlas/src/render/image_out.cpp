@@ -1,0 +1,42 @@
+#include "atlas/render/image_out.h"
+
+#include "atlas/core/error.h"
+#include "atlas/io/exr.h"
+#include "atlas/io/image.h"
+
+#include <cmath>
+#include <string>
+
+namespace atlas::render {
+
+namespace {
+float srgb(float x) { return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f; }
+} // namespace
+
+Field2D tone_map(const Field2D& linear, double exposure) {
+    if (!(exposure > 0) || !std::isfinite(exposure)) throw Error("render: exposure must be finite and > 0, got " + std::to_string(exposure));
+    if (linear.channels() < 3) throw Error("render: tone_map needs 3 colour channels, got " + std::to_string(linear.channels()));
+    Field2D out(linear.resolution(), 3, linear.bounds(), {"r", "g", "b"});
+    for (int c = 0; c < 3; ++c) {
+        auto src = linear.channel(c);
+        auto dst = out.channel(c);
+        for (size_t i = 0; i < src.size(); ++i) {
+            float x = src[i];
+            x = std::isfinite(x) && x > 0 ? x * static_cast<float>(exposure) : 0.0f;
+            dst[i] = srgb(x / (1.0f + x));
+        }
+    }
+    return out;
+}
+
+void write_preview_png(const Field2D& image, const std::filesystem::path& path, double exposure) {
+    io::write_image(tone_map(image, exposure), path);
+}
+
+void write_preview_exr(const Field2D& image, const std::filesystem::path& path) {
+    io::ExrOptions o;
+    o.channel_meaning = "linear radiance r, g, b and view transmittance (atlas render)";
+    io::write_exr(image, path, o);
+}
+
+} // namespace atlas::render

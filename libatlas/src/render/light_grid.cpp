@@ -1,0 +1,89 @@
+#include "light_grid.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace atlas::render::detail {
+
+double exit_distance(const Box3d& b, const Vec3d& p, const Vec3d& d) {
+    double t1 = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] > 1e-12) t1 = std::min(t1, (b.max[a] - p[a]) / d[a]);
+        else if (d[a] < -1e-12) t1 = std::min(t1, (b.min[a] - p[a]) / d[a]);
+    }
+    return std::isfinite(t1) ? std::max(0.0, t1) : 0.0;
+}
+
+LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_(res), bounds_(cloud.bounds()) {
+    for (int a = 0; a < 3; ++a) voxel_[a] = bounds_.size()[a] / res_[a];
+    const size_t n = size_t(res_[0]) * size_t(res_[1]) * size_t(res_[2]);
+    const size_t row = size_t(res_[0]), slab = row * size_t(res_[1]);
+    // 1. The cloud's density at the grid's voxel centres (no near-camera detail).
+    std::vector<float> dens(n);
+    tbb::parallel_for(0, res_[2], [&](int z) {
+        for (int y = 0; y < res_[1]; ++y)
+            for (int x = 0; x < res_[0]; ++x) {
+                const double px = bounds_.min[0] + (x + 0.5) * voxel_[0];
+                const double py = bounds_.min[1] + (y + 0.5) * voxel_[1];
+                const double pz = bounds_.min[2] + (z + 0.5) * voxel_[2];
+                dens[size_t(z) * slab + size_t(y) * row + size_t(x)] = cloud.density_at(px, py, pz, 1e30);
+            }
+    });
+    // 2. Toward the sky: a running sum down each column (midpoint rule).
+    sky_.assign(n, 0.0f);
+    tbb::parallel_for(0, res_[1], [&](int y) {
+        for (int x = 0; x < res_[0]; ++x) {
+            double acc = 0;
+            for (int z = res_[2] - 1; z >= 0; --z) {
+                const size_t i = size_t(z) * slab + size_t(y) * row + size_t(x);
+                sky_[i] = static_cast<float>(acc + 0.5 * dens[i] * voxel_[2]);
+                acc += dens[i] * voxel_[2];
+            }
+        }
+    });
+    // 3. Toward the sun: march the coarse density from each voxel centre.
+    sun_.assign(n, 0.0f);
+    const double step = 0.75 * std::min({voxel_[0], voxel_[1], voxel_[2]});
+    tbb::parallel_for(0, res_[2], [&](int z) {
+        for (int y = 0; y < res_[1]; ++y)
+            for (int x = 0; x < res_[0]; ++x) {
+                const Vec3d p{{bounds_.min[0] + (x + 0.5) * voxel_[0], bounds_.min[1] + (y + 0.5) * voxel_[1],
+                               bounds_.min[2] + (z + 0.5) * voxel_[2]}};
+                const double len = exit_distance(bounds_, p, sun_dir);
+                const int steps = static_cast<int>(std::ceil(len / step));
+                double acc = 0;
+                for (int s = 0; s < steps; ++s) {
+                    const double t0 = s * step, dt = std::min(step, len - t0);
+                    const Vec3d q = p + sun_dir * (t0 + 0.5 * dt);
+                    acc += sample(dens, q[0], q[1], q[2]) * dt;
+                }
+                sun_[size_t(z) * slab + size_t(y) * row + size_t(x)] = static_cast<float>(acc);
+            }
+    });
+}
+
+float LightGrid::sample(const std::vector<float>& g, double x, double y, double z) const {
+    double u[3] = {(x - bounds_.min[0]) / voxel_[0] - 0.5, (y - bounds_.min[1]) / voxel_[1] - 0.5, (z - bounds_.min[2]) / voxel_[2] - 0.5};
+    int i0[3], i1[3];
+    float t[3];
+    for (int a = 0; a < 3; ++a) {
+        double v = std::clamp(u[a], 0.0, double(res_[a] - 1));
+        i0[a] = std::min(static_cast<int>(v), res_[a] - 1);
+        i1[a] = std::min(i0[a] + 1, res_[a] - 1);
+        t[a] = static_cast<float>(v - i0[a]);
+    }
+    const size_t row = size_t(res_[0]), slab = row * size_t(res_[1]);
+    auto at = [&](int xx, int yy, int zz) { return g[size_t(zz) * slab + size_t(yy) * row + size_t(xx)]; };
+    float c00 = at(i0[0], i0[1], i0[2]) + (at(i1[0], i0[1], i0[2]) - at(i0[0], i0[1], i0[2])) * t[0];
+    float c10 = at(i0[0], i1[1], i0[2]) + (at(i1[0], i1[1], i0[2]) - at(i0[0], i1[1], i0[2])) * t[0];
+    float c01 = at(i0[0], i0[1], i1[2]) + (at(i1[0], i0[1], i1[2]) - at(i0[0], i0[1], i1[2])) * t[0];
+    float c11 = at(i0[0], i1[1], i1[2]) + (at(i1[0], i1[1], i1[2]) - at(i0[0], i1[1], i1[2])) * t[0];
+    float c0 = c00 + (c10 - c00) * t[1], c1 = c01 + (c11 - c01) * t[1];
+    return c0 + (c1 - c0) * t[2];
+}
+
+} // namespace atlas::render::detail

@@ -1,0 +1,72 @@
+#include "atlas/render/scene.h"
+
+#include "atlas/core/error.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace atlas::render {
+
+namespace {
+
+Field3DPtr pick_channels(const Field3DPtr& set, const std::vector<std::string>& names) {
+    std::vector<int> idx;
+    for (const auto& n : names) {
+        int c = set->find_channel(n);
+        if (c < 0) throw Error("render: NVDF set has no channel '" + n + "' (expected dimensional_profile, detail_type, density_scale, sdf)");
+        idx.push_back(c);
+    }
+    auto out = std::make_shared<Field3D>(set->resolution(), static_cast<int>(idx.size()), set->bounds(), names);
+    for (size_t i = 0; i < idx.size(); ++i) {
+        auto src = set->channel(idx[i]);
+        std::copy(src.begin(), src.end(), out->channel(static_cast<int>(i)).begin());
+    }
+    return out;
+}
+
+} // namespace
+
+CloudScene scene_from_nvdf_set(Field3DPtr vdb_set, Field3DPtr noise, double noise_tile) {
+    if (!vdb_set) throw Error("render: NVDF set is missing");
+    CloudScene s;
+    s.modeling = pick_channels(vdb_set, {"dimensional_profile", "detail_type", "density_scale"});
+    s.sdf = pick_channels(vdb_set, {"sdf"});
+    s.noise = std::move(noise);
+    s.noise_tile = noise_tile;
+    validate_scene(s);
+    return s;
+}
+
+void validate_scene(const CloudScene& s) {
+    if (!s.modeling) throw Error("render: scene.modeling is missing (expected the modeling NVDF)");
+    if (!s.sdf) throw Error("render: scene.sdf is missing (expected the SDF in metres)");
+    if (s.modeling->channels() < 3)
+        throw Error("render: scene.modeling has " + std::to_string(s.modeling->channels()) +
+                    " channels, expected 3 (dimensional_profile, detail_type, density_scale)");
+    if (s.sdf->resolution() != s.modeling->resolution() || !(s.sdf->bounds() == s.modeling->bounds()))
+        throw Error("render: scene.sdf must have the modeling NVDF's resolution and bounds");
+    if (s.noise && !(std::isfinite(s.noise_tile) && s.noise_tile > 0))
+        throw Error("render: noise_tile must be a finite number of metres > 0, got " + std::to_string(s.noise_tile));
+}
+
+Vec3d sun_direction(double azimuth_deg, double elevation_deg) {
+    const double a = azimuth_deg * std::numbers::pi / 180, e = elevation_deg * std::numbers::pi / 180;
+    return {{std::cos(e) * std::sin(a), -std::cos(e) * std::cos(a), std::sin(e)}};
+}
+
+Camera framing_camera(const Box3d& b, double aspect, double azimuth_deg, double elevation_deg, double fov_deg) {
+    if (!b.valid()) throw Error("render: cannot frame invalid volume bounds");
+    if (!(aspect > 0) || !std::isfinite(aspect)) throw Error("render: framing aspect must be > 0");
+    const Vec3d centre = (b.min + b.max) * 0.5;
+    const double radius = 0.5 * length(b.size());
+    const double half = 0.5 * fov_deg * std::numbers::pi / 180;
+    const double half_min = std::min(half, std::atan(std::tan(half) * aspect));
+    const double dist = radius / std::sin(half_min);
+    Camera c;
+    c.fov_deg = fov_deg;
+    c.look_at = centre;
+    c.position = centre + sun_direction(azimuth_deg, elevation_deg) * dist;
+    return c;
+}
+
+} // namespace atlas::render
