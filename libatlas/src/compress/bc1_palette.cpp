@@ -99,7 +99,10 @@ void bc1_interval_palette(uint16_t c0, uint16_t c1, DecoderSet set, Palette<3>& 
     for (int i = 0; i < 4; ++i)
         for (int c = 0; c < 3; ++c) { p.ref[i][c] = ref[i][c]; p.lo[i][c] = p.hi[i][c] = ref[i][c]; }
     const bool four = c0 > c1;
-    for (Decoder d : decoders_in(set == 0 ? kReferenceOnly : set)) {
+    const DecoderSet use = set == 0 ? kReferenceOnly : set;
+    for (int di = 0; di < kDecoderCount; ++di) {
+        if (!(use & (DecoderSet(1) << di))) continue; // no allocation in the hot loop
+        const Decoder d = static_cast<Decoder>(di);
         float v[4][3];
         if (d == Decoder::Conformant) {
             for (int i = 0; i < 4; ++i)

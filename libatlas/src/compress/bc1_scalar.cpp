@@ -66,7 +66,9 @@ void scalar_palette(uint16_t c0, uint16_t c1, const ScalarUnpack& u, detail::Pal
     for (int i = 0; i < 4; ++i) { p.ref[i][0] = dotw(ref[i]); p.lo[i][0] = p.hi[i][0] = p.ref[i][0]; }
     bool any = false;
     const bool four = c0 > c1;
-    for (Decoder d : decoders_in(u.decoders)) {
+    for (int di = 0; di < kDecoderCount; ++di) {
+        if (!(u.decoders & (DecoderSet(1) << di))) continue; // no allocation in the hot loop
+        const Decoder d = static_cast<Decoder>(di);
         float v[4][3];
         bc1_palette(c0, c1, d, v);
         for (int i = 0; i < 4; ++i) {
@@ -118,28 +120,35 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
     const Levels L = make_levels(u.decoders);
     float smin = src[0], smax = src[0];
     for (int t = 1; t < 16; ++t) { smin = std::min(smin, src[t]); smax = std::max(smax, src[t]); }
-    std::vector<uint16_t> lows = {split(smin, u, L.hi5, L.hi6, false)};
-    std::vector<uint16_t> highs = {split(smax, u, L.hi5, L.hi6, false)};
-    // The Conformant model moves even the endpoints by its base tolerance: one-sided
-    // endpoints must then sit that far below the values they stand for.
-    const float margin = (u.decoders & decoder_bit(Decoder::Conformant)) ? kBc1ConformantBase * u.max_value * 1.0001f : 0.0f;
-    if (margin > 0) {
-        // Its relative term (3% of each channel's endpoint difference) is bounded by the
-        // block's range in R plus one R level, and the full G and B ranges.
+    // Margins below the source: 0, and for the Conformant model its endpoint
+    // tolerance (base, then base + the bound of its relative term).
+    float margins[3] = {0, 0, 0};
+    int nm = 1;
+    if (u.decoders & decoder_bit(Decoder::Conformant)) {
+        const float base = kBc1ConformantBase * u.max_value * 1.0001f;
         const float rel = kConformantRelative * (u.weights[0] * (smax - smin + 2.0f / 31.0f) + u.weights[1] + u.weights[2]);
-        for (float m : {margin, margin + rel}) {
-            lows.push_back(split(smin - m, u, L.hi5, L.hi6, false));
-            highs.push_back(split(smax - m, u, L.hi5, L.hi6, false));
-            if (options.quality != Quality::Fast)
-                for (int t = 0; t < 16; ++t) highs.push_back(split(src[t] - m, u, L.hi5, L.hi6, false));
-        }
+        margins[nm++] = base;
+        margins[nm++] = base + rel;
     }
-    if (!options.one_sided_below || options.quality != Quality::Fast) {
+    float sorted[16];
+    std::copy(src, src + 16, sorted);
+    std::sort(sorted, sorted + 16);
+    std::vector<uint16_t> lows, highs;
+    for (int k = 0; k < nm; ++k) {
+        const float m = margins[k];
+        lows.push_back(split(smin - m, u, L.hi5, L.hi6, false));
+        highs.push_back(split(smax - m, u, L.hi5, L.hi6, false));
+        if (options.quality != Quality::Fast) { // Nubis: move the high endpoint down
+            highs.push_back(split(sorted[13] - m, u, L.hi5, L.hi6, false));
+            highs.push_back(split(sorted[10] - m, u, L.hi5, L.hi6, false));
+        }
+        if (options.quality == Quality::Best)
+            for (int t = 0; t < 16; ++t) highs.push_back(split(src[t] - m, u, L.hi5, L.hi6, false));
+    }
+    if (!options.one_sided_below) {
         lows.push_back(split(smin, u, L.ref5, L.ref6, true));
         highs.push_back(split(smax, u, L.ref5, L.ref6, true));
     }
-    if (options.quality != Quality::Fast)
-        for (int t = 0; t < 16; ++t) highs.push_back(split(src[t], u, L.hi5, L.hi6, false));
     std::sort(highs.begin(), highs.end());
     highs.erase(std::unique(highs.begin(), highs.end()), highs.end());
     std::sort(lows.begin(), lows.end());

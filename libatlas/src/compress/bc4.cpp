@@ -153,7 +153,7 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     for (int t = 1; t < 16; ++t) { smin = std::min(smin, src[t]); smax = std::max(smax, src[t]); }
     const float scale = snorm_ ? 127.0f : 255.0f;
     const int lo_lim = snorm_ ? -127 : 0, hi_lim = snorm_ ? 127 : 255;
-    const int radius = options_.quality == Quality::Fast ? 0 : 1;
+    const int radius = 0; // floor / ceil of the extremes; misses fall back to the exhaustive search
     auto clampi = [&](int v) { return std::clamp(v, lo_lim, hi_lim); };
     const int qlo0 = clampi(int(std::floor(smin * scale))), qlo1 = clampi(int(std::ceil(smin * scale)));
     const int qhi0 = clampi(int(std::floor(smax * scale))), qhi1 = clampi(int(std::ceil(smax * scale)));
@@ -166,11 +166,13 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
         detail::Selection s = detail::select_indices(tables_->pal[size_t(k)], src, os, best.max_err);
         if (best_k < 0 ? std::isfinite(s.max_err) : detail::better(s, best)) { best = s; best_k = k; }
     };
-    for (int h = qhi0 - radius; h <= qhi1 + radius; ++h)
+    const int hstep = options_.quality == Quality::Fast ? std::max(1, qhi1 - qhi0) : 1;
+    for (int h = qhi0 - radius; h <= qhi1 + radius; h += hstep)
         for (int l = qlo0 - radius; l <= qlo1 + radius; ++l) {
             int a = clampi(h), b = clampi(l);
             if (a > b) consider(a, b);  // 8 interpolated values
-            consider(std::min(a, b), std::max(a, b)); // 6 values plus exact extremes
+            if (options_.quality != Quality::Fast || options_.one_sided_below)
+                consider(std::min(a, b), std::max(a, b)); // 6 values plus exact extremes
         }
     const bool missed = best_k < 0 || (options_.max_error >= 0 && best.max_err > options_.max_error);
     if (missed) return encode_exhaustive(src, out);

@@ -1,0 +1,91 @@
+// Compression throughput (texels/s) per format and quality, with the error reached.
+// Large cases use the design's 512x512x64 volume (16.8 M texels) of SDF-like data;
+// "Smoke" cases are tiny (ctest runs them).
+#include "atlas/compress/texture.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+namespace {
+
+using namespace atlas;
+using namespace atlas::compress;
+
+// SDF-like field: distance (metres) to a few spheres, -256..4096 m like Nubis's.
+Field3D sdf_volume(int nx, int ny, int nz) {
+    Field3D f(Vec3i{{nx, ny, nz}}, 1, Box3d{{{0, 0, 0}}, {{nx * 8.0, ny * 8.0, nz * 8.0}}}, {"distance"});
+    for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x) {
+                double d = 1e30;
+                for (int k = 0; k < 4; ++k) {
+                    const double cx = nx * (0.2 + 0.2 * k), cy = ny * (0.3 + 0.13 * k), cz = nz * 0.5;
+                    d = std::min(d, std::sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz)) * 8.0 - 120.0);
+                }
+                f.at(0, x, y, z) = float(std::clamp(d, -256.0, 4096.0));
+            }
+    return f;
+}
+
+Field3D rgb_volume(int nx, int ny, int nz) {
+    Field3D f(Vec3i{{nx, ny, nz}}, 3, Box3d{{{0, 0, 0}}, {{1, 1, 1}}});
+    for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x)
+                for (int c = 0; c < 3; ++c)
+                    f.at(c, x, y, z) = float(0.5 + 0.4 * std::sin(0.05 * x * (c + 1) + 0.031 * y + 0.2 * z + c));
+    return f;
+}
+
+void run(benchmark::State& state, const Field3D& f, Format fmt, Quality q, bool one_sided, DecoderSet decoders) {
+    CompressOptions o;
+    o.format = fmt;
+    o.quality = q;
+    o.one_sided_below = one_sided;
+    o.decoders = decoders;
+    CompressReport last;
+    for (auto _ : state) {
+        EncodedTexture e = encode_texture(f, o);
+        benchmark::DoNotOptimize(e.dds.data.data());
+        last = e.report;
+        state.SetIterationTime(e.report.encode_seconds);
+    }
+    state.counters["texels_per_s"] = last.texels_per_second;
+    state.counters["max_err_m"] = last.bound_max_error;
+    state.counters["rmse_m"] = last.rmse.empty() ? 0 : last.rmse[0];
+    state.counters["mean_under_m"] = last.per_decoder.empty() ? 0 : last.per_decoder[0].mean_under;
+}
+
+const Field3D& sdf_small() { static const Field3D f = sdf_volume(32, 32, 4); return f; }
+const Field3D& sdf_large() { static const Field3D f = sdf_volume(512, 512, 64); return f; }
+const Field3D& rgb_small() { static const Field3D f = rgb_volume(32, 32, 4); return f; }
+const Field3D& rgb_mid() { static const Field3D f = rgb_volume(256, 256, 8); return f; }
+
+void Smoke_Bc4(benchmark::State& s) { run(s, sdf_small(), Format::Bc4, Quality::Normal, false, kAllDecoders); }
+void Smoke_Bc1Scalar(benchmark::State& s) { run(s, sdf_small(), Format::Bc1Scalar, Quality::Normal, true, kAllDecoders); }
+void Smoke_Bc1(benchmark::State& s) { run(s, rgb_small(), Format::Bc1, Quality::Normal, false, kAllDecoders); }
+
+void Bc4Normal_512x512x64(benchmark::State& s) { run(s, sdf_large(), Format::Bc4, Quality::Normal, false, kAllDecoders); }
+void Bc4NormalOneSided_512x512x64(benchmark::State& s) { run(s, sdf_large(), Format::Bc4, Quality::Normal, true, kAllDecoders); }
+void Bc4Fast_512x512x64(benchmark::State& s) { run(s, sdf_large(), Format::Bc4, Quality::Fast, false, kAllDecoders); }
+void Bc1ScalarOneSided_512x512x64(benchmark::State& s) { run(s, sdf_large(), Format::Bc1Scalar, Quality::Normal, true, kAllDecoders); }
+void Bc1ScalarOneSidedReference_512x512x64(benchmark::State& s) { run(s, sdf_large(), Format::Bc1Scalar, Quality::Normal, true, kReferenceOnly); }
+void Bc4OneSidedReference_512x512x64(benchmark::State& s) { run(s, sdf_large(), Format::Bc4, Quality::Normal, true, kReferenceOnly); }
+void Bc1Normal_256x256x8(benchmark::State& s) { run(s, rgb_mid(), Format::Bc1, Quality::Normal, false, kAllDecoders); }
+void Bc1Fast_256x256x8(benchmark::State& s) { run(s, rgb_mid(), Format::Bc1, Quality::Fast, false, kAllDecoders); }
+
+} // namespace
+
+BENCHMARK(Smoke_Bc4)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(Smoke_Bc1Scalar)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(Smoke_Bc1)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(Bc4Fast_512x512x64)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(Bc4Normal_512x512x64)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(Bc4NormalOneSided_512x512x64)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(Bc4OneSidedReference_512x512x64)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(Bc1ScalarOneSided_512x512x64)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(Bc1ScalarOneSidedReference_512x512x64)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(Bc1Fast_256x256x8)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(Bc1Normal_256x256x8)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK_MAIN();
