@@ -1,0 +1,141 @@
+#include "atlas/noise/fill.h"
+
+#include "atlas/core/error.h"
+#include "engine.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <string>
+
+namespace atlas::noise {
+namespace {
+
+using detail::Plan;
+using detail::Scratch;
+
+void check_channels(int channels, int channel, int comps) {
+    if (channel < 0 || channel + comps > channels)
+        throw Error("noise: channel " + std::to_string(channel) + " needs " + std::to_string(comps) +
+                    " channel(s) but the field has " + std::to_string(channels));
+}
+
+// Base lattice coordinate of voxel i of n, wrapped into [0, period).
+inline double voxel_coord(const NoiseSpec& s, int axis, int i, int n) {
+    const double p = double(s.period[axis]);
+    return detail::wrap_coord(s.offset[axis] + s.frequency * (double(i) + 0.5) / double(n) * p, p);
+}
+
+// Stretches the measured min..max of v to out_min..out_max (exact min/max:
+// the same for any thread split).
+void normalize_channel(std::span<float> v, const OutputParams& o) {
+    if (v.empty()) return;
+    const auto [mn, mx] = std::minmax_element(v.begin(), v.end());
+    const double lo = *mn, hi = *mx;
+    const double span = hi - lo;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, v.size(), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            const double t = span > 0 ? (double(v[i]) - lo) / span : 0.0;
+            v[i] = float(o.out_min + t * (o.out_max - o.out_min));
+        }
+    });
+}
+
+void report(const ProgressSink* progress, std::atomic<int>& done, int total) {
+    if (!progress) return;
+    const int d = ++done;
+    if (progress->on_progress) progress->on_progress({"noise", double(d) / total, d, total});
+}
+
+} // namespace
+
+void fill_noise(Field3D& out, int channel, const NoiseSpec& spec, const ProgressSink* progress) {
+    spec.validate(3);
+    const int comps = noise_components(spec.kernel, 3);
+    check_channels(out.channels(), channel, comps);
+    const Plan<3> plan(spec, true);
+    const int nx = out.nx(), ny = out.ny(), nz = out.nz();
+    std::vector<double> xs(size_t(nx), 0.0);
+    for (int i = 0; i < nx; ++i) xs[size_t(i)] = voxel_coord(spec, 0, i, nx);
+    std::atomic<int> done{0};
+    // One z-slice per task: fixed work units, results independent of the split.
+    tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
+        Scratch sc;
+        std::vector<double> ys(static_cast<size_t>(nx), 0.0), zs(static_cast<size_t>(nx), 0.0);
+        for (int z = r.begin(); z != r.end(); ++z) {
+            if (progress) progress->poll();
+            std::fill(zs.begin(), zs.end(), voxel_coord(spec, 2, z, nz));
+            for (int y = 0; y < ny; ++y) {
+                std::fill(ys.begin(), ys.end(), voxel_coord(spec, 1, y, ny));
+                float* dst[3];
+                for (int c = 0; c < comps; ++c) dst[c] = out.channel(channel + c).data() + out.index(0, y, z);
+                detail::evaluate<3>(plan, {xs.data(), ys.data(), zs.data()}, size_t(nx), dst, sc);
+            }
+            report(progress, done, nz);
+        }
+    });
+    if (spec.output.normalize)
+        for (int c = 0; c < comps; ++c) normalize_channel(out.channel(channel + c), spec.output);
+}
+
+void fill_noise(Field2D& out, int channel, const NoiseSpec& spec, const ProgressSink* progress) {
+    spec.validate(2);
+    const int comps = noise_components(spec.kernel, 2);
+    check_channels(out.channels(), channel, comps);
+    const Plan<2> plan(spec, true);
+    const int nx = out.width(), ny = out.height();
+    std::vector<double> xs(size_t(nx), 0.0);
+    for (int i = 0; i < nx; ++i) xs[size_t(i)] = voxel_coord(spec, 0, i, nx);
+    std::atomic<int> done{0};
+    tbb::parallel_for(tbb::blocked_range<int>(0, ny, 1), [&](const tbb::blocked_range<int>& r) {
+        Scratch sc;
+        std::vector<double> ys(static_cast<size_t>(nx), 0.0);
+        for (int y = r.begin(); y != r.end(); ++y) {
+            if (progress) progress->poll();
+            std::fill(ys.begin(), ys.end(), voxel_coord(spec, 1, y, ny));
+            float* dst[2];
+            for (int c = 0; c < comps; ++c) dst[c] = out.channel(channel + c).data() + out.index(0, y);
+            detail::evaluate<2>(plan, {xs.data(), ys.data()}, size_t(nx), dst, sc);
+            report(progress, done, ny);
+        }
+    });
+    if (spec.output.normalize)
+        for (int c = 0; c < comps; ++c) normalize_channel(out.channel(channel + c), spec.output);
+}
+
+namespace {
+template <int D, typename P>
+std::vector<float> sample_points(const NoiseSpec& spec, std::span<const P> points) {
+    spec.validate(D);
+    const int comps = noise_components(spec.kernel, D);
+    const Plan<D> plan(spec, false);
+    const size_t n = points.size();
+    std::array<std::vector<double>, D> u;
+    for (int a = 0; a < D; ++a) u[size_t(a)].resize(n);
+    for (size_t i = 0; i < n; ++i)
+        for (int a = 0; a < D; ++a) {
+            const double p = points[i][a];
+            if (!std::isfinite(p)) throw Error("noise: sample point " + std::to_string(i) + " is not finite");
+            const double per = double(spec.period[a]);
+            u[size_t(a)][i] = detail::wrap_coord(spec.offset[a] + spec.frequency * p * per, per);
+        }
+    std::vector<float> planar(n * size_t(comps));
+    float* dst[3] = {planar.data(), planar.data() + n, planar.data() + 2 * n};
+    std::array<const double*, D> up;
+    for (int a = 0; a < D; ++a) up[size_t(a)] = u[size_t(a)].data();
+    Scratch sc;
+    detail::evaluate<D>(plan, up, n, dst, sc);
+    std::vector<float> r(n * size_t(comps));
+    for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < comps; ++c) r[i * size_t(comps) + size_t(c)] = planar[size_t(c) * n + i];
+    return r;
+}
+} // namespace
+
+std::vector<float> sample_noise(const NoiseSpec& spec, std::span<const Vec3d> points) { return sample_points<3>(spec, points); }
+std::vector<float> sample_noise(const NoiseSpec& spec, std::span<const Vec2d> points) { return sample_points<2>(spec, points); }
+
+} // namespace atlas::noise
