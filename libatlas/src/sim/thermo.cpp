@@ -1,0 +1,63 @@
+// Bolton saturation and Newton saturation adjustment (see thermo.h).
+#include "atlas/sim/thermo.h"
+
+#include "atlas/core/error.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace atlas::sim {
+
+double saturation_vapor_pressure(double T) {
+    T = std::max(T, 100.0);
+    return 611.2 * std::exp(17.67 * (T - 273.15) / (T - 29.65));
+}
+
+double saturation_mixing_ratio(double T, double p) {
+    double es = std::min(saturation_vapor_pressure(T), 0.5 * p);
+    return kEps * es / (p - es);
+}
+
+double exner(double p) { return std::pow(p / kP00, kRd / kCp); }
+
+AdjustResult saturation_adjust(double theta, double qv, double qc, double p, double relax) {
+    if (!std::isfinite(theta) || !std::isfinite(qv) || !std::isfinite(qc) || !std::isfinite(p) || !std::isfinite(relax))
+        throw Error("sim saturation_adjust: non-finite theta, qv, qc, p or relax");
+    if (!(p > 0)) throw Error("sim saturation_adjust: pressure must be > 0 Pa");
+    if (!(theta > 0)) throw Error("sim saturation_adjust: theta must be > 0 K");
+    qv = std::max(qv, 0.0);
+    qc = std::max(qc, 0.0);
+    relax = std::clamp(relax, 0.0, 1.0);
+    const double pi = exner(p), T0 = theta * pi, k = kLv / kCp;
+    auto f = [&](double d) { return qv - d - saturation_mixing_ratio(T0 + k * d, p); };
+    AdjustResult r{theta, qv, qc, 0.0, 0};
+    double lo = -qc, hi = qv;
+    if (f(lo) <= 0) {
+        r.condensed = lo; // sub-saturated even with all cloud evaporated
+    } else {
+        // f is decreasing in d with f(lo) > 0 >= f(hi): Newton, kept inside [lo, hi].
+        double d = std::clamp(0.0, lo, hi);
+        for (int it = 0; it < 60; ++it) {
+            r.iterations = it + 1;
+            double T = T0 + k * d;
+            double fd = f(d);
+            if (fd > 0) lo = d; else hi = d;
+            if (std::fabs(fd) <= 1e-14 + 1e-12 * qv || hi - lo <= 1e-16) break;
+            double h = std::max(1e-6 * T, 1e-3);
+            double dqs = (saturation_mixing_ratio(T + h, p) - saturation_mixing_ratio(T - h, p)) / (2 * h);
+            double next = d - fd / (-1.0 - dqs * k);
+            if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+            d = next;
+        }
+        r.condensed = d;
+    }
+    double d = relax * r.condensed;
+    d = std::clamp(d, -qc, qv);
+    r.qv = qv - d;
+    r.qc = qc + d;
+    r.theta = theta + k * d / pi;
+    r.condensed = d;
+    return r;
+}
+
+} // namespace atlas::sim
