@@ -134,7 +134,8 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
     std::copy(src, src + 16, sorted);
     std::sort(sorted, sorted + 16);
     std::vector<uint16_t> lows, highs;
-    for (int k = 0; k < nm; ++k) {
+    // One-sided under Conformant: endpoints without margin are never feasible.
+    for (int k = (nm > 1 && options.one_sided_below) ? 1 : 0; k < nm; ++k) {
         const float m = margins[k];
         lows.push_back(split(smin - m, u, L.hi5, L.hi6, false));
         highs.push_back(split(smax - m, u, L.hi5, L.hi6, false));
