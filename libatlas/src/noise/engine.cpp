@@ -212,7 +212,7 @@ void output_stage(const OutputParams& o, ValueRange r, float* v, size_t n) {
 } // namespace
 
 template <int D>
-Plan<D>::Plan(const NoiseSpec& s, bool tabulate) : spec(s) {
+Plan<D>::Plan(const NoiseSpec& s, int64_t tabulate) : spec(s) {
     for (int a = 0; a < D; ++a) period[a] = s.period[a];
     const int oct = s.fractal.octaves;
     if (s.kernel == Kernel::Curl) {

@@ -23,9 +23,9 @@ struct Plan {
     std::vector<Lattice<D>> curly;     // Curly-Alligator's curl potentials
     int potentials = D == 3 ? 3 : 1;
 
-    // tabulate: build lattice tables (worth it for whole fields, not for a
-    // few point lookups).
-    Plan(const NoiseSpec& s, bool tabulate);
+    // Lattices of at most max_table_points points are tabulated: worth it
+    // when there are more samples than points (fields), not for a few lookups.
+    Plan(const NoiseSpec& s, int64_t max_table_points);
 };
 
 // Per-thread scratch, reused across batches.

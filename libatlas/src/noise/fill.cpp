@@ -56,7 +56,7 @@ void fill_noise(Field3D& out, int channel, const NoiseSpec& spec, const Progress
     spec.validate(3);
     const int comps = noise_components(spec.kernel, 3);
     check_channels(out.channels(), channel, comps);
-    const Plan<3> plan(spec, true);
+    const Plan<3> plan(spec, int64_t(out.voxel_count()));
     const int nx = out.nx(), ny = out.ny(), nz = out.nz();
     std::vector<double> xs(size_t(nx), 0.0);
     for (int i = 0; i < nx; ++i) xs[size_t(i)] = voxel_coord(spec, 0, i, nx);
@@ -85,7 +85,7 @@ void fill_noise(Field2D& out, int channel, const NoiseSpec& spec, const Progress
     spec.validate(2);
     const int comps = noise_components(spec.kernel, 2);
     check_channels(out.channels(), channel, comps);
-    const Plan<2> plan(spec, true);
+    const Plan<2> plan(spec, int64_t(out.voxel_count()));
     const int nx = out.width(), ny = out.height();
     std::vector<double> xs(size_t(nx), 0.0);
     for (int i = 0; i < nx; ++i) xs[size_t(i)] = voxel_coord(spec, 0, i, nx);
@@ -111,7 +111,7 @@ template <int D, typename P>
 std::vector<float> sample_points(const NoiseSpec& spec, std::span<const P> points) {
     spec.validate(D);
     const int comps = noise_components(spec.kernel, D);
-    const Plan<D> plan(spec, false);
+    const Plan<D> plan(spec, 0);
     const size_t n = points.size();
     std::array<std::vector<double>, D> u;
     for (int a = 0; a < D; ++a) u[size_t(a)].resize(n);

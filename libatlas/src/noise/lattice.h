@@ -4,6 +4,7 @@
 
 #include "atlas/core/hash.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -29,10 +30,11 @@ inline constexpr int64_t kMaxTablePoints = int64_t(1) << 21;
 template <int D>
 class Lattice {
 public:
-    Lattice(IVec<D> period, uint32_t seed, uint32_t stream, bool tabulate) : period_(period), seed_(seed), stream_(stream) {
+    // Tabulates when the lattice has at most max_table_points points (0: never).
+    Lattice(IVec<D> period, uint32_t seed, uint32_t stream, int64_t max_table_points) : period_(period), seed_(seed), stream_(stream) {
         int64_t n = 1;
         for (int p : period) n *= p;
-        if (!tabulate || n > kMaxTablePoints) return;
+        if (n > std::min(max_table_points, kMaxTablePoints)) return;
         table_.resize(size_t(n));
         size_t i = 0;
         const int pz = D == 3 ? period[D - 1] : 1;
