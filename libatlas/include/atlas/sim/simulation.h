@@ -1,0 +1,165 @@
+// atlas/sim/simulation.h - the cloud-growth solver as an object an editor steps.
+//
+// Equations (anelastic; Boussinesq when `anelastic` is false), z up:
+//   du/dt + (u.grad)u = -grad(p'/rho0) + b z + f_vc + nu lap u
+//   div(rho0(z) u) = 0                    (Boussinesq: div u = 0)
+//   dtheta/dt + u.grad theta = S_theta + L_v C / (c_p Pi0) + kappa lap theta'
+//   dqv/dt + u.grad qv = S_qv - C,   dqc/dt + u.grad qc = C
+//   b = g (theta_v - theta_v0) / theta_v0,  theta_v = theta (1 + 0.608 qv - qc)
+// with the hydrostatic reference theta0(z), qv0(z), Pi0(z), p0(z), rho0(z)
+// from an ambient Sounding, and the condensation C by saturation adjustment
+// (thermo.h). Per substep: advect (u, theta, qv, qc), add sources, saturation
+// adjustment, buoyancy / vorticity confinement / diffusion, pressure projection.
+// Time steps are CFL-adaptive; a requested dt is split into equal substeps,
+// at most `max_substeps` of them, else step() throws atlas::Error.
+// Determinism: same inputs, same bytes for any TBB thread count.
+// A Simulation is not thread-safe; its outputs are independent values.
+#pragma once
+
+#include "atlas/core/field.h"
+#include "atlas/sim/advection.h"
+#include "atlas/sim/pressure.h"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace atlas::sim {
+
+// Ambient atmosphere. Heights from the grid bottom (z = 0), in metres.
+struct Sounding {
+    double surface_pressure = 1.0e5; // Pa, [3e4, 1.2e5]
+    double surface_theta = 300.0;    // K, [200, 400]
+    double theta_lapse = 0.0;        // dtheta/dz below the inversion, K/m, [0, 0.05] (0 = neutral)
+    double inversion_height = 1e9;   // m, base of the capping inversion (1e9 = none)
+    double inversion_jump = 0.0;     // K added across the inversion, [0, 20]
+    double inversion_depth = 200.0;  // m, [1, 2000], the jump is spread over it
+    double theta_lapse_above = 0.0;  // K/m above the inversion, [0, 0.05]
+    double surface_rh = 0.0;         // relative humidity at z = 0, [0, 1]
+    double rh_lapse = 0.0;           // RH change per metre below the inversion, [-1e-3, 1e-3]
+    double rh_above = 0.0;           // RH above the inversion, [0, 1]
+
+    // Throws atlas::Error naming the member out of range.
+    void validate() const;
+    double theta_at(double z) const;
+    double rh_at(double z) const;
+};
+
+// Reference profile at cell centres (nz entries each) from a Sounding by
+// hydrostatic integration dPi/dz = -g / (c_p theta0).
+struct ReferenceProfile {
+    std::vector<double> theta, qv, exner, pressure, rho;
+};
+ReferenceProfile make_reference(const Sounding& s, int nz, double dx);
+
+// A heated, moist ground patch whose strength is modulated by value noise
+// from hash_coords(seed, ...): deterministic and resolution-independent.
+struct GroundPatch {
+    double center_x = 0, center_y = 0; // m, in grid coordinates (min corner = 0)
+    double radius = 500;               // m, > 0
+    double depth = 200;                // m above ground that is heated, > 0
+    double heat_rate = 0.01;           // K/s at the centre, [0, 10]
+    double vapour_rate = 0.0;          // kg/kg/s at the centre, [0, 1e-3]
+    double noise_scale = 200;          // m, feature size of the modulation, > 0
+    double noise_amount = 0.5;         // 0 = smooth patch, 1 = fully noise-modulated
+    uint32_t seed = 1;
+};
+
+struct SimOptions {
+    bool anelastic = true;                // false: Boussinesq (rho0 = const)
+    bool moist = true;                    // false: dry (qv, qc stay passive)
+    AdvectionScheme scheme = AdvectionScheme::MacCormack;
+    double cfl = 1.0;                     // max cells travelled per substep, [0.1, 5]
+    int max_substeps = 64;                // [1, 10000]
+    double condensation_rate = 0;         // 1/s; 0 = instantaneous equilibrium, else relax 1 - exp(-rate dt)
+    double vorticity_confinement = 0;     // epsilon, dimensionless, [0, 2]
+    double viscosity = 0;                 // nu, m^2/s, [0, 1e4] (explicit; limits dt to dx^2/(8 nu))
+    double diffusivity = 0;               // kappa for theta', qv, qc, m^2/s, [0, 1e4]
+    std::vector<double> wind;             // optional ambient u(z) per cell row (nz entries), m/s, relaxed to at open x faces
+    ProjectionOptions projection;
+    void validate(int nz) const;
+};
+
+// What one call of step() did.
+struct StepReport {
+    double dt = 0;            // s, total advanced
+    int substeps = 0;
+    double substep_dt = 0;    // s
+    int pressure_iterations = 0;     // summed over substeps
+    int max_pressure_iterations = 0; // worst substep
+    bool pressure_converged = true;
+    DivergenceStats divergence;      // after the last projection, 1/s
+    double total_water = 0;          // sum of qv + qc over cells (kg/kg * cells) after the step
+    double water_drift = 0;          // relative change of total water by the saturation adjustment (should be ~1e-7)
+    double theta_l_drift = 0;        // max |delta theta_l| across the adjustment, K
+    double condensed = 0;            // net condensation in the step, kg/kg summed over cells
+    double max_w = 0, max_speed = 0; // m/s
+    double max_theta_perturbation = 0, min_theta_perturbation = 0; // K, theta - theta0
+    double max_qc = 0;               // kg/kg
+    double seconds_advect = 0, seconds_sources = 0, seconds_thermo = 0, seconds_forces = 0, seconds_project = 0;
+    // {"dt":..,"substeps":..,...} one JSON object.
+    std::string to_json() const;
+};
+
+class Simulation {
+public:
+    // Allocates the state after checking simulation_bytes(spec) against `budget`
+    // (when given). State starts at rest in the reference atmosphere.
+    Simulation(const GridSpec& spec, const Sounding& sounding, const SimOptions& options,
+               const MemoryBudget* budget = nullptr);
+    ~Simulation();
+
+    const GridSpec& spec() const { return spec_; }
+    const ReferenceProfile& reference() const { return ref_; }
+    double time() const { return time_; }
+
+    // Mutable state (for set-up and art direction between steps). Cell arrays
+    // have spec().cells() entries, x fastest.
+    MacVelocity& velocity() { return vel_; }
+    std::vector<float>& theta() { return theta_; } // full potential temperature, K
+    std::vector<float>& qv() { return qv_; }
+    std::vector<float>& qc() { return qc_; }
+    const MacVelocity& velocity() const { return vel_; }
+    const std::vector<float>& theta() const { return theta_; }
+    const std::vector<float>& qv() const { return qv_; }
+    const std::vector<float>& qc() const { return qc_; }
+
+    // Adds a potential-temperature perturbation (K) to every cell.
+    void add_theta(const std::vector<float>& delta);
+    // Continuous sources, per second: heat (K/s) and vapour (kg/kg/s) per
+    // cell. Field3D overloads need the grid's resolution and 1 channel.
+    // Throws atlas::Error naming `what` when a value is NaN/Inf or sizes differ.
+    void set_sources(std::vector<float> heat_rate, std::vector<float> vapour_rate, const std::string& what = "sources");
+    void set_sources(const Field3D& heat_rate, const Field3D& vapour_rate, const std::string& what = "sources");
+    void add_ground_patch(const GroundPatch& patch);
+
+    // Advances by dt seconds (> 0) in equal CFL-limited substeps.
+    StepReport step(double dt);
+
+    // Outputs as cell-centred Field3D over [0, n dx] (world metres).
+    Field3D cloud_water() const;   // "qc", kg/kg
+    Field3D temperature() const;   // "T", K (theta * Pi0)
+    Field3D theta_perturbation() const; // "theta_p", K
+    Field3D vapour() const;        // "qv", kg/kg
+    Field3D velocity_field() const; // "u","v","w" at cell centres, m/s
+
+private:
+    void substep(double dt, StepReport& rep);
+    void buoyancy(double dt);
+    void confinement(double dt);
+    void diffuse(double dt);
+    double max_buoyancy() const;
+
+    GridSpec spec_;
+    SimOptions opt_;
+    ReferenceProfile ref_;
+    std::vector<double> thetav0_;
+    PressureSolver solver_;
+    MacVelocity vel_, vel_tmp_;
+    std::vector<float> theta_, qv_, qc_, tmp_;
+    std::vector<float> heat_src_, vap_src_;
+    double time_ = 0;
+};
+
+} // namespace atlas::sim

@@ -1,0 +1,544 @@
+// The cloud-growth Simulation: sounding, sources, forces, stepping (see simulation.h).
+#include "atlas/sim/simulation.h"
+
+#include "atlas/core/error.h"
+#include "atlas/core/hash.h"
+#include "atlas/sim/thermo.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+namespace atlas::sim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+template <class F>
+void for_slices(int nz, F&& f) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
+        for (int k = r.begin(); k < r.end(); ++k) f(k);
+    });
+}
+
+void check_range(double v, double lo, double hi, const char* what) {
+    if (!(v >= lo && v <= hi)) {
+        char buf[256];
+        std::snprintf(buf, sizeof buf, "sim: %s = %g, expected %g..%g", what, v, lo, hi);
+        throw Error(buf);
+    }
+}
+
+void check_finite(const std::vector<float>& a, const std::string& what) {
+    for (size_t n = 0; n < a.size(); ++n)
+        if (!std::isfinite(a[n])) throw Error("sim: " + what + " holds NaN/Inf at cell " + std::to_string(n));
+}
+
+// Smooth value noise in [0, 1] from hash_coords: deterministic, any resolution.
+double value_noise(uint32_t seed, double x, double y, double z) {
+    int xi = int(std::floor(x)), yi = int(std::floor(y)), zi = int(std::floor(z));
+    double fx = x - xi, fy = y - yi, fz = z - zi;
+    auto s = [](double t) { return t * t * (3 - 2 * t); };
+    fx = s(fx), fy = s(fy), fz = s(fz);
+    double v = 0;
+    for (int c = 0; c < 8; ++c) {
+        int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
+        double w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
+        v += w * hash_to_unit(hash_coords(seed, xi + dx, yi + dy, zi + dz));
+    }
+    return v;
+}
+
+} // namespace
+
+void Sounding::validate() const {
+    check_range(surface_pressure, 3e4, 1.2e5, "sounding.surface_pressure (Pa)");
+    check_range(surface_theta, 200, 400, "sounding.surface_theta (K)");
+    check_range(theta_lapse, 0, 0.05, "sounding.theta_lapse (K/m)");
+    check_range(inversion_height, 0, 1e9, "sounding.inversion_height (m)");
+    check_range(inversion_jump, 0, 20, "sounding.inversion_jump (K)");
+    check_range(inversion_depth, 1, 2000, "sounding.inversion_depth (m)");
+    check_range(theta_lapse_above, 0, 0.05, "sounding.theta_lapse_above (K/m)");
+    check_range(surface_rh, 0, 1, "sounding.surface_rh");
+    check_range(rh_lapse, -1e-3, 1e-3, "sounding.rh_lapse (1/m)");
+    check_range(rh_above, 0, 1, "sounding.rh_above");
+}
+
+double Sounding::theta_at(double z) const {
+    double zi = inversion_height;
+    if (z <= zi) return surface_theta + theta_lapse * z;
+    double base = surface_theta + theta_lapse * zi;
+    double dz = z - zi;
+    double jump = inversion_jump * std::min(dz / inversion_depth, 1.0);
+    return base + jump + theta_lapse_above * dz;
+}
+
+double Sounding::rh_at(double z) const {
+    if (z > inversion_height) return rh_above;
+    return std::clamp(surface_rh + rh_lapse * z, 0.0, 1.0);
+}
+
+ReferenceProfile make_reference(const Sounding& s, int nz, double dx) {
+    s.validate();
+    ReferenceProfile r;
+    r.theta.resize(size_t(nz));
+    r.qv.resize(size_t(nz));
+    r.exner.resize(size_t(nz));
+    r.pressure.resize(size_t(nz));
+    r.rho.resize(size_t(nz));
+    // Hydrostatic: dPi/dz = -g / (cp theta), integrated with fine sub-steps (midpoint rule).
+    double pi = exner(s.surface_pressure), z = 0;
+    for (int k = 0; k < nz; ++k) {
+        double zc = (k + 0.5) * dx;
+        const int sub = 16;
+        double h = (zc - z) / sub;
+        for (int m = 0; m < sub; ++m) {
+            pi -= kGravity / (kCp * s.theta_at(z + (m + 0.5) * h)) * h;
+        }
+        z = zc;
+        if (!(pi > 0.05)) throw Error("sim: the domain top reaches above the modelled atmosphere (Exner < 0.05); lower nz * dx");
+        double p = kP00 * std::pow(pi, kCp / kRd);
+        double th = s.theta_at(zc);
+        double T = th * pi;
+        double qs = saturation_mixing_ratio(T, p);
+        r.theta[size_t(k)] = th;
+        r.exner[size_t(k)] = pi;
+        r.pressure[size_t(k)] = p;
+        r.qv[size_t(k)] = s.rh_at(zc) * qs;
+        r.rho[size_t(k)] = p / (kRd * T * (1 + 0.608 * r.qv[size_t(k)]));
+    }
+    return r;
+}
+
+void SimOptions::validate(int nz) const {
+    check_range(cfl, 0.1, 5, "options.cfl");
+    check_range(max_substeps, 1, 10000, "options.max_substeps");
+    check_range(condensation_rate, 0, 1e9, "options.condensation_rate (1/s)");
+    check_range(vorticity_confinement, 0, 2, "options.vorticity_confinement");
+    check_range(viscosity, 0, 1e4, "options.viscosity (m^2/s)");
+    check_range(diffusivity, 0, 1e4, "options.diffusivity (m^2/s)");
+    if (!wind.empty() && wind.size() != size_t(nz)) throw Error("sim: options.wind needs nz entries (one per cell row)");
+    for (double w : wind) check_range(w, -200, 200, "options.wind (m/s)");
+}
+
+std::string StepReport::to_json() const {
+    char buf[1536];
+    std::snprintf(buf, sizeof buf,
+                  "{\"dt\":%.9g,\"substeps\":%d,\"substep_dt\":%.9g,\"pressure_iterations\":%d,"
+                  "\"max_pressure_iterations\":%d,\"pressure_converged\":%s,\"divergence_l2\":%.9g,"
+                  "\"divergence_max\":%.9g,\"total_water\":%.9g,\"water_drift\":%.9g,\"theta_l_drift\":%.9g,"
+                  "\"condensed\":%.9g,\"max_w\":%.9g,\"max_speed\":%.9g,\"max_theta_perturbation\":%.9g,"
+                  "\"min_theta_perturbation\":%.9g,\"max_qc\":%.9g,\"seconds_advect\":%.6f,\"seconds_sources\":%.6f,"
+                  "\"seconds_thermo\":%.6f,\"seconds_forces\":%.6f,\"seconds_project\":%.6f}",
+                  dt, substeps, substep_dt, pressure_iterations, max_pressure_iterations,
+                  pressure_converged ? "true" : "false", divergence.l2, divergence.max, total_water, water_drift,
+                  theta_l_drift, condensed, max_w, max_speed, max_theta_perturbation, min_theta_perturbation, max_qc,
+                  seconds_advect, seconds_sources, seconds_thermo, seconds_forces, seconds_project);
+    return buf;
+}
+
+static GridSpec checked(const GridSpec& s, const MemoryBudget* budget) {
+    s.validate();
+    if (budget) budget->check(simulation_bytes(s), "sim: simulation state (" + std::to_string(kSimBytesPerCell) + " B/cell)");
+    return s;
+}
+
+Simulation::Simulation(const GridSpec& spec, const Sounding& sounding, const SimOptions& options, const MemoryBudget* budget)
+    : spec_(checked(spec, budget)), opt_(options), ref_(make_reference(sounding, spec.nz, spec.dx)),
+      solver_(spec, options.anelastic ? ref_.rho : std::vector<double>{}), vel_(spec), vel_tmp_(spec) {
+    opt_.validate(spec.nz);
+    const size_t n = spec.cells();
+    theta_.resize(n);
+    qv_.resize(n);
+    qc_.assign(n, 0.f);
+    tmp_.resize(n);
+    heat_src_.assign(n, 0.f);
+    vap_src_.assign(n, 0.f);
+    thetav0_.resize(size_t(spec.nz));
+    for (int k = 0; k < spec.nz; ++k) {
+        thetav0_[size_t(k)] = ref_.theta[size_t(k)] * (1 + 0.608 * ref_.qv[size_t(k)]);
+        size_t base = size_t(k) * spec.nx * spec.ny;
+        std::fill_n(theta_.begin() + long(base), size_t(spec.nx) * spec.ny, float(ref_.theta[size_t(k)]));
+        std::fill_n(qv_.begin() + long(base), size_t(spec.nx) * spec.ny, float(ref_.qv[size_t(k)]));
+    }
+    if (!opt_.wind.empty()) {
+        for (int k = 0; k < spec.nz; ++k)
+            for (int j = 0; j < spec.ny; ++j)
+                for (int i = 0; i <= spec.nx; ++i) vel_.u[vel_.iu(i, j, k)] = float(opt_.wind[size_t(k)]);
+        vel_.enforce_walls();
+        solver_.project(vel_, opt_.projection);
+    }
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::add_theta(const std::vector<float>& delta) {
+    if (delta.size() != theta_.size()) throw Error("sim add_theta: expected one value per cell");
+    check_finite(delta, "add_theta");
+    for (size_t n = 0; n < delta.size(); ++n) theta_[n] += delta[n];
+}
+
+void Simulation::set_sources(std::vector<float> heat, std::vector<float> vap, const std::string& what) {
+    if (heat.empty()) heat.assign(theta_.size(), 0.f);
+    if (vap.empty()) vap.assign(theta_.size(), 0.f);
+    if (heat.size() != theta_.size() || vap.size() != theta_.size())
+        throw Error("sim: " + what + ": source needs one value per cell (" + std::to_string(theta_.size()) + ")");
+    check_finite(heat, what + " (heat rate)");
+    check_finite(vap, what + " (vapour rate)");
+    heat_src_ = std::move(heat);
+    vap_src_ = std::move(vap);
+}
+
+void Simulation::set_sources(const Field3D& heat, const Field3D& vap, const std::string& what) {
+    for (const Field3D* f : {&heat, &vap})
+        if (f->nx() != spec_.nx || f->ny() != spec_.ny || f->nz() != spec_.nz || f->channels() < 1)
+            throw Error("sim: " + what + ": source field resolution must match the grid");
+    auto copy = [](const Field3D& f) { return std::vector<float>(f.channel(0).begin(), f.channel(0).end()); };
+    set_sources(copy(heat), copy(vap), what);
+}
+
+void Simulation::add_ground_patch(const GroundPatch& g) {
+    check_range(g.radius, 1e-3, 1e9, "ground_patch.radius (m)");
+    check_range(g.depth, 1e-3, 1e9, "ground_patch.depth (m)");
+    check_range(g.heat_rate, 0, 10, "ground_patch.heat_rate (K/s)");
+    check_range(g.vapour_rate, 0, 1e-3, "ground_patch.vapour_rate (kg/kg/s)");
+    check_range(g.noise_scale, 1e-3, 1e9, "ground_patch.noise_scale (m)");
+    check_range(g.noise_amount, 0, 1, "ground_patch.noise_amount");
+    check_range(g.center_x, -1e9, 1e9, "ground_patch.center_x (m)");
+    check_range(g.center_y, -1e9, 1e9, "ground_patch.center_y (m)");
+    const double h = spec_.dx;
+    for (int k = 0; k < spec_.nz; ++k)
+        for (int j = 0; j < spec_.ny; ++j)
+            for (int i = 0; i < spec_.nx; ++i) {
+                double x = (i + 0.5) * h, y = (j + 0.5) * h, z = (k + 0.5) * h;
+                if (spec_.ny == 1) y = g.center_y;
+                double r = std::hypot(x - g.center_x, y - g.center_y) / g.radius;
+                if (r >= 1 || z > g.depth) continue;
+                double shape = std::pow(std::cos(0.5 * M_PI * r), 2) * (1 - z / g.depth);
+                double nse = value_noise(g.seed, x / g.noise_scale, y / g.noise_scale, 0.0);
+                double m = shape * ((1 - g.noise_amount) + g.noise_amount * 2 * nse);
+                size_t c = vel_.ic(i, j, k);
+                heat_src_[c] += float(g.heat_rate * m);
+                vap_src_[c] += float(g.vapour_rate * m);
+            }
+}
+
+double Simulation::max_buoyancy() const {
+    double m = 0;
+    for (int k = 0; k < spec_.nz; ++k) {
+        size_t base = size_t(k) * spec_.nx * spec_.ny;
+        for (size_t c = base; c < base + size_t(spec_.nx) * spec_.ny; ++c) {
+            double tv = theta_[c] * (1 + 0.608 * qv_[c] - qc_[c]);
+            m = std::max(m, std::fabs(kGravity * (tv - thetav0_[size_t(k)]) / thetav0_[size_t(k)]));
+        }
+    }
+    return m;
+}
+
+void Simulation::buoyancy(double dt) {
+    const int nx = spec_.nx, ny = spec_.ny, nz = spec_.nz;
+    std::vector<float>& b = tmp_;
+    for_slices(nz, [&](int k) {
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                size_t c = vel_.ic(i, j, k);
+                double tv = double(theta_[c]) * (1 + 0.608 * qv_[c] - qc_[c]);
+                b[c] = float(kGravity * (tv - thetav0_[size_t(k)]) / thetav0_[size_t(k)]);
+            }
+    });
+    for_slices(nz + 1, [&](int k) {
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                double bb = k == 0 ? b[vel_.ic(i, j, 0)] : k == nz ? b[vel_.ic(i, j, nz - 1)]
+                                                                   : 0.5 * (b[vel_.ic(i, j, k - 1)] + b[vel_.ic(i, j, k)]);
+                vel_.w[vel_.iw(i, j, k)] += float(dt * bb);
+            }
+    });
+}
+
+void Simulation::confinement(double dt) {
+    const int nx = spec_.nx, ny = spec_.ny, nz = spec_.nz;
+    const double h = spec_.dx, eps = opt_.vorticity_confinement;
+    const size_t n = spec_.cells();
+    std::vector<float> cu(n), cv(n), cw(n), ox(n), oy(n), oz(n), mag(n), fx(n), fy(n), fz(n);
+    for_slices(nz, [&](int k) {
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                size_t c = vel_.ic(i, j, k);
+                cu[c] = 0.5f * (vel_.u[vel_.iu(i, j, k)] + vel_.u[vel_.iu(i + 1, j, k)]);
+                cv[c] = 0.5f * (vel_.v[vel_.iv(i, j, k)] + vel_.v[vel_.iv(i, j + 1, k)]);
+                cw[c] = 0.5f * (vel_.w[vel_.iw(i, j, k)] + vel_.w[vel_.iw(i, j, k + 1)]);
+            }
+    });
+    // Central differences with clamped neighbours (one-sided at the edges).
+    auto d = [&](const std::vector<float>& a, int i, int j, int k, int axis) -> double {
+        int lo[3] = {i, j, k}, hi[3] = {i, j, k};
+        const int nn[3] = {nx, ny, nz};
+        lo[axis] = std::max(lo[axis] - 1, 0);
+        hi[axis] = std::min(hi[axis] + 1, nn[axis] - 1);
+        int span = hi[axis] - lo[axis];
+        if (span == 0) return 0.0;
+        return (double(a[vel_.ic(hi[0], hi[1], hi[2])]) - a[vel_.ic(lo[0], lo[1], lo[2])]) / (span * h);
+    };
+    for_slices(nz, [&](int k) {
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                size_t c = vel_.ic(i, j, k);
+                ox[c] = float(d(cw, i, j, k, 1) - d(cv, i, j, k, 2));
+                oy[c] = float(d(cu, i, j, k, 2) - d(cw, i, j, k, 0));
+                oz[c] = float(d(cv, i, j, k, 0) - d(cu, i, j, k, 1));
+                mag[c] = std::sqrt(ox[c] * ox[c] + oy[c] * oy[c] + oz[c] * oz[c]);
+            }
+    });
+    for_slices(nz, [&](int k) {
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                size_t c = vel_.ic(i, j, k);
+                double gx = d(mag, i, j, k, 0), gy = d(mag, i, j, k, 1), gz = d(mag, i, j, k, 2);
+                double gl = std::sqrt(gx * gx + gy * gy + gz * gz) + 1e-20;
+                gx /= gl, gy /= gl, gz /= gl;
+                fx[c] = float(eps * h * (gy * oz[c] - gz * oy[c]));
+                fy[c] = float(eps * h * (gz * ox[c] - gx * oz[c]));
+                fz[c] = float(eps * h * (gx * oy[c] - gy * ox[c]));
+            }
+    });
+    for_slices(nz, [&](int k) {
+        for (int j = 0; j < ny; ++j) {
+            for (int i = 1; i < nx; ++i)
+                vel_.u[vel_.iu(i, j, k)] += float(dt * 0.5 * (fx[vel_.ic(i - 1, j, k)] + fx[vel_.ic(i, j, k)]));
+            if (j > 0)
+                for (int i = 0; i < nx; ++i)
+                    vel_.v[vel_.iv(i, j, k)] += float(dt * 0.5 * (fy[vel_.ic(i, j - 1, k)] + fy[vel_.ic(i, j, k)]));
+            if (k > 0)
+                for (int i = 0; i < nx; ++i)
+                    vel_.w[vel_.iw(i, j, k)] += float(dt * 0.5 * (fz[vel_.ic(i, j, k - 1)] + fz[vel_.ic(i, j, k)]));
+        }
+    });
+}
+
+namespace {
+// q += dt * coef * lap(q - ref) on lattice l, zero-gradient edges.
+void diffuse_lattice(const Lattice& l, std::vector<float>& q, double coef_dt_h2, const std::vector<double>* ref_by_k) {
+    std::vector<float> src = q;
+    auto at = [&](int i, int j, int k) {
+        i = std::clamp(i, 0, l.n[0] - 1), j = std::clamp(j, 0, l.n[1] - 1), k = std::clamp(k, 0, l.n[2] - 1);
+        double v = src[(size_t(k) * l.n[1] + j) * l.n[0] + i];
+        return ref_by_k ? v - (*ref_by_k)[size_t(k)] : v;
+    };
+    for_slices(l.n[2], [&](int k) {
+        for (int j = 0; j < l.n[1]; ++j)
+            for (int i = 0; i < l.n[0]; ++i) {
+                double c = at(i, j, k);
+                double lap = at(i - 1, j, k) + at(i + 1, j, k) + at(i, j - 1, k) + at(i, j + 1, k) + at(i, j, k - 1) +
+                             at(i, j, k + 1) - 6 * c;
+                q[(size_t(k) * l.n[1] + j) * l.n[0] + i] += float(coef_dt_h2 * lap);
+            }
+    });
+}
+} // namespace
+
+void Simulation::diffuse(double dt) {
+    const double h2 = spec_.dx * spec_.dx;
+    if (opt_.viscosity > 0) {
+        diffuse_lattice(u_lattice(spec_), vel_.u, opt_.viscosity * dt / h2, nullptr);
+        diffuse_lattice(v_lattice(spec_), vel_.v, opt_.viscosity * dt / h2, nullptr);
+        diffuse_lattice(w_lattice(spec_), vel_.w, opt_.viscosity * dt / h2, nullptr);
+        vel_.enforce_walls();
+    }
+    if (opt_.diffusivity > 0) {
+        Lattice l = cell_lattice(spec_);
+        diffuse_lattice(l, theta_, opt_.diffusivity * dt / h2, &ref_.theta);
+        diffuse_lattice(l, qv_, opt_.diffusivity * dt / h2, &ref_.qv);
+        diffuse_lattice(l, qc_, opt_.diffusivity * dt / h2, nullptr);
+        for (float& x : qc_) x = std::max(x, 0.f);
+        for (float& x : qv_) x = std::max(x, 0.f);
+    }
+}
+
+void Simulation::substep(double dt, StepReport& rep) {
+    const int nx = spec_.nx, ny = spec_.ny, nz = spec_.nz;
+    const size_t plane = size_t(nx) * ny;
+    auto t0 = Clock::now();
+    // 1. Advection of scalars by the old velocity, then of the velocity itself.
+    Lattice cl = cell_lattice(spec_);
+    for (std::vector<float>* q : {&theta_, &qv_, &qc_}) {
+        advect(vel_, cl, *q, tmp_, dt, opt_.scheme);
+        q->swap(tmp_);
+    }
+    advect_velocity(vel_, vel_tmp_, dt, opt_.scheme);
+    std::swap(vel_, vel_tmp_);
+    rep.seconds_advect += seconds_since(t0);
+    // 2. Sources.
+    t0 = Clock::now();
+    for_slices(nz, [&](int k) {
+        for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
+            theta_[c] += float(dt * heat_src_[c]);
+            qv_[c] = std::max(0.f, qv_[c] + float(dt * vap_src_[c]));
+        }
+    });
+    rep.seconds_sources += seconds_since(t0);
+    // 3. Saturation adjustment (water and theta_l accounted per slice, summed in order).
+    t0 = Clock::now();
+    if (opt_.moist) {
+        const double relax = opt_.condensation_rate > 0 ? 1 - std::exp(-opt_.condensation_rate * dt) : 1.0;
+        const size_t nzs = size_t(nz);
+        std::vector<double> before(nzs), after(nzs), drift(nzs), cond(nzs);
+        for_slices(nz, [&](int k) {
+            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)], lk = kLv / (kCp * pi);
+            double wb = 0, wa = 0, dr = 0, cd = 0;
+            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
+                wb += double(qv_[c]) + qc_[c];
+                double thl0 = theta_[c] - lk * qc_[c];
+                AdjustResult r = saturation_adjust(theta_[c], qv_[c], qc_[c], p, relax);
+                float dq = float(r.condensed);
+                dq = std::clamp(dq, -qc_[c], qv_[c]);
+                qv_[c] -= dq;
+                qc_[c] += dq;
+                theta_[c] = float(r.theta);
+                cd += dq;
+                wa += double(qv_[c]) + qc_[c];
+                dr = std::max(dr, std::fabs(theta_[c] - lk * qc_[c] - thl0));
+            }
+            before[size_t(k)] = wb, after[size_t(k)] = wa, drift[size_t(k)] = dr, cond[size_t(k)] = cd;
+        });
+        double wb = 0, wa = 0;
+        for (int k = 0; k < nz; ++k) {
+            wb += before[size_t(k)], wa += after[size_t(k)];
+            rep.theta_l_drift = std::max(rep.theta_l_drift, drift[size_t(k)]);
+            rep.condensed += cond[size_t(k)];
+        }
+        rep.water_drift = std::max(rep.water_drift, wb > 0 ? std::fabs(wa - wb) / wb : 0.0);
+    }
+    rep.seconds_thermo += seconds_since(t0);
+    // 4. Forces.
+    t0 = Clock::now();
+    buoyancy(dt);
+    if (opt_.vorticity_confinement > 0) confinement(dt);
+    if (opt_.viscosity > 0 || opt_.diffusivity > 0) diffuse(dt);
+    rep.seconds_forces += seconds_since(t0);
+    // 5. Projection.
+    t0 = Clock::now();
+    ProjectionReport pr = solver_.project(vel_, opt_.projection);
+    rep.pressure_iterations += pr.iterations;
+    rep.max_pressure_iterations = std::max(rep.max_pressure_iterations, pr.iterations);
+    rep.pressure_converged = rep.pressure_converged && pr.converged;
+    rep.divergence = pr.after;
+    rep.seconds_project += seconds_since(t0);
+}
+
+StepReport Simulation::step(double dt) {
+    if (!std::isfinite(dt) || dt <= 0) throw Error("sim step: dt must be finite and > 0 s");
+    check_finite(theta_, "theta");
+    check_finite(qv_, "qv");
+    check_finite(qc_, "qc");
+    if (!std::isfinite(vel_.max_abs())) throw Error("sim step: velocity holds NaN/Inf");
+    StepReport rep;
+    const double h = spec_.dx;
+    auto limit = [&]() {
+        double lim = 1e30;
+        double vmax = vel_.max_abs();
+        if (vmax > 0) lim = std::min(lim, opt_.cfl * h / vmax);
+        double b = max_buoyancy();
+        if (b > 0) lim = std::min(lim, opt_.cfl * std::sqrt(h / b)); // distance from rest under b stays < cfl cells
+        double nu = std::max(opt_.viscosity, opt_.diffusivity);
+        if (nu > 0) lim = std::min(lim, h * h / (8 * nu));
+        return lim;
+    };
+    double remaining = dt;
+    double first = limit();
+    double need = std::ceil(dt / first - 1e-9);
+    if (need > opt_.max_substeps) {
+        char buf[300];
+        std::snprintf(buf, sizeof buf,
+                      "sim step: dt = %g s needs %.0f substeps at CFL %g (max_substeps = %d); lower dt or raise "
+                      "options.max_substeps",
+                      dt, need, opt_.cfl, opt_.max_substeps);
+        throw Error(buf);
+    }
+    while (remaining > 1e-12 * dt) {
+        if (rep.substeps >= opt_.max_substeps)
+            throw Error("sim step: the flow accelerated past max_substeps = " + std::to_string(opt_.max_substeps) +
+                        " within one step (time reached " + std::to_string(time_) + " s)");
+        double lim = limit();
+        int n = int(std::ceil(remaining / lim - 1e-9));
+        double sdt = n <= 1 ? remaining : remaining / n;
+        substep(sdt, rep);
+        rep.substep_dt = sdt;
+        remaining -= sdt;
+        time_ += sdt;
+        ++rep.substeps;
+    }
+    rep.dt = dt;
+    // Summary statistics (fixed order).
+    double tw = 0;
+    rep.max_theta_perturbation = -1e30, rep.min_theta_perturbation = 1e30;
+    for (int k = 0; k < spec_.nz; ++k) {
+        size_t plane = size_t(spec_.nx) * spec_.ny;
+        for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
+            tw += double(qv_[c]) + qc_[c];
+            double tp = theta_[c] - ref_.theta[size_t(k)];
+            rep.max_theta_perturbation = std::max(rep.max_theta_perturbation, tp);
+            rep.min_theta_perturbation = std::min(rep.min_theta_perturbation, tp);
+            rep.max_qc = std::max(rep.max_qc, double(qc_[c]));
+        }
+    }
+    rep.total_water = tw;
+    for (float w : vel_.w) rep.max_w = std::max(rep.max_w, double(w));
+    rep.max_speed = vel_.max_abs();
+    return rep;
+}
+
+namespace {
+Box3d grid_box(const GridSpec& s) {
+    Box3d b;
+    b.max = Vec3d{{s.nx * s.dx, s.ny * s.dx, s.nz * s.dx}};
+    return b;
+}
+} // namespace
+
+Field3D Simulation::cloud_water() const {
+    Field3D f(Vec3i{{spec_.nx, spec_.ny, spec_.nz}}, 1, grid_box(spec_), {"qc"});
+    std::copy(qc_.begin(), qc_.end(), f.channel(0).begin());
+    return f;
+}
+
+Field3D Simulation::vapour() const {
+    Field3D f(Vec3i{{spec_.nx, spec_.ny, spec_.nz}}, 1, grid_box(spec_), {"qv"});
+    std::copy(qv_.begin(), qv_.end(), f.channel(0).begin());
+    return f;
+}
+
+Field3D Simulation::temperature() const {
+    Field3D f(Vec3i{{spec_.nx, spec_.ny, spec_.nz}}, 1, grid_box(spec_), {"T"});
+    auto out = f.channel(0);
+    size_t plane = size_t(spec_.nx) * spec_.ny;
+    for (size_t c = 0; c < theta_.size(); ++c) out[c] = float(theta_[c] * ref_.exner[c / plane]);
+    return f;
+}
+
+Field3D Simulation::theta_perturbation() const {
+    Field3D f(Vec3i{{spec_.nx, spec_.ny, spec_.nz}}, 1, grid_box(spec_), {"theta_p"});
+    auto out = f.channel(0);
+    size_t plane = size_t(spec_.nx) * spec_.ny;
+    for (size_t c = 0; c < theta_.size(); ++c) out[c] = float(theta_[c] - ref_.theta[c / plane]);
+    return f;
+}
+
+Field3D Simulation::velocity_field() const {
+    Field3D f(Vec3i{{spec_.nx, spec_.ny, spec_.nz}}, 3, grid_box(spec_), {"u", "v", "w"});
+    for (int k = 0; k < spec_.nz; ++k)
+        for (int j = 0; j < spec_.ny; ++j)
+            for (int i = 0; i < spec_.nx; ++i) {
+                f.at(0, i, j, k) = 0.5f * (vel_.u[vel_.iu(i, j, k)] + vel_.u[vel_.iu(i + 1, j, k)]);
+                f.at(1, i, j, k) = 0.5f * (vel_.v[vel_.iv(i, j, k)] + vel_.v[vel_.iv(i, j + 1, k)]);
+                f.at(2, i, j, k) = 0.5f * (vel_.w[vel_.iw(i, j, k)] + vel_.w[vel_.iw(i, j, k + 1)]);
+            }
+    return f;
+}
+
+} // namespace atlas::sim
