@@ -107,6 +107,8 @@ static void validate(const DdsTexture& t, const std::string& what) {
         throw Error(what + ": width, height, depth, array size and mip count must be >= 1");
     if (t.width > 65536 || t.height > 65536 || t.depth > 65536 || t.array_size > 65536)
         throw Error(what + ": dimensions above 65536 are not supported");
+    if (uint64_t(t.width) * uint64_t(t.height) * uint64_t(t.depth) * uint64_t(t.array_size) > (uint64_t(1) << 34))
+        throw Error(what + ": more than 2^34 texels (width x height x depth x array size) is not supported");
     if (!t.volume && t.depth != 1) throw Error(what + ": depth > 1 requires a volume texture");
     if (t.volume && t.array_size != 1) throw Error(what + ": volume textures cannot be arrays");
     int full = 1;
