@@ -56,6 +56,7 @@ int run_cook(const Args&);
 int run_validate(const Args&);
 int run_nodes(const Args&);
 int run_info(const Args&);
+int run_preview(const Args&);
 int run_compress(const Args&);
 int run_decompress(const Args&);
 

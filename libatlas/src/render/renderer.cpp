@@ -310,3 +310,17 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
 }
 
 } // namespace atlas::render
+
+namespace atlas::render {
+
+RenderSettings preview_settings(const Box3d& bounds, int width, int height) {
+    if (width <= 0 || height <= 0)
+        throw Error("render: image size must be at least 1x1 pixels, got " + std::to_string(width) + "x" + std::to_string(height));
+    RenderSettings s;
+    s.width = width;
+    s.height = height;
+    s.camera = framing_camera(bounds, double(width) / double(height));
+    return s;
+}
+
+} // namespace atlas::render

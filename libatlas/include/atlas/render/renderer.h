@@ -88,3 +88,12 @@ struct RenderResult {
 RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settings, const ProgressSink* progress = nullptr);
 
 } // namespace atlas::render
+
+namespace atlas::render {
+
+// Settings for a w x h preview of a volume with these bounds: the default
+// framing camera (framing_camera with its defaults), the default sun and
+// sky, fast mode. Throws atlas::Error on a non-positive size.
+RenderSettings preview_settings(const Box3d& bounds, int width, int height);
+
+} // namespace atlas::render

@@ -58,3 +58,22 @@ Camera framing_camera(const Box3d& bounds, double aspect, double azimuth_deg = 3
 Vec3d sun_direction(double azimuth_deg, double elevation_deg);
 
 } // namespace atlas::render
+
+#include <filesystem>
+#include <vector>
+
+namespace atlas::render {
+
+// A scene from files Atlas (or the Nubis pack) wrote, via io::read_field_file:
+//   one file   a VDB or EXR with channels dimensional_profile, detail_type,
+//              density_scale, sdf (volume/nvdf's vdb_set)
+//   two files  the modeling NVDF (named channels, else the first three:
+//              a TGA slice stack STEM.001.tga is R, G, B), then the SDF:
+//              channel "sdf" in metres, or encoded field data ("field_data",
+//              or a TGA stack's R) decoded d = v * 4352 - 256 metres.
+// voxel_size > 0 (metres) replaces the bounds of files that carry none
+// (images, TGA stacks: [0, n] per axis) with [0, n * voxel_size]; 0 keeps
+// the files' bounds. Throws atlas::Error naming the file and the problem.
+CloudScene load_scene(const std::vector<std::filesystem::path>& files, double voxel_size = 0);
+
+} // namespace atlas::render
