@@ -1,0 +1,70 @@
+// atlas/ndf/superstorm.h - HFW superstorm stencils: mesocyclone and vortex rings.
+//
+// A stencil overrides an NDF set radially. With r the distance to `center`,
+// g(r) = 1 - smoothstep(core * radius, radius, r) (1 in the core, 0 at and
+// beyond `radius`) and w = blend * g:
+//   coverage'   = lerp(coverage, max(coverage, stencil coverage), w)
+//   type', top_type' = lerp(x, storm_type, w)
+//   bottom_type' = lerp(x, max(x, bottom_type), w)
+//   superstorm_coverage' = max(x, w)
+//   min/max_height' = lerp(x, storm min/max height, blend * g(r_d)) where the
+//   distorted radius r_d = r * (1 + distortion * (2 n - 1) * (1 - r / radius))
+//   for r < radius (n: tileable value noise), r_d = r beyond: unchanged at the
+//   centre and beyond the radius, wobbly in between.
+// Beyond the radius the map is unchanged; blend 0 leaves it bit-identical.
+// Pure, thread-safe, deterministic.
+#pragma once
+
+#include "atlas/core/field.h"
+#include "atlas/core/memory.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace atlas::ndf {
+
+struct SuperstormStencil {
+    Vec2d center{{0, 0}};     // metres
+    double radius = 4000;     // metres, > 0
+    double core = 0.3;        // fraction of the radius at full strength, [0,1)
+    double coverage = 1.0;    // [0,1]
+    double blend = 1.0;       // [0,1]
+    double storm_type = 1.0;  // cumulonimbus
+    double bottom_type = 1.0; // ragged underside
+    double min_height = 800;  // metres, storm base at the centre
+    double max_height = 9000; // metres, storm top at the centre (>= min_height)
+    double distortion = 0.3;  // [0,1): radial wobble of the height gradients
+    double noise_scale = 4;   // noise lattice cells across the radius
+    uint32_t seed = 0;
+};
+
+// Throws atlas::Error naming the parameter: radius <= 0, min_height >
+// max_height, values out of range, not finite.
+void validate(const SuperstormStencil& s);
+// True when the stencil's disc overlaps the map's bounds at all.
+bool stencil_touches(const SuperstormStencil& s, const Box2d& bounds);
+// The stencil applied to an NDF set (see the formulas above).
+Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const MemoryBudget* budget);
+
+// One vortex ring: an annulus [inner, outer] metres around the centre.
+struct VortexRing {
+    double inner, outer;  // metres, 0 <= inner < outer
+    double speed;         // rotation, radians per second (falls outward)
+    double skew;          // radians: tilt of the ring's spiral tendrils
+};
+// N rings over [0, radius] (outer radii `radii`, strictly increasing, or
+// evenly spaced when empty), each extended by `overlap` * its width into the
+// next; speed_i = inner_speed * outer_0 / outer_i; skew_i = skew * i / (N-1).
+// Throws on N < 1, radii not strictly increasing, radii beyond the radius.
+std::vector<VortexRing> make_vortex_rings(double radius, int count, const std::vector<double>& radii, double overlap,
+                                          double inner_speed, double skew);
+// JSON sidecar text: {"center":[x,y],"radius":R,"rings":[{"index":i,"inner":..,"outer":..,"speed":..,"skew":..},..]}.
+std::string vortex_rings_json(Vec2d center, double radius, const std::vector<VortexRing>& rings);
+// The ring map: channels "ring_index" (index of the ring whose core holds the
+// texel, -1 outside all rings) and "ring_blend" (0..1 weight of ring index+1
+// in the overlap band past the ring's outer radius).
+Field2D vortex_ring_map(Vec2i res, Box2d bounds, Vec2d center, const std::vector<VortexRing>& rings, double overlap,
+                        const MemoryBudget* budget);
+
+} // namespace atlas::ndf

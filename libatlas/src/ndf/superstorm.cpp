@@ -1,0 +1,153 @@
+// Superstorm stencil: the mesocyclone written radially into an NDF set.
+#include "atlas/ndf/superstorm.h"
+#include "atlas/ndf/ndf_set.h"
+
+#include "atlas/core/error.h"
+#include "atlas/noise/value_noise.h"
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+namespace atlas::ndf {
+
+namespace {
+void in_unit(double v, const char* name) {
+    if (!(v >= 0 && v <= 1)) throw Error(std::string("superstorm: '") + name + "' must be in [0, 1]");
+}
+} // namespace
+
+void validate(const SuperstormStencil& s) {
+    if (!std::isfinite(s.center[0]) || !std::isfinite(s.center[1])) throw Error("superstorm: 'center' must be finite");
+    if (!(s.radius > 0) || !std::isfinite(s.radius)) throw Error("superstorm: 'radius' must be > 0 and finite");
+    if (!(s.core >= 0 && s.core < 1)) throw Error("superstorm: 'core' must be in [0, 1)");
+    in_unit(s.coverage, "coverage");
+    in_unit(s.blend, "blend");
+    in_unit(s.storm_type, "storm_type");
+    in_unit(s.bottom_type, "bottom_type");
+    if (!std::isfinite(s.min_height) || !std::isfinite(s.max_height)) throw Error("superstorm: 'min_height' and 'max_height' must be finite");
+    if (s.min_height > s.max_height) throw Error("superstorm: 'min_height' must not be above 'max_height'");
+    if (!(s.distortion >= 0 && s.distortion < 1)) throw Error("superstorm: 'distortion' must be in [0, 1)");
+    if (!(s.noise_scale > 0) || !std::isfinite(s.noise_scale)) throw Error("superstorm: 'noise_scale' must be > 0");
+}
+
+bool stencil_touches(const SuperstormStencil& s, const Box2d& b) {
+    const double dx = std::max({b.min[0] - s.center[0], 0.0, s.center[0] - b.max[0]});
+    const double dy = std::max({b.min[1] - s.center[1], 0.0, s.center[1] - b.max[1]});
+    return dx * dx + dy * dy < s.radius * s.radius;
+}
+
+Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const MemoryBudget* budget) {
+    check_ndf_set(set);
+    validate(s);
+    (void)budget;
+    Field2D out = set;
+    if (s.blend == 0) return out;
+    const Vec3i period{{1 << 16, 1 << 16, 1}};
+    tbb::parallel_for(0, set.height(), [&](int y) {
+        for (int x = 0; x < set.width(); ++x) {
+            const Vec2d d = set.texel_center(x, y) - s.center;
+            const double r = length(d);
+            if (!(r < s.radius)) continue; // beyond the radius: unchanged
+            const double g = 1.0 - smoothstep(s.core * s.radius, s.radius, r);
+            const double w = s.blend * g;
+            const size_t i = set.index(x, y);
+            auto mix = [&](int c, double target, double weight) {
+                out.channel(c)[i] = float(lerp(double(set.channel(c)[i]), target, weight));
+            };
+            const double cov = set.channel(Coverage)[i];
+            mix(Coverage, std::max(cov, s.coverage), w);
+            mix(Type, s.storm_type, w);
+            mix(TopType, s.storm_type, w);
+            mix(BottomType, std::max(double(set.channel(BottomType)[i]), s.bottom_type), w);
+            out.channel(SuperstormCoverage)[i] = float(std::max(double(set.channel(SuperstormCoverage)[i]), w));
+            // Distorted radius: the wobble vanishes at the centre and at the rim.
+            const double k = s.noise_scale / s.radius;
+            const double n = noise::value_noise(d[0] * k + 4096.0, d[1] * k + 4096.0, 0.0, period, s.seed);
+            const double rd = r * (1.0 + s.distortion * (2.0 * n - 1.0) * (1.0 - r / s.radius));
+            const double wh = s.blend * (1.0 - smoothstep(s.core * s.radius, s.radius, rd));
+            mix(MinHeight, s.min_height, wh);
+            mix(MaxHeight, s.max_height, wh);
+        }
+    });
+    return out;
+}
+
+std::vector<VortexRing> make_vortex_rings(double radius, int count, const std::vector<double>& radii, double overlap,
+                                          double inner_speed, double skew) {
+    if (!(radius > 0) || !std::isfinite(radius)) throw Error("vortex rings: 'radius' must be > 0 and finite");
+    if (count < 1 || count > 256) throw Error("vortex rings: 'rings' must be in [1, 256]");
+    if (!(overlap >= 0 && overlap <= 1)) throw Error("vortex rings: 'overlap' must be in [0, 1]");
+    if (!std::isfinite(inner_speed) || !std::isfinite(skew)) throw Error("vortex rings: 'speed' and 'skew' must be finite");
+    std::vector<double> outer = radii;
+    if (outer.empty())
+        for (int i = 0; i < count; ++i) outer.push_back(radius * (i + 1) / count);
+    if (int(outer.size()) != count)
+        throw Error("vortex rings: 'ring_radii' has " + std::to_string(outer.size()) + " entries, expected " + std::to_string(count));
+    for (size_t i = 0; i < outer.size(); ++i) {
+        if (!(outer[i] > (i ? outer[i - 1] : 0.0)) || !std::isfinite(outer[i]))
+            throw Error("vortex rings: 'ring_radii' must be > 0 and strictly increasing (entry " + std::to_string(i + 1) + ")");
+        if (outer[i] > radius * (1 + 1e-12)) throw Error("vortex rings: 'ring_radii' must not exceed the stencil radius");
+    }
+    std::vector<VortexRing> rings;
+    for (int i = 0; i < count; ++i) {
+        const double in = i ? outer[size_t(i - 1)] : 0.0;
+        rings.push_back({in, outer[size_t(i)], inner_speed * outer[0] / outer[size_t(i)], count > 1 ? skew * i / (count - 1) : 0.0});
+    }
+    return rings;
+}
+
+std::string vortex_rings_json(Vec2d center, double radius, const std::vector<VortexRing>& rings) {
+    auto num = [](double v) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.17g", v);
+        return std::string(buf);
+    };
+    std::string s = "{\"center\": [" + num(center[0]) + ", " + num(center[1]) + "], \"radius\": " + num(radius) + ", \"rings\": [";
+    for (size_t i = 0; i < rings.size(); ++i) {
+        const auto& r = rings[i];
+        s += (i ? ", " : "") + std::string("{\"index\": ") + std::to_string(i) + ", \"inner\": " + num(r.inner) + ", \"outer\": " +
+             num(r.outer) + ", \"speed\": " + num(r.speed) + ", \"skew\": " + num(r.skew) + "}";
+    }
+    return s + "]}\n";
+}
+
+Field2D vortex_ring_map(Vec2i res, Box2d bounds, Vec2d center, const std::vector<VortexRing>& rings, double overlap,
+                        const MemoryBudget* budget) {
+    if (rings.empty()) throw Error("vortex rings: at least one ring");
+    Field2D f(res, 2, bounds, {"ring_index", "ring_blend"}, budget);
+    tbb::parallel_for(0, res[1], [&](int y) {
+        for (int x = 0; x < res[0]; ++x) {
+            const double r = length(f.texel_center(x, y) - center);
+            float idx = -1, blend = 0;
+            for (size_t i = 0; i < rings.size(); ++i) {
+                if (r < rings[i].outer) {
+                    idx = float(i);
+                    break;
+                }
+            }
+            if (idx < 0) {
+                // Past the last ring: the overlap band fades the last ring out.
+                const auto& last = rings.back();
+                const double band = overlap * (last.outer - last.inner);
+                if (band > 0 && r < last.outer + band) {
+                    idx = float(rings.size() - 1);
+                    blend = float(smoothstep(last.outer, last.outer + band, r));
+                }
+            } else if (size_t(idx) > 0) {
+                // Inside ring i: the previous ring's overlap band reaches in.
+                const auto& prev = rings[size_t(idx) - 1];
+                const double band = overlap * (prev.outer - prev.inner);
+                if (band > 0 && r < prev.outer + band) {
+                    idx -= 1;
+                    blend = float(smoothstep(prev.outer, prev.outer + band, r));
+                }
+            }
+            f.at(0, x, y) = idx;
+            f.at(1, x, y) = blend;
+        }
+    });
+    return f;
+}
+
+} // namespace atlas::ndf
