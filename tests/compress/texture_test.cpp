@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -228,6 +229,20 @@ TEST(Texture, SweepRowsImproveWithQuality) {
     auto rows = sweep(sdf_field(16, 16, 1, 0), o);
     ASSERT_EQ(rows.size(), 3u);
     EXPECT_LE(rows[2].max_error, rows[1].max_error + 1e-9);
+    const std::string csv = sweep_csv(rows);
+    EXPECT_EQ(csv.rfind("quality,max_error,rmse,seconds\nfast,", 0), 0u) << csv;
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);
+}
+
+TEST(Texture, ReportJsonHasTheDocumentedKeys) {
+    CompressOptions o;
+    o.format = Format::Bc4;
+    o.max_error = 1e-6f;
+    o.allow_over_bound = true;
+    const std::string j = encode_texture(sdf_field(8, 8, 1, 0), o).report.to_json();
+    for (const char* key : {"\"max_error\"", "\"rmse\"", "\"psnr\"", "\"blocks_over_bound\"", "\"encode_seconds\"",
+                            "\"texels_per_second\"", "\"one_sided_violations\"", "\"decoder\": \"conformant\""})
+        EXPECT_NE(j.find(key), std::string::npos) << key;
 }
 
 } // namespace

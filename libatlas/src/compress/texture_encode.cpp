@@ -385,6 +385,14 @@ std::vector<SweepRow> sweep(const Field3D& field, const CompressOptions& options
     return rows;
 }
 
+std::string sweep_csv(const std::vector<SweepRow>& rows) {
+    std::ostringstream s;
+    s.precision(9);
+    s << "quality,max_error,rmse,seconds\n";
+    for (const SweepRow& r : rows) s << quality_name(r.quality) << ',' << r.max_error << ',' << r.rmse << ',' << r.seconds << '\n';
+    return s.str();
+}
+
 std::string CompressReport::to_json() const {
     std::ostringstream s;
     s.precision(9);

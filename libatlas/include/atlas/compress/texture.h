@@ -178,5 +178,7 @@ struct SweepRow {
     double max_error = 0, rmse = 0, seconds = 0;
 };
 std::vector<SweepRow> sweep(const Field3D& field, const CompressOptions& options);
+// "quality,max_error,rmse,seconds" header and one line per row (errors in source units).
+std::string sweep_csv(const std::vector<SweepRow>& rows);
 
 } // namespace atlas::compress
