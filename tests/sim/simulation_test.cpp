@@ -195,3 +195,63 @@ TEST(SimSimulation, BryanFritschDryCoarse) {
     EXPECT_NEAR(r.max_w, 14.5, 2.5);
     EXPECT_NEAR(r.max_theta_perturbation, 2.07, 0.6);
 }
+
+// Extremes of grid size: 8^3 runs; 256^3 is estimated (140 B/cell = 2.35 GB)
+// and refused by a 1 GiB budget before anything is allocated.
+TEST(SimSimulation, GridExtremesAndMemoryBudget) {
+    GridSpec s;
+    s.nx = s.ny = s.nz = 8;
+    s.dx = 100;
+    Simulation small(s, Sounding{}, {});
+    small.add_theta(std::vector<float>(s.cells(), 0.f));
+    StepReport r = small.step(10.0);
+    EXPECT_TRUE(r.pressure_converged);
+    GridSpec big = s;
+    big.nx = big.ny = big.nz = 256;
+    EXPECT_EQ(simulation_bytes(big), uint64_t(256) * 256 * 256 * kSimBytesPerCell);
+    MemoryBudget budget(1ull << 30);
+    EXPECT_THROW(Simulation(big, Sounding{}, {}, &budget), MemoryBudgetError);
+    GridSpec flat = s;
+    flat.nx = flat.ny = 1;
+    EXPECT_THROW(Simulation(flat, Sounding{}, {}), Error);
+    Sounding bad;
+    bad.surface_rh = 1.5;
+    try {
+        Simulation sim(s, bad, {});
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("surface_rh"), std::string::npos);
+    }
+}
+
+// A ground patch with vapour under an inversion grows a cloud that stays below
+// the inversion top (a loose property: no cloud water above inversion + 600 m).
+TEST(SimSimulation, GroundPatchGrowsCloudCappedByInversion) {
+    GridSpec s = slab(48, 40, 50);
+    Sounding snd;
+    snd.theta_lapse = 0.002;
+    snd.surface_rh = 0.85;
+    snd.inversion_height = 1200;
+    snd.inversion_jump = 6;
+    snd.inversion_depth = 100;
+    snd.rh_above = 0.2;
+    Simulation sim(s, snd, {});
+    GroundPatch g;
+    g.center_x = 1200;
+    g.radius = 500;
+    g.depth = 150;
+    g.heat_rate = 0.05;
+    g.vapour_rate = 2e-6;
+    sim.add_ground_patch(g);
+    StepReport r;
+    for (int n = 0; n < 60; ++n) r = sim.step(10.0);
+    Field3D qc = sim.cloud_water();
+    double top = 0;
+    for (int k = 0; k < s.nz; ++k)
+        for (int i = 0; i < s.nx; ++i)
+            if (qc.at(0, i, 0, k) > 1e-5f) top = std::max(top, (k + 1) * s.dx);
+    std::printf("[sim] ground patch 600 s: max qc %.3g kg/kg, cloud top %.0f m, max w %.2f m/s\n", r.max_qc, top, r.max_w);
+    EXPECT_GT(r.max_qc, 1e-5);
+    EXPECT_LT(top, 1800.0);
+    EXPECT_LT(r.water_drift, 1e-6);
+}
