@@ -7,6 +7,7 @@
 #include "bc1_palette.h"
 
 #include <algorithm>
+#include <memory>
 
 namespace atlas::compress {
 
@@ -24,55 +25,97 @@ int amd_half(int c0, int c1) { return (c0 + c1 + 1) >> 1; }
 
 } // namespace
 
+namespace {
+
+// Palette of one channel (a, b: 5- or 6-bit endpoint values) under one model.
+void channel_palette(int a, int b, bool six, bool four, Decoder d, float out[4]) {
+    if (d == Decoder::Reference || d == Decoder::Conformant) {
+        const float m = six ? 63.0f : 31.0f;
+        out[0] = float(a) / m;
+        out[1] = float(b) / m;
+        if (four) {
+            out[2] = float(2 * a + b) / (3.0f * m);
+            out[3] = float(a + 2 * b) / (3.0f * m);
+        } else {
+            out[2] = float(a + b) / (2.0f * m);
+            out[3] = 0.0f;
+        }
+        return;
+    }
+    const int A = six ? expand6(a) : expand5(a), B = six ? expand6(b) : expand5(b);
+    int v2 = 0, v3 = 0;
+    switch (d) {
+    case Decoder::Tool8:
+        if (four) { v2 = (2 * A + B) / 3; v3 = (A + 2 * B) / 3; }
+        else v2 = (A + B) / 2;
+        break;
+    case Decoder::Tool8Round:
+        if (four) { v2 = (2 * A + B + 1) / 3; v3 = (A + 2 * B + 1) / 3; }
+        else v2 = (A + B + 1) / 2;
+        break;
+    case Decoder::Nvidia:
+        if (four) {
+            v2 = six ? nv_interp6(A, B) : nv_interp5(a, b);
+            v3 = six ? nv_interp6(B, A) : nv_interp5(b, a);
+        } else v2 = six ? nv_half6(A, B) : nv_half5(a, b);
+        break;
+    case Decoder::Amd:
+        if (four) { v2 = amd_interp(A, B); v3 = amd_interp(B, A); }
+        else v2 = amd_half(A, B);
+        break;
+    default: break;
+    }
+    out[0] = float(A) / 255.0f;
+    out[1] = float(B) / 255.0f;
+    out[2] = float(v2) / 255.0f;
+    out[3] = float(v3) / 255.0f;
+}
+
+// Every channel palette of every model, built once (immutable after its
+// thread-safe initialisation): the encoders evaluate thousands of pairs per block.
+struct ChannelTables {
+    float t5[kDecoderCount][2][32][32][4];
+    float t6[kDecoderCount][2][64][64][4];
+};
+
+const ChannelTables& channel_tables() {
+    static const std::unique_ptr<ChannelTables> tables = [] {
+        auto t = std::make_unique<ChannelTables>();
+        for (int d = 0; d < kDecoderCount; ++d)
+            for (int f = 0; f < 2; ++f) {
+                for (int a = 0; a < 32; ++a)
+                    for (int b = 0; b < 32; ++b) channel_palette(a, b, false, f == 1, Decoder(d), t->t5[d][f][a][b]);
+                for (int a = 0; a < 64; ++a)
+                    for (int b = 0; b < 64; ++b) channel_palette(a, b, true, f == 1, Decoder(d), t->t6[d][f][a][b]);
+            }
+        return t;
+    }();
+    return *tables;
+}
+
+} // namespace
+
 void bc1_palette(uint16_t c0, uint16_t c1, Decoder d, float out[4][3]) {
     const bool four = c0 > c1;
     const int raw0[3] = {(c0 >> 11) & 31, (c0 >> 5) & 63, c0 & 31};
     const int raw1[3] = {(c1 >> 11) & 31, (c1 >> 5) & 63, c1 & 31};
     for (int ch = 0; ch < 3; ++ch) {
-        const bool six = ch == 1;
-        const int a = raw0[ch], b = raw1[ch];
-        if (d == Decoder::Reference || d == Decoder::Conformant) {
-            const float m = six ? 63.0f : 31.0f;
-            out[0][ch] = float(a) / m;
-            out[1][ch] = float(b) / m;
-            if (four) {
-                out[2][ch] = float(2 * a + b) / (3.0f * m);
-                out[3][ch] = float(a + 2 * b) / (3.0f * m);
-            } else {
-                out[2][ch] = float(a + b) / (2.0f * m);
-                out[3][ch] = 0.0f;
-            }
-            continue;
-        }
-        const int A = six ? expand6(a) : expand5(a), B = six ? expand6(b) : expand5(b);
-        int v2 = 0, v3 = 0;
-        switch (d) {
-        case Decoder::Tool8:
-            if (four) { v2 = (2 * A + B) / 3; v3 = (A + 2 * B) / 3; }
-            else v2 = (A + B) / 2;
-            break;
-        case Decoder::Tool8Round:
-            if (four) { v2 = (2 * A + B + 1) / 3; v3 = (A + 2 * B + 1) / 3; }
-            else v2 = (A + B + 1) / 2;
-            break;
-        case Decoder::Nvidia:
-            if (four) {
-                v2 = six ? nv_interp6(A, B) : nv_interp5(a, b);
-                v3 = six ? nv_interp6(B, A) : nv_interp5(b, a);
-            } else v2 = six ? nv_half6(A, B) : nv_half5(a, b);
-            break;
-        case Decoder::Amd:
-            if (four) { v2 = amd_interp(A, B); v3 = amd_interp(B, A); }
-            else v2 = amd_half(A, B);
-            break;
-        default: break;
-        }
-        out[0][ch] = float(A) / 255.0f;
-        out[1][ch] = float(B) / 255.0f;
-        out[2][ch] = float(v2) / 255.0f;
-        out[3][ch] = float(v3) / 255.0f;
+        float v[4];
+        channel_palette(raw0[ch], raw1[ch], ch == 1, four, d, v);
+        for (int i = 0; i < 4; ++i) out[i][ch] = v[i];
     }
 }
+
+namespace detail {
+void bc1_palette_fast(uint16_t c0, uint16_t c1, Decoder d, float out[4][3]) {
+    const ChannelTables& T = channel_tables();
+    const int f = c0 > c1 ? 1 : 0, di = int(d);
+    const float* r = T.t5[di][f][(c0 >> 11) & 31][(c1 >> 11) & 31];
+    const float* g = T.t6[di][f][(c0 >> 5) & 63][(c1 >> 5) & 63];
+    const float* b = T.t5[di][f][c0 & 31][c1 & 31];
+    for (int i = 0; i < 4; ++i) { out[i][0] = r[i]; out[i][1] = g[i]; out[i][2] = b[i]; }
+}
+} // namespace detail
 
 void decode_bc1_block(const uint8_t block[8], Decoder d, float rgb[48]) {
     const uint16_t c0 = uint16_t(block[0] | (block[1] << 8)), c1 = uint16_t(block[2] | (block[3] << 8));
@@ -90,7 +133,7 @@ namespace detail {
 void bc1_interval_palette(uint16_t c0, uint16_t c1, DecoderSet set, Palette<3>& p) {
     p.n = 4;
     float ref[4][3];
-    bc1_palette(c0, c1, Decoder::Reference, ref);
+    bc1_palette_fast(c0, c1, Decoder::Reference, ref);
     bool any = false;
     auto merge = [&](int i, int c, float lo, float hi) {
         if (!any) { p.lo[i][c] = lo; p.hi[i][c] = hi; }
@@ -113,7 +156,7 @@ void bc1_interval_palette(uint16_t c0, uint16_t c1, DecoderSet set, Palette<3>& 
             any = true;
             continue;
         }
-        bc1_palette(c0, c1, d, v);
+        bc1_palette_fast(c0, c1, d, v);
         for (int i = 0; i < 4; ++i)
             for (int c = 0; c < 3; ++c) merge(i, c, v[i][c], v[i][c]);
         any = true;

@@ -8,6 +8,9 @@
 
 namespace atlas::compress::detail {
 
+// bc1_palette through precomputed per-channel tables (identical values).
+void bc1_palette_fast(uint16_t c0, uint16_t c1, Decoder d, float out[4][3]);
+
 // Per-channel interval palette of (c0, c1) over a decoder set.
 void bc1_interval_palette(uint16_t c0, uint16_t c1, DecoderSet set, Palette<3>& p);
 

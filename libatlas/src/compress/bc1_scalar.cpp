@@ -62,7 +62,7 @@ void scalar_palette(uint16_t c0, uint16_t c1, const ScalarUnpack& u, detail::Pal
     p.n = 4;
     auto dotw = [&](const float* rgb) { return rgb[0] * u.weights[0] + rgb[1] * u.weights[1] + rgb[2] * u.weights[2]; };
     float ref[4][3];
-    bc1_palette(c0, c1, Decoder::Reference, ref);
+    detail::bc1_palette_fast(c0, c1, Decoder::Reference, ref);
     for (int i = 0; i < 4; ++i) { p.ref[i][0] = dotw(ref[i]); p.lo[i][0] = p.hi[i][0] = p.ref[i][0]; }
     bool any = false;
     const bool four = c0 > c1;
@@ -70,7 +70,7 @@ void scalar_palette(uint16_t c0, uint16_t c1, const ScalarUnpack& u, detail::Pal
         if (!(u.decoders & (DecoderSet(1) << di))) continue; // no allocation in the hot loop
         const Decoder d = static_cast<Decoder>(di);
         float v[4][3];
-        bc1_palette(c0, c1, d, v);
+        detail::bc1_palette_fast(c0, c1, d, v);
         for (int i = 0; i < 4; ++i) {
             float x = dotw(v[i]);
             float lo = x, hi = x;
