@@ -1,0 +1,24 @@
+// ndf/blur: separable Gaussian blur.
+#include "atlas/ndf/operators.h"
+#include "ndf/ndf_params.h"
+
+namespace {
+using namespace atlas;
+using namespace atlas::ndf_nodes;
+
+void declare(NodeDeclaration& d) {
+    d.doc("Separable Gaussian blur of every channel; kernel radius ceil(3 sigma).");
+    d.input("in", PortType::Field2D, "map");
+    d.output("out", PortType::Field2D, "blurred map");
+    d.param_float("sigma", 2.0).range(0, 4096).with_unit("texels").describe("standard deviation (0 copies)");
+    d.param_bool("tileable", true).describe("wrap around the edges (keeps tileable maps tileable); else clamp");
+}
+
+void cook(CookContext& ctx) {
+    ctx.set_output("out", out2d(ndf::blur(*ctx.input_field2d("in"), ctx.get_float("sigma"), wrap_mode(ctx), &ctx.budget())));
+}
+} // namespace
+
+ATLAS_REGISTER_NODE(registry) {
+    registry.add({.name = "ndf/blur", .version = 1, .declare = declare, .cook = cook});
+}
