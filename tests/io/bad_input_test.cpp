@@ -24,6 +24,12 @@ struct Format {
     // Listing VDB grid names reads only the grid descriptors, so a file cut
     // inside the last grid's voxel data may still list: no crash is required.
     bool must_fail_when_truncated = true;
+    // KNOWN LIMITATION: a VDB whose metadata string lengths are corrupted makes
+    // OpenVDB itself allocate up to gigabytes and take minutes before it fails
+    // (seen with single-byte changes near offset 400). It does fail with an
+    // error, but that is too slow and too large for a unit test, so VDB is
+    // left out of the mutation test until Atlas pre-validates VDB headers.
+    bool mutation_test = true;
 };
 
 std::vector<Format> formats() {
@@ -35,8 +41,8 @@ std::vector<Format> formats() {
         {".exr", [=](const fs::path& p) { write_exr(*f3, p); }, [](const fs::path& p) { read_exr(p); }},
         {".png", [=](const fs::path& p) { write_image(*f2, p); }, [](const fs::path& p) { read_image(p); }},
         {".tga", [=](const fs::path& p) { write_image(*f2, p); }, [](const fs::path& p) { read_image(p); }},
-        {".vdb", [=](const fs::path& p) { write_vdb(*f3, p); }, [](const fs::path& p) { read_vdb(p); }},
-        {".vdb", [=](const fs::path& p) { write_vdb(*f3, p); }, [](const fs::path& p) { list_vdb_grids(p); }, false},
+        {".vdb", [=](const fs::path& p) { write_vdb(*f3, p); }, [](const fs::path& p) { read_vdb(p); }, true, false},
+        {".vdb", [=](const fs::path& p) { write_vdb(*f3, p); }, [](const fs::path& p) { list_vdb_grids(p); }, false, false},
     };
 }
 
@@ -115,6 +121,38 @@ TEST(BadInput, TruncatedFilesAreErrors) {
                 }
             }
         }
+    }
+}
+
+// Valid files with a few bytes changed (deterministic positions and values):
+// any outcome but a crash or a foreign exception type is acceptable; errors
+// name the file.
+TEST(BadInput, MutatedFilesNeverCrash) {
+    TempDir dir;
+    int n = 0;
+    for (const auto& f : formats()) {
+        if (!f.mutation_test) continue;
+        const fs::path good = dir / ("good" + std::to_string(n) + f.ext);
+        f.write_valid(good);
+        const std::string bytes = read_bytes(good);
+        for (uint32_t m = 0; m < 40; ++m) {
+            std::string b = bytes;
+            const int flips = 1 + int(hash_coords(77, n, int(m)) % 4);
+            for (int k = 0; k < flips; ++k) {
+                const uint32_t h = hash_coords(78, n, int(m), k);
+                // Half the mutations hit the first 512 bytes, where the headers are.
+                const size_t span = (h & 1) ? std::min<size_t>(512, b.size()) : b.size();
+                b[size_t(h >> 8) % span] = char(hash_coords(79, n, int(m), k) & 0xff);
+            }
+            const fs::path p = dir / ("mut" + std::to_string(n) + "_" + std::to_string(m) + f.ext);
+            write_bytes(p, b);
+            try {
+                f.read(p);
+            } catch (const Error& e) {
+                EXPECT_NE(std::string(e.what()).find(p.filename().string()), std::string::npos) << e.what();
+            }
+        }
+        ++n;
     }
 }
 
