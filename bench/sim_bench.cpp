@@ -66,7 +66,7 @@ void BM_CumulusStep_256(benchmark::State& state) { CumulusStep(state, 256); }
 
 // Bryan & Fritsch (2002) dry: 20 km x 10 km, free-slip walls, 2 K cos^2
 // bubble (r = 2 km, z = 2 km) in a neutral theta0 = 300 K atmosphere, to 1000 s.
-void BryanFritschDry(benchmark::State& state, double dx, AdvectionScheme scheme) {
+void BryanFritschDry(benchmark::State& state, double dx, AdvectionScheme scheme, bool anelastic = true) {
     GridSpec s;
     s.nx = int(std::lround(20000 / dx));
     s.ny = 1;
@@ -75,6 +75,7 @@ void BryanFritschDry(benchmark::State& state, double dx, AdvectionScheme scheme)
     SimOptions o;
     o.moist = false;
     o.scheme = scheme;
+    o.anelastic = anelastic;
     StepReport r;
     int steps = 0;
     for (auto _ : state) {
@@ -94,6 +95,8 @@ void BryanFritschDry(benchmark::State& state, double dx, AdvectionScheme scheme)
 void BM_BryanFritschDry_100m(benchmark::State& state) { BryanFritschDry(state, 100, AdvectionScheme::MacCormack); }
 void BM_BryanFritschDry_200m(benchmark::State& state) { BryanFritschDry(state, 200, AdvectionScheme::MacCormack); }
 void BM_BryanFritschDry_100m_SL(benchmark::State& state) { BryanFritschDry(state, 100, AdvectionScheme::SemiLagrangian); }
+void BM_BryanFritschDry_100m_Boussinesq(benchmark::State& state) { BryanFritschDry(state, 100, AdvectionScheme::MacCormack, false); }
+void BM_BryanFritschDry_200m_Boussinesq(benchmark::State& state) { BryanFritschDry(state, 200, AdvectionScheme::MacCormack, false); }
 
 } // namespace
 
@@ -104,5 +107,7 @@ BENCHMARK(BM_CumulusStep_256)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschDry_100m)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschDry_200m)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschDry_100m_SL)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BryanFritschDry_100m_Boussinesq)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BryanFritschDry_200m_Boussinesq)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -196,7 +196,7 @@ TEST(SimSimulation, BryanFritschDryCoarse) {
     EXPECT_NEAR(r.max_theta_perturbation, 2.07, 0.6);
 }
 
-// Extremes of grid size: 8^3 runs; 256^3 is estimated (140 B/cell = 2.35 GB)
+// Extremes of grid size: 8^3 runs; 256^3 is estimated (216 B/cell = 3.6 GB)
 // and refused by a 1 GiB budget before anything is allocated.
 TEST(SimSimulation, GridExtremesAndMemoryBudget) {
     GridSpec s;

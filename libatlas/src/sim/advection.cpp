@@ -79,13 +79,6 @@ void for_lattice(const Lattice& l, F&& f) {
     });
 }
 
-void semi_lagrangian(const MacVelocity& vel, const Lattice& l, std::span<const float> q, std::span<float> out, double dt) {
-    for_lattice(l, [&](size_t id, const double p[3]) {
-        double src[3];
-        trace(vel, p, dt, src);
-        out[id] = sample_lattice(l, q, src);
-    });
-}
 
 } // namespace
 
@@ -105,27 +98,68 @@ void velocity_at(const MacVelocity& vel, const double p[3], double out[3]) {
     if (g.nx == 1) out[0] = 0;
 }
 
-void advect(const MacVelocity& vel, const Lattice& l, std::span<const float> q, std::span<float> out, double dt,
-            AdvectionScheme scheme) {
-    if (q.size() != l.size() || out.size() != l.size()) throw Error("sim advect: field size does not match its lattice");
+void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::span<const float>> qs,
+                 std::span<const std::span<float>> outs, double dt, AdvectionScheme scheme) {
+    if (qs.size() != outs.size()) throw Error("sim advect: as many outputs as inputs expected");
+    for (size_t f = 0; f < qs.size(); ++f)
+        if (qs[f].size() != l.size() || outs[f].size() != l.size()) throw Error("sim advect: field size does not match its lattice");
     if (!std::isfinite(dt) || dt < 0) throw Error("sim advect: dt must be finite and >= 0");
-    semi_lagrangian(vel, l, q, out, dt);
-    if (scheme == AdvectionScheme::SemiLagrangian) return;
-    std::vector<float> fwd(out.begin(), out.end()), back(l.size());
-    semi_lagrangian(vel, l, fwd, back, -dt);
+    // Trace once per lattice node and reuse it for every field (and, for
+    // MacCormack, for the limiter); the backward trace likewise.
+    std::vector<float> fwd_pos(l.size() * 3), back_pos;
     for_lattice(l, [&](size_t id, const double p[3]) {
         double src[3];
         trace(vel, p, dt, src);
-        if (near_edge(vel.spec, src)) return; // keep semi-Lagrangian
-        Stencil s = stencil(l, src);
-        float lo = q[s.idx[0]], hi = lo;
-        for (int c = 1; c < 8; ++c) {
-            lo = std::min(lo, q[s.idx[c]]);
-            hi = std::max(hi, q[s.idx[c]]);
-        }
-        float corrected = fwd[id] + 0.5f * (q[id] - back[id]);
-        out[id] = std::clamp(corrected, lo, hi);
+        for (int a = 0; a < 3; ++a) fwd_pos[id * 3 + size_t(a)] = float(src[a] - p[a]);
     });
+    auto pos = [&](const std::vector<float>& d, size_t id, const double p[3], double out[3]) {
+        for (int a = 0; a < 3; ++a) out[a] = p[a] + double(d[id * 3 + size_t(a)]);
+    };
+    if (scheme == AdvectionScheme::MacCormack) {
+        back_pos.resize(l.size() * 3);
+        for_lattice(l, [&](size_t id, const double p[3]) {
+            double src[3];
+            trace(vel, p, -dt, src);
+            for (int a = 0; a < 3; ++a) back_pos[id * 3 + size_t(a)] = float(src[a] - p[a]);
+        });
+    }
+    std::vector<float> back;
+    for (size_t f = 0; f < qs.size(); ++f) {
+        std::span<const float> q = qs[f];
+        std::span<float> out = outs[f];
+        for_lattice(l, [&](size_t id, const double p[3]) {
+            double src[3];
+            pos(fwd_pos, id, p, src);
+            out[id] = sample_lattice(l, q, src);
+        });
+        if (scheme == AdvectionScheme::SemiLagrangian) continue;
+        back.resize(l.size());
+        for_lattice(l, [&](size_t id, const double p[3]) {
+            double src[3];
+            pos(back_pos, id, p, src);
+            back[id] = sample_lattice(l, out, src);
+        });
+        for_lattice(l, [&](size_t id, const double p[3]) {
+            double src[3];
+            pos(fwd_pos, id, p, src);
+            if (near_edge(vel.spec, src)) return; // keep semi-Lagrangian
+            Stencil s = stencil(l, src);
+            float lo = q[s.idx[0]], hi = lo;
+            for (int c = 1; c < 8; ++c) {
+                lo = std::min(lo, q[s.idx[c]]);
+                hi = std::max(hi, q[s.idx[c]]);
+            }
+            float corrected = out[id] + 0.5f * (q[id] - back[id]);
+            out[id] = std::clamp(corrected, lo, hi);
+        });
+    }
+}
+
+void advect(const MacVelocity& vel, const Lattice& l, std::span<const float> q, std::span<float> out, double dt,
+            AdvectionScheme scheme) {
+    std::span<const float> qs[1] = {q};
+    std::span<float> outs[1] = {out};
+    advect_many(vel, l, qs, outs, dt, scheme);
 }
 
 void advect_velocity(const MacVelocity& vel, MacVelocity& out, double dt, AdvectionScheme scheme) {

@@ -251,7 +251,7 @@ struct PressureSolver::Impl {
 PressureSolver::PressureSolver(const GridSpec& spec, std::vector<double> rho_cell, const MemoryBudget* budget)
     : impl_(std::make_unique<Impl>()), rho_cell_(std::move(rho_cell)) {
     spec.validate();
-    if (budget) budget->check(uint64_t(spec.cells()) * 56, "sim: pressure solver");
+    if (budget) budget->check(uint64_t(spec.cells()) * 88, "sim: pressure solver");
     if (rho_cell_.empty()) rho_cell_.assign(size_t(spec.nz), 1.0);
     if (rho_cell_.size() != size_t(spec.nz)) throw Error("sim pressure: rho_cell needs nz entries");
     for (double r : rho_cell_)

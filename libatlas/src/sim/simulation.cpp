@@ -366,9 +366,14 @@ void Simulation::substep(double dt, StepReport& rep) {
     auto t0 = Clock::now();
     // 1. Advection of scalars by the old velocity, then of the velocity itself.
     Lattice cl = cell_lattice(spec_);
-    for (std::vector<float>* q : {&theta_, &qv_, &qc_}) {
-        advect(vel_, cl, *q, tmp_, dt, opt_.scheme);
-        q->swap(tmp_);
+    {
+        std::vector<float> a(theta_.size()), b(theta_.size());
+        std::span<const float> in[3] = {theta_, qv_, qc_};
+        std::span<float> out[3] = {tmp_, a, b};
+        advect_many(vel_, cl, in, out, dt, opt_.scheme);
+        theta_.swap(tmp_);
+        qv_.swap(a);
+        qc_.swap(b);
     }
     advect_velocity(vel_, vel_tmp_, dt, opt_.scheme);
     std::swap(vel_, vel_tmp_);

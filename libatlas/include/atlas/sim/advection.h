@@ -43,6 +43,11 @@ void velocity_at(const MacVelocity& vel, const double p[3], double out[3]);
 void advect(const MacVelocity& vel, const Lattice& l, std::span<const float> q, std::span<float> out, double dt,
             AdvectionScheme scheme);
 
+// The same for several fields on one lattice: the back-traces are computed
+// once and shared (qs[f] -> outs[f]). Transient memory: 24 B per lattice node.
+void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::span<const float>> qs,
+                 std::span<const std::span<float>> outs, double dt, AdvectionScheme scheme);
+
 // Self-advection of velocity; `out` gets the result (walls re-imposed).
 void advect_velocity(const MacVelocity& vel, MacVelocity& out, double dt, AdvectionScheme scheme);
 

@@ -47,10 +47,13 @@ struct GridSpec {
 
 // Bytes per cell of a whole Simulation (state, advection scratch, pressure
 // solver with its multigrid hierarchy); the estimate used before allocating.
-// 4-byte floats: u, v, w, theta', qv, qc, qr, two advection scratch copies of
-// each (3 x 7 = 21 floats = 84 B); pressure solver: 6 doubles (48 B) plus about
-// 1/7 of that for coarse levels (8 B): 140 B per cell.
-constexpr uint64_t kSimBytesPerCell = 140;
+// 4-byte floats: state u, v, w, theta, qv, qc (6), velocity scratch (3),
+// scalar scratch (3), sources (2), shared back-traces (6), MacCormack back
+// value (1), vorticity-confinement scratch (10, only when enabled): 31 floats
+// = 124 B. Pressure solver in double: diag, x, b, r, phi, res, z, d, q, rhs
+// (10 doubles = 80 B) plus about 1/7 of 7 doubles for coarse levels (8 B).
+// Total 212 B, rounded up to 216 B per cell.
+constexpr uint64_t kSimBytesPerCell = 216;
 uint64_t simulation_bytes(const GridSpec& spec);
 
 // Velocity on a MAC grid, in m/s.
