@@ -76,7 +76,7 @@ TEST(Bc4, MaxErrorIsMetOrProvablyUnreachable) {
     ob.quality = Quality::Best;
     Bc4Encoder best(false, ob);
     int missed = 0;
-    for (int k = 0; k < 2000; ++k) {
+    for (int k = 0; k < 2000 / test::kExhaustiveDivisor; ++k) {
         float src[16];
         scalar_block(uint64_t(k) + 5, 0, 1, src);
         uint8_t a[8], b[8];
@@ -123,7 +123,7 @@ TEST(Bc4, BestIsOptimalAgainstNaiveSearch) {
         o.decoders = kReferenceOnly;
         o.one_sided_below = os;
         Bc4Encoder enc(false, o);
-        for (int k = 0; k < 6; ++k) {
+        for (int k = 0; k < std::max(1, 6 / test::kExhaustiveDivisor); ++k) {
             float src[16];
             scalar_block(uint64_t(k) * 7 + 3, 0, 1, src);
             uint8_t blk[8];
@@ -138,7 +138,7 @@ TEST(Bc4, NormalNeverBeatsBest) {
     Bc4Encoder normal(false, o);
     o.quality = Quality::Best;
     Bc4Encoder best(false, o);
-    for (int k = 0; k < 300; ++k) {
+    for (int k = 0; k < 300 / test::kExhaustiveDivisor; ++k) {
         float src[16];
         scalar_block(uint64_t(k) + 900, 0, 1, src);
         uint8_t a[8], b[8];
