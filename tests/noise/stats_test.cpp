@@ -112,6 +112,48 @@ TEST(NoiseStats, CurlIsDivergenceFree) {
     }
 }
 
+TEST(NoiseStats, Curl2DIsDivergenceFree) {
+    NoiseSpec s = test::make(Kernel::Curl, 4, 3);
+    s.fractal.octaves = 2;
+    const double h = 1e-4;
+    double worst_ratio = 0;
+    for (int i = 0; i < 200; ++i) {
+        const Vec2d p{{hash_to_unit(hash_coords(4, i, 0)), hash_to_unit(hash_coords(4, i, 1))}};
+        std::vector<Vec2d> q = {{{p[0] + h, p[1]}}, {{p[0] - h, p[1]}}, {{p[0], p[1] + h}}, {{p[0], p[1] - h}}};
+        const auto v = sample_noise(s, std::span<const Vec2d>(q));
+        const double sx = 1.0 / (2 * h * s.period[0]), sy = 1.0 / (2 * h * s.period[1]);
+        const double dxx = (v[0] - v[2]) * sx, dyx = (v[1] - v[3]) * sx, dxy = (v[4] - v[6]) * sy, dyy = (v[5] - v[7]) * sy;
+        const double grad = std::sqrt((dxx * dxx + dyx * dyx + dxy * dxy + dyy * dyy) / 4 + 1e-12);
+        worst_ratio = std::max(worst_ratio, std::fabs(dxx + dyy) / grad);
+    }
+    EXPECT_LT(worst_ratio, 1e-2);
+}
+
+// The Worley features are one computation seen four ways: F1 <= F2,
+// F2-F1 and 1-F1 agree with F1 and F2 wherever nothing was clamped.
+TEST(NoiseStats, WorleyFeaturesAreConsistent) {
+    for (const char* metric : {"euclidean", "manhattan", "chebyshev"}) {
+        std::vector<float> v[4];
+        const char* features[4] = {"f1", "f2", "f2-f1", "inverted-f1"};
+        std::vector<Vec3d> pts;
+        for (int i = 0; i < 500; ++i)
+            pts.push_back({{hash_to_unit(hash_coords(8, i, 0)), hash_to_unit(hash_coords(8, i, 1)), hash_to_unit(hash_coords(8, i, 2))}});
+        for (int f = 0; f < 4; ++f) {
+            NoiseSpec s = test::make(Kernel::Worley, 4, 21);
+            s.worley.feature = parse_worley_feature(features[f]);
+            s.worley.metric = parse_worley_metric(metric);
+            v[f] = sample_noise(s, std::span<const Vec3d>(pts));
+        }
+        for (size_t i = 0; i < pts.size(); ++i) {
+            EXPECT_LE(v[0][i], v[1][i]) << metric;
+            EXPECT_NEAR(v[3][i], 1.0f - v[0][i], 1e-6) << metric;
+            if (v[1][i] < 1.0f) {
+                EXPECT_NEAR(v[2][i], v[1][i] - v[0][i], 1e-6) << metric;
+            }
+        }
+    }
+}
+
 // Negative control for the tile tests: a non-integer frequency must NOT
 // wrap, so the tile comparison is able to fail.
 TEST(NoiseStats, NonIntegerFrequencyDoesNotTile) {
