@@ -245,7 +245,10 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
             f();
         }
     };
-    if (fast) run([&] { grid = std::make_unique<detail::LightGrid>(cloud, settings.light_grid, sun); });
+    // The light grid never needs to be finer than the volume itself.
+    Vec3i grid_res = settings.light_grid;
+    for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], scene.modeling->resolution()[a]);
+    if (fast) run([&] { grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun); });
 
     Integrator in{cloud,
                   grid.get(),

@@ -49,7 +49,8 @@ struct RenderSettings {
     double hg_forward = 0.6, hg_back = -0.3, hg_forward_weight = 0.7;
     double ambient_strength = 1.0;  // >= 0
     double multiple_scattering = 0.5; // strength of the profile-based term, >= 0
-    // Voxel light grid resolution (fast mode); the talk's is 256x256x32.
+    // Voxel light grid resolution (fast mode), capped per axis at the volume's
+    // resolution; the talk's is 256x256x32.
     Vec3i light_grid{{128, 128, 32}};
     // Reference mode step (metres); 0 = a quarter of the smallest voxel.
     double reference_step = 0;
