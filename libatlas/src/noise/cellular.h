@@ -117,4 +117,55 @@ inline float alligator2(const Lattice<2>& L, const Split& sx, const Split& sy, f
     return m1 - m2;
 }
 
+// Row coherence: consecutive samples of a row mostly share a cell, so the
+// 27 neighbours' feature points (relative to the cell corner) and magnitudes
+// are decoded once per cell change. The sample loops below then run over
+// flat arrays the compiler can vectorise.
+struct CellCache3 {
+    int cx = -1, cy = -1, cz = -1;
+    float px[27], py[27], pz[27], m[27];
+
+    void load(const Lattice<3>& L, const Split& sx, const Split& sy, const Split& sz, float jitter) {
+        if (sx.cell == cx && sy.cell == cy && sz.cell == cz) return;
+        cx = sx.cell;
+        cy = sy.cell;
+        cz = sz.cell;
+        const int xs[3] = {sx.prev, sx.cell, sx.next}, ys[3] = {sy.prev, sy.cell, sy.next}, zs[3] = {sz.prev, sz.cell, sz.next};
+        for (int k = 0; k < 3; ++k)
+            for (int j = 0; j < 3; ++j)
+                for (int i = 0; i < 3; ++i) {
+                    const int n = (k * 3 + j) * 3 + i;
+                    const uint64_t b = L.bits(xs[i], ys[j], zs[k]);
+                    px[n] = float(i - 1) + feature_offset(b, 0, jitter);
+                    py[n] = float(j - 1) + feature_offset(b, 1, jitter);
+                    pz[n] = float(k - 1) + feature_offset(b, 2, jitter);
+                    m[n] = bits_unit16(b, 3);
+                }
+    }
+};
+
+template <WorleyMetric M>
+inline F12 worley3_cached(const CellCache3& c, float fx, float fy, float fz) {
+    float f1 = 1e30f, f2 = 1e30f;
+    for (int n = 0; n < 27; ++n) {
+        const float d = metric_combine<M>(metric_combine<M>(metric_combine<M>(0.0f, c.px[n] - fx), c.py[n] - fy), c.pz[n] - fz);
+        f2 = std::min(f2, std::max(f1, d));
+        f1 = std::min(f1, d);
+    }
+    if constexpr (M == WorleyMetric::Euclidean) return {std::sqrt(f1), std::sqrt(f2)};
+    else return {f1, f2};
+}
+
+// Same as alligator3 over a loaded cache (jitter 1).
+inline float alligator3_cached(const CellCache3& c, float fx, float fy, float fz, float inv_r2) {
+    float m1 = 0, m2 = 0;
+    for (int n = 0; n < 27; ++n) {
+        const float dx = c.px[n] - fx, dy = c.py[n] - fy, dz = c.pz[n] - fz;
+        const float v = alligator_bump(c.m[n], (dx * dx + dy * dy + dz * dz) * inv_r2);
+        m2 = std::max(m2, std::min(m1, v));
+        m1 = std::max(m1, v);
+    }
+    return m1 - m2;
+}
+
 } // namespace atlas::noise::detail

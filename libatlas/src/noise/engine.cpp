@@ -46,11 +46,16 @@ inline Splits<D> split_all(const std::array<const double*, D>& u, size_t i, doub
 template <int D, WorleyMetric M>
 void worley_octave(const Lattice<D>& L, const std::array<const double*, D>& u, size_t n, double scale, float jitter,
                    WorleyFeature feature, float* out) {
+    [[maybe_unused]] CellCache3 cache;
     for (size_t i = 0; i < n; ++i) {
         const auto sp = split_all<D>(u, i, scale, L.period());
         F12 f;
-        if constexpr (D == 3) f = worley3<M>(L, sp.s[0], sp.s[1], sp.s[2], jitter);
-        else f = worley2<M>(L, sp.s[0], sp.s[1], jitter);
+        if constexpr (D == 3) {
+            cache.load(L, sp.s[0], sp.s[1], sp.s[2], jitter);
+            f = worley3_cached<M>(cache, sp.s[0].frac, sp.s[1].frac, sp.s[2].frac);
+        } else {
+            f = worley2<M>(L, sp.s[0], sp.s[1], jitter);
+        }
         out[i] = worley_feature(f, feature);
     }
 }
@@ -88,10 +93,15 @@ void scalar_octave(Kernel k, const NoiseSpec& spec, const Lattice<D>& L, const s
     case Kernel::Alligator:
     case Kernel::CurlyAlligator: {
         const float inv_r2 = float(1.0 / (spec.alligator.radius * spec.alligator.radius));
+        [[maybe_unused]] CellCache3 cache;
         for (size_t i = 0; i < n; ++i) {
             const auto sp = split_all<D>(u, i, scale, L.period());
-            if constexpr (D == 3) out[i] = alligator3(L, sp.s[0], sp.s[1], sp.s[2], inv_r2);
-            else out[i] = alligator2(L, sp.s[0], sp.s[1], inv_r2);
+            if constexpr (D == 3) {
+                cache.load(L, sp.s[0], sp.s[1], sp.s[2], 1.0f);
+                out[i] = alligator3_cached(cache, sp.s[0].frac, sp.s[1].frac, sp.s[2].frac, inv_r2);
+            } else {
+                out[i] = alligator2(L, sp.s[0], sp.s[1], inv_r2);
+            }
         }
         break;
     }
