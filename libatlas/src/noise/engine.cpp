@@ -65,15 +65,21 @@ template <int D>
 void scalar_octave(Kernel k, const NoiseSpec& spec, const Lattice<D>& L, const std::array<const double*, D>& u, size_t n,
                    double scale, float* out) {
     switch (k) {
-    case Kernel::Gradient:
+    case Kernel::Gradient: {
+        [[maybe_unused]] GradCache3 gc;
         for (size_t i = 0; i < n; ++i) {
             const auto sp = split_all<D>(u, i, scale, L.period());
             float v;
-            if constexpr (D == 3) v = gradient3(L, sp.s[0], sp.s[1], sp.s[2], nullptr);
-            else v = gradient2(L, sp.s[0], sp.s[1], nullptr);
+            if constexpr (D == 3) {
+                gc.load(L, sp.s[0], sp.s[1], sp.s[2]);
+                v = gradient3(gc, sp.s[0].frac, sp.s[1].frac, sp.s[2].frac, nullptr);
+            } else {
+                v = gradient2(L, sp.s[0], sp.s[1], nullptr);
+            }
             out[i] = std::clamp(v, -1.0f, 1.0f);
         }
         break;
+    }
     case Kernel::Value:
         for (size_t i = 0; i < n; ++i) {
             const auto sp = split_all<D>(u, i, scale, L.period());
@@ -114,13 +120,18 @@ void scalar_octave(Kernel k, const NoiseSpec& spec, const Lattice<D>& L, const s
 template <int D>
 void curl_octave(const Lattice<D>* pots, const std::array<const double*, D>& u, size_t n, double scale, float weight,
                  float* const* out) {
+    [[maybe_unused]] GradCache3 g1, g2, g3;
     for (size_t i = 0; i < n; ++i) {
         const auto sp = split_all<D>(u, i, scale, pots[0].period());
         if constexpr (D == 3) {
             float d1[3], d2[3], d3[3];
-            gradient3(pots[0], sp.s[0], sp.s[1], sp.s[2], d1);
-            gradient3(pots[1], sp.s[0], sp.s[1], sp.s[2], d2);
-            gradient3(pots[2], sp.s[0], sp.s[1], sp.s[2], d3);
+            const float fx = sp.s[0].frac, fy = sp.s[1].frac, fz = sp.s[2].frac;
+            g1.load(pots[0], sp.s[0], sp.s[1], sp.s[2]);
+            g2.load(pots[1], sp.s[0], sp.s[1], sp.s[2]);
+            g3.load(pots[2], sp.s[0], sp.s[1], sp.s[2]);
+            gradient3(g1, fx, fy, fz, d1);
+            gradient3(g2, fx, fy, fz, d2);
+            gradient3(g3, fx, fy, fz, d3);
             out[0][i] += weight * (d3[1] - d2[2]);
             out[1][i] += weight * (d1[2] - d3[0]);
             out[2][i] += weight * (d2[0] - d1[1]);

@@ -19,25 +19,38 @@ inline constexpr float kGrad2[8][2] = {{1, 0}, {kS, kS}, {0, 1}, {-kS, kS}, {-1,
 // Scales the 2D signal to about [-1, 1] (unit gradients peak near 1/sqrt 2).
 inline constexpr float kGrad2Scale = 1.41421356f;
 
+// The 8 corner gradients of one cell; reloaded only when the cell changes
+// (consecutive samples of a row mostly share a cell).
+struct GradCache3 {
+    int cx = -1, cy = -1, cz = -1;
+    float g[8][3];
+
+    void load(const Lattice<3>& L, const Split& sx, const Split& sy, const Split& sz) {
+        if (sx.cell == cx && sy.cell == cy && sz.cell == cz) return;
+        cx = sx.cell;
+        cy = sy.cell;
+        cz = sz.cell;
+        const int xs[2] = {sx.cell, sx.next}, ys[2] = {sy.cell, sy.next}, zs[2] = {sz.cell, sz.next};
+        for (int c = 0; c < 8; ++c) {
+            const float* gr = kGrad3[L.bits(xs[c & 1], ys[(c >> 1) & 1], zs[c >> 2]) & 15u];
+            g[c][0] = gr[0];
+            g[c][1] = gr[1];
+            g[c][2] = gr[2];
+        }
+    }
+};
+
 // Value in about [-1, 1] (not clamped); d (optional) receives d/du, d/dv, d/dw
 // in units per lattice cell.
-inline float gradient3(const Lattice<3>& L, const Split& sx, const Split& sy, const Split& sz, float* d) {
-    const float fx = sx.frac, fy = sy.frac, fz = sz.frac;
+inline float gradient3(const GradCache3& gc, float fx, float fy, float fz, float* d) {
     const float u = fade(fx), v = fade(fy), w = fade(fz);
     float n[8];
-    float g[8][3];
-    const int xs[2] = {sx.cell, sx.next}, ys[2] = {sy.cell, sy.next}, zs[2] = {sz.cell, sz.next};
     for (int c = 0; c < 8; ++c) {
         const int i = c & 1, j = (c >> 1) & 1, k = c >> 2;
-        const float* gr = kGrad3[L.bits(xs[i], ys[j], zs[k]) & 15u];
-        g[c][0] = gr[0];
-        g[c][1] = gr[1];
-        g[c][2] = gr[2];
-        n[c] = gr[0] * (fx - float(i)) + gr[1] * (fy - float(j)) + gr[2] * (fz - float(k));
+        n[c] = gc.g[c][0] * (fx - float(i)) + gc.g[c][1] * (fy - float(j)) + gc.g[c][2] * (fz - float(k));
     }
     // Trilinear blend with the faded weights.
-    const float a = n[0], b = n[1], c_ = n[2], e = n[3], f = n[4], h = n[5], k_ = n[6], l = n[7];
-    const float x00 = a + u * (b - a), x10 = c_ + u * (e - c_), x01 = f + u * (h - f), x11 = k_ + u * (l - k_);
+    const float x00 = n[0] + u * (n[1] - n[0]), x10 = n[2] + u * (n[3] - n[2]), x01 = n[4] + u * (n[5] - n[4]), x11 = n[6] + u * (n[7] - n[6]);
     const float y0 = x00 + v * (x10 - x00), y1 = x01 + v * (x11 - x01);
     const float value = y0 + w * (y1 - y0);
     if (d) {
@@ -47,9 +60,9 @@ inline float gradient3(const Lattice<3>& L, const Split& sx, const Split& sy, co
             const int i = c & 1, j = (c >> 1) & 1, k = c >> 2;
             const float wx = i ? u : 1 - u, wy = j ? v : 1 - v, wz = k ? w : 1 - w;
             const float dwx = i ? du : -du, dwy = j ? dv : -dv, dwz = k ? dw : -dw;
-            dx += dwx * wy * wz * n[c] + wx * wy * wz * g[c][0];
-            dy += wx * dwy * wz * n[c] + wx * wy * wz * g[c][1];
-            dz += wx * wy * dwz * n[c] + wx * wy * wz * g[c][2];
+            dx += dwx * wy * wz * n[c] + wx * wy * wz * gc.g[c][0];
+            dy += wx * dwy * wz * n[c] + wx * wy * wz * gc.g[c][1];
+            dz += wx * wy * dwz * n[c] + wx * wy * wz * gc.g[c][2];
         }
         d[0] = dx;
         d[1] = dy;
