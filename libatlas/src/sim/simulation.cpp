@@ -67,6 +67,7 @@ void Sounding::validate() const {
     check_range(surface_rh, 0, 1, "sounding.surface_rh");
     check_range(rh_lapse, -1e-3, 1e-3, "sounding.rh_lapse (1/m)");
     check_range(rh_above, 0, 1, "sounding.rh_above");
+    check_range(total_water, 0, 0.05, "sounding.total_water (kg/kg)");
 }
 
 double Sounding::theta_at(double z) const {
@@ -91,26 +92,44 @@ ReferenceProfile make_reference(const Sounding& s, int nz, double dx) {
     r.exner.resize(size_t(nz));
     r.pressure.resize(size_t(nz));
     r.rho.resize(size_t(nz));
+    r.qc.assign(size_t(nz), 0.0);
+    const bool saturated = s.total_water > 0;
     // Hydrostatic: dPi/dz = -g / (cp theta), integrated with fine sub-steps (midpoint rule).
     double pi = exner(s.surface_pressure), z = 0;
+    AdjustResult below{s.surface_theta, s.total_water, 0, 0, 0};
+    if (saturated) below = saturation_adjust(s.surface_theta, s.total_water, 0, s.surface_pressure);
+    double theta_below = below.theta;
     for (int k = 0; k < nz; ++k) {
         double zc = (k + 0.5) * dx;
         const int sub = 16;
         double h = (zc - z) / sub;
         for (int m = 0; m < sub; ++m) {
-            pi -= kGravity / (kCp * s.theta_at(z + (m + 0.5) * h)) * h;
+            double th = saturated ? theta_below : s.theta_at(z + (m + 0.5) * h);
+            pi -= kGravity / (kCp * th) * h;
         }
         z = zc;
         if (!(pi > 0.05)) throw Error("sim: the domain top reaches above the modelled atmosphere (Exner < 0.05); lower nz * dx");
         double p = kP00 * std::pow(pi, kCp / kRd);
-        double th = s.theta_at(zc);
+        double th, qv, qc = 0;
+        if (saturated) {
+            // The model's own reversible moist adiabat: the parcel from the cell
+            // below keeps theta, qv, qc (as advection does) and is adjusted at this
+            // cell's pressure (as the solver does), so the profile is neutral for it.
+            AdjustResult a = saturation_adjust(below.theta, below.qv, below.qc, p);
+            below = a;
+            th = a.theta, qv = a.qv, qc = a.qc;
+        } else {
+            th = s.theta_at(zc);
+            qv = s.rh_at(zc) * saturation_mixing_ratio(th * pi, p);
+        }
+        theta_below = th;
         double T = th * pi;
-        double qs = saturation_mixing_ratio(T, p);
         r.theta[size_t(k)] = th;
         r.exner[size_t(k)] = pi;
         r.pressure[size_t(k)] = p;
-        r.qv[size_t(k)] = s.rh_at(zc) * qs;
-        r.rho[size_t(k)] = p / (kRd * T * (1 + 0.608 * r.qv[size_t(k)]));
+        r.qv[size_t(k)] = qv;
+        r.qc[size_t(k)] = qc;
+        r.rho[size_t(k)] = p / (kRd * T * (1 + 0.608 * qv));
     }
     return r;
 }
@@ -161,8 +180,9 @@ Simulation::Simulation(const GridSpec& spec, const Sounding& sounding, const Sim
     vap_src_.assign(n, 0.f);
     thetav0_.resize(size_t(spec.nz));
     for (int k = 0; k < spec.nz; ++k) {
-        thetav0_[size_t(k)] = ref_.theta[size_t(k)] * (1 + 0.608 * ref_.qv[size_t(k)]);
+        thetav0_[size_t(k)] = ref_.theta[size_t(k)] * (1 + 0.608 * ref_.qv[size_t(k)] - ref_.qc[size_t(k)]);
         size_t base = size_t(k) * spec.nx * spec.ny;
+        std::fill_n(qc_.begin() + long(base), size_t(spec.nx) * spec.ny, float(ref_.qc[size_t(k)]));
         std::fill_n(theta_.begin() + long(base), size_t(spec.nx) * spec.ny, float(ref_.theta[size_t(k)]));
         std::fill_n(qv_.begin() + long(base), size_t(spec.nx) * spec.ny, float(ref_.qv[size_t(k)]));
     }

@@ -20,6 +20,12 @@ double saturation_mixing_ratio(double T, double p) {
 
 double exner(double p) { return std::pow(p / kP00, kRd / kCp); }
 
+double equivalent_potential_temperature(double T, double p, double qv, double qt) {
+    const double c = kCp + 4186.0 * qt;
+    const double e = p * qv / (kEps + qv);
+    return T * std::pow((p - e) / kP00, -kRd / c) * std::exp(kLv * qv / (c * T));
+}
+
 AdjustResult saturation_adjust(double theta, double qv, double qc, double p, double relax) {
     if (!std::isfinite(theta) || !std::isfinite(qv) || !std::isfinite(qc) || !std::isfinite(p) || !std::isfinite(relax))
         throw Error("sim saturation_adjust: non-finite theta, qv, qc, p or relax");

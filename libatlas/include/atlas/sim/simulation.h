@@ -39,6 +39,12 @@ struct Sounding {
     double surface_rh = 0.0;         // relative humidity at z = 0, [0, 1]
     double rh_lapse = 0.0;           // RH change per metre below the inversion, [-1e-3, 1e-3]
     double rh_above = 0.0;           // RH above the inversion, [0, 1]
+    // > 0: a saturated, moist-neutral atmosphere with this total water (kg/kg,
+    // [0, 0.05]) at every height; surface_theta is then the surface liquid-water
+    // potential temperature theta_l; the profile follows the solver's own
+    // reversible moist adiabat (theta kept, adjusted at each cell's pressure),
+    // and the RH and lapse members are ignored (the Bryan & Fritsch moist case).
+    double total_water = 0.0;
 
     // Throws atlas::Error naming the member out of range.
     void validate() const;
@@ -49,7 +55,7 @@ struct Sounding {
 // Reference profile at cell centres (nz entries each) from a Sounding by
 // hydrostatic integration dPi/dz = -g / (c_p theta0).
 struct ReferenceProfile {
-    std::vector<double> theta, qv, exner, pressure, rho;
+    std::vector<double> theta, qv, qc, exner, pressure, rho;
 };
 ReferenceProfile make_reference(const Sounding& s, int nz, double dx);
 

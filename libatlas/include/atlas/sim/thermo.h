@@ -32,6 +32,11 @@ double saturation_mixing_ratio(double T, double p);
 // Exner function Pi = (p / p00)^(Rd/cp).
 double exner(double p);
 
+// Equivalent potential temperature of saturated air, Bryan & Fritsch (2002)
+// eq. (6) form with constant L_v: theta_e = T (p_d/p00)^(-R_d/c) exp(L_v qv / (c T)),
+// c = c_pd + c_l qt, c_l = 4186 J/(kg K), p_d = p qv-free partial pressure. K.
+double equivalent_potential_temperature(double T, double p, double qv, double qt);
+
 struct AdjustResult {
     double theta = 0, qv = 0, qc = 0;
     double condensed = 0; // d, kg/kg (negative = evaporated)
