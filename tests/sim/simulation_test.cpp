@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -254,4 +255,26 @@ TEST(SimSimulation, GroundPatchGrowsCloudCappedByInversion) {
     EXPECT_GT(r.max_qc, 1e-5);
     EXPECT_LT(top, 1800.0);
     EXPECT_LT(r.water_drift, 1e-6);
+}
+
+// A saturated, cloudy, moist-neutral atmosphere (total water 0.020 kg/kg) at
+// rest stays at rest: |u| < 1e-3 m/s after 30 steps of 10 s, cloud water
+// unchanged to 1e-6 kg/kg, water drift across adjustment < 1e-6.
+TEST(SimSimulation, SaturatedNeutralAtmosphereAtRestStaysAtRest) {
+    GridSpec s = slab(16, 40, 200);
+    Sounding snd;
+    snd.surface_theta = 285;
+    snd.total_water = 0.02;
+    Simulation sim(s, snd, {});
+    std::vector<float> qc0 = sim.qc();
+    ASSERT_GT(*std::max_element(qc0.begin(), qc0.end()), 1e-3f);
+    StepReport r;
+    for (int n = 0; n < 30; ++n) {
+        r = sim.step(10.0);
+        ASSERT_LT(r.max_speed, 1e-3) << n;
+        ASSERT_LT(r.water_drift, 1e-6);
+    }
+    double dq = 0;
+    for (size_t c = 0; c < qc0.size(); ++c) dq = std::max(dq, double(std::fabs(sim.qc()[c] - qc0[c])));
+    EXPECT_LT(dq, 1e-6);
 }
