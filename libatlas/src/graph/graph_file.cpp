@@ -196,8 +196,11 @@ std::string closest_match(const std::string& word, const std::vector<std::string
 std::string name_hint(const std::string& word, const std::vector<std::string>& candidates, const std::string& intro) {
     if (auto s = closest_match(word, candidates); !s.empty()) return " (did you mean '" + s + "'?)";
     if (candidates.empty()) return "";
+    // Long lists (every node type) are cut: a message is not a manual.
+    constexpr size_t kMaxListed = 12;
     std::string list;
-    for (const auto& c : candidates) list += (list.empty() ? "" : ", ") + c;
+    for (size_t i = 0; i < candidates.size() && i < kMaxListed; ++i) list += (list.empty() ? "" : ", ") + candidates[i];
+    if (candidates.size() > kMaxListed) list += ", and " + std::to_string(candidates.size() - kMaxListed) + " more";
     return " (" + intro + ": " + list + ")";
 }
 
