@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 
 using namespace atlas;
@@ -117,5 +118,43 @@ TEST(NdfNodes, ClearErrors) {
         } catch (const Error& e) {
             EXPECT_NE(std::string(e.what()).find(c.names), std::string::npos) << e.what();
         }
+    }
+}
+
+namespace {
+std::string read_text(const std::filesystem::path& p) {
+    std::FILE* f = std::fopen(p.string().c_str(), "rb");
+    if (!f) return {};
+    std::string s;
+    char buf[4096];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
+    std::fclose(f);
+    return s;
+}
+} // namespace
+
+TEST(NdfGraphs, HzdWeatherShowsTheRainRule) {
+    const std::filesystem::path dir = std::filesystem::path(ATLAS_SOURCE_DIR) / "graphs";
+    Session s(builtin_nodes());
+    s.load_text(read_text(dir / "hzd_weather.yaml"), "hzd_weather.yaml", dir);
+    CookOptions co;
+    co.write_outputs = false;
+    auto w = as<Field2D>(s.get("weather", "out", co));
+    ndf::check_ndf_set(*w);
+    size_t certain = 0;
+    for (size_t i = 0; i < w->voxel_count(); ++i)
+        if (w->channel(ndf::Precipitation)[i] >= 1.0f) {
+            ++certain;
+            ASSERT_EQ(w->channel(ndf::Type)[i], 1.0f);
+            ASSERT_GE(w->channel(ndf::Coverage)[i], 0.7f);
+        }
+    EXPECT_GT(certain, 1000u); // the storm region exists
+    auto unity = as<Field2D>(s.get("unity_map", "out", co));
+    EXPECT_EQ(unity->channels(), 4);
+    for (const char* g : {"superstorm.yaml", "envelope_mountain.yaml"}) {
+        Session other(builtin_nodes());
+        other.load_text(read_text(dir / g), g, dir);
+        EXPECT_NO_THROW(other.cook(co)) << g;
     }
 }
