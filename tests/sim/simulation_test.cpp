@@ -278,3 +278,38 @@ TEST(SimSimulation, SaturatedNeutralAtmosphereAtRestStaysAtRest) {
     for (size_t c = 0; c < qc0.size(); ++c) dq = std::max(dq, double(std::fabs(sim.qc()[c] - qc0[c])));
     EXPECT_LT(dq, 1e-6);
 }
+
+// Outputs are Field3D over [0, n dx] with the grid's resolution; emitter fields
+// of the wrong resolution are refused; the report exports every stated key.
+TEST(SimSimulation, OutputsFieldSourcesAndReportExport) {
+    GridSpec s;
+    s.nx = 12;
+    s.ny = 10;
+    s.nz = 8;
+    s.dx = 25;
+    Sounding snd;
+    snd.surface_rh = 0.95;
+    Simulation sim(s, snd, {});
+    Field3D heat(Vec3i{{12, 10, 8}}, 1, Box3d{Vec3d{{0, 0, 0}}, Vec3d{{300, 250, 200}}});
+    Field3D vap(Vec3i{{12, 10, 8}}, 1, Box3d{Vec3d{{0, 0, 0}}, Vec3d{{300, 250, 200}}});
+    heat.at(0, 6, 5, 1) = 0.5f;
+    vap.at(0, 6, 5, 1) = 1e-4f;
+    sim.set_sources(heat, vap, "node 'src'");
+    Field3D wrong(Vec3i{{12, 10, 7}}, 1, Box3d{Vec3d{{0, 0, 0}}, Vec3d{{1, 1, 1}}});
+    EXPECT_THROW(sim.set_sources(wrong, vap, "node 'src'"), Error);
+    StepReport r = sim.step(4.0);
+    for (const Field3D& f : {sim.cloud_water(), sim.temperature(), sim.vapour(), sim.theta_perturbation()}) {
+        EXPECT_EQ(f.resolution(), (Vec3i{{12, 10, 8}}));
+        EXPECT_EQ(f.bounds().max, (Vec3d{{300, 250, 200}}));
+        for (float x : f.channel(0)) ASSERT_TRUE(std::isfinite(x));
+    }
+    Field3D v = sim.velocity_field();
+    EXPECT_EQ(v.channels(), 3);
+    EXPECT_GT(sim.theta_perturbation().at(0, 6, 5, 1), 0.f);
+    std::string j = r.to_json();
+    for (const char* key : {"\"divergence_l2\"", "\"divergence_max\"", "\"pressure_iterations\"", "\"water_drift\"",
+                            "\"theta_l_drift\"", "\"seconds_advect\"", "\"seconds_project\"", "\"substeps\""})
+        EXPECT_NE(j.find(key), std::string::npos) << key;
+    EXPECT_EQ(j.front(), '{');
+    EXPECT_EQ(j.back(), '}');
+}
