@@ -55,6 +55,21 @@ const std::vector<FormatEntry>& format_table() {
            {"alpha", "0..255: alpha where the field has no 4th channel (default 255)"},
            {"channels", "comma-separated channel names for R, G, B, A (up to 4; missing ones fill with 0, alpha with 'alpha')"}}},
          write_tga_slices_output},
+        {{"dds",
+          {".dds"},
+          {PortType::Field2D, PortType::Field3D},
+          "DDS texture (2D, array or volume) through the error-bounded compressor, with its manifest FILE.dds.json",
+          {{"encoding", "bc1, bc1-scalar, bc4, bc4-snorm, r8, r16, r16f, r32f, rgba8, rgba16f, rgba4 (default rgba16f)"},
+           {"quality", "fast, normal (default) or best"},
+           {"max_error", "guarantee |decoded - source| <= E for every texel, in source units (else the cook fails)"},
+           {"one_sided", "'below': guarantee decoded <= source (SDF field data)"},
+           {"allow_over_bound", "true: write even when blocks miss max_error"},
+           {"decoders", "decoder models the bounds hold for (default all: reference,nvidia,amd,tool8,conformant)"},
+           {"mips", "mip levels, or 'full' (default 1)"},
+           {"range", "'lo,hi': source values mapped to 0..1 (default: the data's min and max)"},
+           {"array", "true: a 3D field becomes a 2D texture array instead of a volume"},
+           kChannels}},
+         write_dds_output},
     };
     return table;
 }

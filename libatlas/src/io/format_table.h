@@ -27,5 +27,7 @@ std::vector<fs::path> write_exr_output(const Value&, const fs::path&, const Outp
 std::vector<fs::path> write_image_output(const Value&, const fs::path&, const OutputOptions&);
 std::vector<fs::path> write_vdb_output(const Value&, const fs::path&, const OutputOptions&);
 std::vector<fs::path> write_tga_slices_output(const Value&, const fs::path&, const OutputOptions&);
+// dds_output.cpp: through atlas::compress.
+std::vector<fs::path> write_dds_output(const Value&, const fs::path&, const OutputOptions&);
 
 } // namespace atlas::io::detail

@@ -1,0 +1,43 @@
+// The "dds" output format: graph outputs encoded through the error-bounded
+// compressor (atlas/compress/texture.h), with the same options as
+// `atlas compress`. Writes OUT.dds and its manifest OUT.dds.json.
+#include "atlas/compress/texture.h"
+#include "atlas/io/output_options.h"
+#include "atlas/io/readers.h"
+#include "format_table.h"
+
+namespace atlas::io::detail {
+
+std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path, const OutputOptions& options) {
+    const OptionReader o(options, path);
+    const Field3DPtr field = as_field3d(value);
+    compress::CompressOptions c;
+    try {
+        c.format = compress::parse_format(o.has("encoding") ? o.text("encoding") : std::string("rgba16f"));
+        if (o.has("quality")) c.quality = compress::parse_quality(o.text("quality").c_str());
+        if (o.has("decoders")) {
+            c.decoders = 0;
+            for (const auto& d : o.list("decoders")) c.decoders |= compress::decoder_bit(compress::parse_decoder(d));
+        }
+    } catch (const Error& e) {
+        throw Error(o.prefix() + e.what());
+    }
+    if (o.has("max_error")) c.max_error = o.number("max_error", 0.0f, 0.0f, INFINITY);
+    if (o.has("one_sided")) {
+        if (o.text("one_sided") != "below") o.bad("one_sided", "'below'");
+        c.one_sided_below = true;
+    }
+    c.allow_over_bound = o.flag("allow_over_bound");
+    if (o.has("mips")) c.mip_levels = o.text("mips") == "full" ? 0 : o.integer("mips", 1, 1, 16);
+    if (o.has("range")) c.value_range = o.range("range", 0.0f, 1.0f);
+    for (const auto& name : o.list("channels")) {
+        const int ch = field->find_channel(name);
+        if (ch < 0) o.bad("channels", "names of the value's channels");
+        c.channels.push_back(ch);
+    }
+    c.as_array = o.flag("array");
+    compress::compress_to_dds(*field, path, c);
+    return {path, fs::path(path.string() + ".json")};
+}
+
+} // namespace atlas::io::detail
