@@ -98,8 +98,8 @@ TEST(SimPressure, IterationsBoundedFrom16To64) {
         if (n == 16) it16 = r.iterations;
         if (n == 64) it64 = r.iterations;
     }
-    EXPECT_LE(it64, 30);
-    EXPECT_LE(it64, 2 * it16 + 4) << it16 << " " << it64;
+    EXPECT_LE(it64, 12);
+    EXPECT_LE(it64, it16 + 3) << it16 << " " << it64;
 }
 
 TEST(SimPressure, RejectsNaNAndMismatch) {
