@@ -11,6 +11,7 @@
 #include <functional>
 
 #include "atlas/core/field_math.h"
+#include "atlas/noise/value_noise.h"
 
 using namespace atlas;
 using namespace atlas::ndf;
@@ -187,4 +188,17 @@ TEST(NdfSet, ChannelsAndPrecipitationRule) {
     EXPECT_THROW(make_ndf_set({{4, 4}}, kBox, 5000, 4000, nullptr), Error);
     EXPECT_THROW(apply_precipitation_rule(set, PrecipitationRule{0.8, 0.8, 0.7, 1.0}, nullptr), Error);
     EXPECT_THROW(apply_precipitation_rule(Field2D({{4, 4}}, 8, kBox), rule, nullptr), Error);
+}
+
+TEST(NdfGenerators, NoiseMatchesTheNoiseLibrary) {
+    // noise2d interpolates library lattice values row by row; it must agree
+    // with the library's own evaluation at the texel centres.
+    const Vec2i res{{40, 24}};
+    const Vec3i period{{5, 3, 1}};
+    Field2D n = noise2d(res, kBox, {{5, 3}}, 1, 0.5, 17, nullptr);
+    for (int y = 0; y < res[1]; ++y)
+        for (int x = 0; x < res[0]; ++x) {
+            const double lx = (x + 0.5) * period[0] / res[0], ly = (y + 0.5) * period[1] / res[1];
+            ASSERT_NEAR(n.at(0, x, y), noise::value_noise(lx, ly, 0.0, period, 17), 2e-6) << x << " " << y;
+        }
 }

@@ -16,6 +16,33 @@ Field2D new_map(Vec2i res, Box2d bounds, const MemoryBudget* budget) {
     return Field2D(res, 1, bounds, {"value"}, budget);
 }
 bool finite2(Vec2d p) { return std::isfinite(p[0]) && std::isfinite(p[1]); }
+
+// One row of 2D value noise (z fixed at a lattice plane) at texel centres
+// x = (i + 0.5) dx: the row's lattice values come from the noise library at
+// integer points (where its interpolation returns the lattice value exactly),
+// blended once in y, then only the x interpolation runs per texel - the
+// library's row function would hash 8 corners per texel for the same result
+// up to float rounding. Same quintic fade, same tiling.
+float quintic(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
+void value_noise_row_2d(std::vector<float>& out, std::vector<float>& lat, double dx, double y, Vec3i p, uint32_t seed) {
+    const double fy = std::floor(y);
+    const float ty = quintic(float(y - fy));
+    const int y0 = int(int64_t(fy) % p[1]), y1 = int((int64_t(fy) + 1) % p[1]);
+    lat.resize(size_t(p[0]));
+    for (int i = 0; i < p[0]; ++i) {
+        const float a = noise::value_noise(double(i), double(y0), 0.0, p, seed);
+        const float b = noise::value_noise(double(i), double(y1), 0.0, p, seed);
+        lat[size_t(i)] = a + (b - a) * ty;
+    }
+    for (size_t i = 0; i < out.size(); ++i) {
+        const double x = (double(i) + 0.5) * dx;
+        const double fx = std::floor(x);
+        const float tx = quintic(float(x - fx));
+        const int64_t xi = int64_t(fx);
+        const float a = lat[size_t(xi % p[0])], b = lat[size_t((xi + 1) % p[0])];
+        out[i] = a + (b - a) * tx;
+    }
+}
 } // namespace
 
 Field2D gradient_linear(Vec2i res, Box2d bounds, Vec2d p0, Vec2d p1, const MemoryBudget* budget) {
@@ -58,6 +85,7 @@ Field2D noise2d(Vec2i res, Box2d bounds, Vec2i period, int octaves, double gain,
     for (int o = 0; o < octaves; ++o, amp *= gain) norm += amp;
     tbb::parallel_for(0, res[1], [&](int y) {
         std::vector<float> row(static_cast<size_t>(res[0]));
+        std::vector<float> lattice;
         float* dst = out.data() + f.index(0, y);
         std::fill(dst, dst + res[0], 0.0f);
         double a = 1.0;
@@ -66,7 +94,13 @@ Field2D noise2d(Vec2i res, Box2d bounds, Vec2i period, int octaves, double gain,
             // Texel centres in lattice units: (i + 0.5) / res * period; the
             // lattice repeats every `period` cells, so the map tiles.
             const double dx = double(p[0]) / res[0];
-            noise::value_noise_row(row, 0.5 * dx, dx, (y + 0.5) * p[1] / res[1], 0.0, p, seed + uint32_t(o) * 1013u);
+            const double yy = (y + 0.5) * p[1] / res[1];
+            const uint32_t s = seed + uint32_t(o) * 1013u;
+            if (p[0] <= 4 * res[0]) {
+                value_noise_row_2d(row, lattice, dx, yy, p, s);
+            } else {
+                noise::value_noise_row(row, 0.5 * dx, dx, yy, 0.0, p, s);
+            }
             for (int x = 0; x < res[0]; ++x) dst[x] += float(a / norm) * row[size_t(x)];
         }
         for (int x = 0; x < res[0]; ++x) dst[x] = std::clamp(dst[x], 0.0f, 1.0f);
