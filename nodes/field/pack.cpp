@@ -32,11 +32,10 @@ std::shared_ptr<F> pack(CookContext& ctx, const std::vector<std::shared_ptr<cons
 
 void cook(CookContext& ctx) {
     std::vector<Value> in;
-    for (const char* p : kPorts) {
-        if (ctx.has_input(p)) {
-            if (in.size() != size_t(&p - kPorts)) ctx.fail(std::string("input '") + p + "' is connected but an earlier one is not");
-            in.push_back(ctx.input(p));
-        }
+    for (size_t i = 0; i < 4; ++i) {
+        if (!ctx.has_input(kPorts[i])) continue;
+        if (in.size() != i) ctx.fail(std::string("input '") + kPorts[i] + "' is connected but an earlier one is not");
+        in.push_back(ctx.input(kPorts[i]));
     }
     std::vector<std::string> names;
     std::stringstream ss(ctx.get_string("names"));

@@ -330,3 +330,29 @@ TEST_F(Fixture, GetReturnsAValueWithoutWriting) {
     EXPECT_FLOAT_EQ(f->at(0, 3, 3, 1), 5.0f);
     EXPECT_FALSE(fs::exists(dir / "out"));
 }
+
+TEST_F(Fixture, PackNodeStacksChannelsInOrder) {
+    const char* g = R"(atlas: 1
+nodes:
+  x: {type: noise/value, params: {resolution: [8, 8, 2], seed: 1}}
+  y: {type: noise/value, params: {resolution: [8, 8, 2], seed: 2}}
+  p: {type: field/pack, inputs: {r: x, g: y}, params: {names: "first,second"}}
+  bad: {type: field/pack, inputs: {r: x, b: y}}
+outputs:
+  - {node: p, file: p.exr}
+)";
+    Session s = session(g);
+    auto p = std::get<Field3DPtr>(s.get("p", "out"));
+    auto x = std::get<Field3DPtr>(s.get("x", "out"));
+    auto y = std::get<Field3DPtr>(s.get("y", "out"));
+    ASSERT_EQ(p->channels(), 2);
+    EXPECT_EQ(p->channel_names(), (std::vector<std::string>{"first", "second"}));
+    EXPECT_TRUE(std::equal(x->channel(0).begin(), x->channel(0).end(), p->channel(0).begin()));
+    EXPECT_TRUE(std::equal(y->channel(0).begin(), y->channel(0).end(), p->channel(1).begin()));
+    try {
+        s.get("bad", "out");
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("input 'b' is connected but an earlier one is not"), std::string::npos) << e.what();
+    }
+}
