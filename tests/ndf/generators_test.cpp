@@ -202,3 +202,24 @@ TEST(NdfGenerators, NoiseMatchesTheNoiseLibrary) {
             ASSERT_NEAR(n.at(0, x, y), noise::value_noise(lx, ly, 0.0, period, 17), 2e-6) << x << " " << y;
         }
 }
+
+TEST(NdfGenerators, ShapeFalloffReachesPastTheLongRadius) {
+    // A tall ellipse (ry > rx): bounding-box culling must not cut the falloff
+    // beside the long axis. At 45 degrees outside the edge, within the falloff.
+    const auto shapes = parse_shapes("ellipse 500 500 20 300 1 200");
+    const Field2D f = paint_shapes({{200, 200}}, kBox, shapes, nullptr);
+    int in_falloff = 0;
+    for (int y = 0; y < 200; ++y)
+        for (int x = 0; x < 200; ++x) {
+            const Vec2d p = f.texel_center(x, y);
+            const double dx = std::abs(p[0] - 500);
+            if (dx > 20 + 200 + 300) {
+                ASSERT_EQ(f.at(0, x, y), 0.0f); // beyond every possible reach
+            }
+            if (f.at(0, x, y) > 0 && f.at(0, x, y) < 1) ++in_falloff;
+        }
+    EXPECT_GT(in_falloff, 500);
+    // Straight beside the centre, 100 m outside the 20 m half-width: inside the falloff.
+    EXPECT_GT(f.at(0, int(620 / 5), int(500 / 5)), 0.0f);
+    EXPECT_LT(f.at(0, int(620 / 5), int(500 / 5)), 1.0f);
+}

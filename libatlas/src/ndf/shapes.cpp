@@ -133,12 +133,32 @@ Field2D paint_shapes(Vec2i res, Box2d bounds, const std::vector<Shape>& shapes, 
     for (size_t i = 0; i < shapes.size(); ++i) check_shape(shapes[i], i);
     Field2D f(res, 1, bounds, {"value"}, budget);
     auto out = f.channel(0);
+    // Conservative bounding boxes: a texel outside one is beyond the shape's
+    // falloff (weight exactly 0), so skipping it changes no value.
+    std::vector<Box2d> boxes;
+    for (const Shape& s : shapes) {
+        Box2d b{s.points[0], s.points[0]};
+        for (const Vec2d& q : s.points)
+            for (int a = 0; a < 2; ++a) b.min[a] = std::min(b.min[a], q[a]), b.max[a] = std::max(b.max[a], q[a]);
+        double grow = s.falloff;
+        if (s.kind == Shape::Kind::Ellipse) grow += std::max(s.radii[0], s.radii[1]);
+        if (s.kind == Shape::Kind::Stroke) grow += 0.5 * s.width;
+        for (int a = 0; a < 2; ++a) {
+            const double margin = 1e-6 * (std::abs(b.min[a]) + std::abs(b.max[a]) + grow) + 1e-12;
+            b.min[a] -= grow + margin;
+            b.max[a] += grow + margin;
+        }
+        boxes.push_back(b);
+    }
     tbb::parallel_for(0, res[1], [&](int y) {
         for (int x = 0; x < res[0]; ++x) {
             const Vec2d p = f.texel_center(x, y);
             double v = 0;
             bool any = false;
-            for (const Shape& s : shapes) {
+            for (size_t k = 0; k < shapes.size(); ++k) {
+                const Shape& s = shapes[k];
+                const Box2d& bb = boxes[k];
+                if (p[0] < bb.min[0] || p[0] > bb.max[0] || p[1] < bb.min[1] || p[1] > bb.max[1]) continue;
                 const double d = outside_distance(s, p);
                 double w;
                 if (d <= 0) w = 1;
