@@ -313,3 +313,19 @@ TEST(SimSimulation, OutputsFieldSourcesAndReportExport) {
     EXPECT_EQ(j.front(), '{');
     EXPECT_EQ(j.back(), '}');
 }
+
+// An ambient shear profile through open x faces is divergence-free, so it is
+// kept (to 1e-4 m/s) and carries a neutral atmosphere along unchanged.
+TEST(SimSimulation, WindShearProfileThroughOpenFaces) {
+    GridSpec s = slab(16, 12, 100);
+    s.boundary[0] = s.boundary[1] = Boundary::Open;
+    SimOptions o;
+    for (int k = 0; k < s.nz; ++k) o.wind.push_back(2.0 + 0.5 * k);
+    Simulation sim(s, Sounding{}, o);
+    for (int n = 0; n < 10; ++n) sim.step(10.0);
+    const auto& v = sim.velocity();
+    for (int k = 0; k < s.nz; ++k)
+        for (int i = 0; i <= s.nx; ++i) ASSERT_NEAR(v.u[v.iu(i, 0, k)], o.wind[size_t(k)], 1e-4) << i << " " << k;
+    o.wind.pop_back();
+    EXPECT_THROW(Simulation(s, Sounding{}, o), Error);
+}
