@@ -1,7 +1,8 @@
 // atlas/sim/pressure.h - pressure projection: makes a MAC velocity divergence-free.
 //
 // Solves div(rho0 grad phi) = div(rho0 u) by conjugate gradients preconditioned
-// with one symmetric multigrid V-cycle (Galerkin aggregation coarse grids,
+// with one symmetric multigrid V-cycle (Galerkin aggregation coarse grids, coarse
+// correction over-corrected by 1.8,
 // red-black Gauss-Seidel smoothing, a dense Cholesky solve on the coarsest
 // grid), then sets u -= grad phi. rho0(z) is the anelastic reference density
 // (all ones = Boussinesq). Closed faces are Neumann, open faces Dirichlet
