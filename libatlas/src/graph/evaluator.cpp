@@ -394,7 +394,9 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             } catch (const CancelledError&) {
                 throw;
             } catch (const std::exception& e) {
-                throw Error(o->where.str() + ": output '" + o->file + "': " + e.what());
+                // Writers already name the output ("output 'x.png': ..."); add the graph position.
+                const std::string msg = e.what();
+                throw Error(o->where.str() + ": " + (msg.rfind("output '", 0) == 0 ? msg : "output '" + o->file + "': " + msg));
             }
         }
         // Everything written: move it into place.
