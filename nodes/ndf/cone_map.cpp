@@ -19,16 +19,7 @@ void declare(NodeDeclaration& d) {
 
 void cook(CookContext& ctx) {
     auto in = ctx.input_field2d("in");
-    const std::string& name = ctx.get_string("channel");
-    int c = in->find_channel(name);
-    if (c < 0) {
-        try {
-            c = std::stoi(name);
-        } catch (const std::exception&) {
-            ctx.fail("'channel': no channel named '" + name + "'");
-        }
-        if (c < 0 || c >= in->channels()) ctx.fail("'channel': index out of range");
-    }
+    const int c = channel_param(ctx, *in, "channel");
     const Vec2d vs = in->voxel_size();
     if (std::abs(vs[0] - vs[1]) > 1e-6 * std::max(vs[0], vs[1])) ctx.warn("texels are not square: cones use the smaller side (conservative)");
     ndf::ConeMapOptions opt;

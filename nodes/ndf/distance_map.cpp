@@ -20,16 +20,7 @@ void declare(NodeDeclaration& d) {
 
 void cook(CookContext& ctx) {
     auto in = ctx.input_field2d("in");
-    const std::string& name = ctx.get_string("channel");
-    int c = in->find_channel(name);
-    if (c < 0) {
-        try {
-            c = std::stoi(name);
-        } catch (const std::exception&) {
-            ctx.fail("'channel': no channel named '" + name + "'");
-        }
-        if (c < 0 || c >= in->channels()) ctx.fail("'channel': index out of range");
-    }
+    const int c = channel_param(ctx, *in, "channel");
     if (!(ctx.get_float("z_max") > ctx.get_float("z_min"))) ctx.fail("'z_max' must be greater than 'z_min'");
     const uint64_t voxels = uint64_t(in->voxel_count()) * uint64_t(ctx.get_int("layers"));
     ctx.check_memory(voxels * (sizeof(float) + sizeof(double)), "the distance map");

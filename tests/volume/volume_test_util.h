@@ -2,6 +2,7 @@
 #pragma once
 
 #include "atlas/core/field.h"
+#include "atlas/volume/mesh_primitives.h"
 
 #include <cmath>
 #include <random>
@@ -51,42 +52,11 @@ inline Field3D random_blobs(Vec3i res, Vec3d voxel, unsigned seed, int blobs = 5
 
 namespace atlas::volume::test {
 
-// Closed UV sphere, outward-facing triangles.
-inline Mesh uv_sphere(Vec3d c, double r, int stacks = 24, int slices = 48) {
-    Mesh m;
-    m.vertices.push_back({{float(c[0]), float(c[1]), float(c[2] + r)}});
-    for (int i = 1; i < stacks; ++i) {
-        const double th = std::numbers::pi * i / stacks;
-        for (int j = 0; j < slices; ++j) {
-            const double ph = 2 * std::numbers::pi * j / slices;
-            m.vertices.push_back({{float(c[0] + r * std::sin(th) * std::cos(ph)), float(c[1] + r * std::sin(th) * std::sin(ph)),
-                                   float(c[2] + r * std::cos(th))}});
-        }
-    }
-    m.vertices.push_back({{float(c[0]), float(c[1]), float(c[2] - r)}});
-    const uint32_t south = uint32_t(m.vertices.size() - 1);
-    auto ring = [&](int i, int j) { return uint32_t(1 + (i - 1) * slices + ((j % slices + slices) % slices)); };
-    for (int j = 0; j < slices; ++j) m.triangles.push_back({0u, ring(1, j), ring(1, j + 1)});
-    for (int i = 1; i + 1 < stacks; ++i)
-        for (int j = 0; j < slices; ++j) {
-            m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
-            m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
-        }
-    for (int j = 0; j < slices; ++j) m.triangles.push_back({ring(stacks - 1, j), south, ring(stacks - 1, j + 1)});
-    return m;
-}
+// Test meshes come from the library's primitives (they are inputs here, not
+// what is under test; mesh_primitives has its own tests).
+inline Mesh uv_sphere(Vec3d c, double r, int stacks = 24, int slices = 48) { return make_sphere_mesh(c, r, stacks, slices); }
 
 // Axis-aligned closed box, outward-facing.
-inline Mesh box_mesh(Vec3d lo, Vec3d hi) {
-    Mesh m;
-    for (int i = 0; i < 8; ++i)
-        m.vertices.push_back({{float(i & 1 ? hi[0] : lo[0]), float(i & 2 ? hi[1] : lo[1]), float(i & 4 ? hi[2] : lo[2])}});
-    const uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (const auto& f : q) {
-        m.triangles.push_back({f[0], f[1], f[2]});
-        m.triangles.push_back({f[0], f[2], f[3]});
-    }
-    return m;
-}
+inline Mesh box_mesh(Vec3d lo, Vec3d hi) { return make_box_mesh((lo + hi) * 0.5, (hi - lo) * 0.5); }
 
 } // namespace atlas::volume::test
