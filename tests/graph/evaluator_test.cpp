@@ -356,3 +356,26 @@ outputs:
         EXPECT_NE(std::string(e.what()).find("input 'b' is connected but an earlier one is not"), std::string::npos) << e.what();
     }
 }
+
+TEST_F(Fixture, DdsOutputReportsItsErrorInTheCookReport) {
+    const char* g = R"(atlas: 1
+nodes:
+  n: {type: noise/value, params: {resolution: [16, 16, 2], octaves: 3}}
+outputs:
+  - {node: n, file: n.dds, options: {encoding: bc4, max_error: 0.1}}
+  - {node: n, file: n.exr}
+)";
+    Session s = session(g);
+    CookResult r = s.cook(options());
+    ASSERT_EQ(r.outputs.size(), 2u);
+    const auto& m = r.outputs[0].metrics;
+    ASSERT_TRUE(m.count("max_error_0") && m.count("bound_max_error") && m.count("encode_seconds"));
+    EXPECT_GT(m.at("max_error_0"), 0.0);           // BC4 of noise is lossy
+    EXPECT_LE(m.at("max_error_0"), m.at("bound_max_error"));
+    EXPECT_LE(m.at("bound_max_error"), 0.1);       // the requested bound holds
+    EXPECT_EQ(m.at("blocks_over_bound"), 0.0);
+    EXPECT_TRUE(r.outputs[1].metrics.empty());     // lossless EXR measures nothing
+    auto j = nlohmann::json::parse(r.to_json("t.yaml"));
+    EXPECT_TRUE(j["outputs"][0]["metrics"].contains("bound_max_error"));
+    EXPECT_TRUE(fs::exists(dir / "out" / "n.dds.json"));
+}

@@ -388,8 +388,8 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 auto& st = staging[root];
                 if (!st) st = std::make_unique<StagedOutputs>(root);
                 if (opt.progress.on_progress) opt.progress.on_progress({"writing " + o->file, 1.0, total, total});
-                io::write_value(values.at(o->node)->at(o->port), st->stage(rel), o->format, o->options);
-                OutputReport orep{o->node, o->port, o->file, o->format, {}};
+                OutputReport orep{o->node, o->port, o->file, o->format, {}, {}};
+                io::write_value(values.at(o->node)->at(o->port), st->stage(rel), o->format, o->options, &orep.metrics);
                 result.outputs.push_back(orep);
             } catch (const CancelledError&) {
                 throw;
@@ -411,7 +411,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             }
         }
     } else {
-        for (const GraphOutput* o : outputs) result.outputs.push_back({o->node, o->port, o->file, o->format, {}});
+        for (const GraphOutput* o : outputs) result.outputs.push_back({o->node, o->port, o->file, o->format, {}, {}});
     }
     result.seconds = seconds_since(t_start);
     return result;

@@ -38,6 +38,9 @@ std::string CookResult::to_json(const std::string& graph_file) const {
         json files = json::array();
         for (const auto& p : o.written) files.push_back(p.string());
         jo["written"] = files;
+        json om = json::object();
+        for (const auto& [k, v] : o.metrics) om[k] = std::isfinite(v) ? json(v) : json(nullptr);
+        jo["metrics"] = om;
         outs.push_back(jo);
     }
     doc["outputs"] = outs;

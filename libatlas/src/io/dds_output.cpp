@@ -8,7 +8,7 @@
 
 namespace atlas::io::detail {
 
-std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path, const OutputOptions& options) {
+std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path, const OutputOptions& options, OutputMetrics& metrics) {
     const OptionReader o(options, path);
     const Field3DPtr field = as_field3d(value);
     compress::CompressOptions c;
@@ -36,7 +36,15 @@ std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path,
         c.channels.push_back(ch);
     }
     c.as_array = o.flag("array");
-    compress::compress_to_dds(*field, path, c);
+    const compress::CompressReport r = compress::compress_to_dds(*field, path, c);
+    // Error against run time, for the cook report.
+    for (size_t ch = 0; ch < r.max_error.size(); ++ch) {
+        metrics["max_error_" + std::to_string(ch)] = r.max_error[ch];
+        metrics["rmse_" + std::to_string(ch)] = r.rmse[ch];
+    }
+    metrics["bound_max_error"] = r.bound_max_error;
+    metrics["blocks_over_bound"] = double(r.blocks_over_bound.size());
+    metrics["encode_seconds"] = r.encode_seconds;
     return {path, fs::path(path.string() + ".json")};
 }
 

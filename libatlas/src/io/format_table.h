@@ -12,7 +12,9 @@
 namespace atlas::io::detail {
 
 // Writes `value` (of a type the format accepts) to `path`; returns the files written.
-using FormatWriter = std::vector<fs::path> (*)(const Value& value, const fs::path& path, const OutputOptions& options);
+// A writer may record error metrics it measured in `metrics`.
+using FormatWriter = std::vector<fs::path> (*)(const Value& value, const fs::path& path, const OutputOptions& options,
+                                               OutputMetrics& metrics);
 
 struct FormatEntry {
     OutputFormat format;
@@ -23,11 +25,11 @@ struct FormatEntry {
 const std::vector<FormatEntry>& format_table();
 
 // The writers (format_writers.cpp).
-std::vector<fs::path> write_exr_output(const Value&, const fs::path&, const OutputOptions&);
-std::vector<fs::path> write_image_output(const Value&, const fs::path&, const OutputOptions&);
-std::vector<fs::path> write_vdb_output(const Value&, const fs::path&, const OutputOptions&);
-std::vector<fs::path> write_tga_slices_output(const Value&, const fs::path&, const OutputOptions&);
+std::vector<fs::path> write_exr_output(const Value&, const fs::path&, const OutputOptions&, OutputMetrics&);
+std::vector<fs::path> write_image_output(const Value&, const fs::path&, const OutputOptions&, OutputMetrics&);
+std::vector<fs::path> write_vdb_output(const Value&, const fs::path&, const OutputOptions&, OutputMetrics&);
+std::vector<fs::path> write_tga_slices_output(const Value&, const fs::path&, const OutputOptions&, OutputMetrics&);
 // dds_output.cpp: through atlas::compress.
-std::vector<fs::path> write_dds_output(const Value&, const fs::path&, const OutputOptions&);
+std::vector<fs::path> write_dds_output(const Value&, const fs::path&, const OutputOptions&, OutputMetrics&);
 
 } // namespace atlas::io::detail

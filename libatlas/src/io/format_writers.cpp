@@ -87,7 +87,7 @@ std::string lower_extension(const fs::path& p) {
 
 } // namespace
 
-std::vector<fs::path> write_exr_output(const Value& v, const fs::path& p, const OutputOptions& opts) {
+std::vector<fs::path> write_exr_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
     const OptionReader o(opts, p);
     ExrOptions eo;
     eo.half = o.flag("half");
@@ -98,7 +98,7 @@ std::vector<fs::path> write_exr_output(const Value& v, const fs::path& p, const 
     return {p};
 }
 
-std::vector<fs::path> write_image_output(const Value& v, const fs::path& p, const OutputOptions& opts) {
+std::vector<fs::path> write_image_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
     const OptionReader o(opts, p);
     const bool tga = lower_extension(p) == ".tga";
     ImageOptions io;
@@ -114,7 +114,7 @@ std::vector<fs::path> write_image_output(const Value& v, const fs::path& p, cons
     return {p};
 }
 
-std::vector<fs::path> write_vdb_output(const Value& v, const fs::path& p, const OutputOptions& opts) {
+std::vector<fs::path> write_vdb_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
     const OptionReader o(opts, p);
     VdbOptions vo;
     vo.tolerance = o.number("tolerance", 0.0f, 0.0f, std::numeric_limits<float>::infinity());
@@ -124,7 +124,7 @@ std::vector<fs::path> write_vdb_output(const Value& v, const fs::path& p, const 
     return {p};
 }
 
-std::vector<fs::path> write_tga_slices_output(const Value& v, const fs::path& p, const OutputOptions& opts) {
+std::vector<fs::path> write_tga_slices_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
     const OptionReader o(opts, p);
     if (lower_extension(p) == ".tga")
         throw Error(o.prefix() + "format 'tga-slices' takes DIR/STEM (it writes STEM.001.tga, STEM.002.tga, ...), not a .tga file name");

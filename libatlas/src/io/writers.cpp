@@ -34,7 +34,8 @@ std::string output_format_for_path(const fs::path& path) {
                 " (known: " + known + "); name the format explicitly (e.g. format: tga-slices)");
 }
 
-std::vector<fs::path> write_value(const Value& value, const fs::path& path, const std::string& format, const OutputOptions& options) {
+std::vector<fs::path> write_value(const Value& value, const fs::path& path, const std::string& format, const OutputOptions& options,
+                                  OutputMetrics* metrics) {
     const auto& table = detail::format_table();
     const auto it = std::find_if(table.begin(), table.end(), [&](const detail::FormatEntry& e) { return e.format.name == format; });
     if (it == table.end()) {
@@ -57,7 +58,10 @@ std::vector<fs::path> write_value(const Value& value, const fs::path& path, cons
             throw Error(prefix(path) + "unknown option '" + kv.first + "' (known: " + list + ")");
         }
     }
-    return it->write(value, path, options);
+    OutputMetrics measured;
+    auto files = it->write(value, path, options, measured);
+    if (metrics) *metrics = std::move(measured);
+    return files;
 }
 
 } // namespace atlas::io

@@ -49,6 +49,7 @@ struct NodeReport {
 struct OutputReport {
     std::string node, port, file, format;
     std::vector<std::filesystem::path> written;
+    std::map<std::string, double> metrics; // what the writer measured, e.g. a DDS encode's errors
 };
 
 struct CookResult {

@@ -40,6 +40,10 @@ std::string output_format_for_path(const fs::path& path);
 // for "tga-slices", where `path` is DIR/STEM and files are DIR/STEM.001.tga...).
 // Throws atlas::Error on a value the format cannot write, an unknown option
 // or a bad option value (naming the option and what it expects).
-std::vector<fs::path> write_value(const Value& value, const fs::path& path, const std::string& format, const OutputOptions& options);
+// Error metrics a writer measured (e.g. a DDS encode's max error), name -> value.
+using OutputMetrics = std::map<std::string, double>;
+
+std::vector<fs::path> write_value(const Value& value, const fs::path& path, const std::string& format, const OutputOptions& options,
+                                  OutputMetrics* metrics = nullptr);
 
 } // namespace atlas::io
