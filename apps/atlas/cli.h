@@ -60,7 +60,4 @@ int run_preview(const Args&);
 int run_compress(const Args&);
 int run_decompress(const Args&);
 
-// Terminal progress bar on stderr (only when stderr is a terminal).
-class ProgressBar;
-
 } // namespace atlas::cli

@@ -59,6 +59,8 @@ std::vector<fs::path> StagedOutputs::staged_files() const {
     return files;
 }
 
+fs::path StagedOutputs::final_path(const fs::path& staged) const { return root_ / staged.lexically_relative(staging_); }
+
 std::vector<fs::path> StagedOutputs::commit() {
     std::vector<fs::path> done;
     for (const auto& rel : staged_files()) {

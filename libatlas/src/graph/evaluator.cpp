@@ -15,7 +15,6 @@
 #include <chrono>
 #include <exception>
 #include <functional>
-#include <mutex>
 #include <set>
 
 namespace atlas {
@@ -268,7 +267,6 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     }
 
     // 6. Cook, level by level; nodes of one level in parallel.
-    std::mutex mutex;
     std::atomic<int> done{0};
     auto report_progress = [&](const std::string& task, double node_fraction) {
         if (!opt.progress.on_progress) return;
@@ -287,10 +285,8 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 try {
                     opt.progress.poll();
                     std::map<std::string, Value> inputs;
-                    {
-                        std::lock_guard<std::mutex> lock(mutex);
-                        for (const auto& [port, b] : n.inputs) inputs[port] = values.at(b.node)->at(source_port(g, registry_, b));
-                    }
+                    // `values` is only written between levels, so reading it here needs no lock.
+                    for (const auto& [port, b] : n.inputs) inputs[port] = values.at(b.node)->at(source_port(g, registry_, b));
                     NodeParams params(&s.type->decl, resolved_params(n, *s.type), g.base_dir);
                     ProgressSink node_progress;
                     node_progress.is_cancelled = opt.progress.is_cancelled;
@@ -375,7 +371,6 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         for (const auto& t : targets) values_out->push_back(values.at(t.first)->at(t.second));
     if (opt.write_outputs && !outputs.empty()) {
         std::map<std::filesystem::path, std::unique_ptr<StagedOutputs>> staging;
-        std::vector<std::pair<size_t, std::vector<std::filesystem::path>>> written;
         for (const GraphOutput* o : outputs) {
             try {
                 opt.progress.poll();
@@ -389,7 +384,8 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 if (!st) st = std::make_unique<StagedOutputs>(root);
                 if (opt.progress.on_progress) opt.progress.on_progress({"writing " + o->file, 1.0, total, total});
                 OutputReport orep{o->node, o->port, o->file, o->format, {}, {}};
-                io::write_value(values.at(o->node)->at(o->port), st->stage(rel), o->format, o->options, &orep.metrics);
+                for (const auto& staged : io::write_value(values.at(o->node)->at(o->port), st->stage(rel), o->format, o->options, &orep.metrics))
+                    orep.written.push_back(st->final_path(staged));
                 result.outputs.push_back(orep);
             } catch (const CancelledError&) {
                 throw;
@@ -400,16 +396,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             }
         }
         // Everything written: move it into place.
-        std::vector<std::filesystem::path> all;
-        for (auto& [root, st] : staging)
-            for (auto& p : st->commit()) all.push_back(p);
-        for (auto& orep : result.outputs) {
-            std::filesystem::path stem = resolve_output_path(opt.out_dir, orep.file, opt.allow_outside_out);
-            for (const auto& p : all) {
-                std::string ps = p.lexically_normal().string(), ss = stem.lexically_normal().string();
-                if (ps == ss || ps.rfind(ss + ".", 0) == 0 || ps.rfind(ss + "/", 0) == 0) orep.written.push_back(p);
-            }
-        }
+        for (auto& [root, st] : staging) st->commit();
     } else {
         for (const GraphOutput* o : outputs) result.outputs.push_back({o->node, o->port, o->file, o->format, {}, {}});
     }

@@ -29,6 +29,8 @@ public:
     // Moves every staged file into place (rename within one file system).
     // Returns the final paths.
     std::vector<fs::path> commit();
+    // Where a file staged at `staged` (a path under the staging area) lands on commit.
+    fs::path final_path(const fs::path& staged) const;
     // Every file the writers produced in the staging area, as relative paths.
     std::vector<fs::path> staged_files() const;
 
