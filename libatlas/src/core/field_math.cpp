@@ -62,24 +62,45 @@ void parallel_blocks(size_t n, Fn&& fn) {
                       tbb::simple_partitioner());
 }
 
+// One operand of a per-voxel operation: a field channel, or a constant when
+// the operand is not connected.
+struct Operand {
+    const float* values = nullptr;
+    float constant = 0.0f;
+    float at(size_t i) const { return values ? values[i] : constant; }
+};
+
+Operand operand(const Value& v, int step, int c, double constant) {
+    if (v.index() == 0) return {nullptr, float(constant)};
+    return {storage(v).channel(step ? c : 0).data(), 0.0f};
+}
+
+// out[i] = op(a[i], x[i], y[i]) over every channel, where x and y are fields
+// (same grid as a, 1 or N channels) or constants.
 template <typename Op>
-Value apply_binary(const Value& a, const Value& b, double bc, const MemoryBudget* budget, Op op) {
-    const int step = operand_step(a, b, "b");
+Value apply_per_voxel(const Value& a, const Value& x, double xc, const char* x_name, const Value& y, double yc, const char* y_name,
+                      const MemoryBudget* budget, Op op) {
+    const int step_x = operand_step(a, x, x_name);
+    const int step_y = operand_step(a, y, y_name);
     Value out = clone_shape(a, storage(a).channels(), budget);
     auto& o = mutable_storage(out);
     const auto& sa = storage(a);
     for (int c = 0; c < sa.channels(); ++c) {
         auto pa = sa.channel(c);
         auto po = o.channel(c);
-        if (b.index() == 0) {
-            const float k = float(bc);
-            parallel_blocks(pa.size(), [&](size_t i0, size_t i1) { for (size_t i = i0; i < i1; ++i) po[i] = op(pa[i], k); });
-        } else {
-            auto pb = storage(b).channel(step ? c : 0);
-            parallel_blocks(pa.size(), [&](size_t i0, size_t i1) { for (size_t i = i0; i < i1; ++i) po[i] = op(pa[i], pb[i]); });
-        }
+        const Operand ox = operand(x, step_x, c, xc), oy = operand(y, step_y, c, yc);
+        parallel_blocks(pa.size(), [&](size_t i0, size_t i1) {
+            for (size_t i = i0; i < i1; ++i) po[i] = op(pa[i], ox.at(i), oy.at(i));
+        });
     }
     return out;
+}
+
+const Value kNoOperand; // an unconnected operand (empty value); immutable
+
+template <typename Op>
+Value apply_binary(const Value& a, const Value& b, double bc, const MemoryBudget* budget, Op op) {
+    return apply_per_voxel(a, b, bc, "b", kNoOperand, 0.0, "t", budget, [op](float x, float y, float) { return op(x, y); });
 }
 
 template <typename Op>
@@ -112,24 +133,7 @@ Value field_binary(const Value& a, const Value& b, double bc, BinaryOp op, const
 
 Value field_lerp(const Value& a, const Value& b, const Value& t, double tc, const MemoryBudget* budget) {
     if (b.index() == 0) throw Error("lerp needs input 'b'");
-    const int step_b = operand_step(a, b, "b");
-    const int step_t = operand_step(a, t, "t");
-    Value out = clone_shape(a, storage(a).channels(), budget);
-    auto& o = mutable_storage(out);
-    const auto& sa = storage(a);
-    for (int c = 0; c < sa.channels(); ++c) {
-        auto pa = sa.channel(c);
-        auto pb = storage(b).channel(step_b ? c : 0);
-        auto po = o.channel(c);
-        if (t.index() == 0) {
-            const float k = float(tc);
-            parallel_blocks(pa.size(), [&](size_t i0, size_t i1) { for (size_t i = i0; i < i1; ++i) po[i] = pa[i] + (pb[i] - pa[i]) * k; });
-        } else {
-            auto pt = storage(t).channel(step_t ? c : 0);
-            parallel_blocks(pa.size(), [&](size_t i0, size_t i1) { for (size_t i = i0; i < i1; ++i) po[i] = pa[i] + (pb[i] - pa[i]) * pt[i]; });
-        }
-    }
-    return out;
+    return apply_per_voxel(a, b, 0.0, "b", t, tc, "t", budget, [](float x, float y, float k) { return x + (y - x) * k; });
 }
 
 Value field_remap(const Value& a, double in_min, double in_max, double out_min, double out_max, bool clamp_output,
