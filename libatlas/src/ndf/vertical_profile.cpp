@@ -33,30 +33,24 @@ void VerticalProfile::validate() const {
     }
 }
 
-double VerticalProfile::bottom(double type, double f) const {
+namespace {
+// Blends a per-type gradient `g(type_gradient, f)` between the two types that bracket `type`.
+template <typename Gradient>
+double blend_types(const std::array<TypeGradient, 4>& types, double type, double f, Gradient g) {
     int i;
     double w;
     bracket(type, i, w);
     const double ff = clamp01(f);
-    return (1 - w) * rise(types[size_t(i)], ff) + w * rise(types[size_t(i + 1)], ff);
+    return (1 - w) * g(types[size_t(i)], ff) + w * g(types[size_t(i + 1)], ff);
 }
+} // namespace
 
-double VerticalProfile::top(double type, double f) const {
-    int i;
-    double w;
-    bracket(type, i, w);
-    const double ff = clamp01(f);
-    return (1 - w) * fall(types[size_t(i)], ff) + w * fall(types[size_t(i + 1)], ff);
-}
+double VerticalProfile::bottom(double type, double f) const { return blend_types(types, type, f, rise); }
+
+double VerticalProfile::top(double type, double f) const { return blend_types(types, type, f, fall); }
 
 double VerticalProfile::density(double type, double f) const {
-    int i;
-    double w;
-    bracket(type, i, w);
-    const double ff = clamp01(f);
-    const auto& a = types[size_t(i)];
-    const auto& b = types[size_t(i + 1)];
-    return (1 - w) * rise(a, ff) * fall(a, ff) + w * rise(b, ff) * fall(b, ff);
+    return blend_types(types, type, f, [](const TypeGradient& g, double ff) { return rise(g, ff) * fall(g, ff); });
 }
 
 double VerticalProfile::split(double top_type, double bottom_type, double f) const { return bottom(bottom_type, f) * top(top_type, f); }
