@@ -105,15 +105,7 @@ Value apply_binary(const Value& a, const Value& b, double bc, const MemoryBudget
 
 template <typename Op>
 Value apply_unary(const Value& a, const MemoryBudget* budget, Op op) {
-    Value out = clone_shape(a, storage(a).channels(), budget);
-    auto& o = mutable_storage(out);
-    const auto& sa = storage(a);
-    for (int c = 0; c < sa.channels(); ++c) {
-        auto pa = sa.channel(c);
-        auto po = o.channel(c);
-        parallel_blocks(pa.size(), [&](size_t i0, size_t i1) { for (size_t i = i0; i < i1; ++i) po[i] = op(pa[i]); });
-    }
-    return out;
+    return apply_per_voxel(a, kNoOperand, 0.0, "b", kNoOperand, 0.0, "t", budget, [op](float x, float, float) { return op(x); });
 }
 
 } // namespace

@@ -27,26 +27,8 @@ struct F12 {
     float f1, f2;
 };
 
-// Nearest and second-nearest feature distances (in cells, metric M).
-template <WorleyMetric M>
-inline F12 worley3(const Lattice<3>& L, const Split& sx, const Split& sy, const Split& sz, float jitter) {
-    float f1 = 1e30f, f2 = 1e30f;
-    const int xs[3] = {sx.prev, sx.cell, sx.next}, ys[3] = {sy.prev, sy.cell, sy.next}, zs[3] = {sz.prev, sz.cell, sz.next};
-    for (int k = 0; k < 3; ++k)
-        for (int j = 0; j < 3; ++j)
-            for (int i = 0; i < 3; ++i) {
-                const uint64_t b = L.bits(xs[i], ys[j], zs[k]);
-                const float dx = float(i - 1) + feature_offset(b, 0, jitter) - sx.frac;
-                const float dy = float(j - 1) + feature_offset(b, 1, jitter) - sy.frac;
-                const float dz = float(k - 1) + feature_offset(b, 2, jitter) - sz.frac;
-                const float d = metric_combine<M>(metric_combine<M>(metric_combine<M>(0.0f, dx), dy), dz);
-                f2 = std::min(f2, std::max(f1, d));
-                f1 = std::min(f1, d);
-            }
-    if constexpr (M == WorleyMetric::Euclidean) return {std::sqrt(f1), std::sqrt(f2)};
-    else return {f1, f2};
-}
-
+// Nearest and second-nearest feature distances (in cells, metric M); the 3D
+// variant is worley3_cached below.
 template <WorleyMetric M>
 inline F12 worley2(const Lattice<2>& L, const Split& sx, const Split& sy, float jitter) {
     float f1 = 1e30f, f2 = 1e30f;
@@ -85,23 +67,7 @@ inline float alligator_bump(float m, float r2) {
 
 // Largest minus second-largest bump: creases where two bumps are equal,
 // rounded billows of random height in between. Range [0, 1).
-inline float alligator3(const Lattice<3>& L, const Split& sx, const Split& sy, const Split& sz, float inv_r2) {
-    float m1 = 0, m2 = 0;
-    const int xs[3] = {sx.prev, sx.cell, sx.next}, ys[3] = {sy.prev, sy.cell, sy.next}, zs[3] = {sz.prev, sz.cell, sz.next};
-    for (int k = 0; k < 3; ++k)
-        for (int j = 0; j < 3; ++j)
-            for (int i = 0; i < 3; ++i) {
-                const uint64_t b = L.bits(xs[i], ys[j], zs[k]);
-                const float dx = float(i - 1) + bits_unit16(b, 0) - sx.frac;
-                const float dy = float(j - 1) + bits_unit16(b, 1) - sy.frac;
-                const float dz = float(k - 1) + bits_unit16(b, 2) - sz.frac;
-                const float v = alligator_bump(bits_unit16(b, 3), (dx * dx + dy * dy + dz * dz) * inv_r2);
-                m2 = std::max(m2, std::min(m1, v));
-                m1 = std::max(m1, v);
-            }
-    return m1 - m2;
-}
-
+// (2D here; the 3D variant is alligator3_cached below.)
 inline float alligator2(const Lattice<2>& L, const Split& sx, const Split& sy, float inv_r2) {
     float m1 = 0, m2 = 0;
     const int xs[3] = {sx.prev, sx.cell, sx.next}, ys[3] = {sy.prev, sy.cell, sy.next};

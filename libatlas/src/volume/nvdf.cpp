@@ -17,40 +17,38 @@ void check_range(double lo, double hi, const char* who) {
         throw Error(std::string(who) + ": range_max must be greater than range_min (both finite), got [" + std::to_string(lo) + ", " +
                     std::to_string(hi) + "]");
 }
+
+// One channel of `src` mapped voxel by voxel into a new single-channel field.
+template <typename Map>
+Field3D map_channel(const Field3D& src, int channel, const char* out_name, const MemoryBudget* budget, Map map) {
+    Field3D out(src.resolution(), 1, src.bounds(), {out_name}, budget);
+    auto s = src.channel(channel);
+    auto d = out.channel(0);
+    for (size_t i = 0; i < s.size(); ++i) d[i] = map(double(s[i]));
+    return out;
+}
 } // namespace
 
 Field3D dimensional_profile(const Field3D& sdf, const DimensionalProfileOptions& o, const MemoryBudget* budget) {
     check_channel(sdf, o.channel, "dimensional_profile");
     if (!(o.depth > 0) || !std::isfinite(o.depth)) throw Error("dimensional_profile: depth must be finite and > 0 metres");
     if (!(o.exponent > 0) || !std::isfinite(o.exponent)) throw Error("dimensional_profile: exponent must be finite and > 0");
-    Field3D out(sdf.resolution(), 1, sdf.bounds(), {"dimensional_profile"}, budget);
-    auto s = sdf.channel(o.channel);
-    auto d = out.channel(0);
-    for (size_t i = 0; i < s.size(); ++i) {
-        const double t = std::clamp(-double(s[i]) / o.depth, 0.0, 1.0);
-        d[i] = float(o.exponent == 1 ? t : std::pow(t, o.exponent));
-    }
-    return out;
+    return map_channel(sdf, o.channel, "dimensional_profile", budget, [&o](double v) {
+        const double t = std::clamp(-v / o.depth, 0.0, 1.0);
+        return float(o.exponent == 1 ? t : std::pow(t, o.exponent));
+    });
 }
 
 Field3D encode_field_data(const Field3D& sdf, double lo, double hi, int channel, const MemoryBudget* budget) {
     check_channel(sdf, channel, "encode_field_data");
     check_range(lo, hi, "encode_field_data");
-    Field3D out(sdf.resolution(), 1, sdf.bounds(), {"field_data"}, budget);
-    auto s = sdf.channel(channel);
-    auto d = out.channel(0);
-    for (size_t i = 0; i < s.size(); ++i) d[i] = float(std::clamp((double(s[i]) - lo) / (hi - lo), 0.0, 1.0));
-    return out;
+    return map_channel(sdf, channel, "field_data", budget, [=](double v) { return float(std::clamp((v - lo) / (hi - lo), 0.0, 1.0)); });
 }
 
 Field3D decode_field_data(const Field3D& enc, double lo, double hi, int channel, const MemoryBudget* budget) {
     check_channel(enc, channel, "decode_field_data");
     check_range(lo, hi, "decode_field_data");
-    Field3D out(enc.resolution(), 1, enc.bounds(), {"sdf"}, budget);
-    auto s = enc.channel(channel);
-    auto d = out.channel(0);
-    for (size_t i = 0; i < s.size(); ++i) d[i] = float(lo + double(s[i]) * (hi - lo));
-    return out;
+    return map_channel(enc, channel, "sdf", budget, [=](double v) { return float(lo + v * (hi - lo)); });
 }
 
 Field3D assemble_modeling_nvdf(const Field3D& dp, const Field3D& dt, const Field3D& ds, const MemoryBudget* budget) {
