@@ -31,6 +31,7 @@ std::vector<std::string> RenderReport::active_features() const {
     f.push_back("ambient");
     f.push_back("multiple_scattering");
     if (point_lights) f.push_back("point_lights");
+    if (sky_gradient) f.push_back("sky_gradient");
     return f;
 }
 
@@ -59,6 +60,8 @@ void check_settings(const RenderSettings& s) {
     for (int i = 0; i < 3; ++i) {
         if (!(s.sun_colour[i] >= 0) || !std::isfinite(s.sun_colour[i])) bad("sun_colour must be finite and >= 0");
         if (!(s.sky_colour[i] >= 0) || !std::isfinite(s.sky_colour[i])) bad("sky_colour must be finite and >= 0");
+        if (s.sky_horizon && (!((*s.sky_horizon)[i] >= 0) || !std::isfinite((*s.sky_horizon)[i])))
+            bad("sky_horizon must be finite and >= 0");
         if (s.light_grid[i] < 1 || s.light_grid[i] > 1024) bad("light_grid must be 1..1024 voxels per axis");
     }
     if (!(s.quality > 0) || !std::isfinite(s.quality) || s.quality > 64) bad("quality must be in (0, 64]");
@@ -70,6 +73,8 @@ void check_settings(const RenderSettings& s) {
     if (!(s.reference_step >= 0) || !std::isfinite(s.reference_step)) bad("reference_step must be finite and >= 0 (0 = automatic)");
     if (!(s.min_transmittance >= 0 && s.min_transmittance < 1)) bad("min_transmittance must be in [0, 1)");
     if (s.threads < 0) bad("threads must be >= 0 (0 = all cores)");
+    if (s.light_samples < 1 || s.light_samples > 64) bad("light_samples must be 1..64");
+    for (size_t i = 0; i < s.lights.size(); ++i) validate_light(s.lights[i], "lights[" + std::to_string(i) + "]");
 }
 
 double hg(double cos_theta, double g) {
@@ -110,9 +115,16 @@ struct Integrator {
     double light_step;
     double ref_step;
     bool near_detail;
+    double ambient[3];                // sky light reaching the cloud, per channel
+    const std::vector<PointLight>& lights;
+    double light_core2;               // squared core radius of the inverse-square falloff
 
-    double march_density(const Vec3d& p, const Vec3d& dir, double step) const {
-        const double len = detail::exit_distance(cloud.bounds(), p, dir);
+    double phase(double cos_theta) const {
+        return s.hg_forward_weight * hg(cos_theta, s.hg_forward) + (1 - s.hg_forward_weight) * hg(cos_theta, s.hg_back);
+    }
+
+    double march_density(const Vec3d& p, const Vec3d& dir, double step, double max_len = 1e300) const {
+        const double len = std::min(max_len, detail::exit_distance(cloud.bounds(), p, dir));
         const int n = static_cast<int>(std::ceil(len / step));
         double acc = 0;
         for (int i = 0; i < n; ++i) {
@@ -144,14 +156,54 @@ struct Integrator {
         sky_sum = grid->sky(p[0], p[1], p[2]);
     }
 
+    // Summed density (density x metres) from p toward a light `len` metres
+    // away along unit `dir`, inside the volume only.
+    double light_depth(const Vec3d& p, const Vec3d& dir, double len) const {
+        if (!grid) return march_density(p, dir, 2 * ref_step, len);
+        const double seg = std::min(len, detail::exit_distance(cloud.bounds(), p, dir));
+        const int n = s.light_samples;
+        double acc = 0;
+        for (int i = 0; i < n; ++i) {
+            const Vec3d q = p + dir * ((i + 0.5) * seg / n);
+            acc += cloud.density_at(q[0], q[1], q[2], 1e30);
+        }
+        return acc * seg / n;
+    }
+
+    // In-scattered radiance weight per channel from every point light at p
+    // (inverse square, window, Beer toward the light, dual-lobe HG).
+    void point_light_radiance(const Vec3d& p, const Vec3d& view, double out[3]) const {
+        out[0] = out[1] = out[2] = 0;
+        for (const PointLight& l : lights) {
+            const Vec3d to = l.position - p;
+            const double r2 = dot(to, to), r = std::sqrt(r2);
+            double window = 1;
+            if (l.radius > 0) {
+                if (r >= l.radius) continue;
+                const double q = r2 / (l.radius * l.radius);
+                window = (1 - q * q) * (1 - q * q);
+            }
+            const double energy = l.intensity * window / (r2 + light_core2);
+            if (!(energy > 0)) continue;
+            // At the light itself the direction is undefined: isotropic there.
+            const Vec3d dir = r > 0 ? to / r : view;
+            const double cos_theta = r > 0 ? dot(view, dir) : 0.0;
+            const double beer = r > 0 ? std::exp(-s.extinction * light_depth(p, dir, r)) : 1.0;
+            const double w = energy * beer * phase(cos_theta);
+            for (int c = 0; c < 3; ++c) out[c] += w * l.colour[c];
+        }
+    }
+
     // Returns radiance (clouds only) and transmittance along one ray.
+    // kLights: compiled with the point-light term only when the scene has lights.
+    template <bool kLights>
     void trace(const Vec3d& o, const Vec3d& dir, float jitter, double rgb[3], double& trans, uint64_t& samples) const {
         rgb[0] = rgb[1] = rgb[2] = 0;
         trans = 1;
         const auto hit = clip_ray(cloud.bounds(), o, dir);
         if (!hit) return;
         const double cos_theta = dot(dir, sun);
-        const double phase = s.hg_forward_weight * hg(cos_theta, s.hg_forward) + (1 - s.hg_forward_weight) * hg(cos_theta, s.hg_back);
+        const double sun_phase = phase(cos_theta);
         const double powder_mix = 0.5 + 0.5 * cos_theta; // no powder darkening looking toward the sun
         const double ms_sun = std::clamp(cos_theta, 0.0, 0.9);
         const double ext = s.extinction;
@@ -189,7 +241,7 @@ struct Integrator {
                     const double tau = ext * sun_sum;
                     const double beer = std::exp(-tau);
                     const double powder = 1 - std::exp(-2 * tau);
-                    const double direct = beer * (powder + (1 - powder) * powder_mix) * phase;
+                    const double direct = beer * (powder + (1 - powder) * powder_mix) * sun_phase;
                     const double dp = detail::saturate(v.profile);
                     const double ms = dp * std::exp(-tau * remap(ms_sun, 0.0, 0.9, 0.25, remap(v.sdf, -128.0, 0.0, 0.05, 0.25)));
                     const double amb = std::sqrt(1 - dp) * std::exp(-ext * sky_sum);
@@ -199,7 +251,12 @@ struct Integrator {
                     // light is scattered toward the eye (albedo 1).
                     const double absorbed = -std::expm1(-sigma * dt);
                     const double w = trans * absorbed;
-                    for (int c = 0; c < 3; ++c) rgb[c] += w * (sun_w * s.sun_colour[c] + sky_w * s.sky_colour[c]);
+                    for (int c = 0; c < 3; ++c) rgb[c] += w * (sun_w * s.sun_colour[c] + sky_w * ambient[c]);
+                    if constexpr (kLights) {
+                        double glow[3];
+                        point_light_radiance(p, dir, glow);
+                        for (int c = 0; c < 3; ++c) rgb[c] += w * glow[c];
+                    }
                     trans *= std::exp(-sigma * dt);
                     if (trans < min_t) break; // the rest is invisible
                 }
@@ -216,8 +273,20 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     detail::CloudSampler cloud(scene);
     const bool fast = settings.mode == RenderMode::Fast;
     const Vec3d sun = normalized(settings.sun_direction);
+    // Lights: the given ones, then each light field's flash in order.
+    std::vector<PointLight> lights = settings.lights;
+    for (const LightField& f : settings.light_fields) {
+        auto flash = flash_lights(f);
+        lights.insert(lights.end(), flash.begin(), flash.end());
+    }
+    // Sky: zenith and horizon; the same colour twice is the uniform sky
+    // (h + (z - h) * t == h exactly, so the uniform look keeps its bytes).
+    const Vec3f zenith = settings.sky_colour, horizon = settings.sky_horizon.value_or(settings.sky_colour);
 
     RenderReport report;
+    report.point_lights = !lights.empty();
+    report.point_light_count = int(lights.size());
+    report.sky_gradient = settings.sky_horizon.has_value();
     report.noise_uprez = cloud.has_noise();
     report.billowy = cloud.has_noise() && cloud.billowy();
     report.sdf_skipping = fast;
@@ -258,7 +327,12 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
                   128 * vmin, // the step doubles every 128 voxels of distance
                   grid ? 0.5 * grid->voxel_min() : 0.0,
                   settings.reference_step > 0 ? settings.reference_step : 0.25 * vmin,
-                  report.near_camera_detail};
+                  report.near_camera_detail,
+                  {double(horizon[0]) + (double(zenith[0]) - double(horizon[0])) * (2.0 / 3.0),
+                   double(horizon[1]) + (double(zenith[1]) - double(horizon[1])) * (2.0 / 3.0),
+                   double(horizon[2]) + (double(zenith[2]) - double(horizon[2])) * (2.0 / 3.0)},
+                  lights,
+                  0.25 * vmin * vmin};
 
     const int w = settings.width, h = settings.height;
     Field2D image({{w, h}}, 4, Box2d{{{0, 0}}, {{double(w), double(h)}}}, {"r", "g", "b", "transmittance"});
@@ -290,8 +364,13 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
                         const Vec3d dir = normalized(fwd + right * u + up * v);
                         const float jitter = hash_to_unit(hash_coords(settings.seed, x, y));
                         double rgb[3], trans;
-                        in.trace(settings.camera.position, dir, jitter, rgb, trans, samples);
-                        for (int c = 0; c < 3; ++c) image.at(c, x, y) = static_cast<float>(rgb[c] + trans * settings.sky_colour[c]);
+                        if (lights.empty()) in.trace<false>(settings.camera.position, dir, jitter, rgb, trans, samples);
+                        else in.trace<true>(settings.camera.position, dir, jitter, rgb, trans, samples);
+                        const double up_t = detail::saturate(dir[2]);
+                        for (int c = 0; c < 3; ++c) {
+                            const double sky = double(horizon[c]) + (double(zenith[c]) - double(horizon[c])) * up_t;
+                            image.at(c, x, y) = static_cast<float>(rgb[c] + trans * sky);
+                        }
                         image.at(3, x, y) = static_cast<float>(trans);
                     }
                 tile_samples[size_t(ti)] = samples;

@@ -21,8 +21,10 @@
 
 #include "atlas/core/field.h"
 #include "atlas/core/progress.h"
+#include "atlas/render/lights.h"
 #include "atlas/render/scene.h"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,7 +39,13 @@ struct RenderSettings {
     Camera camera;
     Vec3d sun_direction{{0.4, -0.6, 0.5}}; // toward the sun, normalised internally
     Vec3f sun_colour{{1.0f, 0.95f, 0.88f}};   // linear radiance, >= 0
-    Vec3f sky_colour{{0.30f, 0.45f, 0.75f}};  // ambient sky and background, >= 0
+    // The sky: sky_colour at the zenith; with sky_horizon set, the
+    // background is lerp(horizon, zenith, saturate(view.z)) and the ambient
+    // term uses the cosine-weighted upper-hemisphere mean of that gradient,
+    // horizon + 2/3 (zenith - horizon). Unset: one uniform colour (the
+    // pre-gradient look, same bytes). Linear radiance, >= 0.
+    Vec3f sky_colour{{0.30f, 0.45f, 0.75f}};
+    std::optional<Vec3f> sky_horizon;
     int width = 320;                          // pixels, > 0
     int height = 180;                         // pixels, > 0
     RenderMode mode = RenderMode::Fast;
@@ -58,6 +66,13 @@ struct RenderSettings {
     double min_transmittance = 0.005;
     uint32_t seed = 1;
     int threads = 0; // 0 = TBB default; results do not depend on it
+    // Optional lights (lights.h). Empty (the default): no light code runs.
+    // light_fields are resolved to point lights (flash_lights) per render.
+    std::vector<PointLight> lights;
+    std::vector<LightField> light_fields;
+    // Fast mode: density samples on the segment toward each point light
+    // (reference mode marches it at 2 x reference_step), 1..64.
+    int light_samples = 4;
 };
 
 // Which parts of the method ran (features the scene does not need are left
@@ -68,7 +83,9 @@ struct RenderReport {
     bool near_camera_detail = false; // twice-folded noise (camera within 198 m of the volume)
     bool sdf_skipping = false;     // fast mode
     bool light_grid = false;       // fast mode
-    bool point_lights = false;     // not implemented: always false, no glow code exists
+    bool point_lights = false;     // at least one point light (given or from a light field)
+    int point_light_count = 0;     // lights integrated (after resolving light fields)
+    bool sky_gradient = false;     // sky_horizon set
     uint64_t density_samples = 0;  // view-ray density evaluations
     // "noise_uprez billowy ..." - the active features, space separated.
     std::vector<std::string> active_features() const;
