@@ -10,11 +10,11 @@ using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
     d.doc("N nested vortex rings around a superstorm centre (rotation speed falling outward, overlapping, skewed). `map`: channels "
-          "ring_index (-1 outside) and ring_blend (weight of the next ring in the overlap band). `table`: N x 1 texels, channels "
-          "inner, outer (m), speed (rad/s), skew (rad) - the sidecar the renderer reads (the library's vortex_rings_json gives the "
-          "same as JSON).");
+          "ring_index (-1 outside) and ring_blend (weight of the next ring in the overlap band). `table`: the sidecar the renderer "
+          "reads, N x 1 texels, channels inner, outer (m), speed (rad/s), skew (rad), overlap_end (m, outer + overlap x width), "
+          "world bounds = the square centre +- radius; write it as JSON (a `.json` output) or EXR.");
     d.output("map", PortType::Field2D, "ring-index / ring-blend map");
-    d.output("table", PortType::Field2D, "ring table, one texel per ring");
+    d.output("table", PortType::Field2D, "ring table, one texel per ring (write as .json: the sidecar)");
     declare_map(d);
     d.param_float2("center", {{30000, 30000}}).with_unit("m").describe("storm centre");
     d.param_float("radius", 8000).with_unit("m").describe("outer radius of the last ring (> 0)");
@@ -45,17 +45,10 @@ void cook(CookContext& ctx) {
     }
     ctx.set_output("map", out2d(ndf::vortex_ring_map(map_resolution(ctx, 2), map_bounds(ctx), ctx.get_float2("center"), rings,
                                                      ctx.get_float("overlap"), &ctx.budget())));
-    Field2D table({{int(rings.size()), 1}}, 4, {{{0, 0}}, {{double(rings.size()), 1}}}, {"inner", "outer", "speed", "skew"});
-    for (size_t i = 0; i < rings.size(); ++i) {
-        table.at(0, int(i), 0) = float(rings[i].inner);
-        table.at(1, int(i), 0) = float(rings[i].outer);
-        table.at(2, int(i), 0) = float(rings[i].speed);
-        table.at(3, int(i), 0) = float(rings[i].skew);
-    }
-    ctx.set_output("table", out2d(std::move(table)));
+    ctx.set_output("table", out2d(ndf::vortex_ring_table(ctx.get_float2("center"), ctx.get_float("radius"), ctx.get_float("overlap"), rings)));
 }
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "ndf/vortex_rings", .version = 1, .declare = declare, .cook = cook});
+    registry.add({.name = "ndf/vortex_rings", .version = 2, .declare = declare, .cook = cook});
 }

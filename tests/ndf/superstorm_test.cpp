@@ -114,7 +114,7 @@ TEST(Superstorm, VortexRings) {
             EXPECT_EQ(rings[i].inner, rings[i - 1].outer);
         }
     }
-    const std::string json = vortex_rings_json({{1, 2}}, 6000, rings);
+    const std::string json = vortex_rings_json({{1, 2}}, 6000, 0.25, rings);
     EXPECT_NE(json.find("\"rings\": [{\"index\": 0"), std::string::npos);
     EXPECT_NE(json.find("\"index\": 5"), std::string::npos);
     const Box2d box{{{-8000, -8000}}, {{8000, 8000}}};
@@ -131,4 +131,23 @@ TEST(Superstorm, VortexRings) {
                 ASSERT_EQ(idx, float(int(r / 1000))) << r;
             }
         }
+}
+
+TEST(Superstorm, VortexRingTableHoldsTheSidecar) {
+    const auto rings = make_vortex_rings(6000, 4, {1000, 2500, 4000, 6000}, 0.3, 0.8, 0.4);
+    const Field2D t = vortex_ring_table({{500, -700}}, 6000, 0.3, rings);
+    ASSERT_EQ(t.width(), 4);
+    ASSERT_EQ(t.height(), 1);
+    EXPECT_DOUBLE_EQ(0.5 * (t.bounds().min[0] + t.bounds().max[0]), 500.0);
+    EXPECT_DOUBLE_EQ(0.5 * (t.bounds().min[1] + t.bounds().max[1]), -700.0);
+    EXPECT_DOUBLE_EQ(0.5 * (t.bounds().max[0] - t.bounds().min[0]), 6000.0);
+    for (int i = 0; i < 4; ++i) {
+        const auto& r = rings[size_t(i)];
+        EXPECT_EQ(t.at(t.find_channel("inner"), i, 0), float(r.inner));
+        EXPECT_EQ(t.at(t.find_channel("outer"), i, 0), float(r.outer));
+        EXPECT_EQ(t.at(t.find_channel("speed"), i, 0), float(r.speed));
+        EXPECT_EQ(t.at(t.find_channel("skew"), i, 0), float(r.skew));
+        EXPECT_EQ(t.at(t.find_channel("overlap_end"), i, 0), float(r.outer + 0.3 * (r.outer - r.inner)));
+    }
+    EXPECT_THROW(vortex_ring_table({{0, 0}}, 6000, 0.3, {}), Error);
 }

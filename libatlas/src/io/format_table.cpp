@@ -2,10 +2,72 @@
 // the end (the order is what `atlas` and docs list).
 #include "format_table.h"
 
+#include "atlas/core/error.h"
+#include "atlas/core/files.h"
+#include "atlas/io/output_options.h"
+
+#include <nlohmann/json.hpp>
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+
 namespace atlas::io::detail {
 
 namespace {
 const std::pair<std::string, std::string> kChannels{"channels", "comma-separated channel names to write, in this order (default: all)"};
+
+// The double nearest the float's shortest decimal form: JSON shows 0.05, not
+// 0.05000000074505806, and parsing it back as float gives the same float.
+double shortest(float v) {
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    double d = 0;
+    std::from_chars(buf, r.ptr, d);
+    return d;
+}
+
+// A small 2D field (a table such as the vortex-ring sidecar) as JSON text:
+// float values as JSON numbers (shortest round-trip form), NaN/Inf as null.
+std::vector<fs::path> write_json_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
+    const OptionReader o(opts, p);
+    const Field2D& f = *std::get<Field2DPtr>(v);
+    const uint64_t texels = uint64_t(f.width()) * uint64_t(f.height());
+    if (texels > 65536) throw Error(o.prefix() + "a JSON table holds at most 65536 texels, the field has " + std::to_string(texels));
+    std::vector<int> idx;
+    for (const auto& n : o.list("channels")) {
+        const int c = f.find_channel(n);
+        if (c < 0) o.bad("channels", "channel names of the value");
+        idx.push_back(c);
+    }
+    if (idx.empty())
+        for (int c = 0; c < f.channels(); ++c) idx.push_back(c);
+    nlohmann::ordered_json j;
+    j["resolution"] = {f.width(), f.height()};
+    j["bounds"] = {{"min", {f.bounds().min[0], f.bounds().min[1]}}, {"max", {f.bounds().max[0], f.bounds().max[1]}}};
+    j["center"] = {0.5 * (f.bounds().min[0] + f.bounds().max[0]), 0.5 * (f.bounds().min[1] + f.bounds().max[1])};
+    auto& names = j["channels"] = nlohmann::ordered_json::array();
+    for (int c : idx) names.push_back(f.channel_name(c));
+    auto& rows = j["rows"] = nlohmann::ordered_json::array();
+    for (int y = 0; y < f.height(); ++y)
+        for (int x = 0; x < f.width(); ++x) {
+            nlohmann::ordered_json row;
+            row["x"] = x;
+            row["y"] = y;
+            for (int c : idx) {
+                const float val = f.at(c, x, y);
+                row[f.channel_name(c)] = std::isfinite(val) ? nlohmann::ordered_json(shortest(val)) : nlohmann::ordered_json(nullptr);
+            }
+            rows.push_back(std::move(row));
+        }
+    const std::string text = j.dump(1) + "\n";
+    write_file_atomic(p, [&](const fs::path& tmp) {
+        std::ofstream out(tmp, std::ios::binary);
+        out << text;
+        if (!out.flush()) throw Error(o.prefix() + "cannot write " + p.filename().string());
+    });
+    return {p};
+}
 } // namespace
 
 const std::vector<FormatEntry>& format_table() {
@@ -70,6 +132,13 @@ const std::vector<FormatEntry>& format_table() {
            {"array", "true: a 3D field becomes a 2D texture array instead of a volume"},
            kChannels}},
          write_dds_output},
+        {{"json",
+          {".json"},
+          {PortType::Field2D},
+          "a small 2D field (at most 65536 texels) as a JSON table, e.g. a sidecar: resolution, world bounds and their centre, "
+          "channel names, and rows [{x, y, <channel>: value, ...}] with x fastest (NaN/Inf as null)",
+          {kChannels}},
+         write_json_output},
     };
     return table;
 }

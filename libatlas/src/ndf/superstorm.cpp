@@ -97,19 +97,35 @@ std::vector<VortexRing> make_vortex_rings(double radius, int count, const std::v
     return rings;
 }
 
-std::string vortex_rings_json(Vec2d center, double radius, const std::vector<VortexRing>& rings) {
+std::string vortex_rings_json(Vec2d center, double radius, double overlap, const std::vector<VortexRing>& rings) {
     auto num = [](double v) {
         char buf[64];
         std::snprintf(buf, sizeof buf, "%.17g", v);
         return std::string(buf);
     };
-    std::string s = "{\"center\": [" + num(center[0]) + ", " + num(center[1]) + "], \"radius\": " + num(radius) + ", \"rings\": [";
+    std::string s = "{\"center\": [" + num(center[0]) + ", " + num(center[1]) + "], \"radius\": " + num(radius) + ", \"overlap\": " + num(overlap) + ", \"rings\": [";
     for (size_t i = 0; i < rings.size(); ++i) {
         const auto& r = rings[i];
         s += (i ? ", " : "") + std::string("{\"index\": ") + std::to_string(i) + ", \"inner\": " + num(r.inner) + ", \"outer\": " +
-             num(r.outer) + ", \"speed\": " + num(r.speed) + ", \"skew\": " + num(r.skew) + "}";
+             num(r.outer) + ", \"overlap_end\": " + num(r.outer + overlap * (r.outer - r.inner)) + ", \"speed\": " + num(r.speed) + ", \"skew\": " + num(r.skew) + "}";
     }
     return s + "]}\n";
+}
+
+Field2D vortex_ring_table(Vec2d center, double radius, double overlap, const std::vector<VortexRing>& rings) {
+    if (rings.empty()) throw Error("vortex rings: at least one ring");
+    const Box2d box{{{center[0] - radius, center[1] - radius}}, {{center[0] + radius, center[1] + radius}}};
+    if (!box.valid()) throw Error("vortex rings: 'center' and 'radius' must be finite, radius > 0");
+    Field2D t({{int(rings.size()), 1}}, 5, box, {"inner", "outer", "speed", "skew", "overlap_end"});
+    for (size_t i = 0; i < rings.size(); ++i) {
+        const auto& r = rings[i];
+        t.at(0, int(i), 0) = float(r.inner);
+        t.at(1, int(i), 0) = float(r.outer);
+        t.at(2, int(i), 0) = float(r.speed);
+        t.at(3, int(i), 0) = float(r.skew);
+        t.at(4, int(i), 0) = float(r.outer + overlap * (r.outer - r.inner));
+    }
+    return t;
 }
 
 Field2D vortex_ring_map(Vec2i res, Box2d bounds, Vec2d center, const std::vector<VortexRing>& rings, double overlap,

@@ -59,8 +59,15 @@ struct VortexRing {
 // Throws on N < 1, radii not strictly increasing, radii beyond the radius.
 std::vector<VortexRing> make_vortex_rings(double radius, int count, const std::vector<double>& radii, double overlap,
                                           double inner_speed, double skew);
-// JSON sidecar text: {"center":[x,y],"radius":R,"rings":[{"index":i,"inner":..,"outer":..,"speed":..,"skew":..},..]}.
-std::string vortex_rings_json(Vec2d center, double radius, const std::vector<VortexRing>& rings);
+// JSON sidecar text: {"center":[x,y],"radius":R,"overlap":o,"rings":[{"index":i,"inner":..,"outer":..,
+// "overlap_end":..,"speed":..,"skew":..},..]} with overlap_end = outer + overlap * (outer - inner) (m).
+std::string vortex_rings_json(Vec2d center, double radius, double overlap, const std::vector<VortexRing>& rings);
+// The same table as a field the graph writes (EXR, or JSON through the `json`
+// output format): N x 1 texels, channels inner, outer (m), speed (rad/s), skew
+// (rad), overlap_end (m); world bounds = the square [center - radius, center +
+// radius], so the bounds' centre is the storm centre and half their width the
+// radius. Values are stored as float.
+Field2D vortex_ring_table(Vec2d center, double radius, double overlap, const std::vector<VortexRing>& rings);
 // The ring map: channels "ring_index" (index of the ring whose core holds the
 // texel, -1 outside all rings) and "ring_blend" (0..1 weight of ring index+1
 // in the overlap band past the ring's outer radius).
