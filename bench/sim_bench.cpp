@@ -177,8 +177,50 @@ void BM_BryanFritschMoist_100m(benchmark::State& state) { BryanFritschMoist(stat
 void BM_BryanFritschMoist_200m(benchmark::State& state) { BryanFritschMoist(state, 200); }
 void BM_BryanFritschMoist_100m_dt1(benchmark::State& state) { BryanFritschMoist(state, 100, 1.0); }
 
+// Robert (1993) dry rising thermal: 1000 m x 1000 m slab, theta0 = 300 K
+// neutral, 0.5 K bubble of radius 250 m with a Gaussian edge (e-folding 100 m)
+// at (500, 260) m, anelastic, 10 s steps to 600 s.
+void RobertThermal(benchmark::State& state, double dx) {
+    GridSpec s;
+    s.nx = s.nz = int(std::lround(1000 / dx));
+    s.ny = 1;
+    s.dx = dx;
+    SimOptions o;
+    o.moist = false;
+    StepReport r;
+    double wpeak = 0, top = 0;
+    for (auto _ : state) {
+        Simulation sim(s, Sounding{}, o);
+        std::vector<float> d(s.cells());
+        for (int k = 0; k < s.nz; ++k)
+            for (int i = 0; i < s.nx; ++i) {
+                double rr = std::hypot((i + 0.5) * dx - 500, (k + 0.5) * dx - 260);
+                d[size_t(k) * s.nx + i] = float(rr <= 250 ? 0.5 : 0.5 * std::exp(-std::pow((rr - 250) / 100, 2)));
+            }
+        sim.add_theta(d);
+        wpeak = 0;
+        while (sim.time() < 600 - 1e-9) {
+            r = sim.step(std::min(10.0, 600 - sim.time()));
+            wpeak = std::max(wpeak, r.max_w);
+        }
+        top = 0; // highest cell centre with theta' > 0.1 K
+        for (int k = 0; k < s.nz; ++k)
+            for (int i = 0; i < s.nx; ++i)
+                if (sim.theta()[size_t(k) * s.nx + i] - sim.reference().theta[size_t(k)] > 0.1) top = (k + 0.5) * dx;
+    }
+    state.counters["max_w_600s"] = r.max_w;
+    state.counters["peak_w"] = wpeak;
+    state.counters["max_theta_p"] = r.max_theta_perturbation;
+    state.counters["top_theta_p_gt_0.1"] = top;
+    state.counters["div_max_per_s"] = r.divergence.max;
+}
+void BM_RobertThermal_10m(benchmark::State& state) { RobertThermal(state, 10); }
+void BM_RobertThermal_5m(benchmark::State& state) { RobertThermal(state, 5); }
+
 } // namespace
 
+BENCHMARK(BM_RobertThermal_10m)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_RobertThermal_5m)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschMoist_100m)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschMoist_200m)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschMoist_100m_dt1)->Unit(benchmark::kMillisecond)->Iterations(1);
