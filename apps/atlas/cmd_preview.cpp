@@ -5,15 +5,19 @@
 #include "progress_bar.h"
 
 #include "atlas/core/error.h"
+#include "atlas/core/files.h"
 #include "atlas/graph/evaluator.h"
 #include "atlas/io/readers.h"
 #include "atlas/render/image_out.h"
 #include "atlas/render/renderer.h"
 #include "atlas/render/sweep.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace atlas::cli {
@@ -43,7 +47,10 @@ bool is_graph(const std::string& f) {
 }
 
 // The NVDF set a graph writes: the first volume/nvdf node with an output.
-render::CloudScene scene_from_graph(const std::string& file, int jobs, ProgressSink progress) {
+// Cooked like `atlas cook` (same disk cache, so a second preview of an
+// unchanged graph cooks nothing) but without writing the graph's files.
+render::CloudScene scene_from_graph(const std::string& file, int jobs, ProgressSink progress,
+                                    const std::optional<std::filesystem::path>& cache_dir, bool quiet) {
     Session session(builtin_nodes());
     session.load(file);
     for (const auto& out : session.graph().outputs) {
@@ -52,17 +59,41 @@ render::CloudScene scene_from_graph(const std::string& file, int jobs, ProgressS
         CookOptions o;
         o.write_outputs = false;
         o.jobs = jobs;
+        o.cache_dir = cache_dir;
         o.progress = std::move(progress);
-        Value v = session.get(out.node, "vdb_set", o);
+        o.outputs = {out.file};
+        const CookResult r = session.cook(o);
+        if (!quiet)
+            std::fprintf(stderr, "graph: cooked %zu, cached %zu nodes in %.2f s%s\n", r.with_status("cooked").size(),
+                         r.with_status("cached").size(), r.seconds, cache_dir ? (" (cache " + cache_dir->string() + ")").c_str() : "");
+        Value v = session.get(out.node, "vdb_set", o); // from the session's memory cache now
         return render::scene_from_nvdf_set(std::get<Field3DPtr>(v));
     }
     throw Error(file + ": the graph writes no volume/nvdf output to preview");
 }
 
-void write_picture(const Field2D& image, const std::filesystem::path& path, double exposure) {
-    auto ext = path.extension().string();
-    if (ext == ".exr") render::write_preview_exr(image, path);
-    else render::write_preview_png(image, path, exposure);
+// Writes into `staged` (a temporary path); the caller moves it into place.
+void write_picture(const Field2D& image, const std::filesystem::path& staged, double exposure) {
+    auto ext = staged.extension().string();
+    if (ext == ".exr") render::write_preview_exr(image, staged);
+    else render::write_preview_png(image, staged, exposure);
+}
+
+// A picture written atomically: a failed render or write leaves no file.
+void write_picture_atomic(const Field2D& image, const std::filesystem::path& path, double exposure) {
+    write_file_atomic(path, [&](const std::filesystem::path& tmp) { write_picture(image, tmp, exposure); });
+}
+
+render::PointLight parse_light(const std::string& text) {
+    const size_t n = std::count(text.begin(), text.end(), ',') + 1;
+    if (n != 7 && n != 8) throw UsageError{"--light expects X,Y,Z,R,G,B,INTENSITY[,RADIUS], got '" + text + "'", "preview"};
+    auto v = numbers(text, n, "--light");
+    render::PointLight l;
+    l.position = {{v[0], v[1], v[2]}};
+    l.colour = {{float(v[3]), float(v[4]), float(v[5])}};
+    l.intensity = v[6];
+    l.radius = n == 8 ? v[7] : 0.0;
+    return l;
 }
 
 } // namespace
@@ -89,9 +120,13 @@ int run_preview(const Args& a) {
 
     Field3DPtr noise;
     if (a.has("--noise")) noise = io::as_field3d(io::read_field_file(a.get("--noise")));
+    if (a.has("--cache") && a.has("--no-cache")) throw UsageError{"--cache and --no-cache contradict each other", "preview"};
+    std::optional<std::filesystem::path> cache_dir;
+    if (a.has("--cache")) cache_dir = a.get("--cache");
+    else if (const char* env = std::getenv("ATLAS_CACHE_DIR"); env && *env && !a.has("--no-cache")) cache_dir = env;
     render::CloudScene scene;
     if (a.positional.size() == 1 && is_graph(a.positional[0])) {
-        scene = scene_from_graph(a.positional[0], jobs, sink);
+        scene = scene_from_graph(a.positional[0], jobs, sink, cache_dir, quiet);
     } else {
         std::vector<std::filesystem::path> files(a.positional.begin(), a.positional.end());
         scene = render::load_scene(files, a.has("--voxel") ? numbers(a.get("--voxel"), 1, "--voxel")[0] : 0.0);
@@ -116,6 +151,12 @@ int run_preview(const Args& a) {
     if (a.has("--quality")) s.quality = numbers(a.get("--quality"), 1, "--quality")[0];
     if (a.has("--extinction")) s.extinction = numbers(a.get("--extinction"), 1, "--extinction")[0];
     if (a.has("--reference")) s.mode = render::RenderMode::Reference;
+    if (a.has("--sky")) {
+        auto v = numbers(a.get("--sky"), 6, "--sky");
+        s.sky_colour = {{float(v[0]), float(v[1]), float(v[2])}};
+        s.sky_horizon = Vec3f{{float(v[3]), float(v[4]), float(v[5])}};
+    }
+    for (const auto& l : a.all("--light")) s.lights.push_back(parse_light(l));
     const double exposure = a.has("--exposure") ? numbers(a.get("--exposure"), 1, "--exposure")[0] : 1.5;
 
     if (a.has("--sweep")) {
@@ -125,7 +166,7 @@ int run_preview(const Args& a) {
         std::printf("quality,seconds,rmse_radiance,rmse_transmittance\n");
         std::printf("reference,%.3f,0,0\n", r.reference_seconds);
         for (const auto& row : r.rows) std::printf("%g,%.3f,%.6f,%.6f\n", row.quality, row.seconds, row.rmse, row.transmittance_rmse);
-        if (a.has("--out")) write_picture(r.reference, a.get("--out"), exposure);
+        if (a.has("--out")) write_picture_atomic(r.reference, a.get("--out"), exposure);
         return 0;
     }
 
@@ -137,21 +178,26 @@ int run_preview(const Args& a) {
     if (frames == 0) {
         auto r = render::render_clouds(scene, s, &sink);
         report = r.report;
-        write_picture(r.image, out, exposure);
+        write_picture_atomic(r.image, out, exposure);
         bar.finish();
         std::cout << out.string() << "\n";
     } else {
+        // All frames or none: staged beside OUT, moved into place at the end.
+        StagedOutputs staged(out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path());
+        std::vector<std::filesystem::path> paths;
         for (int i = 0; i < frames; ++i) {
             s.camera = render::framing_camera(bounds, double(w) / h, 30 + 360.0 * i / frames);
             auto r = render::render_clouds(scene, s, &sink);
             report = r.report;
             char suffix[32];
             std::snprintf(suffix, sizeof suffix, "_%03d", i);
-            const auto path = out.parent_path() / (out.stem().string() + suffix + out.extension().string());
-            write_picture(r.image, path, exposure);
-            std::cout << path.string() << "\n";
+            const std::filesystem::path name = out.stem().string() + suffix + out.extension().string();
+            write_picture(r.image, staged.stage(name), exposure);
+            paths.push_back(out.parent_path() / name);
         }
+        staged.commit();
         bar.finish();
+        for (const auto& p : paths) std::cout << p.string() << "\n";
     }
     if (!quiet) {
         const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
