@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs the whole test suite (ctest).
-# First the core suite is built with AddressSanitizer and UndefinedBehavior-
-# Sanitizer and run (more suites: ATLAS_SANITIZE_SUITES; skip:
+# First the numerical suites (core, noise, compress, sim) are built with
+# AddressSanitizer and UndefinedBehaviorSanitizer and run (other suites:
+# ATLAS_SANITIZE_SUITES; skip:
 # ATLAS_SKIP_SANITIZERS=1); then the Release build runs everything, so ctest's
 # summary is the last word.
 # Usage: scripts/test.sh [ctest arguments], e.g. scripts/test.sh -R graph
@@ -9,10 +10,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 
-# Suites built and run under ASan + UBSan first. CI runs the core suite (cheap);
-# set ATLAS_SANITIZE_SUITES="core_test graph_test io_test ..." for more (each
-# pulls in the modules it links, so a full list roughly doubles a cold build).
-SANITIZE_SUITES="${ATLAS_SANITIZE_SUITES:-core_test}"
+# Suites built and run under ASan + UBSan first. CI runs the suites of the
+# modules that link nothing but core and TBB (about 4 min cold on 2 cores);
+# set ATLAS_SANITIZE_SUITES="... graph_test io_test ..." for more (those pull in
+# OpenVDB/OpenImageIO/CGAL, so a full list roughly doubles a cold build).
+SANITIZE_SUITES="${ATLAS_SANITIZE_SUITES:-core_test noise_test compress_test sim_test}"
 if [ "${ATLAS_SKIP_SANITIZERS:-0}" != "1" ] && [ $# -eq 0 ] && [ -n "$SANITIZE_SUITES" ]; then
   echo "== sanitizer run (ASan + UBSan): $SANITIZE_SUITES" >&2
   SAN_DIR="${ATLAS_SANITIZER_BUILD_DIR:-build-asan}"
