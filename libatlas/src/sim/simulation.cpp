@@ -143,38 +143,51 @@ void SimOptions::validate(int nz) const {
     check_range(diffusivity, 0, 1e4, "options.diffusivity (m^2/s)");
     if (!wind.empty() && wind.size() != size_t(nz)) throw Error("sim: options.wind needs nz entries (one per cell row)");
     for (double w : wind) check_range(w, -200, 200, "options.wind (m/s)");
+    if (rain) kessler.validate();
+    if (rain && !moist) throw Error("sim: options.rain needs options.moist");
+}
+
+uint64_t simulation_bytes(const GridSpec& spec, const SimOptions& options) {
+    return simulation_bytes(spec) + (options.rain ? uint64_t(spec.cells()) * kSimRainBytesPerCell : 0);
 }
 
 std::string StepReport::to_json() const {
-    char buf[1536];
+    char buf[2048];
     std::snprintf(buf, sizeof buf,
                   "{\"dt\":%.9g,\"substeps\":%d,\"substep_dt\":%.9g,\"pressure_iterations\":%d,"
                   "\"max_pressure_iterations\":%d,\"pressure_converged\":%s,\"divergence_l2\":%.9g,"
                   "\"divergence_max\":%.9g,\"total_water\":%.9g,\"water_drift\":%.9g,\"theta_l_drift\":%.9g,"
                   "\"condensed\":%.9g,\"max_w\":%.9g,\"max_speed\":%.9g,\"max_theta_perturbation\":%.9g,"
                   "\"min_theta_perturbation\":%.9g,\"max_qc\":%.9g,\"seconds_advect\":%.6f,\"seconds_sources\":%.6f,"
-                  "\"seconds_thermo\":%.6f,\"seconds_forces\":%.6f,\"seconds_project\":%.6f}",
+                  "\"seconds_thermo\":%.6f,\"seconds_forces\":%.6f,\"seconds_project\":%.6f,\"water_mass\":%.9g,"
+                  "\"rain_fallout\":%.9g,\"autoconverted\":%.9g,\"accreted\":%.9g,\"rain_evaporated\":%.9g,"
+                  "\"max_qr\":%.9g,\"sedimentation_substeps\":%d,\"seconds_rain\":%.6f}",
                   dt, substeps, substep_dt, pressure_iterations, max_pressure_iterations,
                   pressure_converged ? "true" : "false", divergence.l2, divergence.max, total_water, water_drift,
                   theta_l_drift, condensed, max_w, max_speed, max_theta_perturbation, min_theta_perturbation, max_qc,
-                  seconds_advect, seconds_sources, seconds_thermo, seconds_forces, seconds_project);
+                  seconds_advect, seconds_sources, seconds_thermo, seconds_forces, seconds_project, water_mass,
+                  rain_fallout, autoconverted, accreted, rain_evaporated, max_qr, sedimentation_substeps, seconds_rain);
     return buf;
 }
 
-static GridSpec checked(const GridSpec& s, const MemoryBudget* budget) {
+static GridSpec checked(const GridSpec& s, const SimOptions& o, const MemoryBudget* budget) {
     s.validate();
-    if (budget) budget->check(simulation_bytes(s), "sim: simulation state (" + std::to_string(kSimBytesPerCell) + " B/cell)");
+    if (budget)
+        budget->check(simulation_bytes(s, o), "sim: simulation state (" +
+                                                  std::to_string(kSimBytesPerCell + (o.rain ? kSimRainBytesPerCell : 0)) +
+                                                  " B/cell)");
     return s;
 }
 
 Simulation::Simulation(const GridSpec& spec, const Sounding& sounding, const SimOptions& options, const MemoryBudget* budget)
-    : spec_(checked(spec, budget)), opt_(options), ref_(make_reference(sounding, spec.nz, spec.dx)),
+    : spec_(checked(spec, options, budget)), opt_(options), ref_(make_reference(sounding, spec.nz, spec.dx)),
       solver_(spec, options.anelastic ? ref_.rho : std::vector<double>{}), vel_(spec), vel_tmp_(spec) {
     opt_.validate(spec.nz);
     const size_t n = spec.cells();
     theta_.resize(n);
     qv_.resize(n);
     qc_.assign(n, 0.f);
+    if (opt_.rain) qr_.assign(n, 0.f);
     tmp_.resize(n);
     heat_src_.assign(n, 0.f);
     vap_src_.assign(n, 0.f);
@@ -253,7 +266,7 @@ double Simulation::max_buoyancy() const {
     for (int k = 0; k < spec_.nz; ++k) {
         size_t base = size_t(k) * spec_.nx * spec_.ny;
         for (size_t c = base; c < base + size_t(spec_.nx) * spec_.ny; ++c) {
-            double tv = theta_[c] * (1 + 0.608 * qv_[c] - qc_[c]);
+            double tv = theta_[c] * (1 + 0.608 * qv_[c] - qc_[c] - (qr_.empty() ? 0.f : qr_[c]));
             m = std::max(m, std::fabs(kGravity * (tv - thetav0_[size_t(k)]) / thetav0_[size_t(k)]));
         }
     }
@@ -267,7 +280,7 @@ void Simulation::buoyancy(double dt) {
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i) {
                 size_t c = vel_.ic(i, j, k);
-                double tv = double(theta_[c]) * (1 + 0.608 * qv_[c] - qc_[c]);
+                double tv = double(theta_[c]) * (1 + 0.608 * qv_[c] - qc_[c] - (qr_.empty() ? 0.f : qr_[c]));
                 b[c] = float(kGravity * (tv - thetav0_[size_t(k)]) / thetav0_[size_t(k)]);
             }
     });
@@ -387,13 +400,14 @@ void Simulation::substep(double dt, StepReport& rep) {
     // 1. Advection of scalars by the old velocity, then of the velocity itself.
     Lattice cl = cell_lattice(spec_);
     {
-        std::vector<float> a(theta_.size()), b(theta_.size());
-        std::span<const float> in[3] = {theta_, qv_, qc_};
-        std::span<float> out[3] = {tmp_, a, b};
-        advect_many(vel_, cl, in, out, dt, opt_.scheme);
+        std::vector<float> a(theta_.size()), b(theta_.size()), c(qr_.size());
+        std::span<const float> in[4] = {theta_, qv_, qc_, qr_};
+        std::span<float> out[4] = {tmp_, a, b, c};
+        advect_many(vel_, cl, std::span(in, qr_.empty() ? 3 : 4), std::span(out, qr_.empty() ? 3 : 4), dt, opt_.scheme);
         theta_.swap(tmp_);
         qv_.swap(a);
         qc_.swap(b);
+        qr_.swap(c);
     }
     advect_velocity(vel_, vel_tmp_, dt, opt_.scheme);
     std::swap(vel_, vel_tmp_);
@@ -440,6 +454,20 @@ void Simulation::substep(double dt, StepReport& rep) {
         rep.water_drift = std::max(rep.water_drift, wb > 0 ? std::fabs(wa - wb) / wb : 0.0);
     }
     rep.seconds_thermo += seconds_since(t0);
+    // 3b. Kessler warm rain: conversions, evaporation, fallout.
+    if (!qr_.empty()) {
+        t0 = Clock::now();
+        KesslerReport kr = kessler_conversions(spec_, theta_, qv_, qc_, qr_, ref_.pressure, ref_.exner, ref_.rho, dt, opt_.kessler);
+        rep.autoconverted += kr.autoconverted;
+        rep.accreted += kr.accreted;
+        rep.rain_evaporated += kr.evaporated;
+        if (opt_.kessler.sedimentation) {
+            KesslerReport sr = rain_sedimentation(spec_, qr_, ref_.rho, dt, opt_.kessler);
+            rep.rain_fallout += sr.fallout;
+            rep.sedimentation_substeps += sr.sedimentation_substeps;
+        }
+        rep.seconds_rain += seconds_since(t0);
+    }
     // 4. Forces.
     t0 = Clock::now();
     buoyancy(dt);
@@ -461,6 +489,7 @@ StepReport Simulation::step(double dt) {
     check_finite(theta_, "theta");
     check_finite(qv_, "qv");
     check_finite(qc_, "qc");
+    check_finite(qr_, "qr");
     if (!std::isfinite(vel_.max_abs())) throw Error("sim step: velocity holds NaN/Inf");
     StepReport rep;
     const double h = spec_.dx;
@@ -501,16 +530,25 @@ StepReport Simulation::step(double dt) {
     rep.dt = dt;
     // Summary statistics (fixed order).
     double tw = 0;
+    const double cell_volume = h * h * h;
     rep.max_theta_perturbation = -1e30, rep.min_theta_perturbation = 1e30;
     for (int k = 0; k < spec_.nz; ++k) {
         size_t plane = size_t(spec_.nx) * spec_.ny;
+        double row = 0;
         for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
-            tw += double(qv_[c]) + qc_[c];
+            double q = double(qv_[c]) + qc_[c];
+            if (!qr_.empty()) {
+                q += qr_[c];
+                rep.max_qr = std::max(rep.max_qr, double(qr_[c]));
+            }
+            row += q;
             double tp = theta_[c] - ref_.theta[size_t(k)];
             rep.max_theta_perturbation = std::max(rep.max_theta_perturbation, tp);
             rep.min_theta_perturbation = std::min(rep.min_theta_perturbation, tp);
             rep.max_qc = std::max(rep.max_qc, double(qc_[c]));
         }
+        tw += row;
+        rep.water_mass += row * ref_.rho[size_t(k)] * cell_volume;
     }
     rep.total_water = tw;
     for (float w : vel_.w) rep.max_w = std::max(rep.max_w, double(w));
@@ -535,6 +573,12 @@ Field3D Simulation::cloud_water() const {
 Field3D Simulation::vapour() const {
     Field3D f(Vec3i{{spec_.nx, spec_.ny, spec_.nz}}, 1, grid_box(spec_), {"qv"});
     std::copy(qv_.begin(), qv_.end(), f.channel(0).begin());
+    return f;
+}
+
+Field3D Simulation::rain_water() const {
+    Field3D f(Vec3i{{spec_.nx, spec_.ny, spec_.nz}}, 1, grid_box(spec_), {"qr"});
+    if (!qr_.empty()) std::copy(qr_.begin(), qr_.end(), f.channel(0).begin());
     return f;
 }
 

@@ -18,6 +18,7 @@
 
 #include "atlas/core/field.h"
 #include "atlas/sim/advection.h"
+#include "atlas/sim/kessler.h"
 #include "atlas/sim/pressure.h"
 
 #include <cstdint>
@@ -84,8 +85,19 @@ struct SimOptions {
     double diffusivity = 0;               // kappa for theta', qv, qc, m^2/s, [0, 1e4]
     std::vector<double> wind;             // optional ambient u(z) per cell row (nz entries), m/s, relaxed to at open x faces
     ProjectionOptions projection;
+    // Kessler warm rain (kessler.h): qr is advected, made from qc by
+    // autoconversion and accretion, evaporates in subsaturated air, loads the
+    // buoyancy and falls out through the floor. Off by default (needs moist);
+    // adds kSimRainBytesPerCell.
+    bool rain = false;
+    KesslerOptions kessler;
     void validate(int nz) const;
 };
+
+// Extra bytes per cell when options.rain is on: qr and its advection output.
+constexpr uint64_t kSimRainBytesPerCell = 8;
+// simulation_bytes(spec) plus the rain fields when options.rain is on.
+uint64_t simulation_bytes(const GridSpec& spec, const SimOptions& options);
 
 // What one call of step() did.
 struct StepReport {
@@ -96,7 +108,12 @@ struct StepReport {
     int max_pressure_iterations = 0; // worst substep
     bool pressure_converged = true;
     DivergenceStats divergence;      // after the last projection, 1/s
-    double total_water = 0;          // sum of qv + qc over cells (kg/kg * cells) after the step
+    double total_water = 0;          // sum of qv + qc + qr over cells (kg/kg * cells) after the step
+    double water_mass = 0;           // kg: sum of rho0 (qv + qc + qr) dx^3 after the step
+    double rain_fallout = 0;         // kg of rain that left through the floor during the step (0 without rain)
+    double autoconverted = 0, accreted = 0, rain_evaporated = 0; // kg/kg summed over cells, this step
+    double max_qr = 0;               // kg/kg
+    int sedimentation_substeps = 0;  // summed over substeps
     double water_drift = 0;          // relative change of total water by the saturation adjustment (should be ~1e-7)
     double theta_l_drift = 0;        // max |delta theta_l| across the adjustment, K
     double condensed = 0;            // net condensation in the step, kg/kg summed over cells
@@ -104,6 +121,7 @@ struct StepReport {
     double max_theta_perturbation = 0, min_theta_perturbation = 0; // K, theta - theta0
     double max_qc = 0;               // kg/kg
     double seconds_advect = 0, seconds_sources = 0, seconds_thermo = 0, seconds_forces = 0, seconds_project = 0;
+    double seconds_rain = 0;
     // {"dt":..,"substeps":..,...} one JSON object.
     std::string to_json() const;
 };
@@ -126,10 +144,12 @@ public:
     std::vector<float>& theta() { return theta_; } // full potential temperature, K
     std::vector<float>& qv() { return qv_; }
     std::vector<float>& qc() { return qc_; }
+    std::vector<float>& qr() { return qr_; } // rain, kg/kg; empty unless options.rain
     const MacVelocity& velocity() const { return vel_; }
     const std::vector<float>& theta() const { return theta_; }
     const std::vector<float>& qv() const { return qv_; }
     const std::vector<float>& qc() const { return qc_; }
+    const std::vector<float>& qr() const { return qr_; }
 
     // Adds a potential-temperature perturbation (K) to every cell.
     void add_theta(const std::vector<float>& delta);
@@ -148,6 +168,7 @@ public:
     Field3D temperature() const;   // "T", K (theta * Pi0)
     Field3D theta_perturbation() const; // "theta_p", K
     Field3D vapour() const;        // "qv", kg/kg
+    Field3D rain_water() const;    // "qr", kg/kg (zeros without rain)
     Field3D velocity_field() const; // "u","v","w" at cell centres, m/s
 
 private:
@@ -163,7 +184,7 @@ private:
     std::vector<double> thetav0_;
     PressureSolver solver_;
     MacVelocity vel_, vel_tmp_;
-    std::vector<float> theta_, qv_, qc_, tmp_;
+    std::vector<float> theta_, qv_, qc_, qr_, tmp_;
     std::vector<float> heat_src_, vap_src_;
     double time_ = 0;
 };
