@@ -57,10 +57,10 @@ Field2D cirrus_texture(const CirrusSpec& spec, const MemoryBudget* budget) {
     // Rotated coordinates (u along the streaks, v across) are integer
     // combinations of x and y, so a lattice that tiles in (u, v) tiles in (x, y).
     // u spans |a| + |b| tile units per texture: divide the period to keep the feature size.
-    const NoiseSpec warp = make_spec(noise::Kernel::Curl, {{P, P}}, 2, noise::Combinator::Fbm, spec.seed + 1);
+    const NoiseSpec warp = make_spec(noise::Kernel::Curl, {{P, P}}, 1, noise::Combinator::Fbm, spec.seed + 1);
     const NoiseSpec veil = make_spec(noise::Kernel::Gradient, {{P, P * S}}, 6, noise::Combinator::Fbm, spec.seed + 2);
     const NoiseSpec veil_large = make_spec(noise::Kernel::Value, {{P, P}}, 3, noise::Combinator::Fbm, spec.seed + 3);
-    const NoiseSpec fibres = make_spec(noise::Kernel::Gradient, {{2 * P, 2 * P * S}}, 5, noise::Combinator::Ridged, spec.seed + 4);
+    const NoiseSpec fibres = make_spec(noise::Kernel::Gradient, {{P, 2 * P * S}}, 5, noise::Combinator::Ridged, spec.seed + 4);
     const NoiseSpec patches = make_spec(noise::Kernel::Value, {{P, P}}, 3, noise::Combinator::Fbm, spec.seed + 5);
     NoiseSpec puffs = make_spec(noise::Kernel::Worley, {{8 * P, 8 * P}}, 2, noise::Combinator::Fbm, spec.seed + 6);
     puffs.worley.feature = noise::WorleyFeature::InvertedF1;

@@ -25,7 +25,7 @@ struct CirrusSpec {
     Vec2i streak_direction{{1, 0}}; // integer lattice vector the streaks run along (not 0,0; |a|,|b| <= 16)
     int period = 4;                 // [1, 256] base lattice cells across the texture (size of the largest features)
     int stretch = 6;                // [1, 64] streak length / width of the cirrus and cirrostratus looks
-    double warp = 0.08;             // [0, 1] domain-warp displacement, in texture widths
+    double warp = 0.04;             // [0, 1] domain-warp displacement, in texture widths
     uint32_t seed = 0;
 };
 
