@@ -217,7 +217,7 @@ TEST(NdfGraphs, HzdWeatherWritesEveryEngineLayout) {
     // The file names say which engine each layout is for.
     const std::string yaml = read_file_bytes(dir / "hzd_weather.yaml");
     for (const char* f : {"hzd_weather_map_rgb_coverage_precip_type.png", "unity_hdrp_cloud_map_rgba_coverage_rain_type_maxheight.png",
-                          "unity_hdrp_cloud_lut_rgb_density_erosion_ambient.exr",
+                          "unity_hdrp_cloud_lut_rgb_density_erosion_ambient.png", "unreal_cloud_profile_lut_rgb_bottom_top_density.png",
                           "unity_hdrp_cloud_layer_latlong_rgba_cumulus_stratus_cirrus_wispy.png",
                           "unreal_cloud_weather_rgba_coverage_type_minheight_maxheight.png"})
         EXPECT_NE(yaml.find(f), std::string::npos) << f;
