@@ -1,0 +1,338 @@
+// sim/cloud_growth: runs the cloud-growth solver (atlas::sim::Simulation) and
+// returns cloud water as density, optional extra fields, and a frame sequence
+// for the 'vdb-sequence' output format. The node is a thin adapter: the
+// physics is in libatlas/sim (docs/solver.md).
+#include "atlas/sim/simulation.h"
+#include "sim_params.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace {
+using namespace atlas;
+
+const std::vector<std::string> kSequenceGrids = {"density", "temperature", "vapor", "vel"};
+
+void declare(NodeDeclaration& d) {
+    d.doc("Grows clouds by simulating rising moist air (anelastic, MAC grid, MacCormack or semi-Lagrangian advection, "
+          "multigrid-preconditioned CG projection, saturation adjustment; see docs/solver.md). The grid has 'resolution' "
+          "cubic cells of 'dx' metres with its minimum corner at 'origin'. Runs ceil(duration / frame_dt) steps of frame_dt, "
+          "each split into CFL-limited substeps. Sources: the optional 'emitter' field (sim/emitter; sampled at cell "
+          "centres, zero outside it), a built-in noise-modulated ground patch (patch_radius > 0) and an initial warm "
+          "bubble (bubble_theta != 0). Outputs cloud water as 'out' (channel 'density', kg/kg), temperature, vapour, "
+          "velocity at cell centres, and 'sequence': every sequence_every-th frame's chosen grids as channels "
+          "'NNNN:GRID' for the 'vdb-sequence' format. Each step's divergence (L2, max), pressure iterations, water "
+          "and theta_l drift across the saturation adjustment and seconds per stage go into the cook report as "
+          "'step_NNNN.*' metrics, with totals and maxima. Memory (216 B per cell plus outputs) is checked before allocating.");
+    d.input("sounding", PortType::Field2D, "sim/sounding record (default: the sim/sounding defaults)").optional = true;
+    d.input("emitter", PortType::Field3D, "heat (K/s) and vapour (kg/kg/s) rates, e.g. sim/emitter; channels 'heat' and 'vapour' or 0 and 1").optional = true;
+    d.output("out", PortType::Field3D, "cloud water mixing ratio after the last step, channel 'density', kg/kg");
+    d.output("temperature", PortType::Field3D, "absolute temperature after the last step, channel 'temperature', K");
+    d.output("vapour", PortType::Field3D, "water-vapour mixing ratio after the last step, channel 'vapor', kg/kg");
+    d.output("velocity", PortType::Field3D, "velocity at cell centres after the last step, channels 'vel.x', 'vel.y', 'vel.z', m/s");
+    d.output("sequence", PortType::Field3D, "frames for the 'vdb-sequence' format: channels 'NNNN:GRID', NNNN = 1, 2, ...");
+    d.param_int3("resolution", {{64, 64, 64}}).range(1, 4096).with_unit("cells").describe("cells along x, y, z (at least 2 along two axes)");
+    d.param_float("dx", 40).range(1e-3, 1e5).with_unit("m").describe("cubic cell edge");
+    d.param_float3("origin", {{0, 0, 0}}).with_unit("m").describe("world position of the grid's minimum corner");
+    d.param_enum("boundary", {"closed", "open_top", "open_sides_top"}, "closed")
+        .describe("closed: free-slip walls everywhere; open_top: the top is open; open_sides_top: only the floor is a wall");
+    d.param_float("duration", 300).range(1e-6, 1e7).with_unit("s").describe("simulated time");
+    d.param_float("frame_dt", 10).range(1e-6, 1e5).with_unit("s").describe("time per step (one report row, one potential sequence frame)");
+    d.param_float("cfl", 1).range(0.1, 5).with_unit("cells").describe("max cells travelled per substep");
+    d.param_int("max_substeps", 64).range(1, 10000).describe("substep budget per step (more is an error naming the node)");
+    d.param_enum("scheme", {"maccormack", "semi_lagrangian"}, "maccormack").describe("advection scheme (MacCormack is limited)");
+    d.param_bool("anelastic", true).describe("false: Boussinesq (constant reference density)");
+    d.param_bool("moist", true).describe("false: dry (vapour and cloud water are passive)");
+    d.param_float("pressure_tolerance", 1e-6).range(1e-12, 0.1).describe("relative residual of the pressure solve");
+    d.param_int("pressure_max_iterations", 200).range(1, 10000).describe("CG iteration cap per projection");
+    d.param_bool("multigrid", true).describe("multigrid-preconditioned CG (false: Jacobi-preconditioned)");
+    d.param_float("condensation_rate", 0).range(0, 1e9).with_unit("1/s").describe("0: instantaneous saturation adjustment");
+    d.param_float("vorticity_confinement", 0).range(0, 2).describe("epsilon of vorticity confinement (billowy detail)");
+    d.param_float("viscosity", 0).range(0, 1e4).with_unit("m^2/s").describe("explicit kinematic viscosity");
+    d.param_float("diffusivity", 0).range(0, 1e4).with_unit("m^2/s").describe("explicit diffusivity of theta', qv, qc");
+    d.param_float("wind", 0).range(-200, 200).with_unit("m/s").describe("ambient x wind at the ground");
+    d.param_float("wind_shear", 0).range(-1, 1).with_unit("1/s").describe("change of the x wind per metre of height");
+    d.param_float("patch_radius", 0).range(0, 1e9).with_unit("m").describe("built-in ground patch radius (0 = none)");
+    d.param_float2("patch_center", {{0, 0}}).with_unit("m").describe("world x, y of the patch centre");
+    d.param_float("patch_depth", 200).range(1e-3, 1e9).with_unit("m").describe("heated depth above the floor");
+    d.param_float("patch_heat_rate", 0.01).range(0, 10).with_unit("K/s").describe("heat source at the patch centre");
+    d.param_float("patch_vapour_rate", 0).range(0, 1e-3).with_unit("kg/kg/s").describe("vapour source at the patch centre");
+    d.param_float("patch_noise_scale", 200).range(1e-3, 1e9).with_unit("m").describe("feature size of the patch's noise");
+    d.param_float("patch_noise_amount", 0.5).range(0, 1).describe("0 = smooth patch, 1 = fully noise-modulated");
+    d.param_int("seed", 1).range(0, 4294967295.0).describe("seed of the patch noise");
+    d.param_float("bubble_theta", 0).range(-20, 20).with_unit("K").describe("initial cos^2 warm bubble amplitude (0 = none)");
+    d.param_float3("bubble_center", {{0, 0, 500}}).with_unit("m").describe("world centre of the bubble");
+    d.param_float("bubble_radius", 500).range(1e-3, 1e9).with_unit("m").describe("bubble radius");
+    d.param_int("sequence_every", 0).range(0, 100000).describe("keep every K-th step as a sequence frame (0: only the last)");
+    d.param_string("sequence_grids", "density").describe("comma-separated grids per frame: density, temperature, vapor, vel");
+}
+
+std::vector<std::string> split_grids(const CookContext& ctx) {
+    std::vector<std::string> out;
+    std::stringstream in(ctx.get_string("sequence_grids"));
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        item.erase(0, item.find_first_not_of(" \t"));
+        item.erase(item.find_last_not_of(" \t") + 1);
+        if (item.empty()) continue;
+        if (std::find(kSequenceGrids.begin(), kSequenceGrids.end(), item) == kSequenceGrids.end())
+            ctx.fail("parameter 'sequence_grids': unknown grid '" + item + "' (known: density, temperature, vapor, vel)");
+        if (std::find(out.begin(), out.end(), item) != out.end()) ctx.fail("parameter 'sequence_grids': '" + item + "' is listed twice");
+        out.push_back(item);
+    }
+    if (out.empty()) ctx.fail("parameter 'sequence_grids' names no grid (use density, temperature, vapor, vel)");
+    return out;
+}
+
+sim::SimOptions options_from(const CookContext& ctx, int nz, double dx) {
+    sim::SimOptions o;
+    o.anelastic = ctx.get_bool("anelastic");
+    o.moist = ctx.get_bool("moist");
+    o.scheme = ctx.get_string("scheme") == "maccormack" ? sim::AdvectionScheme::MacCormack : sim::AdvectionScheme::SemiLagrangian;
+    o.cfl = ctx.get_float("cfl");
+    o.max_substeps = int(ctx.get_int("max_substeps"));
+    o.condensation_rate = ctx.get_float("condensation_rate");
+    o.vorticity_confinement = ctx.get_float("vorticity_confinement");
+    o.viscosity = ctx.get_float("viscosity");
+    o.diffusivity = ctx.get_float("diffusivity");
+    o.projection.tolerance = ctx.get_float("pressure_tolerance");
+    o.projection.max_iterations = int(ctx.get_int("pressure_max_iterations"));
+    o.projection.multigrid = ctx.get_bool("multigrid");
+    const double wind = ctx.get_float("wind"), shear = ctx.get_float("wind_shear");
+    if (wind != 0 || shear != 0)
+        for (int k = 0; k < nz; ++k) o.wind.push_back(std::clamp(wind + shear * (k + 0.5) * dx, -200.0, 200.0));
+    return o;
+}
+
+// The emitter field sampled at the grid's cell centres (world positions);
+// cells outside the emitter's bounds get no source.
+void apply_emitter(CookContext& ctx, sim::Simulation& sim, const Vec3d& origin) {
+    const Field3DPtr e = ctx.input_field3d("emitter");
+    int hc = e->find_channel("heat"), vc = e->find_channel("vapour");
+    if (hc < 0) hc = 0;
+    if (vc < 0) vc = e->channels() > 1 ? 1 : -1;
+    for (int c : {hc, vc}) {
+        if (c < 0) continue;
+        for (float v : e->channel(c))
+            if (!std::isfinite(v)) ctx.fail("input 'emitter' channel '" + e->channel_name(c) + "' holds NaN/Inf; source rates must be finite");
+    }
+    const sim::GridSpec& s = sim.spec();
+    std::vector<float> heat(s.cells(), 0.f), vap(s.cells(), 0.f);
+    const Box3d& b = e->bounds();
+    size_t n = 0;
+    for (int k = 0; k < s.nz; ++k)
+        for (int j = 0; j < s.ny; ++j)
+            for (int i = 0; i < s.nx; ++i, ++n) {
+                const Vec3d p{{origin[0] + (i + 0.5) * s.dx, origin[1] + (j + 0.5) * s.dx, origin[2] + (k + 0.5) * s.dx}};
+                bool inside = true;
+                for (int a = 0; a < 3; ++a) inside = inside && p[a] >= b.min[a] && p[a] <= b.max[a];
+                if (!inside) continue;
+                heat[n] = e->sample_world(hc, p, WrapMode::Clamp);
+                if (vc >= 0) vap[n] = e->sample_world(vc, p, WrapMode::Clamp);
+            }
+    sim.set_sources(std::move(heat), std::move(vap), "node '" + ctx.node_name() + "' input 'emitter'");
+}
+
+std::vector<float> bubble(const sim::GridSpec& s, const Vec3d& origin, double amp, const Vec3d& c, double r) {
+    std::vector<float> d(s.cells(), 0.f);
+    size_t n = 0;
+    for (int k = 0; k < s.nz; ++k)
+        for (int j = 0; j < s.ny; ++j)
+            for (int i = 0; i < s.nx; ++i, ++n) {
+                const double x = origin[0] + (i + 0.5) * s.dx - c[0], y = origin[1] + (j + 0.5) * s.dx - c[1],
+                             z = origin[2] + (k + 0.5) * s.dx - c[2];
+                const double l = std::sqrt(x * x + (s.ny > 1 ? y * y : 0.0) + z * z) / r;
+                if (l < 1) d[n] = float(amp * std::pow(std::cos(0.5 * M_PI * l), 2));
+            }
+    return d;
+}
+
+// A copy of a solver output over the node's world bounds, with new channel names.
+Field3DPtr placed(const CookContext& ctx, const Field3D& f, const Box3d& box, std::vector<std::string> names) {
+    auto out = ctx.make_field3d(f.resolution(), f.channels(), box, std::move(names));
+    for (int c = 0; c < f.channels(); ++c) std::copy(f.channel(c).begin(), f.channel(c).end(), out->channel(c).begin());
+    return out;
+}
+
+std::string step_key(int step, const char* what) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "step_%04d.%s", step, what);
+    return buf;
+}
+
+void record_step(CookContext& ctx, int step, const sim::StepReport& r) {
+    ctx.metric(step_key(step, "substeps"), r.substeps);
+    ctx.metric(step_key(step, "pressure_iterations"), r.pressure_iterations);
+    ctx.metric(step_key(step, "div_l2"), r.divergence.l2);
+    ctx.metric(step_key(step, "div_max"), r.divergence.max);
+    ctx.metric(step_key(step, "water_drift"), r.water_drift);
+    ctx.metric(step_key(step, "theta_l_drift"), r.theta_l_drift);
+    ctx.metric(step_key(step, "max_w"), r.max_w);
+    ctx.metric(step_key(step, "max_qc"), r.max_qc);
+    ctx.metric(step_key(step, "seconds_advect"), r.seconds_advect);
+    ctx.metric(step_key(step, "seconds_sources"), r.seconds_sources);
+    ctx.metric(step_key(step, "seconds_thermo"), r.seconds_thermo);
+    ctx.metric(step_key(step, "seconds_forces"), r.seconds_forces);
+    ctx.metric(step_key(step, "seconds_project"), r.seconds_project);
+}
+
+void cook(CookContext& ctx) {
+    const Vec3i res = ctx.get_int3("resolution");
+    sim::GridSpec spec;
+    spec.nx = res[0];
+    spec.ny = res[1];
+    spec.nz = res[2];
+    spec.dx = ctx.get_float("dx");
+    const std::string& bnd = ctx.get_string("boundary");
+    if (bnd == "open_top") spec.boundary[5] = sim::Boundary::Open;
+    if (bnd == "open_sides_top") {
+        spec.boundary = sim::all_open();
+        spec.boundary[4] = sim::Boundary::Closed;
+    }
+    sim_nodes::naming_node(ctx, [&] { spec.validate(); });
+    const Vec3d origin = ctx.get_float3("origin");
+    const Box3d box{origin, {{origin[0] + res[0] * spec.dx, origin[1] + res[1] * spec.dx, origin[2] + res[2] * spec.dx}}};
+    if (!box.valid()) ctx.fail("origin + resolution * dx is not a valid box (too large or non-finite)");
+
+    const double duration = ctx.get_float("duration"), frame_dt = ctx.get_float("frame_dt");
+    const double nsteps_real = std::ceil(duration / frame_dt * (1 - 1e-12));
+    if (!(nsteps_real <= 1e6)) ctx.fail("duration / frame_dt is " + std::to_string(nsteps_real) + " steps; at most 1e6");
+    const int steps = std::max(1, int(nsteps_real));
+    const int every = int(ctx.get_int("sequence_every"));
+    if (every > steps)
+        ctx.fail("parameter 'sequence_every' is " + std::to_string(every) + " but the run has only " + std::to_string(steps) + " step(s)");
+    const int frames = every == 0 ? 1 : steps / every;
+    const std::vector<std::string> grids = split_grids(ctx);
+    int per_frame = 0;
+    for (const auto& g : grids) per_frame += g == "vel" ? 3 : 1;
+
+    // Everything this cook holds at its peak, checked before anything is allocated.
+    const uint64_t cells = spec.cells();
+    const uint64_t state = sim::simulation_bytes(spec);
+    const uint64_t outputs = field_bytes(cells, 6 + uint64_t(frames) * uint64_t(per_frame));
+    ctx.check_memory(state + outputs, "the simulation (" + std::to_string(sim::kSimBytesPerCell) + " B per cell) and its outputs");
+    ctx.metric("simulation_bytes", double(state));
+
+    sim::Sounding snd;
+    if (ctx.has_input("sounding")) snd = sim_nodes::sounding_from_record(ctx, *ctx.input_field2d("sounding"), "sounding");
+    else {
+        // The sim/sounding node's defaults, so an unconnected input means the same atmosphere.
+        snd.theta_lapse = 0.003;
+        snd.inversion_height = 2500;
+        snd.inversion_jump = 4;
+        snd.theta_lapse_above = 0.004;
+        snd.surface_rh = 0.85;
+        snd.rh_lapse = -1e-4;
+        snd.rh_above = 0.3;
+    }
+    const sim::SimOptions opt = options_from(ctx, spec.nz, spec.dx);
+    sim::Simulation sim = sim_nodes::naming_node(ctx, [&] {
+        opt.validate(spec.nz);
+        return sim::Simulation(spec, snd, opt, &ctx.budget());
+    });
+    sim_nodes::naming_node(ctx, [&] {
+        if (ctx.has_input("emitter")) apply_emitter(ctx, sim, origin);
+        if (ctx.get_float("patch_radius") > 0) {
+            sim::GroundPatch g;
+            const Vec2d c = ctx.get_float2("patch_center");
+            g.center_x = c[0] - origin[0];
+            g.center_y = c[1] - origin[1];
+            g.radius = ctx.get_float("patch_radius");
+            g.depth = ctx.get_float("patch_depth");
+            g.heat_rate = ctx.get_float("patch_heat_rate");
+            g.vapour_rate = ctx.get_float("patch_vapour_rate");
+            g.noise_scale = ctx.get_float("patch_noise_scale");
+            g.noise_amount = ctx.get_float("patch_noise_amount");
+            g.seed = uint32_t(ctx.get_int("seed"));
+            sim.add_ground_patch(g);
+        }
+        if (const double a = ctx.get_float("bubble_theta"); a != 0)
+            sim.add_theta(bubble(spec, origin, a, ctx.get_float3("bubble_center"), ctx.get_float("bubble_radius")));
+    });
+
+    std::vector<std::string> seq_names;
+    for (int f = 1; f <= frames; ++f) {
+        char prefix[16];
+        std::snprintf(prefix, sizeof prefix, "%04d:", f);
+        for (const auto& g : grids) {
+            if (g == "vel")
+                for (const char* a : {"vel.x", "vel.y", "vel.z"}) seq_names.push_back(prefix + std::string(a));
+            else
+                seq_names.push_back(prefix + g);
+        }
+    }
+    auto sequence = ctx.make_field3d(res, int(seq_names.size()), box, seq_names);
+    int next_channel = 0;
+    auto keep_frame = [&] {
+        for (const auto& g : grids) {
+            if (g == "density") {
+                std::copy(sim.qc().begin(), sim.qc().end(), sequence->channel(next_channel++).begin());
+            } else if (g == "vapor") {
+                std::copy(sim.qv().begin(), sim.qv().end(), sequence->channel(next_channel++).begin());
+            } else if (g == "temperature") {
+                const Field3D t = sim.temperature();
+                std::copy(t.channel(0).begin(), t.channel(0).end(), sequence->channel(next_channel++).begin());
+            } else {
+                const Field3D v = sim.velocity_field();
+                for (int a = 0; a < 3; ++a) std::copy(v.channel(a).begin(), v.channel(a).end(), sequence->channel(next_channel++).begin());
+            }
+        }
+    };
+
+    double div_l2 = 0, div_max = 0, water = 0, theta_l = 0, max_w = 0, max_qc = 0;
+    double s_adv = 0, s_src = 0, s_thermo = 0, s_forces = 0, s_proj = 0;
+    int substeps = 0, iterations = 0, unconverged = 0;
+    for (int step = 1; step <= steps; ++step) {
+        ctx.progress(double(step - 1) / steps);
+        const sim::StepReport r = sim_nodes::naming_node(ctx, [&] { return sim.step(frame_dt); });
+        record_step(ctx, step, r);
+        div_l2 = std::max(div_l2, r.divergence.l2);
+        div_max = std::max(div_max, r.divergence.max);
+        water = std::max(water, std::fabs(r.water_drift));
+        theta_l = std::max(theta_l, r.theta_l_drift);
+        max_w = std::max(max_w, r.max_w);
+        max_qc = std::max(max_qc, r.max_qc);
+        s_adv += r.seconds_advect;
+        s_src += r.seconds_sources;
+        s_thermo += r.seconds_thermo;
+        s_forces += r.seconds_forces;
+        s_proj += r.seconds_project;
+        substeps += r.substeps;
+        iterations += r.pressure_iterations;
+        if (!r.pressure_converged) ++unconverged;
+        if (every > 0 && step % every == 0 && step / every <= frames) keep_frame();
+    }
+    if (every == 0) keep_frame();
+    ctx.progress(1.0);
+    if (unconverged > 0)
+        ctx.warn(std::to_string(unconverged) + " step(s) ended with a pressure solve that did not reach pressure_tolerance within "
+                 "pressure_max_iterations");
+    ctx.metric("steps", steps);
+    ctx.metric("substeps", substeps);
+    ctx.metric("pressure_iterations", iterations);
+    ctx.metric("div_l2_max", div_l2);
+    ctx.metric("div_max_max", div_max);
+    ctx.metric("water_drift_max", water);
+    ctx.metric("theta_l_drift_max", theta_l);
+    ctx.metric("max_w", max_w);
+    ctx.metric("max_qc", max_qc);
+    ctx.metric("seconds_advect", s_adv);
+    ctx.metric("seconds_sources", s_src);
+    ctx.metric("seconds_thermo", s_thermo);
+    ctx.metric("seconds_forces", s_forces);
+    ctx.metric("seconds_project", s_proj);
+    ctx.metric("sequence_frames", frames);
+
+    ctx.set_output("out", Field3DPtr(placed(ctx, sim.cloud_water(), box, {"density"})));
+    ctx.set_output("temperature", Field3DPtr(placed(ctx, sim.temperature(), box, {"temperature"})));
+    ctx.set_output("vapour", Field3DPtr(placed(ctx, sim.vapour(), box, {"vapor"})));
+    ctx.set_output("velocity", Field3DPtr(placed(ctx, sim.velocity_field(), box, {"vel.x", "vel.y", "vel.z"})));
+    ctx.set_output("sequence", Field3DPtr(std::move(sequence)));
+}
+} // namespace
+
+ATLAS_REGISTER_NODE(registry) {
+    registry.add({.name = "sim/cloud_growth", .version = 1, .declare = declare, .cook = cook});
+}
