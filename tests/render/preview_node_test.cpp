@@ -66,3 +66,29 @@ TEST(RenderPreviewNode, NeedsAnNvdfSet) {
     auto bad = std::make_shared<Field3D>(set->resolution(), 2, set->bounds());
     EXPECT_THROW(cook({}, {{"nvdf", Field3DPtr(bad)}}), Error);
 }
+
+TEST(RenderPreviewNode, LightsSkyAndFlashParamsReachTheRenderer) {
+    auto set = nvdf_set();
+    const std::vector<double> size{20, 12};
+    const std::vector<double> horizon{0.9, 0.8, 0.6};
+    auto out = cook({{"size", size}, {"lights", std::string("50 50 50 1 0.5 0.2 2e4; 10 20 30 0 0 1 1e3 40")}, {"sky_horizon", horizon}},
+                    {{"nvdf", set}});
+    auto image = std::get<Field2DPtr>(out.at("image"));
+    // The same through the library.
+    auto scene = render::scene_from_nvdf_set(set);
+    auto s = render::preview_settings(set->bounds(), 20, 12);
+    s.sun_direction = render::sun_direction(60, 35);
+    s.sky_horizon = Vec3f{{0.9f, 0.8f, 0.6f}};
+    s.lights = {{{{50, 50, 50}}, {{1, 0.5f, 0.2f}}, 2e4, 0}, {{{10, 20, 30}}, {{0, 0, 1}}, 1e3, 40}};
+    auto r = render::render_clouds(scene, s);
+    EXPECT_TRUE(r.report.point_lights);
+    EXPECT_TRUE(r.report.sky_gradient);
+    EXPECT_TRUE(r.image == *image);
+    // A flash field with one hot voxel inside the cloud changes the picture.
+    auto field = std::make_shared<Field3D>(Vec3i{{4, 4, 4}}, 1, set->bounds());
+    field->at(0, 2, 2, 2) = 1;
+    auto flash = std::get<Field2DPtr>(cook({{"size", size}, {"flash_count", int64_t(2)}}, {{"nvdf", set}, {"flash_probability", Field3DPtr(field)}}).at("image"));
+    auto plain = std::get<Field2DPtr>(cook({{"size", size}}, {{"nvdf", set}}).at("image"));
+    EXPECT_FALSE(*flash == *plain);
+    EXPECT_THROW(cook({{"lights", std::string("1 2 3")}}, {{"nvdf", set}}), Error);
+}
