@@ -19,34 +19,62 @@ Lattice w_lattice(const GridSpec& s) { return {{s.nx, s.ny, s.nz + 1}, {0.5, 0.5
 
 namespace {
 
-struct Stencil {
-    size_t idx[8];
-    double wt[8];
+// The trilinear cell around p: base index, per-axis strides to the upper
+// neighbour (0 on a single-sample axis or at the clamped upper edge) and the
+// fractional weights. Positions are clamped into the lattice.
+struct Corners {
+    size_t base;
+    size_t step[3];
+    double f[3];
 };
 
-// Corner indices and weights of the trilinear stencil at p.
-Stencil stencil(const Lattice& l, const double p[3]) {
-    int i0[3], i1[3];
-    double f[3];
+inline Corners corners(const Lattice& l, const double p[3]) {
+    Corners c;
+    const size_t stride[3] = {1, size_t(l.n[0]), size_t(l.n[0]) * size_t(l.n[1])};
+    c.base = 0;
     for (int a = 0; a < 3; ++a) {
+        const int n = l.n[a];
+        if (n <= 1) {
+            c.f[a] = 0;
+            c.step[a] = 0;
+            continue;
+        }
         double x = p[a] - l.offset[a];
-        double hi = double(l.n[a] - 1);
-        x = std::clamp(x, 0.0, hi);
-        int i = std::min(int(x), std::max(l.n[a] - 2, 0));
-        f[a] = l.n[a] > 1 ? x - i : 0.0;
-        i0[a] = i;
-        i1[a] = std::min(i + 1, l.n[a] - 1);
+        x = x < 0 ? 0 : (x > n - 1 ? n - 1 : x);
+        int i = int(x);
+        if (i > n - 2) i = n - 2;
+        c.f[a] = x - i;
+        c.step[a] = stride[a];
+        c.base += size_t(i) * stride[a];
     }
-    Stencil s;
-    int c = 0;
-    for (int dz = 0; dz < 2; ++dz)
-        for (int dy = 0; dy < 2; ++dy)
-            for (int dx = 0; dx < 2; ++dx, ++c) {
-                int x = dx ? i1[0] : i0[0], y = dy ? i1[1] : i0[1], z = dz ? i1[2] : i0[2];
-                s.idx[c] = (size_t(z) * l.n[1] + y) * l.n[0] + x;
-                s.wt[c] = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
-            }
-    return s;
+    return c;
+}
+
+inline double lerp_at(const float* q, const Corners& c) {
+    const float* b = q + c.base;
+    const size_t sx = c.step[0], sy = c.step[1], sz = c.step[2];
+    const double fx = c.f[0], fy = c.f[1], fz = c.f[2];
+    auto row = [&](const float* r) { return double(r[0]) + fx * (double(r[sx]) - double(r[0])); };
+    const double c00 = row(b), c10 = row(b + sy), c01 = row(b + sz), c11 = row(b + sy + sz);
+    const double c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+    return c0 + fz * (c1 - c0);
+}
+
+inline void minmax_at(const float* q, const Corners& c, float& lo, float& hi) {
+    const float* b = q + c.base;
+    const size_t o[8] = {0,
+                         c.step[0],
+                         c.step[1],
+                         c.step[0] + c.step[1],
+                         c.step[2],
+                         c.step[0] + c.step[2],
+                         c.step[1] + c.step[2],
+                         c.step[0] + c.step[1] + c.step[2]};
+    lo = hi = b[0];
+    for (int k = 1; k < 8; ++k) {
+        lo = std::min(lo, b[o[k]]);
+        hi = std::max(hi, b[o[k]]);
+    }
 }
 
 // True when p lies within one cell of a domain edge along an axis with more than one cell.
@@ -83,73 +111,82 @@ void for_lattice(const Lattice& l, F&& f) {
 } // namespace
 
 float sample_lattice(const Lattice& l, std::span<const float> q, const double p[3]) {
-    Stencil s = stencil(l, p);
-    double v = 0;
-    for (int c = 0; c < 8; ++c) v += s.wt[c] * double(q[s.idx[c]]);
-    return float(v);
+    return float(lerp_at(q.data(), corners(l, p)));
 }
 
 void velocity_at(const MacVelocity& vel, const double p[3], double out[3]) {
     const GridSpec& g = vel.spec;
-    double inv = 1.0 / g.dx;
-    out[0] = sample_lattice(u_lattice(g), vel.u, p) * inv;
-    out[1] = g.ny > 1 ? sample_lattice(v_lattice(g), vel.v, p) * inv : 0.0;
-    out[2] = sample_lattice(w_lattice(g), vel.w, p) * inv;
-    if (g.nx == 1) out[0] = 0;
+    const double inv = 1.0 / g.dx;
+    out[0] = g.nx > 1 ? lerp_at(vel.u.data(), corners(u_lattice(g), p)) * inv : 0.0;
+    out[1] = g.ny > 1 ? lerp_at(vel.v.data(), corners(v_lattice(g), p)) * inv : 0.0;
+    out[2] = g.nz > 1 ? lerp_at(vel.w.data(), corners(w_lattice(g), p)) * inv : 0.0;
 }
 
 void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::span<const float>> qs,
                  std::span<const std::span<float>> outs, double dt, AdvectionScheme scheme) {
+    AdvectionScratch scratch;
+    advect_many(vel, l, qs, outs, dt, scheme, scratch);
+}
+
+void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::span<const float>> qs,
+                 std::span<const std::span<float>> outs, double dt, AdvectionScheme scheme, AdvectionScratch& scratch) {
     if (qs.size() != outs.size()) throw Error("sim advect: as many outputs as inputs expected");
     for (size_t f = 0; f < qs.size(); ++f)
         if (qs[f].size() != l.size() || outs[f].size() != l.size()) throw Error("sim advect: field size does not match its lattice");
     if (!std::isfinite(dt) || dt < 0) throw Error("sim advect: dt must be finite and >= 0");
     // Trace once per lattice node and reuse it for every field (and, for
-    // MacCormack, for the limiter); the backward trace likewise.
-    std::vector<float> fwd_pos(l.size() * 3), back_pos;
+    // MacCormack, for the limiter); the backward trace likewise. The scratch
+    // keeps its capacity between calls (no per-step allocation).
+    const bool mac = scheme == AdvectionScheme::MacCormack;
+    std::vector<float>& fwd_pos = scratch.forward;
+    std::vector<float>& back_pos = scratch.backward;
+    fwd_pos.resize(l.size() * 3);
+    if (mac) back_pos.resize(l.size() * 3);
     for_lattice(l, [&](size_t id, const double p[3]) {
-        double src[3];
+        double src[3], dst[3];
         trace(vel, p, dt, src);
         for (int a = 0; a < 3; ++a) fwd_pos[id * 3 + size_t(a)] = float(src[a] - p[a]);
+        if (!mac) return;
+        trace(vel, p, -dt, dst);
+        for (int a = 0; a < 3; ++a) back_pos[id * 3 + size_t(a)] = float(dst[a] - p[a]);
     });
     auto pos = [&](const std::vector<float>& d, size_t id, const double p[3], double out[3]) {
         for (int a = 0; a < 3; ++a) out[a] = p[a] + double(d[id * 3 + size_t(a)]);
     };
-    if (scheme == AdvectionScheme::MacCormack) {
-        back_pos.resize(l.size() * 3);
-        for_lattice(l, [&](size_t id, const double p[3]) {
-            double src[3];
-            trace(vel, p, -dt, src);
-            for (int a = 0; a < 3; ++a) back_pos[id * 3 + size_t(a)] = float(src[a] - p[a]);
-        });
-    }
-    std::vector<float> back;
+    std::vector<float>& fwd_val = scratch.value;
+    if (mac) fwd_val.resize(l.size());
     for (size_t f = 0; f < qs.size(); ++f) {
         std::span<const float> q = qs[f];
         std::span<float> out = outs[f];
+        if (!mac) {
+            for_lattice(l, [&](size_t id, const double p[3]) {
+                double src[3];
+                pos(fwd_pos, id, p, src);
+                out[id] = float(lerp_at(q.data(), corners(l, src)));
+            });
+            continue;
+        }
         for_lattice(l, [&](size_t id, const double p[3]) {
             double src[3];
             pos(fwd_pos, id, p, src);
-            out[id] = sample_lattice(l, q, src);
+            fwd_val[id] = float(lerp_at(q.data(), corners(l, src)));
         });
-        if (scheme == AdvectionScheme::SemiLagrangian) continue;
-        back.resize(l.size());
-        for_lattice(l, [&](size_t id, const double p[3]) {
-            double src[3];
-            pos(back_pos, id, p, src);
-            back[id] = sample_lattice(l, out, src);
-        });
+        // Backward step of the forward result, error correction and limiter in
+        // one pass (reads fwd_val everywhere, writes only out[id]).
         for_lattice(l, [&](size_t id, const double p[3]) {
             double src[3];
             pos(fwd_pos, id, p, src);
-            if (near_edge(vel.spec, src)) return; // keep semi-Lagrangian
-            Stencil s = stencil(l, src);
-            float lo = q[s.idx[0]], hi = lo;
-            for (int c = 1; c < 8; ++c) {
-                lo = std::min(lo, q[s.idx[c]]);
-                hi = std::max(hi, q[s.idx[c]]);
+            const float fv = fwd_val[id];
+            if (near_edge(vel.spec, src)) {
+                out[id] = fv; // keep semi-Lagrangian
+                return;
             }
-            float corrected = out[id] + 0.5f * (q[id] - back[id]);
+            double bsrc[3];
+            pos(back_pos, id, p, bsrc);
+            const float back = float(lerp_at(fwd_val.data(), corners(l, bsrc)));
+            float lo, hi;
+            minmax_at(q.data(), corners(l, src), lo, hi);
+            const float corrected = fv + 0.5f * (q[id] - back);
             out[id] = std::clamp(corrected, lo, hi);
         });
     }
@@ -163,11 +200,21 @@ void advect(const MacVelocity& vel, const Lattice& l, std::span<const float> q, 
 }
 
 void advect_velocity(const MacVelocity& vel, MacVelocity& out, double dt, AdvectionScheme scheme) {
+    AdvectionScratch scratch;
+    advect_velocity(vel, out, dt, scheme, scratch);
+}
+
+void advect_velocity(const MacVelocity& vel, MacVelocity& out, double dt, AdvectionScheme scheme, AdvectionScratch& scratch) {
     const GridSpec& g = vel.spec;
     if (out.u.size() != vel.u.size() || out.v.size() != vel.v.size() || out.w.size() != vel.w.size()) out = MacVelocity(g);
-    advect(vel, u_lattice(g), vel.u, out.u, dt, scheme);
-    if (g.ny > 1) advect(vel, v_lattice(g), vel.v, out.v, dt, scheme);
-    advect(vel, w_lattice(g), vel.w, out.w, dt, scheme);
+    auto one = [&](const Lattice& l, const std::vector<float>& q, std::vector<float>& o) {
+        std::span<const float> qs[1] = {q};
+        std::span<float> os[1] = {o};
+        advect_many(vel, l, qs, os, dt, scheme, scratch);
+    };
+    if (g.nx > 1) one(u_lattice(g), vel.u, out.u);
+    if (g.ny > 1) one(v_lattice(g), vel.v, out.v);
+    if (g.nz > 1) one(w_lattice(g), vel.w, out.w);
     out.enforce_walls();
 }
 

@@ -107,7 +107,7 @@ struct PressureSolver::Impl {
     std::vector<double> chol; // dense Cholesky factor of the coarsest level (row-major lower)
     size_t nchol = 0;
     bool singular = false;
-    std::vector<double> phi, res, z, d, q, partial;
+    std::vector<double> phi, res, z, d, q, partial, rhs;
 
     void coarsen() {
         while (true) {
@@ -204,10 +204,13 @@ struct PressureSolver::Impl {
         for (int s = 0; s < 2; ++s) f.gs(0), f.gs(1);
         f.residual();
         Level& c = levels[l + 1];
-        std::fill(c.b.begin(), c.b.end(), 0.0);
-        for (int k = 0; k < f.nz; ++k)
-            for (int j = 0; j < f.ny; ++j)
-                for (int i = 0; i < f.nx; ++i) c.b[c.id(i / f.fx, j / f.fy, k / f.fz)] += f.r[f.id(i, j, k)];
+        // Restriction: each coarse slice sums its own fine slices (disjoint writes).
+        for_slices(c.nz, [&](int K) {
+            std::fill(c.b.begin() + long(c.id(0, 0, K)), c.b.begin() + long(c.id(0, 0, K) + size_t(c.nx) * c.ny), 0.0);
+            for (int k = K * f.fz; k < (K + 1) * f.fz; ++k)
+                for (int j = 0; j < f.ny; ++j)
+                    for (int i = 0; i < f.nx; ++i) c.b[c.id(i / f.fx, j / f.fy, K)] += f.r[f.id(i, j, k)];
+        });
         vcycle(l + 1);
         for_slices(f.nz, [&](int k) {
             for (int j = 0; j < f.ny; ++j)
@@ -308,7 +311,8 @@ ProjectionReport PressureSolver::project(MacVelocity& vel, const ProjectionOptio
     const int nx = s.nx, ny = s.ny, nz = s.nz;
     Level& L = m.levels[0];
     std::vector<double>& b = L.b;
-    std::vector<double> rhs(s.cells());
+    std::vector<double>& rhs = m.rhs;
+    rhs.resize(s.cells());
     for_slices(nz, [&](int k) {
         double rc = rho_cell_[size_t(k)], rlo = rho_face_[size_t(k)], rhi = rho_face_[size_t(k + 1)];
         for (int j = 0; j < ny; ++j)

@@ -181,7 +181,8 @@ static GridSpec checked(const GridSpec& s, const SimOptions& o, const MemoryBudg
 
 Simulation::Simulation(const GridSpec& spec, const Sounding& sounding, const SimOptions& options, const MemoryBudget* budget)
     : spec_(checked(spec, options, budget)), opt_(options), ref_(make_reference(sounding, spec.nz, spec.dx)),
-      solver_(spec, options.anelastic ? ref_.rho : std::vector<double>{}), vel_(spec), vel_tmp_(spec) {
+      solver_(spec, options.anelastic ? ref_.rho : std::vector<double>{}), vel_(spec), vel_tmp_(spec),
+      scratch_(std::make_unique<AdvectionScratch>()) {
     opt_.validate(spec.nz);
     const size_t n = spec.cells();
     theta_.resize(n);
@@ -400,16 +401,20 @@ void Simulation::substep(double dt, StepReport& rep) {
     // 1. Advection of scalars by the old velocity, then of the velocity itself.
     Lattice cl = cell_lattice(spec_);
     {
-        std::vector<float> a(theta_.size()), b(theta_.size()), c(qr_.size());
+        std::vector<float>&a = scalar_tmp_[0], &b = scalar_tmp_[1], &c = scalar_tmp_[2];
+        a.resize(theta_.size());
+        b.resize(theta_.size());
+        c.resize(qr_.size());
         std::span<const float> in[4] = {theta_, qv_, qc_, qr_};
         std::span<float> out[4] = {tmp_, a, b, c};
-        advect_many(vel_, cl, std::span(in, qr_.empty() ? 3 : 4), std::span(out, qr_.empty() ? 3 : 4), dt, opt_.scheme);
+        advect_many(vel_, cl, std::span(in, qr_.empty() ? 3 : 4), std::span(out, qr_.empty() ? 3 : 4), dt, opt_.scheme,
+                    *scratch_);
         theta_.swap(tmp_);
         qv_.swap(a);
         qc_.swap(b);
         qr_.swap(c);
     }
-    advect_velocity(vel_, vel_tmp_, dt, opt_.scheme);
+    advect_velocity(vel_, vel_tmp_, dt, opt_.scheme, *scratch_);
     std::swap(vel_, vel_tmp_);
     rep.seconds_advect += seconds_since(t0);
     // 2. Sources.

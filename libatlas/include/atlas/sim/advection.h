@@ -14,6 +14,7 @@
 #include "atlas/sim/mac_grid.h"
 
 #include <span>
+#include <vector>
 
 namespace atlas::sim {
 
@@ -50,5 +51,16 @@ void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::
 
 // Self-advection of velocity; `out` gets the result (walls re-imposed).
 void advect_velocity(const MacVelocity& vel, MacVelocity& out, double dt, AdvectionScheme scheme);
+
+// Reusable work buffers for the advection calls below (back-trace offsets and
+// the MacCormack forward values, 28 B per lattice node at most); keeping one
+// per simulation avoids allocating and zeroing them every step. Not shared
+// between threads; results do not depend on its previous contents.
+struct AdvectionScratch {
+    std::vector<float> forward, backward, value;
+};
+void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::span<const float>> qs,
+                 std::span<const std::span<float>> outs, double dt, AdvectionScheme scheme, AdvectionScratch& scratch);
+void advect_velocity(const MacVelocity& vel, MacVelocity& out, double dt, AdvectionScheme scheme, AdvectionScratch& scratch);
 
 } // namespace atlas::sim

@@ -185,6 +185,8 @@ private:
     PressureSolver solver_;
     MacVelocity vel_, vel_tmp_;
     std::vector<float> theta_, qv_, qc_, qr_, tmp_;
+    std::vector<float> scalar_tmp_[3];                 // advection outputs, swapped with the state
+    std::unique_ptr<AdvectionScratch> scratch_;        // back-traces kept between steps
     std::vector<float> heat_src_, vap_src_;
     double time_ = 0;
 };
