@@ -70,6 +70,9 @@ std::vector<fs::path> write_json_output(const Value& v, const fs::path& p, const
 }
 } // namespace
 
+// vdb_sequence.cpp
+std::vector<fs::path> write_vdb_sequence_output(const Value&, const fs::path&, const OutputOptions&, OutputMetrics&);
+
 const std::vector<FormatEntry>& format_table() {
     static const std::vector<FormatEntry> table = {
         {{"exr",
@@ -139,6 +142,13 @@ const std::vector<FormatEntry>& format_table() {
           "channel names, and rows [{x, y, <channel>: value, ...}] with x fastest (NaN/Inf as null)",
           {kChannels}},
          write_json_output},
+        {{"vdb-sequence",
+          {},
+          {PortType::Field3D},
+          "one VDB per frame, DIR/STEM.NNNN.vdb, from channels named NNNN:GRID (sim/cloud_growth's 'sequence'); GRID.x/.y/.z "
+          "become one vec3s grid GRID, others float fog volumes; the path is DIR/STEM",
+          {{"tolerance", "values with |v| <= tolerance stay inactive (background 0; default 0)"}}},
+         write_vdb_sequence_output},
     };
     return table;
 }
