@@ -103,8 +103,15 @@ double process_cpu_seconds() {
     return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
-void fast(benchmark::State& st, const CloudScene& sc, int which, int w, int h) {
+void fast(benchmark::State& st, const CloudScene& sc, int which, int w, int h, bool glow = false) {
     RenderSettings s = view(which, w, h);
+    if (glow) {
+        // Internal glow in cumulus A, B and the ring: three point lights, 4
+        // density samples toward each per cloud sample.
+        s.lights = {{{{1050, 1350, 220}}, {{1.0f, 0.25f, 0.1f}}, 4e4, 400},
+                    {{{2900, 930, 190}}, {{1.0f, 0.25f, 0.1f}}, 4e4, 400},
+                    {{{2800, 2800, 240}}, {{0.6f, 0.7f, 1.0f}}, 4e4, 400}};
+    }
     uint64_t samples = 0;
     const double cpu0 = process_cpu_seconds();
     for (auto _ : st) {
@@ -129,6 +136,8 @@ void error_vs_reference(benchmark::State& st, const CloudScene& sc, int which, i
 
 void BM_Fast960Ground(benchmark::State& st) { fast(st, scene(), 0, 960, 540); }
 void BM_Fast960Inside(benchmark::State& st) { fast(st, scene(), 1, 960, 540); }
+void BM_Fast960GroundGlow(benchmark::State& st) { fast(st, scene(), 0, 960, 540, true); }
+void BM_SmokeGlow(benchmark::State& st) { fast(st, smoke_scene(), 0, 32, 18, true); }
 void BM_ErrorGround240(benchmark::State& st) { error_vs_reference(st, scene(), 0, 240, 135); }
 void BM_ErrorInside240(benchmark::State& st) { error_vs_reference(st, scene(), 1, 240, 135); }
 void BM_SmokeFast(benchmark::State& st) { fast(st, smoke_scene(), 0, 32, 18); }
@@ -138,8 +147,10 @@ void BM_SmokeError(benchmark::State& st) { error_vs_reference(st, smoke_scene(),
 
 BENCHMARK(BM_Fast960Ground)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 BENCHMARK(BM_Fast960Inside)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+BENCHMARK(BM_Fast960GroundGlow)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 BENCHMARK(BM_ErrorGround240)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 BENCHMARK(BM_ErrorInside240)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 BENCHMARK(BM_SmokeFast)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SmokeError)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SmokeGlow)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();
