@@ -85,13 +85,49 @@ bool near_edge(const GridSpec& g, const double p[3]) {
     return false;
 }
 
-void trace(const MacVelocity& vel, const double p[3], double dt, double out[3]) {
+// Velocity (cells/s) at p on all three face lattices at once: the per-axis
+// index and fraction are computed once for the face (offset 0) and the
+// centre (offset 0.5) positions and shared by the components.
+struct AxisPos {
+    size_t i;
+    double f;
+    bool step; // an upper neighbour exists
+};
+inline AxisPos axis_pos(double x, int n) { // n samples at x = 0 .. n-1
+    if (n <= 1) return {0, 0.0, false};
+    x = x < 0 ? 0 : (x > n - 1 ? n - 1 : x);
+    int i = int(x);
+    if (i > n - 2) i = n - 2;
+    return {size_t(i), x - i, true};
+}
+inline double lerp3(const float* q, const AxisPos& ax, const AxisPos& ay, const AxisPos& az, size_t sy, size_t sz) {
+    Corners c;
+    c.base = ax.i + ay.i * sy + az.i * sz;
+    c.step[0] = ax.step ? 1 : 0;
+    c.step[1] = ay.step ? sy : 0;
+    c.step[2] = az.step ? sz : 0;
+    c.f[0] = ax.f, c.f[1] = ay.f, c.f[2] = az.f;
+    return lerp_at(q, c);
+}
+inline void velocity_fast(const MacVelocity& vel, const double p[3], double out[3]) {
+    const GridSpec& g = vel.spec;
+    const int nx = g.nx, ny = g.ny, nz = g.nz;
+    const AxisPos fx = axis_pos(p[0], nx + 1), cx = axis_pos(p[0] - 0.5, nx);
+    const AxisPos fy = axis_pos(p[1], ny + 1), cy = axis_pos(p[1] - 0.5, ny);
+    const AxisPos fz = axis_pos(p[2], nz + 1), cz = axis_pos(p[2] - 0.5, nz);
+    const double inv = 1.0 / g.dx;
+    out[0] = nx > 1 ? lerp3(vel.u.data(), fx, cy, cz, size_t(nx + 1), size_t(nx + 1) * ny) * inv : 0.0;
+    out[1] = ny > 1 ? lerp3(vel.v.data(), cx, fy, cz, size_t(nx), size_t(nx) * (ny + 1)) * inv : 0.0;
+    out[2] = nz > 1 ? lerp3(vel.w.data(), cx, cy, fz, size_t(nx), size_t(nx) * ny) * inv : 0.0;
+}
+
+// Midpoint back-trace over dt from p whose velocity v0 is already known.
+void trace_from(const MacVelocity& vel, const double p[3], const double v0[3], double dt, double out[3]) {
     const GridSpec& g = vel.spec;
     const double n[3] = {double(g.nx), double(g.ny), double(g.nz)};
-    double v0[3], mid[3], v1[3];
-    velocity_at(vel, p, v0);
+    double mid[3], v1[3];
     for (int a = 0; a < 3; ++a) mid[a] = std::clamp(p[a] - 0.5 * dt * v0[a], 0.0, n[a]);
-    velocity_at(vel, mid, v1);
+    velocity_fast(vel, mid, v1);
     for (int a = 0; a < 3; ++a) out[a] = std::clamp(p[a] - dt * v1[a], 0.0, n[a]);
 }
 
@@ -114,13 +150,7 @@ float sample_lattice(const Lattice& l, std::span<const float> q, const double p[
     return float(lerp_at(q.data(), corners(l, p)));
 }
 
-void velocity_at(const MacVelocity& vel, const double p[3], double out[3]) {
-    const GridSpec& g = vel.spec;
-    const double inv = 1.0 / g.dx;
-    out[0] = g.nx > 1 ? lerp_at(vel.u.data(), corners(u_lattice(g), p)) * inv : 0.0;
-    out[1] = g.ny > 1 ? lerp_at(vel.v.data(), corners(v_lattice(g), p)) * inv : 0.0;
-    out[2] = g.nz > 1 ? lerp_at(vel.w.data(), corners(w_lattice(g), p)) * inv : 0.0;
-}
+void velocity_at(const MacVelocity& vel, const double p[3], double out[3]) { velocity_fast(vel, p, out); }
 
 void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::span<const float>> qs,
                  std::span<const std::span<float>> outs, double dt, AdvectionScheme scheme) {
@@ -143,11 +173,12 @@ void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::
     fwd_pos.resize(l.size() * 3);
     if (mac) back_pos.resize(l.size() * 3);
     for_lattice(l, [&](size_t id, const double p[3]) {
-        double src[3], dst[3];
-        trace(vel, p, dt, src);
+        double src[3], dst[3], v0[3];
+        velocity_fast(vel, p, v0); // shared by the forward and backward traces
+        trace_from(vel, p, v0, dt, src);
         for (int a = 0; a < 3; ++a) fwd_pos[id * 3 + size_t(a)] = float(src[a] - p[a]);
         if (!mac) return;
-        trace(vel, p, -dt, dst);
+        trace_from(vel, p, v0, -dt, dst);
         for (int a = 0; a < 3; ++a) back_pos[id * 3 + size_t(a)] = float(dst[a] - p[a]);
     });
     auto pos = [&](const std::vector<float>& d, size_t id, const double p[3], double out[3]) {
