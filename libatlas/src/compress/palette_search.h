@@ -10,6 +10,10 @@
 #include <cstdint>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace atlas::compress::detail {
 
 template <int C>
@@ -44,8 +48,72 @@ inline float entry_error_t(const Palette<C>& p, int i, const float* s) {
     return e;
 }
 
+#if defined(__SSE2__)
+// C == 1 (BC4, bc1-scalar), the encoders' hot loop, with SSE2 (x86-64 baseline):
+// the same IEEE operations as the generic path, hence the same choices. MAXPS(a, b)
+// is exactly `a > b ? a : b` and MINPS(a, b) `a < b ? a : b`, as written there.
+template <bool OneSided>
+inline Selection select_indices_scalar_t(const Palette<1>& p, const float* src, float stop_above) {
+    const __m128 zero = _mm_setzero_ps(), vinf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    Selection out;
+    __m128 s[4], best[4], err[8][4];
+    for (int q = 0; q < 4; ++q) { s[q] = _mm_loadu_ps(src + 4 * q); best[q] = vinf; }
+    for (int i = 0; i < p.n; ++i) {
+        const __m128 vlo = _mm_set1_ps(p.lo[i][0]), vhi = _mm_set1_ps(p.hi[i][0]);
+        for (int q = 0; q < 4; ++q) {
+            __m128 e = _mm_max_ps(_mm_max_ps(_mm_sub_ps(vhi, s[q]), _mm_sub_ps(s[q], vlo)), zero);
+            if constexpr (OneSided) {
+                const __m128 above = _mm_cmpgt_ps(vhi, s[q]);
+                e = _mm_or_ps(_mm_and_ps(above, vinf), _mm_andnot_ps(above, e));
+            }
+            err[i][q] = e;
+            best[q] = _mm_min_ps(e, best[q]);
+        }
+    }
+    // Errors are >= 0 and never NaN, so the max does not depend on the order.
+    __m128 m = _mm_max_ps(_mm_max_ps(best[0], best[1]), _mm_max_ps(best[2], best[3]));
+    m = _mm_max_ps(m, _mm_movehl_ps(m, m));
+    m = _mm_max_ss(m, _mm_shuffle_ps(m, m, 1));
+    const float block_max = _mm_cvtss_f32(m);
+    if (!(block_max <= stop_above)) return out; // infeasible or worse than the incumbent
+    out.max_err = block_max;
+    const __m128 vmax = _mm_set1_ps(block_max);
+    __m128d best_sq[8], best_i[8], sd[8];
+    for (int q = 0; q < 4; ++q) {
+        sd[2 * q] = _mm_cvtps_pd(s[q]);
+        sd[2 * q + 1] = _mm_cvtps_pd(_mm_movehl_ps(s[q], s[q]));
+    }
+    for (int h = 0; h < 8; ++h) { best_sq[h] = _mm_set1_pd(std::numeric_limits<double>::infinity()); best_i[h] = _mm_setzero_pd(); }
+    for (int i = 0; i < p.n; ++i) {
+        __m128 ok[4];
+        int any = 0;
+        for (int q = 0; q < 4; ++q) { ok[q] = _mm_cmple_ps(err[i][q], vmax); any |= _mm_movemask_ps(ok[q]); }
+        if (!any) continue; // no texel may use entry i
+        const __m128d vr = _mm_set1_pd(double(p.ref[i][0])), vi = _mm_set1_pd(double(i));
+        for (int h = 0; h < 8; ++h) {
+            const __m128 okq = ok[h / 2];
+            const __m128d allowed = _mm_castps_pd((h & 1) ? _mm_unpackhi_ps(okq, okq) : _mm_unpacklo_ps(okq, okq));
+            const __m128d d = _mm_sub_pd(vr, sd[h]);
+            const __m128d sq = _mm_mul_pd(d, d);
+            const __m128d take = _mm_and_pd(allowed, _mm_cmplt_pd(sq, best_sq[h])); // first minimum wins
+            best_sq[h] = _mm_or_pd(_mm_and_pd(take, sq), _mm_andnot_pd(take, best_sq[h]));
+            best_i[h] = _mm_or_pd(_mm_and_pd(take, vi), _mm_andnot_pd(take, best_i[h]));
+        }
+    }
+    double sq[16], bi[16];
+    for (int h = 0; h < 8; ++h) { _mm_storeu_pd(sq + 2 * h, best_sq[h]); _mm_storeu_pd(bi + 2 * h, best_i[h]); }
+    double total = 0;
+    for (int t = 0; t < 16; ++t) { out.idx[t] = uint8_t(bi[t]); total += sq[t]; }
+    out.sum_sq = total;
+    return out;
+}
+#endif
+
 template <int C, bool OneSided>
 inline Selection select_indices_t(const Palette<C>& p, const float* src, float stop_above) {
+#if defined(__SSE2__)
+    if constexpr (C == 1) return select_indices_scalar_t<OneSided>(p, src, stop_above);
+#endif
     Selection out;
     float block_max = 0;
     for (int t = 0; t < 16; ++t) {
