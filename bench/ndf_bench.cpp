@@ -50,6 +50,34 @@ void BM_HzdWeatherSetSmoke(benchmark::State& state) {
 }
 BENCHMARK(BM_HzdWeatherSetSmoke);
 
+// The recipe's stages one by one at 2048^2 (which node dominates).
+void BM_Stage(benchmark::State& state) {
+    const int n = 2048;
+    const Vec2i res{{n, n}};
+    const Box2d box{{{0, 0}}, {{60000, 60000}}};
+    const Field2D a = noise2d(res, box, {{6, 6}}, 5, 0.55, 11, nullptr);
+    const Field2D b = noise2d(res, box, {{3, 3}}, 2, 0.5, 12, nullptr);
+    const auto shapes = parse_shapes("ellipse 40000 22000 9000 6000 1.0 6000; stroke 3000 0.8 3000 30000 30000 42000 34000 52000 30000");
+    const Curve curve = Curve::parse("0 0; 0.35 0.05; 0.55 0.55; 0.75 0.9; 1 1");
+    Field2D set = make_ndf_set(res, box, 1500, 4000, nullptr);
+    for (auto _ : state) {
+        switch (state.range(0)) {
+        case 0: benchmark::DoNotOptimize(noise2d(res, box, {{6, 6}}, 5, 0.55, 11, nullptr)); break;
+        case 1: benchmark::DoNotOptimize(domain_warp(a, b, 2500, WrapMode::Wrap, nullptr)); break;
+        case 2: benchmark::DoNotOptimize(paint_shapes(res, box, shapes, nullptr)); break;
+        case 3: benchmark::DoNotOptimize(apply_curve(a, curve, nullptr)); break;
+        case 4: benchmark::DoNotOptimize(threshold(a, 0.7, 0.2, nullptr)); break;
+        case 5: benchmark::DoNotOptimize(composite(a, b, nullptr, CompositeOp::Max, 1.0, nullptr)); break;
+        case 6: benchmark::DoNotOptimize(make_ndf_set(res, box, 1500, 4000, nullptr)); break;
+        case 7: benchmark::DoNotOptimize(apply_precipitation_rule(set, PrecipitationRule{}, nullptr)); break;
+        case 8: benchmark::DoNotOptimize(blur(a, 4, WrapMode::Wrap, nullptr)); break;
+        }
+    }
+    static const char* const names[] = {"noise 5 oct", "warp", "shapes", "curve", "threshold", "composite", "set alloc", "rain rule", "blur sigma 4"};
+    state.SetLabel(names[state.range(0)]);
+}
+BENCHMARK(BM_Stage)->DenseRange(0, 8)->Unit(benchmark::kMillisecond);
+
 Field2D heights(int n) {
     // A smooth envelope top: the weather recipe's coverage as max height.
     Field2D c = noise2d({{n, n}}, {{{0, 0}}, {{double(n), double(n)}}}, {{4, 4}}, 4, 0.5, 5, nullptr);
