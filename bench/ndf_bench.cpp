@@ -15,7 +15,8 @@ namespace {
 using namespace atlas;
 using namespace atlas::ndf;
 
-// The recipe of graphs/hzd_weather.yaml (same nodes, same parameters).
+// The recipe of graphs/hzd_weather.yaml (same nodes, same parameters). Values
+// move into shared pointers as the graph hands them on (no extra copies).
 Field2D hzd_weather(int n) {
     const Vec2i res{{n, n}};
     const Box2d box{{{0, 0}}, {{60000, 60000}}};
@@ -24,9 +25,9 @@ Field2D hzd_weather(int n) {
     Field2D warped = domain_warp(cov_noise, warp_noise, 2500, WrapMode::Wrap, nullptr);
     Field2D coverage = apply_curve(warped, Curve::parse("0 0; 0.35 0.05; 0.55 0.55; 0.75 0.9; 1 1"), nullptr);
     Field2D type_noise = noise2d(res, box, {{2, 2}}, 3, 0.5, 21, nullptr);
-    Value type = field_remap(Field2DPtr(std::make_shared<Field2D>(type_noise)), 0.2, 0.8, 0, 0.67, true, nullptr);
+    Value type = field_remap(Field2DPtr(std::make_shared<Field2D>(std::move(type_noise))), 0.2, 0.8, 0, 0.67, true, nullptr);
     Field2D drizzle = threshold(noise2d(res, box, {{4, 4}}, 3, 0.5, 31, nullptr), 0.7, 0.2, nullptr);
-    Value light = field_remap(Field2DPtr(std::make_shared<Field2D>(drizzle)), 0, 1, 0, 0.4, true, nullptr);
+    Value light = field_remap(Field2DPtr(std::make_shared<Field2D>(std::move(drizzle))), 0, 1, 0, 0.4, true, nullptr);
     Field2D storm = paint_shapes(res, box, parse_shapes("ellipse 40000 22000 9000 6000 1.0 6000; stroke 3000 0.8 3000 30000 30000 42000 34000 52000 30000"), nullptr);
     Field2D precip = composite(*std::get<Field2DPtr>(light), storm, nullptr, CompositeOp::Max, 1.0, nullptr);
     Field2D set = make_ndf_set(res, box, 1500, 4000, nullptr);
