@@ -1,19 +1,25 @@
 // BC6H: the decoder against hand-worked blocks built bit by bit from the D3D11 layout
 // table, and the encoder's properties (bounds, round trips, adversarial blocks).
 #include "atlas/compress/bc6h.h"
+#include "atlas/compress/texture.h"
 #include "atlas/core/error.h"
 
 #include "test_blocks.h"
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 namespace atlas::compress {
 namespace {
@@ -517,6 +523,208 @@ TEST(Bc6hEncode, MaxErrorMissFallsBackToBest) {
         if (eb < en) ++escalated;
     }
     std::printf("best improved on normal in %d of 300 gradient blocks\n", escalated);
+}
+
+// ---------------------------------------------------------------------------------
+// Textures: DDS round trips, OpenImageIO as an independent decoder, input checks
+
+fs::path temp_dir(const std::string& name) {
+    const fs::path d = fs::temp_directory_path() / ("atlas_bc6h_" + name + "_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+}
+
+// OIIO 2.4's DDS reader decodes BC6H itself: feed it random 128-bit blocks (every mode,
+// every partition, reserved headers) and our encoder's output, and compare every value.
+void compare_with_oiio(const DdsTexture& tex, const std::string& name, int& mismatches, int& infinities) {
+    const fs::path p = temp_dir("oiio") / (name + ".dds");
+    const std::vector<uint8_t> bytes = encode_dds(tex);
+    {
+        std::ofstream f(p, std::ios::binary);
+        f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    }
+    const Field3D ours = decode_texture(read_dds_file(p), nullptr);
+    auto in = OIIO::ImageInput::open(p.string());
+    ASSERT_TRUE(in) << OIIO::geterror();
+    const OIIO::ImageSpec& spec = in->spec();
+    ASSERT_EQ(spec.width, tex.width);
+    ASSERT_EQ(spec.height, tex.height);
+    ASSERT_EQ(spec.nchannels, 3);
+    std::vector<float> px(size_t(tex.width) * size_t(tex.height) * 3);
+    ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, px.data()));
+    in->close();
+    for (int y = 0; y < tex.height; ++y)
+        for (int x = 0; x < tex.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const float theirs = px[(size_t(y) * size_t(tex.width) + size_t(x)) * 3 + size_t(c)];
+                const float mine = ours.at(c, x, y, 0);
+                if (std::isinf(mine)) ++infinities;
+                if (!(theirs == mine) && !(std::isnan(theirs) && std::isnan(mine))) {
+                    if (mismatches < 5)
+                        std::printf("%s: texel (%d, %d) channel %d: OIIO %.9g, Atlas %.9g\n", name.c_str(), x, y, c, theirs, mine);
+                    ++mismatches;
+                }
+            }
+}
+
+TEST(Bc6hTexture, OpenImageIoDecodesRandomBlocksIdentically) {
+    for (bool sg : {false, true}) {
+        DdsTexture tex;
+        tex.format = sg ? DxgiFormat::BC6H_SF16 : DxgiFormat::BC6H_UF16;
+        tex.width = 256;
+        tex.height = 256;
+        tex.data.resize(tex.total_bytes());
+        for (size_t i = 0; i < tex.data.size(); ++i) tex.data[i] = uint8_t(test::unit(sg ? 99 : 98, i) * 256.0);
+        int mismatches = 0, infinities = 0;
+        compare_with_oiio(tex, sg ? "random_sf16" : "random_uf16", mismatches, infinities);
+        std::printf("%s: %d of %d values differ from OIIO (%d infinities from the SF16 16-bit endpoint -32768)\n",
+                    sg ? "SF16" : "UF16", mismatches, 256 * 256 * 3, infinities);
+        EXPECT_EQ(mismatches, 0);
+    }
+}
+
+Field3D hdr_volume(int nx, int ny, int nz, bool sg) {
+    Field3D f(Vec3i{{nx, ny, nz}}, 3, Box3d{{{0, 0, 0}}, {{double(nx), double(ny), double(nz)}}});
+    for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const double d = std::sqrt(double((x - 12) * (x - 12) + (y - 20) * (y - 20) + 4 * (z - 3) * (z - 3)));
+                f.at(0, x, y, z) = float(200.0 * std::exp(-d / 6.0));                       // radiance falling off
+                f.at(1, x, y, z) = float(0.5 + 0.4 * std::sin(0.3 * x + 0.2 * y + 0.5 * z)); // density-like
+                f.at(2, x, y, z) = float((sg ? -1.0 : 1.0) * 1e-3 * (1 + x + y));            // small values
+            }
+    return f;
+}
+
+TEST(Bc6hTexture, VolumeRoundTripThroughDdsWithMips) {
+    for (Format fmt : {Format::Bc6hUf16, Format::Bc6hSf16}) {
+        const Field3D src = hdr_volume(32, 32, 8, fmt == Format::Bc6hSf16);
+        const fs::path p = temp_dir("volume") / (std::string(format_name(fmt)) + ".dds");
+        CompressOptions o;
+        o.format = fmt;
+        o.mip_levels = 0;
+        const CompressReport rep = compress_to_dds(src, p, o);
+        const DdsTexture tex = read_dds_file(p);
+        EXPECT_TRUE(tex.volume);
+        EXPECT_EQ(tex.mip_levels, 6); // 32 -> 1
+        EXPECT_EQ(tex.depth, 8);
+        EXPECT_EQ(tex.format, fmt == Format::Bc6hSf16 ? DxgiFormat::BC6H_SF16 : DxgiFormat::BC6H_UF16);
+        // Level 0 through the public reader, compared here independently.
+        const Field3D back = read_dds(p);
+        double worst = 0;
+        for (int c = 0; c < 3; ++c)
+            for (size_t i = 0; i < src.channel(c).size(); ++i)
+                worst = std::max(worst, double(std::fabs(back.channel(c)[i] - src.channel(c)[i])));
+        EXPECT_EQ(worst, rep.bound_max_error);
+        EXPECT_LE(worst, 0.06 * 200.0); // sanity: a few percent of the largest value
+        const CompressReport v = verify_dds(p, src);
+        EXPECT_EQ(v.bound_max_error, rep.bound_max_error);
+        // Mip 1 (16x16x4, 2x2x2 box) decoded block by block against the box-filtered source.
+        const int w = 16, h = 16, d = 4;
+        const uint8_t* base = tex.data.data() + tex.offset(0, 1);
+        double mip_worst = 0;
+        for (int z = 0; z < d; ++z)
+            for (int by = 0; by < h / 4; ++by)
+                for (int bx = 0; bx < w / 4; ++bx) {
+                    float dec[48];
+                    decode_bc6h_block(base + ((size_t(z) * 4 + size_t(by)) * 4 + size_t(bx)) * 16, fmt == Format::Bc6hSf16, dec);
+                    for (int t = 0; t < 16; ++t)
+                        for (int c = 0; c < 3; ++c) {
+                            const int x = bx * 4 + t % 4, y = by * 4 + t / 4;
+                            double sum = 0;
+                            for (int k = 0; k < 8; ++k) sum += src.at(c, 2 * x + (k & 1), 2 * y + (k >> 1 & 1), 2 * z + (k >> 2));
+                            mip_worst = std::max(mip_worst, std::fabs(dec[3 * t + c] - sum / 8));
+                        }
+                }
+        EXPECT_LE(mip_worst, 0.06 * 200.0);
+        std::printf("%s volume: level 0 max error %.4g, mip 1 max error %.4g\n", format_name(fmt), worst, mip_worst);
+        // The manifest states the format and the (absent) bound.
+        std::ifstream mf(p.string() + ".json");
+        std::stringstream ms;
+        ms << mf.rdbuf();
+        const TextureManifest man = TextureManifest::from_json(ms.str(), "manifest");
+        EXPECT_EQ(man.encoding, format_name(fmt));
+        EXPECT_EQ(man.dxgi_format, fmt == Format::Bc6hSf16 ? "BC6H_SF16" : "BC6H_UF16");
+        EXPECT_FALSE(man.max_error.has_value());
+    }
+}
+
+TEST(Bc6hTexture, EncoderOutputAgreesWithOpenImageIo) {
+    CompressOptions o;
+    o.format = Format::Bc6hSf16;
+    const EncodedTexture e = encode_texture(hdr_volume(40, 28, 1, true), o); // not a multiple of 4 in y
+    int mismatches = 0, infinities = 0;
+    compare_with_oiio(e.dds, "encoded_sf16", mismatches, infinities);
+    EXPECT_EQ(mismatches, 0);
+    EXPECT_EQ(infinities, 0);
+}
+
+TEST(Bc6hTexture, BytesDoNotDependOnThreadCount) {
+    CompressOptions o;
+    o.format = Format::Bc6hUf16;
+    o.mip_levels = 0;
+    const Field3D src = hdr_volume(32, 24, 4, false);
+    std::vector<uint8_t> one, many;
+    {
+        tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 1);
+        one = encode_texture(src, o).dds.data;
+    }
+    many = encode_texture(src, o).dds.data;
+    EXPECT_EQ(one, many);
+}
+
+TEST(Bc6hTexture, BoundMissesAreReportedWithPositionAndBestError) {
+    CompressOptions o;
+    o.format = Format::Bc6hUf16;
+    o.max_error = 1e-4f; // below what the radiance falloff allows
+    const Field3D src = hdr_volume(16, 16, 1, false);
+    try {
+        compress_to_dds(src, temp_dir("miss") / "m.dds", o);
+        FAIL() << "no BoundError";
+    } catch (const BoundError& e) {
+        ASSERT_FALSE(e.report().blocks_over_bound.empty());
+        for (const BlockMiss& m : e.report().blocks_over_bound) {
+            EXPECT_GT(m.best_error, 1e-4f);
+            EXPECT_EQ(m.x % 4, 0);
+        }
+        EXPECT_NE(std::string(e.what()).find("bc6h"), std::string::npos);
+    }
+    o.allow_over_bound = true;
+    const CompressReport r = compress_to_dds(src, temp_dir("miss") / "m.dds", o);
+    EXPECT_FALSE(r.blocks_over_bound.empty());
+    float worst_miss = 0;
+    for (const BlockMiss& m : r.blocks_over_bound) worst_miss = std::max(worst_miss, m.best_error);
+    EXPECT_EQ(double(worst_miss), r.bound_max_error);
+    // A reachable bound passes.
+    o.max_error = float(r.bound_max_error) * 1.01f;
+    o.allow_over_bound = false;
+    EXPECT_NO_THROW(compress_to_dds(src, temp_dir("miss") / "m.dds", o));
+}
+
+TEST(Bc6hTexture, InvalidInputIsAClearError) {
+    Field3D f = hdr_volume(8, 8, 1, false);
+    CompressOptions o;
+    o.format = Format::Bc6hUf16;
+    auto expect_error = [&](const std::string& needle) {
+        try {
+            encode_texture(f, o);
+            ADD_FAILURE() << "no error for " << needle;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+        }
+    };
+    f.at(2, 3, 5, 0) = -1.0f;
+    expect_error("texel (3, 5, 0)");
+    expect_error("negative");
+    o.format = Format::Bc6hSf16;
+    EXPECT_NO_THROW(encode_texture(f, o));
+    f.at(1, 2, 2, 0) = 70000.0f;
+    expect_error("65504");
+    f.at(1, 2, 2, 0) = NAN;
+    expect_error("NaN");
+    f.at(1, 2, 2, 0) = 0.0f;
+    o.one_sided_below = true;
+    expect_error("one-sided");
 }
 
 } // namespace

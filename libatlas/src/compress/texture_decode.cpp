@@ -1,6 +1,7 @@
 // Decoding DDS levels (every format, every decoder model), read_dds and verify_dds.
 #include "atlas/compress/bc1.h"
 #include "atlas/compress/bc4.h"
+#include "atlas/compress/bc6h.h"
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
 #include "half.h"
@@ -35,7 +36,6 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
     L.hi.assign(size_t(L.channels), std::vector<float>(n));
     const uint8_t* base = tex.data.data() + tex.offset(layer, mip);
     const DxgiFormat f = tex.format;
-    if (f == DxgiFormat::BC6H_UF16 || f == DxgiFormat::BC6H_SF16) throw Error("BC6H decoding is not implemented yet");
     if (is_block_compressed(f)) {
         const int bw = std::max(1, (L.w + 3) / 4), bh = std::max(1, (L.h + 3) / 4);
         const int unit = format_unit_bytes(f);
@@ -45,7 +45,10 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
                     const uint8_t* blk = base + ((size_t(z) * size_t(bh) + size_t(by)) * size_t(bw) + size_t(bx)) * size_t(unit);
                     float lo[48], hi[48];
                     int ch = L.channels;
-                    if (f == DxgiFormat::BC4_UNORM || f == DxgiFormat::BC4_SNORM) {
+                    if (f == DxgiFormat::BC6H_UF16 || f == DxgiFormat::BC6H_SF16) {
+                        decode_bc6h_block(blk, f == DxgiFormat::BC6H_SF16, lo); // exact: no decoder tolerance
+                        std::copy(lo, lo + 48, hi);
+                    } else if (f == DxgiFormat::BC4_UNORM || f == DxgiFormat::BC4_SNORM) {
                         const bool sn = f == DxgiFormat::BC4_SNORM;
                         if (decoder == Decoder::Conformant) decode_bc4_interval(blk, sn, decoder_bit(decoder), lo, hi);
                         else { decode_bc4_block(blk, sn, decoder, lo); std::copy(lo, lo + 16, hi); }

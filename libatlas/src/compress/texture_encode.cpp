@@ -3,6 +3,7 @@
 #include "atlas/compress/bc1.h"
 #include "atlas/compress/bc1_scalar.h"
 #include "atlas/compress/bc4.h"
+#include "atlas/compress/bc6h.h"
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
 #include "half.h"
@@ -111,20 +112,23 @@ void encode_bc(const LevelData& L, int layer, Format fmt, const BlockOptions& bo
                const ProgressSink* progress) {
     const auto& P = L.planes[size_t(layer)];
     const size_t nblocks = size_t(bw) * size_t(bh) * size_t(L.d);
+    const bool bc6h = fmt == Format::Bc6hUf16 || fmt == Format::Bc6hSf16;
+    const size_t unit = bc6h ? 16 : 8;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nblocks, 64), [&](const tbb::blocked_range<size_t>& r) {
         if (progress) progress->poll();
         for (size_t b = r.begin(); b != r.end(); ++b) {
             const int bx = int(b % size_t(bw)), by = int((b / size_t(bw)) % size_t(bh)), z = int(b / (size_t(bw) * size_t(bh)));
             float src[48];
-            const int ch = fmt == Format::Bc1 ? 3 : 1;
+            const int ch = (fmt == Format::Bc1 || bc6h) ? 3 : 1;
             for (int t = 0; t < 16; ++t) {
                 const int x = std::min(bx * 4 + t % 4, L.w - 1), y = std::min(by * 4 + t / 4, L.h - 1); // edge replicate
                 const size_t at = (size_t(z) * size_t(L.h) + size_t(y)) * size_t(L.w) + size_t(x);
                 for (int c = 0; c < ch; ++c) src[ch * t + c] = P[size_t(c)][at];
             }
             BlockResult res;
-            uint8_t* dst = out + b * 8;
-            if (fmt == Format::Bc1) res = encode_bc1_block(src, bo, dst);
+            uint8_t* dst = out + b * unit;
+            if (bc6h) res = encode_bc6h_block(src, fmt == Format::Bc6hSf16, bo, dst);
+            else if (fmt == Format::Bc1) res = encode_bc1_block(src, bo, dst);
             else if (fmt == Format::Bc1Scalar) res = encode_bc1_scalar_block(src, unpack, bo, dst);
             else res = bc4->encode(src, dst);
             blocks[b] = {res.max_error, res.one_sided_ok};
@@ -136,8 +140,10 @@ void encode_bc(const LevelData& L, int layer, Format fmt, const BlockOptions& bo
 
 EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, const ProgressSink* progress) {
     const auto t0 = std::chrono::steady_clock::now();
-    if (o.format == Format::Bc6hUf16 || o.format == Format::Bc6hSf16)
-        throw Error(std::string("compress: format '") + format_name(o.format) + "' is not implemented yet (use rgba16f)");
+    const bool bc6h = o.format == Format::Bc6hUf16 || o.format == Format::Bc6hSf16;
+    if (bc6h && o.one_sided_below)
+        throw Error(std::string("compress: one-sided below is not supported for format '") + format_name(o.format) +
+                    "' (use bc4, bc1-scalar or an uncompressed format for one-sided data)");
     const DxgiFormat dx = dxgi_format(o.format);
     const bool scalar = o.format == Format::Bc1Scalar;
     const int stored = scalar ? 1 : format_channels(dx);
@@ -181,11 +187,18 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
             map.lo = lo;
             map.hi = hi;
         }
-    } else if (dx == DxgiFormat::R16_FLOAT || dx == DxgiFormat::R16G16B16A16_FLOAT) {
+    } else if (dx == DxgiFormat::R16_FLOAT || dx == DxgiFormat::R16G16B16A16_FLOAT || bc6h) {
         for (int c : chans)
-            for (size_t i = 0; i < field.channel(c).size(); ++i)
-                if (std::fabs(field.channel(c)[i]) > 65504.0f)
-                    throw Error("compress: source " + texel_name(field, c, i) + " exceeds the half-float range (65504)");
+            for (size_t i = 0; i < field.channel(c).size(); ++i) {
+                const float v = field.channel(c)[i];
+                if (std::fabs(v) > 65504.0f)
+                    throw Error("compress: source " + texel_name(field, c, i) + " = " + std::to_string(v) +
+                                " exceeds the half-float range (65504)");
+                // BC6H UF16 stores no sign: negative values are an error, not a silent clamp.
+                if (o.format == Format::Bc6hUf16 && v < 0.0f)
+                    throw Error("compress: source " + texel_name(field, c, i) + " = " + std::to_string(v) +
+                                " is negative; format 'bc6h' (UF16) stores values >= 0 (use bc6h-sf16)");
+            }
     }
     const float nmin = map.kind == MapKind::Snorm ? -1.0f : 0.0f;
 
@@ -245,6 +258,9 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     bo.quality = o.quality;
     bo.one_sided_below = o.one_sided_below;
     bo.decoders = o.decoders == 0 ? kReferenceOnly : o.decoders;
+    // BC6H decoding is integer-exact in the specification: every decoder model gives the
+    // same values, so one decode measures the guarantee for all of them.
+    if (bc6h) bo.decoders = kReferenceOnly;
     const double scale = map.scale();
     bo.max_error = o.max_error ? float(*o.max_error / scale) : -1.0f;
     std::unique_ptr<Bc4Encoder> bc4;
