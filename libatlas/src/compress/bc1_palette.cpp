@@ -115,6 +115,10 @@ void bc1_palette_fast(uint16_t c0, uint16_t c1, Decoder d, float out[4][3]) {
     const float* b = T.t5[di][f][c0 & 31][c1 & 31];
     for (int i = 0; i < 4; ++i) { out[i][0] = r[i]; out[i][1] = g[i]; out[i][2] = b[i]; }
 }
+const float* bc1_channel_palette(Decoder d, bool four, bool six, int a, int b) {
+    const ChannelTables& T = channel_tables();
+    return six ? T.t6[int(d)][four ? 1 : 0][a][b] : T.t5[int(d)][four ? 1 : 0][a][b];
+}
 } // namespace detail
 
 void decode_bc1_block(const uint8_t block[8], Decoder d, float rgb[48]) {

@@ -11,6 +11,10 @@ namespace atlas::compress::detail {
 // bc1_palette through precomputed per-channel tables (identical values).
 void bc1_palette_fast(uint16_t c0, uint16_t c1, Decoder d, float out[4][3]);
 
+// The 4 palette values of one channel (five-bit R/B or six-bit G endpoints a, b;
+// `four`: the 4-colour mode, c0 > c1) under a decoder, from the same tables.
+const float* bc1_channel_palette(Decoder d, bool four, bool six, int a, int b);
+
 // Per-channel interval palette of (c0, c1) over a decoder set.
 void bc1_interval_palette(uint16_t c0, uint16_t c1, DecoderSet set, Palette<3>& p);
 

@@ -6,45 +6,28 @@
 #include "atlas/compress/bc1.h"
 #include "atlas/core/error.h"
 #include "bc1_palette.h"
+#include "bc1_scalar_palette.h"
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
+#include <memory>
 
 namespace atlas::compress {
 
 namespace {
 
-// Decoded value of channel level i (bits = 5 or 6) under a decoder's endpoint rule.
-float level_value(int i, int bits, Decoder d) {
-    const int m = (1 << bits) - 1;
-    if (d == Decoder::Reference || d == Decoder::Conformant) return float(i) / float(m);
-    const int e = bits == 5 ? ((i << 3) | (i >> 2)) : ((i << 2) | (i >> 4));
-    return float(e) / 255.0f;
-}
+using detail::channel_level_value;
 
-struct Levels {
-    float hi5[32], hi6[64]; // largest value of each level over the decoders (round-down safety)
-    float ref5[32], ref6[64];
-};
-
-Levels make_levels(DecoderSet set) {
-    Levels L;
-    for (int i = 0; i < 32; ++i) { L.ref5[i] = level_value(i, 5, Decoder::Reference); L.hi5[i] = L.ref5[i]; }
-    for (int i = 0; i < 64; ++i) { L.ref6[i] = level_value(i, 6, Decoder::Reference); L.hi6[i] = L.ref6[i]; }
-    for (Decoder d : decoders_in(set)) {
-        for (int i = 0; i < 32; ++i) L.hi5[i] = std::max(L.hi5[i], level_value(i, 5, d));
-        for (int i = 0; i < 64; ++i) L.hi6[i] = std::max(L.hi6[i], level_value(i, 6, d));
-    }
-    return L;
-}
-
-// Largest level index whose (weighted) value is <= v, or 0.
+// Largest level index whose (weighted) value is <= v, or 0. Levels increase with
+// the index, so the levels that fit form a prefix: binary search.
 int floor_level(const float* table, int n, float w, float v) {
-    int best = 0;
-    for (int i = 0; i < n; ++i)
-        if (table[i] * w <= v) best = i;
-    return best;
+    int lo = 0, hi = n; // table[i] * w <= v for every i < lo; fails for i >= hi
+    while (lo < hi) {
+        const int mid = (lo + hi) / 2;
+        if (table[mid] * w <= v) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo > 0 ? lo - 1 : 0;
 }
 
 // Greedy split of v into R, G, B; `nearest_last` rounds the B digit to nearest.
@@ -58,34 +41,16 @@ uint16_t split(float v, const ScalarUnpack& u, const float* t5, const float* t6,
     return uint16_t((r << 11) | (g << 5) | b);
 }
 
-void scalar_palette(uint16_t c0, uint16_t c1, const ScalarUnpack& u, detail::Palette<1>& p) {
-    p.n = 4;
-    auto dotw = [&](const float* rgb) { return rgb[0] * u.weights[0] + rgb[1] * u.weights[1] + rgb[2] * u.weights[2]; };
-    float ref[4][3];
-    detail::bc1_palette_fast(c0, c1, Decoder::Reference, ref);
-    for (int i = 0; i < 4; ++i) { p.ref[i][0] = dotw(ref[i]); p.lo[i][0] = p.hi[i][0] = p.ref[i][0]; }
-    bool any = false;
-    const bool four = c0 > c1;
-    for (int di = 0; di < kDecoderCount; ++di) {
-        if (!(u.decoders & (DecoderSet(1) << di))) continue; // no allocation in the hot loop
-        const Decoder d = static_cast<Decoder>(di);
-        float v[4][3];
-        detail::bc1_palette_fast(c0, c1, d, v);
-        for (int i = 0; i < 4; ++i) {
-            float x = dotw(v[i]);
-            float lo = x, hi = x;
-            if (d == Decoder::Conformant && (four || i != 3)) { // per-channel tolerance through the weights
-                float t = 0;
-                for (int c = 0; c < 3; ++c) t += u.weights[size_t(c)] * bc1_conformant_tolerance(ref[0][c], ref[1][c]);
-                lo -= t;
-                hi += t;
-            }
-            if (!any) { p.lo[i][0] = lo; p.hi[i][0] = hi; }
-            else { p.lo[i][0] = std::min(p.lo[i][0], lo); p.hi[i][0] = std::max(p.hi[i][0], hi); }
-        }
-        any = true;
+// A small sorted set of endpoint codes without allocation.
+struct Codes {
+    uint16_t v[64];
+    int n = 0;
+    void add(uint16_t c) { if (n < 64) v[n++] = c; }
+    void sort_unique() {
+        std::sort(v, v + n);
+        n = int(std::unique(v, v + n) - v);
     }
-}
+};
 
 } // namespace
 
@@ -95,8 +60,8 @@ ScalarUnpack bc1_scalar_unpack(DecoderSet decoders) {
     u.decoders = decoders;
     float step5 = 0, step6 = 0;
     for (Decoder d : decoders_in(decoders)) {
-        for (int i = 0; i < 31; ++i) step5 = std::max(step5, level_value(i + 1, 5, d) - level_value(i, 5, d));
-        for (int i = 0; i < 63; ++i) step6 = std::max(step6, level_value(i + 1, 6, d) - level_value(i, 6, d));
+        for (int i = 0; i < 31; ++i) step5 = std::max(step5, channel_level_value(i + 1, 5, d) - channel_level_value(i, 5, d));
+        for (int i = 0; i < 63; ++i) step6 = std::max(step6, channel_level_value(i + 1, 6, d) - channel_level_value(i, 6, d));
     }
     u.weights = {1.0f, step5, step5 * step6};
     u.max_value = u.weights[0] + u.weights[1] + u.weights[2];
@@ -117,7 +82,8 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
         throw Error("encode_bc1_scalar_block: options.decoders differs from the unpack weights' decoder set");
     // Round-down against the largest decoded level keeps endpoints below the source
     // for every decoder; the reference table gives the nearest alternatives.
-    const Levels L = make_levels(u.decoders);
+    std::unique_ptr<detail::ScalarTables> local;
+    const detail::ScalarTables& T = detail::scalar_tables(u, local);
     float smin = src[0], smax = src[0];
     for (int t = 1; t < 16; ++t) { smin = std::min(smin, src[t]); smax = std::max(smax, src[t]); }
     // Margins below the source: 0, and for the Conformant model its endpoint
@@ -133,34 +99,32 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
     float sorted[16];
     std::copy(src, src + 16, sorted);
     std::sort(sorted, sorted + 16);
-    std::vector<uint16_t> lows, highs;
+    Codes lows, highs;
     // One-sided under Conformant: endpoints without margin are never feasible.
     for (int k = (nm > 1 && options.one_sided_below) ? 1 : 0; k < nm; ++k) {
         const float m = margins[k];
-        lows.push_back(split(smin - m, u, L.hi5, L.hi6, false));
-        highs.push_back(split(smax - m, u, L.hi5, L.hi6, false));
+        lows.add(split(smin - m, u, T.hi5, T.hi6, false));
+        highs.add(split(smax - m, u, T.hi5, T.hi6, false));
         if (options.quality != Quality::Fast) { // Nubis: move the high endpoint down
-            highs.push_back(split(sorted[13] - m, u, L.hi5, L.hi6, false));
-            highs.push_back(split(sorted[10] - m, u, L.hi5, L.hi6, false));
+            highs.add(split(sorted[13] - m, u, T.hi5, T.hi6, false));
+            highs.add(split(sorted[10] - m, u, T.hi5, T.hi6, false));
         }
         if (options.quality == Quality::Best)
-            for (int t = 0; t < 16; ++t) highs.push_back(split(src[t] - m, u, L.hi5, L.hi6, false));
+            for (int t = 0; t < 16; ++t) highs.add(split(src[t] - m, u, T.hi5, T.hi6, false));
     }
     if (!options.one_sided_below) {
-        lows.push_back(split(smin, u, L.ref5, L.ref6, true));
-        highs.push_back(split(smax, u, L.ref5, L.ref6, true));
+        lows.add(split(smin, u, T.ref5, T.ref6, true));
+        highs.add(split(smax, u, T.ref5, T.ref6, true));
     }
-    std::sort(highs.begin(), highs.end());
-    highs.erase(std::unique(highs.begin(), highs.end()), highs.end());
-    std::sort(lows.begin(), lows.end());
-    lows.erase(std::unique(lows.begin(), lows.end()), lows.end());
+    highs.sort_unique();
+    lows.sort_unique();
 
     detail::Selection best;
     uint16_t b0 = 0, b1 = 0;
     bool have = false;
     auto consider = [&](uint16_t c0, uint16_t c1) {
         detail::Palette<1> p;
-        scalar_palette(c0, c1, u, p);
+        detail::scalar_interval_palette(T, c0, c1, p);
         detail::Selection s = detail::select_indices(p, src, options.one_sided_below, have ? best.max_err : INFINITY);
         if (!std::isfinite(s.max_err)) return;
         if (!have || detail::better(s, best)) { best = s; b0 = c0; b1 = c1; have = true; }
@@ -169,8 +133,8 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
         consider(std::max(a, b), std::min(a, b));
         consider(std::min(a, b), std::max(a, b));
     };
-    for (uint16_t h : highs)
-        for (uint16_t l : lows) both(h, l);
+    for (int i = 0; i < highs.n; ++i)
+        for (int j = 0; j < lows.n; ++j) both(highs.v[i], lows.v[j]);
     const bool missed = !have || (options.max_error >= 0 && best.max_err > options.max_error);
     if (options.quality == Quality::Best || missed) {
         // Nudge both endpoint codes by a few units (neighbouring codes are neighbouring values).
@@ -189,7 +153,7 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
         both(0, 0);
         if (!have) {
             detail::Palette<1> p;
-            scalar_palette(0, 0, u, p);
+            detail::scalar_interval_palette(T, 0, 0, p);
             detail::Selection s = detail::select_indices(p, src, false);
             detail::write_bc1_block(0, 0, s.idx, out);
             return {s.max_err, s.sum_sq, false};

@@ -56,26 +56,31 @@ template <bool OneSided>
 inline Selection select_indices_scalar_t(const Palette<1>& p, const float* src, float stop_above) {
     const __m128 zero = _mm_setzero_ps(), vinf = _mm_set1_ps(std::numeric_limits<float>::infinity());
     Selection out;
-    __m128 s[4], best[4], err[8][4];
-    for (int q = 0; q < 4; ++q) { s[q] = _mm_loadu_ps(src + 4 * q); best[q] = vinf; }
-    for (int i = 0; i < p.n; ++i) {
-        const __m128 vlo = _mm_set1_ps(p.lo[i][0]), vhi = _mm_set1_ps(p.hi[i][0]);
-        for (int q = 0; q < 4; ++q) {
+    __m128 s[4], err[8][4], block = zero;
+    const __m128 vstop = _mm_set1_ps(stop_above);
+    // Quads of texels in order, each against every entry, so that a candidate that
+    // cannot beat the incumbent is usually dropped after the first quad.
+    for (int q = 0; q < 4; ++q) {
+        s[q] = _mm_loadu_ps(src + 4 * q);
+        __m128 best = vinf;
+        for (int i = 0; i < p.n; ++i) {
+            const __m128 vlo = _mm_set1_ps(p.lo[i][0]), vhi = _mm_set1_ps(p.hi[i][0]);
             __m128 e = _mm_max_ps(_mm_max_ps(_mm_sub_ps(vhi, s[q]), _mm_sub_ps(s[q], vlo)), zero);
             if constexpr (OneSided) {
                 const __m128 above = _mm_cmpgt_ps(vhi, s[q]);
                 e = _mm_or_ps(_mm_and_ps(above, vinf), _mm_andnot_ps(above, e));
             }
             err[i][q] = e;
-            best[q] = _mm_min_ps(e, best[q]);
+            best = _mm_min_ps(e, best);
         }
+        // !(best <= stop) for any texel: infeasible or worse than the incumbent.
+        if (_mm_movemask_ps(_mm_cmple_ps(best, vstop)) != 15) return out;
+        block = _mm_max_ps(best, block);
     }
     // Errors are >= 0 and never NaN, so the max does not depend on the order.
-    __m128 m = _mm_max_ps(_mm_max_ps(best[0], best[1]), _mm_max_ps(best[2], best[3]));
-    m = _mm_max_ps(m, _mm_movehl_ps(m, m));
+    __m128 m = _mm_max_ps(block, _mm_movehl_ps(block, block));
     m = _mm_max_ss(m, _mm_shuffle_ps(m, m, 1));
     const float block_max = _mm_cvtss_f32(m);
-    if (!(block_max <= stop_above)) return out; // infeasible or worse than the incumbent
     out.max_err = block_max;
     const __m128 vmax = _mm_set1_ps(block_max);
     __m128d best_sq[8], best_i[8], sd[8];
