@@ -160,24 +160,57 @@ void region_extremes(const Block& b, uint16_t mask, float lo[3], float hi[3]) {
     }
 }
 
-// Sum over regions of the squared distances to each region's principal line (q domain).
-float partition_residual(const Block& b, int p) {
-    float total = 0;
-    for (int r = 0; r < 2; ++r) {
-        const uint16_t mask = r ? kPartitions[p] : uint16_t(~kPartitions[p]);
-        float lo[3], hi[3];
-        region_extremes(b, mask, lo, hi);
-        float ax[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-        const float len2 = ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2];
-        for (int t = 0; t < 16; ++t)
-            if (mask >> t & 1) {
-                const float d[3] = {b.q[t][0] - lo[0], b.q[t][1] - lo[1], b.q[t][2] - lo[2]};
-                const float dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                const float pr = d[0] * ax[0] + d[1] * ax[1] + d[2] * ax[2];
-                total += len2 > 0 ? std::max(0.0f, dd - pr * pr / len2) : dd;
-            }
+// Moments of a set of texels (q domain), in double: q^2 sums reach 7e10.
+struct Moments {
+    double n = 0, s[3] = {0, 0, 0}, ss[6] = {0, 0, 0, 0, 0, 0}; // xx xy xz yy yz zz
+};
+
+// Sum of squared distances of the texels to their principal line: trace(C) - lambda_max(C).
+double line_residual(const Moments& m) {
+    if (m.n < 2) return 0;
+    const double c[6] = {m.ss[0] - m.s[0] * m.s[0] / m.n, m.ss[1] - m.s[0] * m.s[1] / m.n, m.ss[2] - m.s[0] * m.s[2] / m.n,
+                         m.ss[3] - m.s[1] * m.s[1] / m.n, m.ss[4] - m.s[1] * m.s[2] / m.n, m.ss[5] - m.s[2] * m.s[2] / m.n};
+    const double trace = c[0] + c[3] + c[5];
+    double v[3] = {0, 0, 0};
+    v[c[0] >= c[3] && c[0] >= c[5] ? 0 : c[3] >= c[5] ? 1 : 2] = 1;
+    double lambda = 0;
+    for (int it = 0; it < 6; ++it) {
+        const double w[3] = {c[0] * v[0] + c[1] * v[1] + c[2] * v[2], c[1] * v[0] + c[3] * v[1] + c[4] * v[2],
+                             c[2] * v[0] + c[4] * v[1] + c[5] * v[2]};
+        const double len = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        if (!(len > 0)) break;
+        lambda = len; // |C v| with |v| = 1 converges to lambda_max
+        for (int k = 0; k < 3; ++k) v[k] = w[k] / len;
     }
-    return total;
+    return std::max(0.0, trace - lambda);
+}
+
+// The residual of every two-region partition, from per-texel moments.
+void partition_residuals(const Block& b, double res[32]) {
+    double p[16][9];
+    Moments all;
+    for (int t = 0; t < 16; ++t) {
+        const double x = b.q[t][0], y = b.q[t][1], z = b.q[t][2];
+        const double v[9] = {x, y, z, x * x, x * y, x * z, y * y, y * z, z * z};
+        for (int k = 0; k < 9; ++k) p[t][k] = v[k];
+        all.n += 1;
+        for (int k = 0; k < 3; ++k) all.s[k] += v[k];
+        for (int k = 0; k < 6; ++k) all.ss[k] += v[3 + k];
+    }
+    for (int part = 0; part < 32; ++part) {
+        Moments r1;
+        for (int t = 0; t < 16; ++t)
+            if (kPartitions[part] >> t & 1) {
+                r1.n += 1;
+                for (int k = 0; k < 3; ++k) r1.s[k] += p[t][k];
+                for (int k = 0; k < 6; ++k) r1.ss[k] += p[t][3 + k];
+            }
+        Moments r0;
+        r0.n = all.n - r1.n;
+        for (int k = 0; k < 3; ++k) r0.s[k] = all.s[k] - r1.s[k];
+        for (int k = 0; k < 6; ++k) r0.ss[k] = all.ss[k] - r1.ss[k];
+        res[part] = line_residual(r0) + line_residual(r1);
+    }
 }
 
 // Real-valued endpoints (q domain) of a (partition, regions) choice, ordered so that each
@@ -273,8 +306,9 @@ Candidate search(const Block& b, Quality q) {
 
     // Two regions: partitions ranked by the principal-line residual.
     int order[32];
-    float res[32];
-    for (int p = 0; p < 32; ++p) { order[p] = p; res[p] = partition_residual(b, p); }
+    double res[32];
+    partition_residuals(b, res);
+    for (int p = 0; p < 32; ++p) order[p] = p;
     std::stable_sort(order, order + 32, [&](int x, int y) { return res[x] < res[y]; });
     const int tries = q == Quality::Best ? 32 : 4;
     Candidate top[3];
