@@ -9,7 +9,11 @@
 // from two explicit samples toward the sun plus a precomputed voxel light
 // grid, Beer's law with the powder term, dual-lobe Henyey-Greenstein;
 // ambient from the profile attenuated by summed density toward the sky; the
-// multiple-scattering approximation from the profile.
+// multiple-scattering approximation from the profile. Optional point lights
+// and lightning-flash lights (lights.h: inverse square, a few density
+// samples toward each light, the same phase function) and a zenith-to-horizon
+// sky gradient; without them that code does not run and the bytes are those
+// of the renderer before they existed.
 //
 // Reference mode is the same integrator with small fixed steps, no SDF
 // skipping, fully marched light and sky rays and no light grid.
