@@ -17,14 +17,34 @@ Field2D new_map(Vec2i res, Box2d bounds, const MemoryBudget* budget) {
 }
 bool finite2(Vec2d p) { return std::isfinite(p[0]) && std::isfinite(p[1]); }
 
-// One row of 2D value noise (z fixed at a lattice plane) at texel centres
-// x = (i + 0.5) dx: the row's lattice values come from the noise library at
-// integer points (where its interpolation returns the lattice value exactly),
-// blended once in y, then only the x interpolation runs per texel - the
-// library's row function would hash 8 corners per texel for the same result
-// up to float rounding. Same quintic fade, same tiling.
+// 2D value noise (z fixed at a lattice plane) at texel centres x = (i + 0.5) dx:
+// a row's lattice values come from the noise library at integer points
+// (where its interpolation returns the lattice value exactly), blended once
+// in y, then only the x interpolation runs per texel - the library's row
+// function would hash 8 corners per texel for the same result up to float
+// rounding. Same quintic fade, same tiling. The x taps and fade weights are
+// the same for every row, so they are computed once per octave.
 float quintic(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
-void value_noise_row_2d(std::vector<float>& out, std::vector<float>& lat, double dx, double y, Vec3i p, uint32_t seed) {
+struct XTaps {
+    std::vector<int> i0, i1;
+    std::vector<float> t;
+};
+XTaps x_taps(int n, double dx, int period) {
+    XTaps k;
+    k.i0.resize(size_t(n));
+    k.i1.resize(size_t(n));
+    k.t.resize(size_t(n));
+    for (int i = 0; i < n; ++i) {
+        const double x = (double(i) + 0.5) * dx;
+        const double fx = std::floor(x);
+        const int64_t xi = int64_t(fx);
+        k.t[size_t(i)] = quintic(float(x - fx));
+        k.i0[size_t(i)] = int(xi % period);
+        k.i1[size_t(i)] = int((xi + 1) % period);
+    }
+    return k;
+}
+void value_noise_row_2d(std::vector<float>& out, std::vector<float>& lat, const XTaps& k, double y, Vec3i p, uint32_t seed) {
     const double fy = std::floor(y);
     const float ty = quintic(float(y - fy));
     const int y0 = int(int64_t(fy) % p[1]), y1 = int((int64_t(fy) + 1) % p[1]);
@@ -35,12 +55,8 @@ void value_noise_row_2d(std::vector<float>& out, std::vector<float>& lat, double
         lat[size_t(i)] = a + (b - a) * ty;
     }
     for (size_t i = 0; i < out.size(); ++i) {
-        const double x = (double(i) + 0.5) * dx;
-        const double fx = std::floor(x);
-        const float tx = quintic(float(x - fx));
-        const int64_t xi = int64_t(fx);
-        const float a = lat[size_t(xi % p[0])], b = lat[size_t((xi + 1) % p[0])];
-        out[i] = a + (b - a) * tx;
+        const float a = lat[size_t(k.i0[i])], b = lat[size_t(k.i1[i])];
+        out[i] = a + (b - a) * k.t[i];
     }
 }
 } // namespace
@@ -83,6 +99,15 @@ Field2D noise2d(Vec2i res, Box2d bounds, Vec2i period, int octaves, double gain,
     auto out = f.channel(0);
     double norm = 0, amp = 1;
     for (int o = 0; o < octaves; ++o, amp *= gain) norm += amp;
+    // Octave o: lattice period << o; texel centres in lattice units are
+    // (i + 0.5) / res * period, and the lattice repeats every period cells,
+    // so the map tiles. Octaves with more than 4 lattice cells per texel use
+    // the library's row function instead.
+    std::vector<XTaps> taps(static_cast<size_t>(octaves));
+    for (int o = 0; o < octaves; ++o) {
+        const int px = period[0] << o;
+        if (px <= 4 * res[0]) taps[size_t(o)] = x_taps(res[0], double(px) / res[0], px);
+    }
     tbb::parallel_for(0, res[1], [&](int y) {
         std::vector<float> row(static_cast<size_t>(res[0]));
         std::vector<float> lattice;
@@ -91,17 +116,16 @@ Field2D noise2d(Vec2i res, Box2d bounds, Vec2i period, int octaves, double gain,
         double a = 1.0;
         for (int o = 0; o < octaves; ++o, a *= gain) {
             const Vec3i p{{period[0] << o, period[1] << o, 1}};
-            // Texel centres in lattice units: (i + 0.5) / res * period; the
-            // lattice repeats every `period` cells, so the map tiles.
             const double dx = double(p[0]) / res[0];
             const double yy = (y + 0.5) * p[1] / res[1];
             const uint32_t s = seed + uint32_t(o) * 1013u;
             if (p[0] <= 4 * res[0]) {
-                value_noise_row_2d(row, lattice, dx, yy, p, s);
+                value_noise_row_2d(row, lattice, taps[size_t(o)], yy, p, s);
             } else {
                 noise::value_noise_row(row, 0.5 * dx, dx, yy, 0.0, p, s);
             }
-            for (int x = 0; x < res[0]; ++x) dst[x] += float(a / norm) * row[size_t(x)];
+            const float w = float(a / norm);
+            for (int x = 0; x < res[0]; ++x) dst[x] += w * row[size_t(x)];
         }
         for (int x = 0; x < res[0]; ++x) dst[x] = std::clamp(dst[x], 0.0f, 1.0f);
     });
