@@ -3,6 +3,8 @@
 #include "atlas/sim/simulation.h"
 #include "atlas/sim/thermo.h"
 
+#include "atlas/core/error.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -175,4 +177,80 @@ TEST(SimPhysics, RobertRisingThermal) {
     EXPECT_LT(rise, 550);
     EXPECT_GT(wpeak, 2.0);
     EXPECT_LT(wpeak, 5.0);
+}
+
+// Bryan & Fritsch reversible thermodynamics: the adjustment keeps theta_e and
+// q_t (1e-9 relative) from any start, including far supersaturated or fully
+// evaporating parcels, lands on saturation (or below with qc = 0), and the
+// moist-neutral sounding has theta_e = 320 K at every level (1e-6 K) and is
+// hydrostatic in theta_rho against an independent fine integration (1e-7).
+TEST(SimPhysics, ReversibleThetaEAdjustmentAndSounding) {
+    struct Start {
+        double theta, qv, qc, p;
+    } starts[] = {{300, 0.03, 0.0, 9e4}, {290, 0.0, 0.02, 8e4}, {310, 0.001, 0.001, 6e4}, {280, 0.012, 0.008, 1e5}, {350, 0.0, 0.0, 5e4}};
+    for (const Start& st : starts) {
+        const double pi = exner(st.p), qt = st.qv + st.qc;
+        const double the0 = equivalent_potential_temperature(st.theta * pi, st.p, st.qv, qt);
+        AdjustResult a = saturation_adjust_theta_e(st.theta, st.qv, st.qc, st.p);
+        EXPECT_NEAR(equivalent_potential_temperature(a.theta * pi, st.p, a.qv, a.qv + a.qc), the0, 1e-9 * the0);
+        EXPECT_NEAR(a.qv + a.qc, qt, 1e-15);
+        EXPECT_GE(a.qc, 0);
+        EXPECT_GE(a.qv, 0);
+        const double qs = saturation_mixing_ratio(a.theta * pi, st.p);
+        if (a.qc > 0) {
+            EXPECT_NEAR(a.qv, qs, 1e-9);
+        } else {
+            EXPECT_LE(a.qv, qs * (1 + 1e-9));
+        }
+    }
+    EXPECT_THROW(saturation_adjust_theta_e(std::nan(""), 0.01, 0, 1e5), Error);
+    Sounding snd;
+    snd.theta_e = 320;
+    snd.total_water = 0.02;
+    const int nz = 50;
+    ReferenceProfile r = make_reference(snd, nz, 200.0);
+    double pi = exner(snd.surface_pressure), z = 0;
+    for (int k = 0; k < nz; ++k) {
+        const double p = r.pressure[size_t(k)], e = r.exner[size_t(k)];
+        EXPECT_NEAR(equivalent_potential_temperature(r.theta[size_t(k)] * e, p, r.qv[size_t(k)], 0.02), 320.0, 1e-6) << k;
+        EXPECT_NEAR(r.qv[size_t(k)] + r.qc[size_t(k)], 0.02, 1e-15);
+        // Independent integration: 2000 explicit Euler-midpoint steps per cell.
+        const double zc = (k + 0.5) * 200, h = (zc - z) / 2000;
+        for (int m = 0; m < 2000; ++m) {
+            auto theta_rho = [&](double pp) {
+                const double pr = kP00 * std::pow(pp, kCp / kRd);
+                const double T = equilibrium_temperature_theta_e(320, pr, 0.02, 290);
+                const double qv = std::min(0.02, saturation_mixing_ratio(T, pr));
+                return T / pp * (1 + qv / kEps) / 1.02;
+            };
+            const double half = pi - 0.5 * h * kGravity / (kCp * theta_rho(pi));
+            pi -= h * kGravity / (kCp * theta_rho(half));
+        }
+        z = zc;
+        EXPECT_NEAR(e, pi, 1e-7) << k;
+    }
+    Sounding bad = snd;
+    bad.total_water = 0;
+    EXPECT_THROW(make_reference(bad, 10, 100), Error);
+}
+
+// The reversible moist-neutral atmosphere at rest stays at rest in the
+// reversible model (|u| < 1e-3 m/s over 30 steps of 10 s; qc changes < 1e-6).
+TEST(SimPhysics, ReversibleSaturatedNeutralAtmosphereStaysAtRest) {
+    GridSpec s = slab(16, 40, 200);
+    Sounding snd;
+    snd.theta_e = 320;
+    snd.total_water = 0.02;
+    SimOptions o;
+    o.reversible_theta_e = true;
+    Simulation sim(s, snd, o);
+    std::vector<float> qc0 = sim.qc();
+    StepReport r;
+    for (int n = 0; n < 30; ++n) {
+        r = sim.step(10.0);
+        ASSERT_LT(r.max_speed, 1e-3) << n;
+    }
+    double dq = 0;
+    for (size_t c = 0; c < qc0.size(); ++c) dq = std::max(dq, double(std::fabs(sim.qc()[c] - qc0[c])));
+    EXPECT_LT(dq, 1e-6);
 }

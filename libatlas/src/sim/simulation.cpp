@@ -68,6 +68,8 @@ void Sounding::validate() const {
     check_range(rh_lapse, -1e-3, 1e-3, "sounding.rh_lapse (1/m)");
     check_range(rh_above, 0, 1, "sounding.rh_above");
     check_range(total_water, 0, 0.05, "sounding.total_water (kg/kg)");
+    if (theta_e != 0) check_range(theta_e, 250, 400, "sounding.theta_e (K)");
+    if (theta_e != 0 && !(total_water > 0)) throw Error("sim: sounding.theta_e needs sounding.total_water > 0");
 }
 
 double Sounding::theta_at(double z) const {
@@ -93,6 +95,45 @@ ReferenceProfile make_reference(const Sounding& s, int nz, double dx) {
     r.pressure.resize(size_t(nz));
     r.rho.resize(size_t(nz));
     r.qc.assign(size_t(nz), 0.0);
+    if (s.theta_e > 0) {
+        // Bryan & Fritsch moist-neutral: theta_e and q_t constant, saturated;
+        // dPi/dz = -g / (c_p theta_rho) by Heun's rule on 16 sub-steps per cell.
+        const double qt = s.total_water;
+        double T_guess = s.theta_e;
+        auto state = [&](double pi_at, double& th, double& qv, double& qc) {
+            const double p = kP00 * std::pow(pi_at, kCp / kRd);
+            const double T = equilibrium_temperature_theta_e(s.theta_e, p, qt, T_guess);
+            T_guess = T;
+            qv = std::min(qt, saturation_mixing_ratio(T, p));
+            qc = qt - qv;
+            th = T / pi_at;
+            return th * (1 + qv / kEps) / (1 + qt);
+        };
+        double pi = exner(s.surface_pressure), z = 0, th, qv, qc;
+        for (int k = 0; k < nz; ++k) {
+            const double zc = (k + 0.5) * dx;
+            const int sub = 16;
+            const double h = (zc - z) / sub;
+            for (int m = 0; m < sub; ++m) {
+                const double r1 = state(pi, th, qv, qc);
+                const double pred = pi - kGravity / (kCp * r1) * h;
+                if (!(pred > 0.05)) break;
+                const double r2 = state(pred, th, qv, qc);
+                pi -= 0.5 * kGravity / kCp * (1 / r1 + 1 / r2) * h;
+            }
+            z = zc;
+            if (!(pi > 0.05)) throw Error("sim: the domain top reaches above the modelled atmosphere (Exner < 0.05); lower nz * dx");
+            const double rho_theta = state(pi, th, qv, qc);
+            const double p = kP00 * std::pow(pi, kCp / kRd);
+            r.theta[size_t(k)] = th;
+            r.qv[size_t(k)] = qv;
+            r.qc[size_t(k)] = qc;
+            r.exner[size_t(k)] = pi;
+            r.pressure[size_t(k)] = p;
+            r.rho[size_t(k)] = p / (kRd * rho_theta * pi); // p = rho R_d T_rho
+        }
+        return r;
+    }
     const bool saturated = s.total_water > 0;
     // Hydrostatic: dPi/dz = -g / (cp theta), integrated with fine sub-steps (midpoint rule).
     double pi = exner(s.surface_pressure), z = 0;
@@ -400,6 +441,15 @@ void Simulation::substep(double dt, StepReport& rep) {
     auto t0 = Clock::now();
     // 1. Advection of scalars by the old velocity, then of the velocity itself.
     Lattice cl = cell_lattice(spec_);
+    // Reversible mode: theta_e (conserved by reversible moist adiabatic motion)
+    // is what gets advected; theta is recovered afterwards at the new level.
+    if (opt_.reversible_theta_e && opt_.moist) {
+        for_slices(nz, [&](int k) {
+            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
+            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
+                theta_[c] = float(equivalent_potential_temperature(theta_[c] * pi, p, qv_[c], double(qv_[c]) + qc_[c]));
+        });
+    }
     {
         std::vector<float>&a = scalar_tmp_[0], &b = scalar_tmp_[1], &c = scalar_tmp_[2];
         a.resize(theta_.size());
@@ -413,6 +463,13 @@ void Simulation::substep(double dt, StepReport& rep) {
         qv_.swap(a);
         qc_.swap(b);
         qr_.swap(c);
+    }
+    if (opt_.reversible_theta_e && opt_.moist) {
+        for_slices(nz, [&](int k) {
+            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
+            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
+                theta_[c] = float(temperature_from_theta_e(theta_[c], p, qv_[c], double(qv_[c]) + qc_[c]) / pi);
+        });
     }
     advect_velocity(vel_, vel_tmp_, dt, opt_.scheme, *scratch_);
     std::swap(vel_, vel_tmp_);
@@ -438,7 +495,8 @@ void Simulation::substep(double dt, StepReport& rep) {
             for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
                 wb += double(qv_[c]) + qc_[c];
                 double thl0 = theta_[c] - lk * qc_[c];
-                AdjustResult r = saturation_adjust(theta_[c], qv_[c], qc_[c], p, relax);
+                AdjustResult r = opt_.reversible_theta_e ? saturation_adjust_theta_e(theta_[c], qv_[c], qc_[c], p, relax)
+                                                         : saturation_adjust(theta_[c], qv_[c], qc_[c], p, relax);
                 float dq = float(r.condensed);
                 dq = std::clamp(dq, -qc_[c], qv_[c]);
                 qv_[c] -= dq;

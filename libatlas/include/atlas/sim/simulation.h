@@ -47,6 +47,14 @@ struct Sounding {
     // and the RH and lapse members are ignored (the Bryan & Fritsch moist case).
     double total_water = 0.0;
 
+    // > 0 together with total_water: the Bryan & Fritsch (2002) moist-neutral
+    // sounding instead: every level saturated with this equivalent potential
+    // temperature (K, [250, 400]; thermo.h formula, c_pd + c_l q_t) and
+    // total_water, integrated hydrostatically with the density potential
+    // temperature theta_rho = theta (1 + qv / eps) / (1 + q_t); surface_theta is
+    // then ignored. Use with SimOptions::reversible_theta_e.
+    double theta_e = 0;
+
     // Throws atlas::Error naming the member out of range.
     void validate() const;
     double theta_at(double z) const;
@@ -91,6 +99,11 @@ struct SimOptions {
     // adds kSimRainBytesPerCell.
     bool rain = false;
     KesslerOptions kessler;
+    // Bryan & Fritsch (2002) reversible thermodynamics: the saturation
+    // adjustment keeps theta_e (saturation_adjust_theta_e: heat capacity of the
+    // liquid counted) instead of the linearised theta_l. StepReport's
+    // theta_l_drift then measures the difference between the two. Default off.
+    bool reversible_theta_e = false;
     void validate(int nz) const;
 };
 

@@ -43,6 +43,24 @@ struct AdjustResult {
     int iterations = 0;
 };
 
+// Temperature (K) at which a parcel with vapour qv and total water qt at
+// pressure p has the given equivalent potential temperature (the formula
+// above; strictly increasing in T). Newton kept inside [100, 500] K.
+double temperature_from_theta_e(double theta_e, double p, double qv, double qt);
+
+// Equilibrium temperature (K) of total water qt at pressure p with the given
+// theta_e: theta_e(T, p, min(qt, q_s(T, p)), qt) = theta_e. T_guess starts
+// the safeguarded Newton iteration (bracket [100, 500] K).
+double equilibrium_temperature_theta_e(double theta_e, double p, double qt, double T_guess);
+
+// Bryan & Fritsch (2002) reversible adjustment: the parcel goes to
+// equilibrium (qv = min(qt, q_s(T, p)), qc = qt - qv) keeping its equivalent
+// potential temperature theta_e(T, p, qv, qt) (c = c_pd + c_l qt: the heat
+// capacity of the liquid is counted) and qt = qv + qc exactly. `relax` as
+// below (the condensed amount is relaxed, T follows from theta_e). Throws
+// atlas::Error on non-finite input or p <= 0. Pure, thread-safe.
+AdjustResult saturation_adjust_theta_e(double theta, double qv, double qc, double p, double relax = 1.0);
+
 // Saturation adjustment of one parcel to equilibrium (see the file comment).
 // `relax` in [0, 1] is the fraction of the way to equilibrium taken this step:
 // 1 - exp(-rate * dt) for a finite condensation rate (1 = instantaneous).
