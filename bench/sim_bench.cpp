@@ -110,7 +110,9 @@ void BM_BryanFritschDry_50m(benchmark::State& state) { BryanFritschDry(state, 50
 // potential temperature is raised to theta_v0 (1 + theta'/300) with the dry
 // case's 2 K cos^2 theta', the parcel kept saturated at total water 0.020, so
 // the initial buoyancy equals the dry case's (theta_e' is then ~3.9 K, not 2 K).
-void BryanFritschMoist(benchmark::State& state, double dx, double step = 5.0) {
+// reversible = true: B&F's own thermodynamics (SimOptions::reversible_theta_e,
+// Sounding::theta_e = 320 K), the bubble found on the saturated branch by T.
+void BryanFritschMoist(benchmark::State& state, double dx, double step = 5.0, bool reversible = false) {
     const double qt = 0.020;
     auto theta_e_at = [&](double thl, double p) {
         AdjustResult a = saturation_adjust(thl, qt, 0, p);
@@ -131,6 +133,10 @@ void BryanFritschMoist(benchmark::State& state, double dx, double step = 5.0) {
     snd.total_water = qt;
     SimOptions o;
     o.max_substeps = 1000;
+    if (reversible) {
+        snd.theta_e = 320;
+        o.reversible_theta_e = true;
+    }
     StepReport r;
     double max_the = 0;
     for (auto _ : state) {
@@ -144,6 +150,18 @@ void BryanFritschMoist(benchmark::State& state, double dx, double step = 5.0) {
                 const size_t kk = size_t(k);
                 double pi = ref.exner[kk], p = ref.pressure[kk];
                 double target = ref.theta[kk] * (1 + 0.608 * ref.qv[kk] - ref.qc[kk]) * (1 + dtheta[c] / 300.0);
+                if (reversible) { // saturated at q_t with theta_v on target: bisection on T
+                    double t0 = ref.theta[kk] * pi - 5, t1 = ref.theta[kk] * pi + 10;
+                    for (int it = 0; it < 60; ++it) {
+                        double T = 0.5 * (t0 + t1), qv = std::min(qt, saturation_mixing_ratio(T, p));
+                        ((T / pi) * (1 + 0.608 * qv - (qt - qv)) < target ? t0 : t1) = T;
+                    }
+                    double T = 0.5 * (t0 + t1), qv = std::min(qt, saturation_mixing_ratio(T, p));
+                    sim.theta()[c] = float(T / pi);
+                    sim.qv()[c] = float(qv);
+                    sim.qc()[c] = float(qt - qv);
+                    continue;
+                }
                 double thl0 = ref.theta[kk] - kLv / (kCp * pi) * ref.qc[kk];
                 double a0 = 0, a1 = 10; // theta_l increment giving that theta_v (monotone)
                 for (int it = 0; it < 60; ++it) {
@@ -176,6 +194,9 @@ void BryanFritschMoist(benchmark::State& state, double dx, double step = 5.0) {
 void BM_BryanFritschMoist_100m(benchmark::State& state) { BryanFritschMoist(state, 100); }
 void BM_BryanFritschMoist_200m(benchmark::State& state) { BryanFritschMoist(state, 200); }
 void BM_BryanFritschMoist_100m_dt1(benchmark::State& state) { BryanFritschMoist(state, 100, 1.0); }
+void BM_BryanFritschMoistReversible_100m(benchmark::State& state) { BryanFritschMoist(state, 100, 5.0, true); }
+void BM_BryanFritschMoistReversible_100m_dt1(benchmark::State& state) { BryanFritschMoist(state, 100, 1.0, true); }
+void BM_BryanFritschMoistReversible_200m(benchmark::State& state) { BryanFritschMoist(state, 200, 5.0, true); }
 
 // Robert (1993) dry rising thermal: 1000 m x 1000 m slab, theta0 = 300 K
 // neutral, 0.5 K bubble of radius 250 m with a Gaussian edge (e-folding 100 m)
@@ -224,6 +245,9 @@ BENCHMARK(BM_RobertThermal_5m)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschMoist_100m)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschMoist_200m)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschMoist_100m_dt1)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BryanFritschMoistReversible_100m)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BryanFritschMoistReversible_100m_dt1)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BryanFritschMoistReversible_200m)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_CumulusStep_Smoke)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CumulusStep_64)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_CumulusStep_128)->Unit(benchmark::kMillisecond)->Iterations(2);
