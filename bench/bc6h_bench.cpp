@@ -1,6 +1,6 @@
 // BC6H encoding throughput (texels/s) and error per quality. Data: a smooth 3-channel
-// HDR modeling field (density-like [0,1], radiance-like 0..~600 with exponential
-// falloff, a height gradient). The target is Normal on 512x512x64 (16.8 M
+// HDR modeling field (density-like [0,1], radiance-like: a sum of three 600 exp(-d/24)
+// bumps, a height gradient). The target is Normal on 512x512x64 (16.8 M
 // texels) in <= 30 s; the slab cases give texels/s for extrapolation
 // (counter extrapolated_512x512x64_s). "Smoke" runs in well under 2 s for CI.
 #include "atlas/compress/texture.h"

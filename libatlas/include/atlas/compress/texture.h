@@ -31,8 +31,8 @@ enum class Format {
     Bc1Scalar, // one channel across RGB565 (Nubis field data), 4 bpp
     Bc4,       // one channel UNORM, 4 bpp
     Bc4Snorm,  // one channel SNORM, 4 bpp
-    Bc6hUf16,  // not implemented yet: throws atlas::Error
-    Bc6hSf16,  // not implemented yet: throws atlas::Error
+    Bc6hUf16,  // RGB half float, unsigned, 8 bpp (values stored as is; negative input is an error)
+    Bc6hSf16,  // RGB half float, signed, 8 bpp (one-sided bounds are refused for BC6H)
     R8, R16, R16F, R32F, Rgba8, Rgba16F, Rgba4,
 };
 // "bc1", "bc1-scalar", "bc4", "bc4-snorm", "bc6h", "bc6h-sf16", "r8", "r16", "r16f",
