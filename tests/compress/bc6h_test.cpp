@@ -525,6 +525,50 @@ TEST(Bc6hEncode, MaxErrorMissFallsBackToBest) {
     std::printf("best improved on normal in %d of 300 gradient blocks\n", escalated);
 }
 
+// The written indices are optimal for the written endpoints: for every texel, rewriting its
+// index bits (positions from the spec: indices follow the 82 or 65 header/endpoint bits,
+// anchors one bit shorter, the shape in bits 77..81) to any other legal value and decoding
+// never gives that texel a smaller max-channel error.
+TEST(Bc6hEncode, IndicesAreOptimalForTheWrittenPalette) {
+    auto get = [](const uint8_t* b, int pos) { return (b[pos / 8] >> (pos % 8)) & 1; };
+    auto set = [](uint8_t* b, int pos, int v) { b[pos / 8] = uint8_t((b[pos / 8] & ~(1 << (pos % 8))) | (v << (pos % 8))); };
+    for (bool sg : {false, true})
+        for (uint64_t k = 0; k < 3000; ++k) {
+            float src[48];
+            hdr_block(k * 7 + 3, sg, src);
+            BlockOptions o;
+            uint8_t blk[16];
+            encode_bc6h_block(src, sg, o, blk);
+            const int mode = bc6h_block_mode(blk);
+            ASSERT_GE(mode, 1);
+            const bool two = mode <= 10;
+            int shape = 0;
+            for (int i = 0; i < 5; ++i) shape |= get(blk, 77 + i) << i;
+            float dec[48];
+            decode_bc6h_block(blk, sg, dec);
+            int pos = two ? 82 : 65;
+            for (int t = 0; t < 16; ++t) {
+                const int bits = (two ? 3 : 4) - ((t == 0 || (two && t == kTestAnchor[shape])) ? 1 : 0);
+                auto texel_err = [&](const float* d) {
+                    float m = 0;
+                    for (int c = 0; c < 3; ++c) m = std::max(m, std::fabs(d[3 * t + c] - src[3 * t + c]));
+                    return m;
+                };
+                const float chosen = texel_err(dec);
+                for (int v = 0; v < (1 << bits); ++v) {
+                    uint8_t alt[16];
+                    std::memcpy(alt, blk, 16);
+                    for (int i = 0; i < bits; ++i) set(alt, pos + i, (v >> i) & 1);
+                    float d2[48];
+                    decode_bc6h_block(alt, sg, d2);
+                    ASSERT_LE(chosen, texel_err(d2)) << "block " << k << " texel " << t << " index " << v;
+                }
+                pos += bits;
+            }
+            ASSERT_EQ(pos, 128);
+        }
+}
+
 // ---------------------------------------------------------------------------------
 // Textures: DDS round trips, OpenImageIO as an independent decoder, input checks
 
