@@ -274,6 +274,15 @@ TEST(Forecast, PresetMapFormulas) {
         ASSERT_NEAR(full.channel(2)[i], base + (1 - base) * 0.6, 1e-6);
         ASSERT_EQ(full.channel(3)[i], float(p.cirrus_coverage));
     }
+    // The noise is equalised, so cumulus_coverage is the share of the sky:
+    // coverage > c exactly where n > 1 - c.
+    for (double c : {0.2, 0.54, 0.85}) {
+        p.cumulus_coverage = c;
+        const Field2D m = preset_weather_map(p, noise, {}, nullptr);
+        size_t above = 0;
+        for (float v : m.channel(0)) above += v > c + 1e-6;
+        EXPECT_NEAR(double(above) / double(m.voxel_count()), c, 2.0 / double(m.voxel_count()) + 0.01) << c;
+    }
     // A whole map size of drift is no drift (the noise tiles).
     p.cumulus_coverage = 0.5;
     EXPECT_LT(max_abs_diff(preset_weather_map(p, noise, {}, nullptr), preset_weather_map(p, noise, spec.bounds.size(), nullptr)), 1e-5);
@@ -371,6 +380,14 @@ TEST(Forecast, SequenceSlicesManifestAndThreads) {
     EXPECT_EQ(t.height(), 2);
     EXPECT_EQ(t.at(t.find_channel("hour"), 1, 0), 9.5f);
     EXPECT_NEAR(t.at(t.find_channel("weight"), 1, 0), j["frames"][1]["regions"][0]["presets"][1]["weight"].get<double>(), 1e-6);
+    for (int i = 0; i < 6; ++i)
+        for (int r = 0; r < 2; ++r) {
+            double sum = 0;
+            for (const auto& p : f.presets) sum += t.at(t.find_channel("preset:" + p.name), i, r);
+            EXPECT_NEAR(sum, 1, 1e-6);
+            const PresetBlend b = forecast_blend(f, r, 2 + 7.5 * i);
+            EXPECT_NEAR(t.at(t.find_channel("preset:" + f.presets[size_t(b.to)].name), i, r), b.from == b.to ? 1 : b.weight, 1e-6);
+        }
 }
 
 TEST(Forecast, Fc6GraphCooks) {

@@ -289,8 +289,20 @@ Field2D make_weather_noise(const WeatherMapSpec& spec, const MemoryBudget* budge
     const Vec2i type_period{{std::max(1, spec.period[0] / 2), std::max(1, spec.period[1] / 2)}};
     Field2D type = noise2d(spec.resolution, spec.bounds, type_period, std::min(spec.octaves, 3), spec.gain, spec.seed + 7919u, budget);
     Field2D out(spec.resolution, 2, spec.bounds, {"coverage_noise", "type_noise"}, budget);
-    std::copy(cov.channel(0).begin(), cov.channel(0).end(), out.channel(0).begin());
-    std::copy(type.channel(0).begin(), type.channel(0).end(), out.channel(1).begin());
+    // FBM values crowd around 0.5: replace each value by its rank (histogram
+    // equalisation, ties broken by index), so the noise is uniform on [0,1]
+    // and a preset's cumulus_coverage c is the share of texels with
+    // n > 1 - c: "coverage" means the share of the sky.
+    const Field2D* src[2] = {&cov, &type};
+    std::vector<uint32_t> order(cov.voxel_count());
+    for (int c = 0; c < 2; ++c) {
+        const auto in = src[c]->channel(0);
+        for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
+        std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return in[a] < in[b] || (in[a] == in[b] && a < b); });
+        auto o = out.channel(c);
+        const double n = double(order.size());
+        for (size_t r = 0; r < order.size(); ++r) o[order[r]] = float((double(r) + 0.5) / n);
+    }
     return out;
 }
 
@@ -477,6 +489,7 @@ Field2D forecast_manifest_table(const Forecast& f, const WeatherMapSpec& spec, d
     validate_forecast(f);
     check_sequence(start_hour, step_hours, slices);
     std::vector<std::string> names = {"hour", "from", "to", "weight", "drift_x", "drift_y"};
+    for (const auto& p : f.presets) names.push_back("preset:" + p.name);
     for (const auto& fi : preset_fields()) names.push_back(fi.name);
     const int nr = int(f.regions.size());
     Field2D t({{slices, nr}}, int(names.size()), Box2d{{{0, 0}}, {{double(slices), double(nr)}}}, names);
@@ -488,6 +501,9 @@ Field2D forecast_manifest_table(const Forecast& f, const WeatherMapSpec& spec, d
             const Vec2d d = forecast_drift(f, r, hour, spec.bounds.size());
             int c = 0;
             for (double v : {hour, double(b.from), double(b.to), b.weight, d[0], d[1]}) t.at(c++, i, r) = float(v);
+            t.at(c + b.from, i, r) += float(1 - b.weight);
+            t.at(c + b.to, i, r) += float(b.weight);
+            c += int(f.presets.size());
             for (const auto& fi : preset_fields()) t.at(c++, i, r) = float(p.*fi.member);
         }
     return t;

@@ -99,7 +99,9 @@ struct WeatherMapSpec {
     uint32_t seed = 0;
 };
 
-// Two tileable noise channels ("coverage_noise", "type_noise") in [0,1].
+// Two tileable noise channels ("coverage_noise", "type_noise"): value-noise
+// FBMs (noise2d), each histogram-equalised (texel -> (rank + 0.5) / count,
+// ties by index), so each is uniform on (0,1).
 Field2D make_weather_noise(const WeatherMapSpec& spec, const MemoryBudget* budget);
 
 // Channel names of a weather map: coverage, precipitation, type, cirrus_coverage.
@@ -131,8 +133,10 @@ Field3D cook_forecast(const Forecast& f, const WeatherMapSpec& spec, double star
 std::string forecast_manifest_json(const Forecast& f, const WeatherMapSpec& spec, double start_hour, double step_hours, int slices);
 
 // The same per (slice, region) as a table field, width = slices, height =
-// regions, channels: hour, from, to, weight, drift_x, drift_y, then every
-// preset field (preset_fields() order) - for graph outputs (json/exr).
+// regions, channels: hour, from, to (preset indices), weight (of `to`),
+// drift_x, drift_y (m), then "preset:NAME" = the weight of each preset
+// (summing to 1), then every preset field (preset_fields() order) - for
+// graph outputs (json/exr).
 Field2D forecast_manifest_table(const Forecast& f, const WeatherMapSpec& spec, double start_hour, double step_hours, int slices);
 
 } // namespace atlas::ndf
