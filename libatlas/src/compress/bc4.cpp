@@ -8,6 +8,10 @@
 #include <cstring>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace atlas::compress {
 
 namespace {
@@ -49,7 +53,9 @@ void interval_palette(uint8_t b0, uint8_t b1, bool snorm, DecoderSet set, detail
     palette_values(b0, b1, snorm, Decoder::Reference, ref);
     for (int i = 0; i < 8; ++i) { p.ref[i][0] = ref[i]; p.lo[i][0] = ref[i]; p.hi[i][0] = ref[i]; }
     bool any = false;
-    for (Decoder d : decoders_in(set)) {
+    for (int di = 0; di < kDecoderCount; ++di) {
+        if (!(set & (DecoderSet(1) << di))) continue; // no allocation: 65,536 palettes per encoder
+        const Decoder d = static_cast<Decoder>(di);
         float v[8];
         if (d == Decoder::Conformant) {
             const bool eight = snorm ? (static_cast<int8_t>(b0) > static_cast<int8_t>(b1)) : (b0 > b1);
@@ -102,43 +108,162 @@ void decode_bc4_interval(const uint8_t block[8], bool snorm, DecoderSet set, flo
     }
 }
 
-struct Bc4Encoder::Tables {
+namespace {
+struct PairTables {
     std::vector<detail::Palette<1>> pal; // index b0 * 256 + b1
-    std::vector<float> pal_min, pal_max; // range of lo / hi over the entries (pruning)
+    std::vector<float> pal_min;          // min lo over all entries (one-sided feasibility)
+    // Range [imin, imax] of the entries other than the 6-value mode's exact constants
+    // (lower bounds), whether the pair is in that mode, and per row b0 and mode the
+    // extremes of those ranges (whole rows are skipped).
+    std::vector<float> imin, imax;
+    std::vector<uint8_t> six;
+    std::vector<float> six_mask; // all bits set where six (SIMD blend)
+    float row_imin[256][2], row_imax[256][2];
+    float c_lo = 0, c_hi = 1; // the 6-value mode's constants
 };
+} // namespace
+
+struct Bc4Encoder::Tables : PairTables {};
 
 Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
     : snorm_(snorm), options_(options), tables_(std::make_unique<Tables>()) {
     if (options_.decoders == 0) options_.decoders = kReferenceOnly;
-    tables_->pal.resize(65536);
-    tables_->pal_min.resize(65536);
-    tables_->pal_max.resize(65536);
+    Tables& T = *tables_;
+    T.pal.resize(65536);
+    T.pal_min.resize(65536);
+    T.imin.resize(65536);
+    T.imax.resize(65536);
+    T.six.resize(65536);
+    T.six_mask.resize(65536);
+    T.c_lo = snorm_ ? -1.0f : 0.0f;
+    for (int r = 0; r < 256; ++r)
+        for (int m = 0; m < 2; ++m) { T.row_imin[r][m] = INFINITY; T.row_imax[r][m] = -INFINITY; }
     for (int k = 0; k < 65536; ++k) {
-        auto& p = tables_->pal[size_t(k)];
-        interval_palette(uint8_t(k >> 8), uint8_t(k & 255), snorm_, options_.decoders, p);
-        float mn = p.lo[0][0], mx = p.hi[0][0];
-        for (int i = 1; i < 8; ++i) { mn = std::min(mn, p.lo[i][0]); mx = std::max(mx, p.hi[i][0]); }
-        tables_->pal_min[size_t(k)] = mn;
-        tables_->pal_max[size_t(k)] = mx;
+        const uint8_t b0 = uint8_t(k >> 8), b1 = uint8_t(k & 255);
+        auto& p = T.pal[size_t(k)];
+        interval_palette(b0, b1, snorm_, options_.decoders, p);
+        const bool eight = snorm_ ? (static_cast<int8_t>(b0) > static_cast<int8_t>(b1)) : (b0 > b1);
+        const int interp = eight ? 8 : 6;
+        float mn = p.lo[0][0], imx = p.hi[0][0];
+        for (int i = 1; i < 8; ++i) mn = std::min(mn, p.lo[i][0]);
+        float imn = p.lo[0][0];
+        for (int i = 1; i < interp; ++i) { imn = std::min(imn, p.lo[i][0]); imx = std::max(imx, p.hi[i][0]); }
+        T.pal_min[size_t(k)] = mn;
+        T.imin[size_t(k)] = imn;
+        T.imax[size_t(k)] = imx;
+        T.six[size_t(k)] = eight ? 0 : 1;
+        const uint32_t all_bits = eight ? 0u : 0xffffffffu;
+        std::memcpy(&T.six_mask[size_t(k)], &all_bits, 4);
+        const int m = eight ? 0 : 1;
+        T.row_imin[b0][m] = std::min(T.row_imin[b0][m], imn);
+        T.row_imax[b0][m] = std::max(T.row_imax[b0][m], imx);
     }
 }
 
 Bc4Encoder::~Bc4Encoder() = default;
 
-BlockResult Bc4Encoder::encode_exhaustive(const float src[16], uint8_t out[8]) const {
+namespace {
+
+// The exhaustive search over all 65,536 pairs, starting from an incumbent (seed_k
+// < 0: none). Returns the lexicographic minimum of (max error, squared error, pair
+// index) over the feasible pairs, exactly what a plain scan in index order keeping
+// strict improvements returns: pairs are skipped only by true lower bounds.
+//   * A pair's entries other than the constants span [imin, imax]; every texel that
+//     the constants cannot serve within the incumbent's error E must be within E of
+//     that span (float subtraction is monotone, so this bounds the computed error).
+//   * For the 8-value mode every texel counts; rows are skipped by their extremes.
+int search_all_pairs(const PairTables& T, const float src[16], bool os, detail::Selection& best, int best_k) {
     float smin = src[0], smax = src[0];
     for (int t = 1; t < 16; ++t) { smin = std::min(smin, src[t]); smax = std::max(smax, src[t]); }
-    detail::Selection best;
-    int best_k = -1;
-    const bool os = options_.one_sided_below;
-    for (int k = 0; k < 65536; ++k) {
-        // Lower bound: the block's extremes must be reached by the palette's range.
-        float lb = std::max(tables_->pal_min[size_t(k)] - smin, smax - tables_->pal_max[size_t(k)]);
-        if (lb > best.max_err) continue;
-        if (os && tables_->pal_min[size_t(k)] > smin) continue;
-        detail::Selection s = detail::select_indices(tables_->pal[size_t(k)], src, os, best.max_err);
-        if (best_k < 0 ? std::isfinite(s.max_err) : detail::better(s, best)) { best = s; best_k = k; }
+    // Error of a constant entry c for texel s, as select_indices computes it.
+    auto const_err = [&](float c, float s) {
+        if (os && c > s) return INFINITY;
+        const float a = c - s, b = s - c;
+        return std::max(0.0f, a > b ? a : b);
+    };
+    float mid_lo = INFINITY, mid_hi = -INFINITY, mid_for = -1;
+    auto update_mid = [&]() { // texels the 6-value mode's constants cannot serve within E
+        if (mid_for == best.max_err) return;
+        mid_for = best.max_err;
+        mid_lo = INFINITY;
+        mid_hi = -INFINITY;
+        for (int t = 0; t < 16; ++t)
+            if (!(const_err(T.c_lo, src[t]) <= best.max_err) && !(const_err(T.c_hi, src[t]) <= best.max_err)) {
+                mid_lo = std::min(mid_lo, src[t]);
+                mid_hi = std::max(mid_hi, src[t]);
+            }
+    };
+    auto bound = [](float imn, float imx, float lo, float hi) { return lo > hi ? -INFINITY : std::max(imn - lo, hi - imx); };
+    // The sorted texels, median and quartiles first: a palette with a gap inside the
+    // block's range is usually rejected by one of the first texels tried.
+    float sorted[16], probe[16];
+    std::copy(src, src + 16, sorted);
+    std::sort(sorted, sorted + 16);
+    constexpr int kProbeOrder[16] = {7, 3, 11, 1, 5, 9, 13, 0, 2, 4, 6, 8, 10, 12, 14, 15};
+    for (int t = 0; t < 16; ++t) probe[t] = sorted[kProbeOrder[t]];
+    uint8_t cand[256];
+    for (int b0 = 0; b0 < 256; ++b0) {
+        update_mid();
+        const bool row8 = !(bound(T.row_imin[b0][0], T.row_imax[b0][0], smin, smax) > best.max_err);
+        const bool row6 = !(bound(T.row_imin[b0][1], T.row_imax[b0][1], mid_lo, mid_hi) > best.max_err);
+        if (!row8 && !row6) continue;
+        // Pairs of the row that pass the range bounds (the incumbent may improve
+        // below, so this is a superset; select_indices has the final word).
+        int n = 0;
+        const size_t row = size_t(b0) * 256;
+#if defined(__SSE2__)
+        {
+            const __m128 vsmin = _mm_set1_ps(smin), vsmax = _mm_set1_ps(smax), vmlo = _mm_set1_ps(mid_lo),
+                         vmhi = _mm_set1_ps(mid_hi), ve = _mm_set1_ps(best.max_err), vninf = _mm_set1_ps(-INFINITY);
+            const __m128 mid_empty = mid_lo > mid_hi ? _mm_castsi128_ps(_mm_set1_epi32(-1)) : _mm_setzero_ps();
+            const __m128 en8 = row8 ? _mm_castsi128_ps(_mm_set1_epi32(-1)) : _mm_setzero_ps();
+            const __m128 en6 = row6 ? _mm_castsi128_ps(_mm_set1_epi32(-1)) : _mm_setzero_ps();
+            for (int b1 = 0; b1 < 256; b1 += 4) {
+                const __m128 imn = _mm_loadu_ps(&T.imin[row + size_t(b1)]), imx = _mm_loadu_ps(&T.imax[row + size_t(b1)]);
+                const __m128 six = _mm_loadu_ps(&T.six_mask[row + size_t(b1)]);
+                const __m128 lb8 = _mm_max_ps(_mm_sub_ps(vsmax, imx), _mm_sub_ps(imn, vsmin)); // = std::max(imn - lo, hi - imx)
+                __m128 lb6 = _mm_max_ps(_mm_sub_ps(vmhi, imx), _mm_sub_ps(imn, vmlo));
+                lb6 = _mm_or_ps(_mm_and_ps(mid_empty, vninf), _mm_andnot_ps(mid_empty, lb6));
+                const __m128 lb = _mm_or_ps(_mm_and_ps(six, lb6), _mm_andnot_ps(six, lb8));
+                const __m128 enabled = _mm_or_ps(_mm_and_ps(six, en6), _mm_andnot_ps(six, en8));
+                __m128 pass = _mm_and_ps(enabled, _mm_cmple_ps(lb, ve));
+                if (os) pass = _mm_and_ps(pass, _mm_cmple_ps(_mm_loadu_ps(&T.pal_min[row + size_t(b1)]), vsmin));
+                int bits = _mm_movemask_ps(pass);
+                for (int j = 0; j < 4; ++j)
+                    if (bits & (1 << j)) cand[n++] = uint8_t(b1 + j);
+            }
+        }
+#else
+        for (int b1 = 0; b1 < 256; ++b1) {
+            const size_t k = row + size_t(b1);
+            const bool six = T.six[k] != 0;
+            if (!(six ? row6 : row8)) continue;
+            const float lb = six ? bound(T.imin[k], T.imax[k], mid_lo, mid_hi) : bound(T.imin[k], T.imax[k], smin, smax);
+            if (lb > best.max_err) continue;
+            if (os && T.pal_min[k] > smin) continue; // no entry at or below the block minimum
+            cand[n++] = uint8_t(b1);
+        }
+#endif
+        for (int c = 0; c < n; ++c) {
+            const size_t k = row + cand[c];
+            if (!detail::palette_within(T.pal[k], probe, os, best.max_err)) continue;
+            detail::Selection s = detail::select_indices(T.pal[k], src, os, best.max_err);
+            if (!std::isfinite(s.max_err)) continue;
+            const bool tie = s.max_err == best.max_err && s.sum_sq == best.sum_sq;
+            if (best_k < 0 || detail::better(s, best) || (tie && int(k) < best_k)) {
+                best = s;
+                best_k = int(k);
+                update_mid();
+            }
+        }
     }
+    return best_k;
+}
+} // namespace
+
+BlockResult Bc4Encoder::encode_exhaustive(const float src[16], uint8_t out[8]) const {
+    detail::Selection best;
+    const int best_k = search_all_pairs(*tables_, src, options_.one_sided_below, best, -1);
     if (best_k < 0) { // cannot happen for UNORM/SNORM (0 / -1 entry), kept for safety
         std::memset(out, 0, 8);
         return {std::numeric_limits<float>::infinity(), 0, false};
@@ -148,12 +273,10 @@ BlockResult Bc4Encoder::encode_exhaustive(const float src[16], uint8_t out[8]) c
 }
 
 BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
-    if (options_.quality == Quality::Best) return encode_exhaustive(src, out);
     float smin = src[0], smax = src[0];
     for (int t = 1; t < 16; ++t) { smin = std::min(smin, src[t]); smax = std::max(smax, src[t]); }
     const float scale = snorm_ ? 127.0f : 255.0f;
     const int lo_lim = snorm_ ? -127 : 0, hi_lim = snorm_ ? 127 : 255;
-    const int radius = 0; // floor / ceil of the extremes; misses fall back to the exhaustive search
     auto clampi = [&](int v) { return std::clamp(v, lo_lim, hi_lim); };
     const int qlo0 = clampi(int(std::floor(smin * scale))), qlo1 = clampi(int(std::ceil(smin * scale)));
     const int qhi0 = clampi(int(std::floor(smax * scale))), qhi1 = clampi(int(std::ceil(smax * scale)));
@@ -166,16 +289,24 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
         detail::Selection s = detail::select_indices(tables_->pal[size_t(k)], src, os, best.max_err);
         if (best_k < 0 ? std::isfinite(s.max_err) : detail::better(s, best)) { best = s; best_k = k; }
     };
+    // Floor / ceil of the extremes (Best and blocks missing the bound start the
+    // exhaustive search from this incumbent: the result is the same, found sooner).
     const int hstep = options_.quality == Quality::Fast ? std::max(1, qhi1 - qhi0) : 1;
-    for (int h = qhi0 - radius; h <= qhi1 + radius; h += hstep)
-        for (int l = qlo0 - radius; l <= qlo1 + radius; ++l) {
+    for (int h = qhi0; h <= qhi1; h += hstep)
+        for (int l = qlo0; l <= qlo1; ++l) {
             int a = clampi(h), b = clampi(l);
             if (a > b) consider(a, b);  // 8 interpolated values
             if (options_.quality != Quality::Fast || options_.one_sided_below)
                 consider(std::min(a, b), std::max(a, b)); // 6 values plus exact extremes
         }
     const bool missed = best_k < 0 || (options_.max_error >= 0 && best.max_err > options_.max_error);
-    if (missed) return encode_exhaustive(src, out);
+    if (missed || options_.quality == Quality::Best) {
+        best_k = search_all_pairs(*tables_, src, os, best, best_k);
+        if (best_k < 0) { // cannot happen for UNORM/SNORM (0 / -1 entry), kept for safety
+            std::memset(out, 0, 8);
+            return {std::numeric_limits<float>::infinity(), 0, false};
+        }
+    }
     write_block(uint8_t(best_k >> 8), uint8_t(best_k & 255), best.idx, out);
     return {best.max_err, best.sum_sq, true};
 }

@@ -114,6 +114,22 @@ inline Selection select_indices_scalar_t(const Palette<1>& p, const float* src, 
 }
 #endif
 
+// Whether a one-channel palette serves every texel within `stop` (the first pass of
+// select_indices alone, in any texel order: a filter before the full selection).
+inline bool palette_within(const Palette<1>& p, const float* src, bool one_sided, float stop) {
+    for (int t = 0; t < 16; ++t) {
+        const float s = src[t];
+        bool ok = false;
+        for (int i = 0; i < p.n && !ok; ++i) {
+            if (one_sided && p.hi[i][0] > s) continue;
+            const float a = p.hi[i][0] - s, b = s - p.lo[i][0];
+            ok = std::max(0.0f, a > b ? a : b) <= stop;
+        }
+        if (!ok) return false;
+    }
+    return true;
+}
+
 template <int C, bool OneSided>
 inline Selection select_indices_t(const Palette<C>& p, const float* src, float stop_above) {
 #if defined(__SSE2__)
