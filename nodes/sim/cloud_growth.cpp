@@ -6,6 +6,7 @@
 #include "sim_params.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -20,12 +21,12 @@ void declare(NodeDeclaration& d) {
           "multigrid-preconditioned CG projection, saturation adjustment; see docs/solver.md). The grid has 'resolution' "
           "cubic cells of 'dx' metres with its minimum corner at 'origin'. Runs ceil(duration / frame_dt) steps of frame_dt, "
           "each split into CFL-limited substeps. Sources: the optional 'emitter' field (sim/emitter; sampled at cell "
-          "centres, zero outside it), a built-in noise-modulated ground patch (patch_radius > 0) and an initial warm "
+          "centres: copied when its cells line up with the grid's, else trilinear; zero outside it), a built-in noise-modulated ground patch (patch_radius > 0) and an initial warm "
           "bubble (bubble_theta != 0). Outputs cloud water as 'out' (channel 'density', kg/kg), temperature, vapour, "
           "velocity at cell centres, and 'sequence': every sequence_every-th frame's chosen grids as channels "
           "'NNNN:GRID' for the 'vdb-sequence' format. Each step's divergence (L2, max), pressure iterations, water "
           "and theta_l drift across the saturation adjustment and seconds per stage go into the cook report as "
-          "'step_NNNN.*' metrics, with totals and maxima. Memory (216 B per cell plus outputs) is checked before allocating.");
+          "'step_NNNN.*' metrics, with totals and maxima, and the cloud base and top (m above the floor, qc > 1e-5; -1: no cloud). Memory (216 B per cell plus outputs) is checked before allocating.");
     d.input("sounding", PortType::Field2D, "sim/sounding record (default: the sim/sounding defaults)").optional = true;
     d.input("emitter", PortType::Field3D, "heat (K/s) and vapour (kg/kg/s) rates, e.g. sim/emitter; channels 'heat' and 'vapour' or 0 and 1").optional = true;
     d.output("out", PortType::Field3D, "cloud water mixing ratio after the last step, channel 'density', kg/kg");
@@ -121,10 +122,26 @@ void apply_emitter(CookContext& ctx, sim::Simulation& sim, const Vec3d& origin) 
     const sim::GridSpec& s = sim.spec();
     std::vector<float> heat(s.cells(), 0.f), vap(s.cells(), 0.f);
     const Box3d& b = e->bounds();
+    // Same cell size and an integral offset: copy cells (exact), else sample trilinearly.
+    bool aligned = true;
+    std::array<long, 3> off{};
+    for (int a = 0; a < 3; ++a) {
+        const double vs = e->voxel_size()[a], o = (b.min[a] - origin[a]) / s.dx;
+        off[size_t(a)] = std::lround(o);
+        aligned = aligned && std::fabs(vs - s.dx) <= 1e-9 * s.dx && std::fabs(o - double(off[size_t(a)])) <= 1e-6;
+    }
+    const Vec3i er = e->resolution();
     size_t n = 0;
     for (int k = 0; k < s.nz; ++k)
         for (int j = 0; j < s.ny; ++j)
             for (int i = 0; i < s.nx; ++i, ++n) {
+                if (aligned) {
+                    const long x = i - off[0], y = j - off[1], z = k - off[2];
+                    if (x < 0 || y < 0 || z < 0 || x >= er[0] || y >= er[1] || z >= er[2]) continue;
+                    heat[n] = e->at(hc, int(x), int(y), int(z));
+                    if (vc >= 0) vap[n] = e->at(vc, int(x), int(y), int(z));
+                    continue;
+                }
                 const Vec3d p{{origin[0] + (i + 0.5) * s.dx, origin[1] + (j + 0.5) * s.dx, origin[2] + (k + 0.5) * s.dx}};
                 bool inside = true;
                 for (int a = 0; a < 3; ++a) inside = inside && p[a] >= b.min[a] && p[a] <= b.max[a];
@@ -162,7 +179,28 @@ std::string step_key(int step, const char* what) {
     return buf;
 }
 
-void record_step(CookContext& ctx, int step, const sim::StepReport& r) {
+// Heights (m above the grid floor) of the lowest and highest cell centres
+// holding cloud (qc > threshold); -1 when there is none.
+std::pair<double, double> cloud_extent(const sim::Simulation& sim, float threshold) {
+    const sim::GridSpec& s = sim.spec();
+    const size_t layer = size_t(s.nx) * size_t(s.ny);
+    int lo = -1, hi = -1;
+    for (int k = 0; k < s.nz; ++k) {
+        const auto first = sim.qc().begin() + std::ptrdiff_t(size_t(k) * layer);
+        if (std::any_of(first, first + std::ptrdiff_t(layer), [&](float q) { return q > threshold; })) {
+            if (lo < 0) lo = k;
+            hi = k;
+        }
+    }
+    return {lo < 0 ? -1.0 : (lo + 0.5) * s.dx, hi < 0 ? -1.0 : (hi + 0.5) * s.dx};
+}
+
+constexpr float kCloudThreshold = 1e-5f; // kg/kg: a visible cloud edge
+
+void record_step(CookContext& ctx, int step, const sim::StepReport& r, const sim::Simulation& sim) {
+    const auto [base, top] = cloud_extent(sim, kCloudThreshold);
+    ctx.metric(step_key(step, "cloud_base"), base);
+    ctx.metric(step_key(step, "cloud_top"), top);
     ctx.metric(step_key(step, "substeps"), r.substeps);
     ctx.metric(step_key(step, "pressure_iterations"), r.pressure_iterations);
     ctx.metric(step_key(step, "div_l2"), r.divergence.l2);
@@ -287,7 +325,7 @@ void cook(CookContext& ctx) {
     for (int step = 1; step <= steps; ++step) {
         ctx.progress(double(step - 1) / steps);
         const sim::StepReport r = sim_nodes::naming_node(ctx, [&] { return sim.step(frame_dt); });
-        record_step(ctx, step, r);
+        record_step(ctx, step, r, sim);
         div_l2 = std::max(div_l2, r.divergence.l2);
         div_max = std::max(div_max, r.divergence.max);
         water = std::max(water, std::fabs(r.water_drift));
@@ -324,6 +362,9 @@ void cook(CookContext& ctx) {
     ctx.metric("seconds_forces", s_forces);
     ctx.metric("seconds_project", s_proj);
     ctx.metric("sequence_frames", frames);
+    const auto [base, top] = cloud_extent(sim, kCloudThreshold);
+    ctx.metric("cloud_base", base);
+    ctx.metric("cloud_top", top);
 
     ctx.set_output("out", Field3DPtr(placed(ctx, sim.cloud_water(), box, {"density"})));
     ctx.set_output("temperature", Field3DPtr(placed(ctx, sim.temperature(), box, {"temperature"})));
