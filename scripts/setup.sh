@@ -10,6 +10,7 @@ PACKAGES=(
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev libboost-iostreams-dev
   libtet1.5-dev libtbb-dev libyaml-cpp-dev zlib1g-dev libblosc-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev
+  libsquish-dev
 )
 
 missing=()

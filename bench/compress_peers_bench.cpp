@@ -1,0 +1,303 @@
+// Atlas's BC1 / BC4 encoders side by side with libsquish on the same inputs, in one run:
+// single-thread time per image and the error of the decoded result (Reference decoder,
+// in 8-bit steps). Built only when libsquish is found (Debian libsquish-dev).
+//
+// Inputs: a smooth field (gradient + value noise, 512x512) and natural images (PNG
+// renders the project generates, docs/images/, or files named by ATLAS_PEER_IMAGES,
+// ':'-separated). Every encoder gets the same 8-bit source (squish needs 8-bit);
+// BC4 inputs are the images' luminance.
+//
+// Extra modes used by bench/compare_nvcompress.sh:
+//   compress_peers_bench --write-inputs DIR   writes the inputs as PNG (RGB and grey)
+//   compress_peers_bench --rmse FILE.dds SOURCE.png   RMSE / max error of a DDS (our decoder)
+#include "atlas/compress/bc1.h"
+#include "atlas/compress/bc4.h"
+#include "atlas/compress/texture.h"
+
+#include <OpenImageIO/imageio.h>
+#include <benchmark/benchmark.h>
+#include <squish.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace atlas::compress;
+
+// 8-bit RGB image, width and height multiples of 4.
+struct Image {
+    std::string name;
+    int w = 0, h = 0;
+    std::vector<uint8_t> rgb; // 3 per texel
+    uint8_t grey(size_t i) const { // Rec. 709 luminance, rounded
+        return uint8_t(std::lround(0.2126 * rgb[3 * i] + 0.7152 * rgb[3 * i + 1] + 0.0722 * rgb[3 * i + 2]));
+    }
+};
+
+double hash01(int x, int y, int s) {
+    uint32_t h = uint32_t(x) * 0x8da6b343u ^ uint32_t(y) * 0xd8163841u ^ uint32_t(s) * 0xcb1ab31fu;
+    h ^= h >> 13; h *= 0x5bd1e995u; h ^= h >> 15;
+    return double(h) / 4294967296.0;
+}
+
+// Value noise, bilinear between lattice points `cell` texels apart.
+double value_noise(double x, double y, int cell, int seed) {
+    const int ix = int(std::floor(x / cell)), iy = int(std::floor(y / cell));
+    const double fx = x / cell - ix, fy = y / cell - iy;
+    const double sx = fx * fx * (3 - 2 * fx), sy = fy * fy * (3 - 2 * fy);
+    const double a = hash01(ix, iy, seed), b = hash01(ix + 1, iy, seed), c = hash01(ix, iy + 1, seed), d = hash01(ix + 1, iy + 1, seed);
+    return (a * (1 - sx) + b * sx) * (1 - sy) + (c * (1 - sx) + d * sx) * sy;
+}
+
+Image smooth_image() {
+    Image im;
+    im.name = "smooth 512x512 (gradient + noise)";
+    im.w = im.h = 512;
+    im.rgb.resize(size_t(im.w) * size_t(im.h) * 3);
+    for (int y = 0; y < im.h; ++y)
+        for (int x = 0; x < im.w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const double g = (x + (c + 1) * 0.5 * y) / (im.w * (1 + 0.5 * (c + 1)));
+                const double v = 0.7 * g + 0.2 * value_noise(x, y, 32, c) + 0.1 * value_noise(x, y, 8, c + 7);
+                im.rgb[(size_t(y) * size_t(im.w) + size_t(x)) * 3 + size_t(c)] = uint8_t(std::lround(std::clamp(v, 0.0, 1.0) * 255));
+            }
+    return im;
+}
+
+bool load_png(const std::string& path, Image& im) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) return false;
+    const OIIO::ImageSpec& spec = in->spec();
+    std::vector<uint8_t> px(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, px.data())) return false;
+    im.w = spec.width / 4 * 4;
+    im.h = spec.height / 4 * 4;
+    if (im.w == 0 || im.h == 0) return false;
+    im.rgb.resize(size_t(im.w) * size_t(im.h) * 3);
+    for (int y = 0; y < im.h; ++y)
+        for (int x = 0; x < im.w; ++x)
+            for (int c = 0; c < 3; ++c)
+                im.rgb[(size_t(y) * size_t(im.w) + size_t(x)) * 3 + size_t(c)] =
+                    px[(size_t(y) * size_t(spec.width) + size_t(x)) * size_t(spec.nchannels) + size_t(std::min(c, spec.nchannels - 1))];
+    const size_t slash = path.find_last_of('/');
+    im.name = path.substr(slash == std::string::npos ? 0 : slash + 1) + " " + std::to_string(im.w) + "x" + std::to_string(im.h);
+    return true;
+}
+
+std::vector<Image> inputs() {
+    std::vector<Image> out{smooth_image()};
+    std::string list;
+    if (const char* env = std::getenv("ATLAS_PEER_IMAGES")) list = env;
+    else
+        list = std::string(ATLAS_SOURCE_DIR) + "/docs/images/render_cloudscape_inside.png:" + ATLAS_SOURCE_DIR +
+               "/docs/images/ndf_hzd_weather.png";
+    size_t start = 0;
+    while (start <= list.size()) {
+        const size_t end = std::min(list.find(':', start), list.size());
+        Image im;
+        if (end > start && load_png(list.substr(start, end - start), im)) out.push_back(std::move(im));
+        start = end + 1;
+    }
+    return out;
+}
+
+// Errors of decoded values against the 8-bit source, in 8-bit steps.
+struct Errors {
+    double sq = 0, max = 0;
+    size_t n = 0;
+    void add(double decoded01, uint8_t src) {
+        const double d = (decoded01 - src / 255.0) * 255.0;
+        sq += d * d;
+        max = std::max(max, std::fabs(d));
+        ++n;
+    }
+    double rmse() const { return n ? std::sqrt(sq / double(n)) : 0; }
+};
+
+enum class Codec { AtlasFast, AtlasNormal, AtlasBest, AtlasNormalAll, SquishRange, SquishCluster, SquishIterative };
+
+const char* codec_name(Codec c) {
+    switch (c) {
+    case Codec::AtlasFast: return "atlas_fast";
+    case Codec::AtlasNormal: return "atlas_normal";
+    case Codec::AtlasBest: return "atlas_best";
+    case Codec::AtlasNormalAll: return "atlas_normal_all6decoders";
+    case Codec::SquishRange: return "squish_fast_rangefit";
+    case Codec::SquishCluster: return "squish_normal_clusterfit";
+    case Codec::SquishIterative: return "squish_best_iterativeclusterfit";
+    }
+    return "?";
+}
+
+bool is_atlas(Codec c) { return c == Codec::AtlasFast || c == Codec::AtlasNormal || c == Codec::AtlasBest || c == Codec::AtlasNormalAll; }
+
+BlockOptions atlas_options(Codec c) {
+    BlockOptions o;
+    o.quality = c == Codec::AtlasFast ? Quality::Fast : c == Codec::AtlasBest ? Quality::Best : Quality::Normal;
+    o.decoders = c == Codec::AtlasNormalAll ? kAllDecoders : kReferenceOnly; // squish targets one decoder too
+    return o;
+}
+
+// Encodes the whole image single-threaded; returns seconds, fills the errors.
+double run_bc1(const Image& im, Codec codec, Errors& err) {
+    const int bw = im.w / 4, bh = im.h / 4;
+    std::vector<uint8_t> blocks(size_t(bw) * size_t(bh) * 8);
+    const BlockOptions o = atlas_options(codec);
+    const int flags = squish::kDxt1 | (codec == Codec::SquishRange ? squish::kColourRangeFit
+                                       : codec == Codec::SquishIterative ? squish::kColourIterativeClusterFit
+                                                                         : squish::kColourClusterFit);
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int by = 0; by < bh; ++by)
+        for (int bx = 0; bx < bw; ++bx) {
+            uint8_t* out = &blocks[(size_t(by) * size_t(bw) + size_t(bx)) * 8];
+            if (is_atlas(codec)) {
+                float src[48];
+                for (int t = 0; t < 16; ++t)
+                    for (int c = 0; c < 3; ++c)
+                        src[3 * t + c] = im.rgb[((size_t(by) * 4 + size_t(t / 4)) * size_t(im.w) + size_t(bx) * 4 + size_t(t % 4)) * 3 + size_t(c)] / 255.0f;
+                encode_bc1_block(src, o, out);
+            } else {
+                uint8_t rgba[64];
+                for (int t = 0; t < 16; ++t) {
+                    for (int c = 0; c < 3; ++c)
+                        rgba[4 * t + c] = im.rgb[((size_t(by) * 4 + size_t(t / 4)) * size_t(im.w) + size_t(bx) * 4 + size_t(t % 4)) * 3 + size_t(c)];
+                    rgba[4 * t + 3] = 255;
+                }
+                squish::Compress(rgba, out, flags);
+            }
+        }
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (int by = 0; by < bh; ++by)
+        for (int bx = 0; bx < bw; ++bx) {
+            float rgb[48];
+            decode_bc1_block(&blocks[(size_t(by) * size_t(bw) + size_t(bx)) * 8], Decoder::Reference, rgb);
+            for (int t = 0; t < 16; ++t)
+                for (int c = 0; c < 3; ++c)
+                    err.add(rgb[3 * t + c], im.rgb[((size_t(by) * 4 + size_t(t / 4)) * size_t(im.w) + size_t(bx) * 4 + size_t(t % 4)) * 3 + size_t(c)]);
+        }
+    return s;
+}
+
+double run_bc4(const Image& im, Codec codec, Errors& err) {
+    const int bw = im.w / 4, bh = im.h / 4;
+    std::vector<uint8_t> blocks(size_t(bw) * size_t(bh) * 8);
+    std::unique_ptr<Bc4Encoder> enc;
+    if (is_atlas(codec)) enc = std::make_unique<Bc4Encoder>(false, atlas_options(codec)); // tables: once per texture
+    auto grey = [&](int bx, int by, int t) { return im.grey((size_t(by) * 4 + size_t(t / 4)) * size_t(im.w) + size_t(bx) * 4 + size_t(t % 4)); };
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int by = 0; by < bh; ++by)
+        for (int bx = 0; bx < bw; ++bx) {
+            uint8_t* out = &blocks[(size_t(by) * size_t(bw) + size_t(bx)) * 8];
+            if (enc) {
+                float src[16];
+                for (int t = 0; t < 16; ++t) src[t] = grey(bx, by, t) / 255.0f;
+                enc->encode(src, out);
+            } else {
+                uint8_t rgba[64] = {};
+                for (int t = 0; t < 16; ++t) rgba[4 * t] = grey(bx, by, t); // squish's BC4 reads red
+                squish::Compress(rgba, out, squish::kBc4);
+            }
+        }
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (int by = 0; by < bh; ++by)
+        for (int bx = 0; bx < bw; ++bx) {
+            float v[16];
+            decode_bc4_block(&blocks[(size_t(by) * size_t(bw) + size_t(bx)) * 8], false, Decoder::Reference, v);
+            for (int t = 0; t < 16; ++t) err.add(v[t], grey(bx, by, t));
+        }
+    return s;
+}
+
+const std::vector<Image>& images() {
+    static const std::vector<Image> im = inputs();
+    return im;
+}
+
+void peer(benchmark::State& state, int image, bool bc4, Codec codec) {
+    const Image& im = images()[size_t(image)];
+    Errors err;
+    for (auto _ : state) {
+        err = Errors{};
+        const double s = bc4 ? run_bc4(im, codec, err) : run_bc1(im, codec, err);
+        state.SetIterationTime(s);
+        state.counters["Mtexels_per_s"] = double(im.w) * im.h / s / 1e6;
+    }
+    state.counters["rmse_8bit"] = err.rmse();
+    state.counters["max_err_8bit"] = err.max;
+}
+
+int write_inputs(const std::string& dir) {
+    int k = 0;
+    for (const Image& im : images()) {
+        const std::string base = dir + "/input" + std::to_string(k++);
+        std::vector<uint8_t> grey(size_t(im.w) * size_t(im.h) * 3);
+        for (size_t i = 0; i < size_t(im.w) * size_t(im.h); ++i) grey[3 * i] = grey[3 * i + 1] = grey[3 * i + 2] = im.grey(i);
+        for (int g = 0; g < 2; ++g) {
+            const std::string path = base + (g ? "_grey.png" : "_rgb.png");
+            auto out = OIIO::ImageOutput::create(path);
+            OIIO::ImageSpec spec(im.w, im.h, 3, OIIO::TypeDesc::UINT8);
+            if (!out || !out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, g ? grey.data() : im.rgb.data())) {
+                std::fprintf(stderr, "cannot write %s\n", path.c_str());
+                return 1;
+            }
+            out->close();
+            std::printf("%s\t%s\n", path.c_str(), im.name.c_str());
+        }
+    }
+    return 0;
+}
+
+// RMSE and max error (8-bit steps, channels R,G,B or R only for BC4) of a DDS
+// decoded by Atlas's Reference decoder against an 8-bit PNG.
+int rmse_of(const std::string& dds, const std::string& png) {
+    Image src;
+    if (!load_png(png, src)) { std::fprintf(stderr, "cannot read %s\n", png.c_str()); return 1; }
+    const atlas::Field3D f = read_dds(dds, Decoder::Reference);
+    Errors err;
+    const int ch = std::min(3, f.channels());
+    for (int y = 0; y < src.h; ++y)
+        for (int x = 0; x < src.w; ++x)
+            for (int c = 0; c < ch; ++c)
+                err.add(f.at(c, x, y, 0), src.rgb[(size_t(y) * size_t(src.w) + size_t(x)) * 3 + size_t(c)]);
+    std::printf("rmse_8bit %.4f max_err_8bit %.3f channels %d\n", err.rmse(), err.max, ch);
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    if (argc == 3 && std::strcmp(argv[1], "--write-inputs") == 0) return write_inputs(argv[2]);
+    if (argc == 4 && std::strcmp(argv[1], "--rmse") == 0) {
+        try { return rmse_of(argv[2], argv[3]); } catch (const std::exception& e) { std::fprintf(stderr, "%s\n", e.what()); return 1; }
+    }
+    const Codec bc1[] = {Codec::AtlasFast, Codec::AtlasNormal, Codec::AtlasBest, Codec::AtlasNormalAll,
+                         Codec::SquishRange, Codec::SquishCluster, Codec::SquishIterative};
+    const Codec bc4[] = {Codec::AtlasFast, Codec::AtlasNormal, Codec::AtlasBest, Codec::AtlasNormalAll, Codec::SquishCluster};
+    for (int i = 0; i < int(images().size()); ++i) {
+        const std::string tag = "[" + images()[size_t(i)].name + "]";
+        for (Codec c : bc1)
+            benchmark::RegisterBenchmark(("BC1/" + std::string(codec_name(c)) + tag).c_str(), peer, i, false, c)
+                ->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+        for (Codec c : bc4)
+            benchmark::RegisterBenchmark(("BC4/" + std::string(c == Codec::SquishCluster ? "squish" : codec_name(c)) + tag).c_str(),
+                                         peer, i, true, c)
+                ->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+    }
+    // A tiny case for the ctest smoke run (the filter "Smoke").
+    benchmark::RegisterBenchmark("Smoke_PeersBc4Squish", [](benchmark::State& s) {
+        uint8_t rgba[64] = {}, out[8];
+        for (auto _ : s) { squish::Compress(rgba, out, squish::kBc4); benchmark::DoNotOptimize(out); }
+    });
+    benchmark::Initialize(&argc, argv);
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}
