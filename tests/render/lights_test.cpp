@@ -230,14 +230,21 @@ TEST(RenderLights, SameBytesWithOneAndTwoThreads) {
     auto scene = sphere_scene(24, 100, 30, 0.6);
     scene.noise = make_noise(16);
     scene.noise_tile = 40;
-    RenderSettings s = golden_settings(RenderMode::Fast, true);
-    s.lights.push_back({{{50, 50, 50}}, {{1, 0.3f, 0.2f}}, 2e4, 80});
-    s.sky_horizon = Vec3f{{0.8f, 0.7f, 0.6f}};
-    s.threads = 1;
-    auto a = render_clouds(scene, s);
-    s.threads = 2;
-    auto b = render_clouds(scene, s);
-    EXPECT_TRUE(same_bytes(a.image, b.image));
+    auto field = std::make_shared<Field3D>(Vec3i{{5, 5, 5}}, 1, scene.modeling->bounds());
+    for (float& v : field->channel(0)) v = 0.5f;
+    for (RenderMode mode : {RenderMode::Fast, RenderMode::Reference}) {
+        RenderSettings s = golden_settings(mode, true);
+        s.reference_step = 3; // 5 marched light rays per sample: keep the test quick
+        s.lights.push_back({{{50, 50, 50}}, {{1, 0.3f, 0.2f}}, 2e4, 80});
+        s.light_fields.push_back({field, 0, {{0.7f, 0.8f, 1}}, 1e4, 60, 9, 2, 4});
+        s.sky_horizon = Vec3f{{0.8f, 0.7f, 0.6f}};
+        s.threads = 1;
+        auto a = render_clouds(scene, s);
+        s.threads = 2;
+        auto b = render_clouds(scene, s);
+        EXPECT_EQ(a.report.point_light_count, 5);
+        EXPECT_TRUE(same_bytes(a.image, b.image)) << "mode " << int(mode);
+    }
 }
 
 TEST(RenderLights, BadLightsAreClearErrors) {
