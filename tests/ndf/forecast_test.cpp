@@ -408,3 +408,48 @@ TEST(Forecast, Fc6GraphCooks) {
     EXPECT_EQ(std::get<Field2DPtr>(s.get("cirrus", "out", co))->channels(), 3);
     EXPECT_EQ(std::get<Field2DPtr>(s.get("cirrus_horizon", "out", co))->resolution(), (Vec2i{{2048, 128}}));
 }
+
+TEST(Forecast, NodesHashTheirFilesAndReportErrors) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("atlas_fc6_nodes_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+    fs::create_directories(dir);
+    auto write = [&](const std::string& name, const std::string& text) { std::ofstream(dir / name) << text; };
+    write("p.yaml", "atlas_presets: 1\npresets:\n  a: {cumulus_coverage: 0.3, wind_speed: 4}\n  b: {cumulus_coverage: 0.8}\n");
+    write("f.yaml", "atlas_forecast: 1\npresets: p.yaml\nregions:\n  - name: all\n    keys: [[0, a], [60, b]]\n");
+    Session s(builtin_nodes());
+    s.load_text(R"(atlas: 1
+nodes:
+  fc:
+    type: ndf/forecast
+    params: {forecast: f.yaml, resolution: [16, 16], bounds_max: [1000, 1000], slices: 4, step_hours: 30}
+  pr:
+    type: ndf/weather_preset
+    params: {presets: p.yaml, preset: a, resolution: [16, 16], bounds_max: [1000, 1000]}
+outputs: []
+)",
+                "g.yaml", dir);
+    CookOptions co;
+    co.write_outputs = false;
+    const auto h0 = s.node_hashes();
+    const auto maps0 = std::get<Field3DPtr>(s.get("fc", "maps", co));
+    const auto pr0 = std::get<Field2DPtr>(s.get("pr", "out", co));
+    // Editing the presets file (which the forecast names) changes both nodes' hashes and results.
+    write("p.yaml", "atlas_presets: 1\npresets:\n  a: {cumulus_coverage: 0.6, wind_speed: 4}\n  b: {cumulus_coverage: 0.8}\n");
+    const auto h1 = s.node_hashes();
+    EXPECT_NE(h0.at("fc"), h1.at("fc"));
+    EXPECT_NE(h0.at("pr"), h1.at("pr"));
+    EXPECT_FALSE(*maps0 == *std::get<Field3DPtr>(s.get("fc", "maps", co)));
+    EXPECT_FALSE(*pr0 == *std::get<Field2DPtr>(s.get("pr", "out", co)));
+    // Errors reach the caller with the file position and the field.
+    write("f.yaml", "atlas_forecast: 1\npresets: p.yaml\nregions:\n  - name: all\n    keys: [[0, a], [60, c]]\n");
+    try {
+        s.get("fc", "maps", co);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("f.yaml:5:"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("unknown preset 'c'"), std::string::npos) << e.what();
+    }
+    s.set_text("pr", "preset", "zzz");
+    EXPECT_THROW(s.get("pr", "out", co), Error);
+    fs::remove_all(dir);
+}
