@@ -340,6 +340,16 @@ TEST(Forecast, ExtremeInputs) {
     hour.regions[0].keys = {{0.5, 0}, {0.25, 2}};
     EXPECT_THROW(validate_forecast(hour), Error);
     EXPECT_THROW(forecast_weather_map(hour, noise, 0, nullptr), Error);
+    // 1 m and 1e9 m maps, 1 x 1 texels: finite values in range.
+    for (double size : {1.0, 1e9})
+        for (Vec2i res : {Vec2i{{1, 1}}, Vec2i{{17, 5}}}) {
+            WeatherMapSpec w = spec;
+            w.bounds = Box2d{{{-size, 0}}, {{0, size}}};
+            w.resolution = res;
+            const Field3D seq = cook_forecast(test_forecast(), w, 5, 13, 3, nullptr, nullptr);
+            for (int c = 0; c < 4; ++c)
+                for (float v : seq.channel(c)) ASSERT_TRUE(std::isfinite(v) && v >= 0 && v <= 1) << size;
+        }
     // Non-finite hours, bad sequences.
     EXPECT_THROW(forecast_blend(test_forecast(), 0, NAN), Error);
     EXPECT_THROW(cook_forecast(test_forecast(), spec, 0, 0, 4, nullptr, nullptr), Error);
