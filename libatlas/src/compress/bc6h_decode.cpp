@@ -171,7 +171,9 @@ bool unpack(const uint8_t block[16], bool is_signed, Logical& out) {
 
 bool fits(int m, const int e[4][3], bool is_signed) {
     const ModeInfo& mi = kModes[m];
-    const int lo = is_signed ? -(1 << (mi.w - 1)) : 0, hi = is_signed ? (1 << (mi.w - 1)) - 1 : (1 << mi.w) - 1;
+    // Signed codes stay symmetric: -2^(w-1) adds nothing below w = 16 (it unquantizes like
+    // -(2^(w-1) - 1)) and at w = 16 it would finish to an infinity.
+    const int lo = is_signed ? -((1 << (mi.w - 1)) - 1) : 0, hi = is_signed ? (1 << (mi.w - 1)) - 1 : (1 << mi.w) - 1;
     for (int k = 0; k < 2 * mi.regions; ++k)
         for (int c = 0; c < 3; ++c) {
             if (e[k][c] < lo || e[k][c] > hi) return false;

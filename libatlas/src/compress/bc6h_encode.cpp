@@ -30,7 +30,7 @@ inline float half_bits_to_float(uint16_t h) {
         f = float(m) * (1.0f / 16777216.0f);
         return s ? -f : f;
     }
-    const uint32_t bits = s | ((e + 112) << 23) | (m << 13); // e < 31: decoded BC6H halves are finite
+    const uint32_t bits = e == 31 ? (s | 0x7f800000u | (m << 13)) : (s | ((e + 112) << 23) | (m << 13));
     std::memcpy(&f, &bits, 4);
     return f;
 }

@@ -45,7 +45,8 @@ bool unpack(const uint8_t block[16], bool is_signed, Logical& out);
 // fits()); anchor indices must have their top bit clear.
 void pack(const Logical& in, bool is_signed, uint8_t block[16]);
 
-// True when endpoints 1..3 of `e` can be stored in mode `m` (delta ranges, w-bit range).
+// True when the endpoints of `e` can be stored in mode `m` (delta ranges, w-bit range;
+// signed codes limited to +-(2^(w-1) - 1), the encoder's choice).
 bool fits(int m, const int e[4][3], bool is_signed);
 
 // Unquantize a w-bit endpoint to the 16-bit interpolation domain (spec formulas).
