@@ -10,10 +10,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <numbers>
+#include <string>
+#include <tuple>
+#include <vector>
 
 using namespace atlas;
 using namespace atlas::ndf;
@@ -221,4 +225,50 @@ TEST(NdfGraphs, HzdWeatherWritesEveryEngineLayout) {
                           "unity_hdrp_cloud_layer_latlong_rgba_cumulus_stratus_cirrus_wispy.png",
                           "unreal_cloud_weather_rgba_coverage_type_minheight_maxheight.png"})
         EXPECT_NE(yaml.find(f), std::string::npos) << f;
+}
+
+namespace {
+// PNG chunk types in file order (the signature skipped); empty on a non-PNG.
+std::vector<std::string> png_chunks(const std::string& d, int& bit_depth, int& colour_type) {
+    std::vector<std::string> out;
+    if (d.size() < 8 || d.compare(1, 3, "PNG") != 0) return out;
+    for (size_t i = 8; i + 8 <= d.size();) {
+        const uint32_t n = (uint32_t(uint8_t(d[i])) << 24) | (uint32_t(uint8_t(d[i + 1])) << 16) | (uint32_t(uint8_t(d[i + 2])) << 8) |
+                           uint32_t(uint8_t(d[i + 3]));
+        const std::string type = d.substr(i + 4, 4);
+        if (type == "IHDR") {
+            bit_depth = uint8_t(d[i + 16]);
+            colour_type = uint8_t(d[i + 17]);
+        }
+        out.push_back(type);
+        i += 12 + n;
+    }
+    return out;
+}
+} // namespace
+
+TEST(NdfGraphs, EngineTexturesAreLinearPngs) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::path(ATLAS_SOURCE_DIR) / "graphs";
+    const fs::path out = fs::temp_directory_path() / ("atlas_engine_png_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+    fs::remove_all(out);
+    fs::create_directories(out);
+    Session s(builtin_nodes());
+    s.load_text(read_file_bytes(dir / "hzd_weather.yaml"), "hzd_weather.yaml", dir);
+    CookOptions co;
+    co.out_dir = out;
+    const std::string map = "unity_hdrp_cloud_map_rgba_coverage_rain_type_maxheight.png";
+    const std::string lut = "unity_hdrp_cloud_lut_rgb_density_erosion_ambient.png";
+    co.outputs = {map, lut};
+    s.cook(co);
+    for (const auto& [file, depth, colour] : {std::tuple{map, 8, 6}, std::tuple{lut, 16, 2}}) {
+        int bits = 0, type = -1;
+        const auto chunks = png_chunks(read_file_bytes(out / file), bits, type);
+        ASSERT_FALSE(chunks.empty()) << file;
+        EXPECT_EQ(bits, depth) << file;
+        EXPECT_EQ(type, colour) << file; // 6 = RGBA, 2 = RGB
+        for (const char* c : {"sRGB", "gAMA", "iCCP", "cHRM"}) // no colour-space tag: linear data
+            EXPECT_EQ(std::find(chunks.begin(), chunks.end(), c), chunks.end()) << file << " has " << c;
+    }
+    fs::remove_all(out);
 }
