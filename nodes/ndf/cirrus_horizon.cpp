@@ -31,6 +31,4 @@ void cook(CookContext& ctx) {
 }
 } // namespace
 
-ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "ndf/cirrus_horizon", .version = 1, .declare = declare, .cook = cook});
-}
+ATLAS_REGISTER_NODE(registry) { registry.add({.name = "ndf/cirrus_horizon", .version = 1, .declare = declare, .cook = cook}); }

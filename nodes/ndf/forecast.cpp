@@ -1,6 +1,6 @@
 // ndf/forecast: cook an FC6 forecast into a sequence of weather maps.
-#include "atlas/core/files.h"
 #include "atlas/ndf/forecast.h"
+#include "atlas/core/files.h"
 #include "ndf/ndf_params.h"
 
 namespace {

@@ -73,7 +73,8 @@ Blobs blobs(const Field2D& f, int c, float level) {
                 ++n;
                 const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
                 for (int k = 0; k < 4; ++k)
-                    if (nx[k] >= 0 && nx[k] < W && ny[k] >= 0 && ny[k] < H && f.at(c, nx[k], ny[k]) > level && label[f.index(nx[k], ny[k])] < 0) {
+                    if (nx[k] >= 0 && nx[k] < W && ny[k] >= 0 && ny[k] < H && f.at(c, nx[k], ny[k]) > level &&
+                        label[f.index(nx[k], ny[k])] < 0) {
                         label[f.index(nx[k], ny[k])] = 1;
                         stack.push_back({nx[k], ny[k]});
                     }

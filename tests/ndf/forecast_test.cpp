@@ -106,15 +106,19 @@ TEST(Forecast, ErrorsNameFileLineAndField) {
     // Regions after the first need a rect; the first takes none.
     e = forecast_error(head + "      - [0, calm]\n  - name: s\n    keys: [[0, calm]]\n");
     EXPECT_NE(e.detail().find("region 's': regions after the first need a rect"), std::string::npos) << e.what();
-    EXPECT_NE(forecast_error("atlas_forecast: 1\nregions:\n  - name: r\n    rect: [0, 0, 1, 1]\n    keys: [[0, calm]]\n").detail().find("whole map"),
+    EXPECT_NE(forecast_error("atlas_forecast: 1\nregions:\n  - name: r\n    rect: [0, 0, 1, 1]\n    keys: [[0, calm]]\n")
+                  .detail()
+                  .find("whole map"),
               std::string::npos);
-    EXPECT_NE(forecast_error("atlas_forecast: 1\nregions:\n  - {name: r, keys: [[0, calm]]}\n  - {name: s, rect: [5, 0, 1, 1], keys: [[0, calm]]}\n")
+    EXPECT_NE(forecast_error(
+                  "atlas_forecast: 1\nregions:\n  - {name: r, keys: [[0, calm]]}\n  - {name: s, rect: [5, 0, 1, 1], keys: [[0, calm]]}\n")
                   .detail()
                   .find("xmin < xmax"),
               std::string::npos);
     // Period, transition, version, keys.
     EXPECT_NE(forecast_error("atlas_forecast: 1\nperiod_hours: 0\nregions: []\n").detail().find("period_hours"), std::string::npos);
-    EXPECT_NE(forecast_error("atlas_forecast: 1\ntransition_hours: -2\nregions: []\n").detail().find("transition_hours"), std::string::npos);
+    EXPECT_NE(forecast_error("atlas_forecast: 1\ntransition_hours: -2\nregions: []\n").detail().find("transition_hours"),
+              std::string::npos);
     EXPECT_NE(forecast_error("atlas_forecast: 3\nregions: []\n").detail().find("atlas_forecast: 1"), std::string::npos);
     EXPECT_NE(forecast_error(head + "      - [0]\n").detail().find("[hour, preset]"), std::string::npos);
     EXPECT_NE(forecast_error("atlas_forecast: 1\nregion: []\n").detail().find("unknown key 'region'"), std::string::npos);
@@ -421,7 +425,8 @@ TEST(Forecast, Fc6GraphCooks) {
 
 TEST(Forecast, NodesHashTheirFilesAndReportErrors) {
     namespace fs = std::filesystem;
-    const fs::path dir = fs::temp_directory_path() / ("atlas_fc6_nodes_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("atlas_fc6_nodes_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
     fs::create_directories(dir);
     auto write = [&](const std::string& name, const std::string& text) { std::ofstream(dir / name) << text; };
     write("p.yaml", "atlas_presets: 1\npresets:\n  a: {cumulus_coverage: 0.3, wind_speed: 4}\n  b: {cumulus_coverage: 0.8}\n");

@@ -84,7 +84,8 @@ TEST(WeatherPreset, ErrorsNameFileLineAndField) {
     EXPECT_NE(parse_error("atlas_presets: 2\npresets:\n  a: {fog: 0}\n").detail().find("atlas_presets: 1"), std::string::npos);
     EXPECT_NE(parse_error("atlas_presets: 1\npresets: {}\n").detail().find("non-empty"), std::string::npos);
     EXPECT_EQ(parse_error("atlas_presets: 1\npresets:\n  a: {fog: [0\n").where().file, "p.yaml");
-    EXPECT_NE(parse_error("atlas_presets: 1\npresets:\n  a: {fog: 0}\ncolour: red\n").detail().find("unknown key 'colour'"), std::string::npos);
+    EXPECT_NE(parse_error("atlas_presets: 1\npresets:\n  a: {fog: 0}\ncolour: red\n").detail().find("unknown key 'colour'"),
+              std::string::npos);
 }
 
 TEST(WeatherPreset, ValidateNamesTheField) {

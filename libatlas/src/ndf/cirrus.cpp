@@ -31,7 +31,8 @@ float unsigned_gradient(float v) { return 0.5f * (v + 1.0f); }
 
 void check_res(Vec2i r, const char* who) {
     if (r[0] < 1 || r[1] < 1 || r[0] > 16384 || r[1] > 16384)
-        throw Error(std::string(who) + ": 'resolution' = " + std::to_string(r[0]) + "x" + std::to_string(r[1]) + " is out of range [1, 16384] per axis");
+        throw Error(std::string(who) + ": 'resolution' = " + std::to_string(r[0]) + "x" + std::to_string(r[1]) +
+                    " is out of range [1, 16384] per axis");
 }
 void check_unit(double v, const char* who, const char* name) {
     if (!(v >= 0 && v <= 1)) throw Error(std::string(who) + ": '" + name + "' must be in [0, 1]");
@@ -75,7 +76,8 @@ Field2D cirrus_texture(const CirrusSpec& spec, const MemoryBudget* budget) {
         const std::vector<float> curl = noise::sample_noise(warp, std::span<const Vec2d>(p));
         // Curl components are O(1) per lattice cell (|c| <= 21, typically < 3): scale to texture widths.
         for (int x = 0; x < W; ++x) {
-            const Vec2d w{{p[size_t(x)][0] + spec.warp * curl[2 * size_t(x)] / 3.0, p[size_t(x)][1] + spec.warp * curl[2 * size_t(x) + 1] / 3.0}};
+            const Vec2d w{
+                {p[size_t(x)][0] + spec.warp * curl[2 * size_t(x)] / 3.0, p[size_t(x)][1] + spec.warp * curl[2 * size_t(x) + 1] / 3.0}};
             q[size_t(x)] = Vec2d{{a * w[0] + b * w[1], -b * w[0] + a * w[1]}};
         }
         const std::vector<float> v_veil = noise::sample_noise(veil, std::span<const Vec2d>(q));
@@ -112,8 +114,10 @@ Field2D cirrus_horizon(const CirrusHorizonSpec& spec, const MemoryBudget* budget
     constexpr int kYPeriod = 2048;
     const double y_scale = spec.cells_up / kYPeriod;
     const NoiseSpec layer = make_spec(noise::Kernel::Gradient, {{spec.cells_along, kYPeriod}}, 6, noise::Combinator::Fbm, spec.seed + 11);
-    const NoiseSpec fine = make_spec(noise::Kernel::Gradient, {{4 * spec.cells_along, kYPeriod}}, 4, noise::Combinator::Ridged, spec.seed + 12);
-    const NoiseSpec warp = make_spec(noise::Kernel::Gradient, {{std::max(1, spec.cells_along / 4), kYPeriod}}, 2, noise::Combinator::Fbm, spec.seed + 13);
+    const NoiseSpec fine =
+        make_spec(noise::Kernel::Gradient, {{4 * spec.cells_along, kYPeriod}}, 4, noise::Combinator::Ridged, spec.seed + 12);
+    const NoiseSpec warp =
+        make_spec(noise::Kernel::Gradient, {{std::max(1, spec.cells_along / 4), kYPeriod}}, 2, noise::Combinator::Fbm, spec.seed + 13);
     Field2D out(spec.resolution, 1, Box2d{{{0, 0}}, {{1, 1}}}, {"cirrus_horizon"}, budget);
     tbb::parallel_for(0, H, [&](int y) {
         const double v = (y + 0.5) / H;

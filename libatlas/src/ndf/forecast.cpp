@@ -143,7 +143,8 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
     if (!root || !root.IsMap()) throw ParseError({filename, 1, 1}, "expected a map with 'atlas_forecast: 1', 'presets' and 'regions'");
     const YAML::Node version = root["atlas_forecast"];
     if (!version || !version.IsScalar() || version.Scalar() != "1")
-        throw ParseError(version ? where(filename, version) : SourceLocation{filename, 1, 1}, "expected 'atlas_forecast: 1' (the forecast file version)");
+        throw ParseError(version ? where(filename, version) : SourceLocation{filename, 1, 1},
+                         "expected 'atlas_forecast: 1' (the forecast file version)");
     for (const auto& kv : root) {
         const std::string key = kv.first.Scalar();
         if (key != "atlas_forecast" && key != "presets" && key != "period_hours" && key != "transition_hours" && key != "regions")
@@ -179,7 +180,8 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
         }
         if (const YAML::Node n = rn["rect"]) {
             if (r == 0) throw ParseError(where(filename, n), who + ": the first region covers the whole map and takes no rect");
-            if (!n.IsSequence() || n.size() != 4) throw ParseError(where(filename, n), who + ": rect must be [xmin, ymin, xmax, ymax] in metres");
+            if (!n.IsSequence() || n.size() != 4)
+                throw ParseError(where(filename, n), who + ": rect must be [xmin, ymin, xmax, ymax] in metres");
             double v[4];
             for (size_t i = 0; i < 4; ++i) v[i] = as_number(filename, n[i], who + ": rect");
             reg.whole_map = false;
@@ -195,7 +197,8 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
         }
         const YAML::Node keys = rn["keys"];
         if (!keys || !keys.IsSequence() || keys.size() == 0)
-            throw ParseError(keys ? where(filename, keys) : where(filename, rn), who + ": 'keys' must be a non-empty list of [hour, preset]");
+            throw ParseError(keys ? where(filename, keys) : where(filename, rn),
+                             who + ": 'keys' must be a non-empty list of [hour, preset]");
         for (const auto& kn : keys) {
             YAML::Node hn, pn;
             if (kn.IsSequence() && kn.size() == 2) {
@@ -210,7 +213,8 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
             ForecastKey k;
             k.hour = as_number(filename, hn, who + ": key hour");
             if (!(k.hour >= 0 && k.hour < f.period_hours))
-                throw ParseError(where(filename, hn), who + ": key hour " + num(k.hour) + " is out of range [0, " + num(f.period_hours) + ")");
+                throw ParseError(where(filename, hn),
+                                 who + ": key hour " + num(k.hour) + " is out of range [0, " + num(f.period_hours) + ")");
             if (!reg.keys.empty() && !(k.hour > reg.keys.back().hour))
                 throw ParseError(where(filename, hn), who + ": key hour " + num(k.hour) + " is not after the previous key (" +
                                                           num(reg.keys.back().hour) + "); keys must be in increasing hour order");
@@ -421,7 +425,8 @@ Field3D cook_forecast(const Forecast& f, const WeatherMapSpec& spec, double star
     const size_t plane = size_t(spec.resolution[0]) * size_t(spec.resolution[1]);
     for (int i = 0; i < slices; ++i) {
         const Field2D m = forecast_weather_map(f, noise, start_hour + i * step_hours, budget);
-        for (int c = 0; c < 4; ++c) std::copy(m.channel(c).begin(), m.channel(c).end(), out.channel(c).begin() + std::ptrdiff_t(plane * size_t(i)));
+        for (int c = 0; c < 4; ++c)
+            std::copy(m.channel(c).begin(), m.channel(c).end(), out.channel(c).begin() + std::ptrdiff_t(plane * size_t(i)));
         if (progress) {
             if (progress->on_progress) progress->on_progress({"forecast slices", double(i + 1) / slices, i + 1, slices});
             progress->poll();
@@ -448,8 +453,10 @@ std::string forecast_manifest_json(const Forecast& f, const WeatherMapSpec& spec
     for (const auto& r : f.regions) {
         J jr;
         jr["name"] = r.name;
-        if (r.whole_map) jr["rect"] = nullptr;
-        else jr["rect"] = {r.rect.min[0], r.rect.min[1], r.rect.max[0], r.rect.max[1]};
+        if (r.whole_map)
+            jr["rect"] = nullptr;
+        else
+            jr["rect"] = {r.rect.min[0], r.rect.min[1], r.rect.max[0], r.rect.max[1]};
         jr["blend_m"] = r.blend;
         regions.push_back(jr);
     }

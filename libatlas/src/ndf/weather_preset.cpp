@@ -26,7 +26,8 @@ const std::vector<PresetFieldInfo>& preset_fields() {
         {"lightning", &P::lightning, 0, 1, false, "", "lightning frequency"},
         {"fog", &P::fog, 0, 1, false, "", "fog density"},
         {"cloud_type", &P::cloud_type, 0, 1, false, "", "mean cloud type (0 stratus, 1/3 stratocumulus, 2/3 cumulus, 1 cumulonimbus)"},
-        {"type_variation", &P::type_variation, 0, 1, false, "", "spread of the type around cloud_type (type = cloud_type + variation (2 n - 1))"},
+        {"type_variation", &P::type_variation, 0, 1, false, "",
+         "spread of the type around cloud_type (type = cloud_type + variation (2 n - 1))"},
         {"coverage_contrast", &P::coverage_contrast, 0.1, 100, false, "", "slope of the noise -> coverage map"},
         {"rain_threshold", &P::rain_threshold, 0, 1, true, "", "coverage where rain starts"},
         {"min_height", &P::min_height, -1000, 30000, false, "m", "cloud base"},
@@ -90,7 +91,8 @@ std::vector<WeatherPreset> parse_presets(const std::string& text, const std::str
     if (!root || !root.IsMap()) throw ParseError({filename, 1, 1}, "expected a map with 'atlas_presets: 1' and 'presets'");
     const YAML::Node version = root["atlas_presets"];
     if (!version || !version.IsScalar() || version.Scalar() != "1")
-        throw ParseError(version ? where(filename, version) : SourceLocation{filename, 1, 1}, "expected 'atlas_presets: 1' (the presets file version)");
+        throw ParseError(version ? where(filename, version) : SourceLocation{filename, 1, 1},
+                         "expected 'atlas_presets: 1' (the presets file version)");
     for (const auto& kv : root) {
         const std::string key = kv.first.Scalar();
         if (key != "atlas_presets" && key != "presets")
@@ -98,7 +100,8 @@ std::vector<WeatherPreset> parse_presets(const std::string& text, const std::str
     }
     const YAML::Node list = root["presets"];
     if (!list || !list.IsMap() || list.size() == 0)
-        throw ParseError(list ? where(filename, list) : SourceLocation{filename, 1, 1}, "'presets' must be a non-empty map of name -> fields");
+        throw ParseError(list ? where(filename, list) : SourceLocation{filename, 1, 1},
+                         "'presets' must be a non-empty map of name -> fields");
 
     std::vector<WeatherPreset> out;
     std::set<std::string> names;
@@ -140,9 +143,7 @@ std::vector<WeatherPreset> parse_presets(const std::string& text, const std::str
     return out;
 }
 
-std::vector<WeatherPreset> load_presets(const std::filesystem::path& file) {
-    return parse_presets(read_file_bytes(file), file.string());
-}
+std::vector<WeatherPreset> load_presets(const std::filesystem::path& file) { return parse_presets(read_file_bytes(file), file.string()); }
 
 int find_preset(const std::vector<WeatherPreset>& presets, const std::string& name) {
     for (size_t i = 0; i < presets.size(); ++i)

@@ -41,9 +41,9 @@ struct ForecastKey {
 
 struct ForecastRegion {
     std::string name;
-    bool whole_map = true; // region 0 must be; later regions have a rect
-    Box2d rect{};          // metres (world XY), when !whole_map
-    double blend = 0;      // metres (>= 0): width of the smooth border, centred on the rect edge
+    bool whole_map = true;         // region 0 must be; later regions have a rect
+    Box2d rect{};                  // metres (world XY), when !whole_map
+    double blend = 0;              // metres (>= 0): width of the smooth border, centred on the rect edge
     std::vector<ForecastKey> keys; // at least one
 };
 
@@ -93,9 +93,9 @@ Vec2d forecast_drift(const Forecast& f, int region, double hour, Vec2d map_size)
 struct WeatherMapSpec {
     Vec2i resolution{{256, 256}};
     Box2d bounds{{{0, 0}}, {{60000, 60000}}}; // metres
-    Vec2i period{{6, 6}};    // coverage noise lattice cells across the map (the type noise uses half, at least 1)
-    int octaves = 5;         // [1, 16]
-    double gain = 0.55;      // [0, 1]
+    Vec2i period{{6, 6}};                     // coverage noise lattice cells across the map (the type noise uses half, at least 1)
+    int octaves = 5;                          // [1, 16]
+    double gain = 0.55;                       // [0, 1]
     uint32_t seed = 0;
 };
 

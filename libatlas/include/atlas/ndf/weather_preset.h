@@ -35,12 +35,12 @@ struct WeatherPreset {
     double lightning = 0;          // [0,1] lightning frequency
     double fog = 0;                // [0,1] fog density
     // --- NDF graph parameters the preset drives ---
-    double cloud_type = 0.5;        // [0,1] mean cloud type (0 stratus .. 2/3 cumulus, 1 cumulonimbus)
-    double type_variation = 0.3;    // [0,1] spread of type around cloud_type, driven by a noise
-    double coverage_contrast = 3;   // [0.1,100] slope of the noise -> coverage map around its midpoint
-    double rain_threshold = 0.5;    // [0,1) coverage where rain starts; precipitation = rain * smoothstep(thr, 1, coverage)
-    double min_height = 1500;       // metres [-1000, 30000]: cloud base
-    double max_height = 4000;       // metres [-1000, 30000], >= min_height: cloud top
+    double cloud_type = 0.5;      // [0,1] mean cloud type (0 stratus .. 2/3 cumulus, 1 cumulonimbus)
+    double type_variation = 0.3;  // [0,1] spread of type around cloud_type, driven by a noise
+    double coverage_contrast = 3; // [0.1,100] slope of the noise -> coverage map around its midpoint
+    double rain_threshold = 0.5;  // [0,1) coverage where rain starts; precipitation = rain * smoothstep(thr, 1, coverage)
+    double min_height = 1500;     // metres [-1000, 30000]: cloud base
+    double max_height = 4000;     // metres [-1000, 30000], >= min_height: cloud top
 };
 
 // One numeric preset field: its YAML name, range, unit and meaning (what
