@@ -104,6 +104,18 @@ TEST(SimKessler, EvaporationBoundedBySaturation) {
             EXPECT_NEAR(double(c.qv[n]) + c.qr[n], 6e-3, 1e-9);
         }
     }
+    {
+        Column c(2);
+        c.qr[1] = std::nanf("");
+        try {
+            kessler_conversions(s, c.theta, c.qv, c.qc, c.qr, c.p, c.pi, c.rho, 1.0, o);
+            FAIL() << "NaN accepted";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("qr"), std::string::npos) << e.what();
+        }
+        EXPECT_THROW(rain_sedimentation(s, c.qr, c.rho, 1.0, o), Error);
+        EXPECT_THROW(kessler_conversions(s, c.theta, c.qv, c.qc, c.qr, c.p, c.pi, c.rho, -1.0, o), Error);
+    }
     Column c(2);
     for (size_t n = 0; n < c.qv.size(); ++n) c.qv[n] = float(1.01 * saturation_mixing_ratio(300 * c.pi[n / 2], c.p[n / 2]));
     std::fill(c.qr.begin(), c.qr.end(), 1e-3f);

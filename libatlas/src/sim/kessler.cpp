@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 namespace atlas::sim {
 namespace {
@@ -27,6 +28,12 @@ void check(double v, double lo, double hi, const char* what) {
         std::snprintf(buf, sizeof buf, "sim kessler: %s = %g, expected %g..%g", what, v, lo, hi);
         throw Error(buf);
     }
+}
+
+void check_finite(std::span<const float> a, const char* what) {
+    for (size_t n = 0; n < a.size(); ++n)
+        if (!std::isfinite(a[n]))
+            throw Error(std::string("sim kessler: ") + what + " holds NaN/Inf at cell " + std::to_string(n));
 }
 
 void check_sizes(const GridSpec& s, size_t n, size_t nrho) {
@@ -66,6 +73,10 @@ KesslerReport kessler_conversions(const GridSpec& s, std::span<float> theta, std
     check_sizes(s, qc.size(), rho.size());
     check_sizes(s, qr.size(), size_t(s.nz));
     if (!std::isfinite(dt) || dt < 0) throw Error("sim kessler: dt must be finite and >= 0 s");
+    check_finite(theta, "theta");
+    check_finite(qv, "qv");
+    check_finite(qc, "qc");
+    check_finite(qr, "qr");
     const size_t plane = size_t(s.nx) * s.ny;
     std::vector<double> au(size_t(s.nz)), ac(size_t(s.nz)), ev(size_t(s.nz));
     for_range(s.nz, [&](int k) {
@@ -119,6 +130,7 @@ KesslerReport rain_sedimentation(const GridSpec& s, std::span<float> qr, const s
     o.validate();
     check_sizes(s, qr.size(), rho.size());
     if (!std::isfinite(dt) || dt < 0) throw Error("sim kessler: dt must be finite and >= 0 s");
+    check_finite(qr, "qr");
     KesslerReport rep;
     const int nx = s.nx, ny = s.ny, nz = s.nz;
     const size_t plane = size_t(nx) * ny;
