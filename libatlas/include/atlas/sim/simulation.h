@@ -8,8 +8,11 @@
 //   b = g (theta_v - theta_v0) / theta_v0,  theta_v = theta (1 + 0.608 qv - qc)
 // with the hydrostatic reference theta0(z), qv0(z), Pi0(z), p0(z), rho0(z)
 // from an ambient Sounding, and the condensation C by saturation adjustment
-// (thermo.h). Per substep: advect (u, theta, qv, qc), add sources, saturation
-// adjustment, buoyancy / vorticity confinement / diffusion, pressure projection.
+// (thermo.h). Per substep: advect (u, theta, qv, qc[, qr]), add sources,
+// saturation adjustment, optional Kessler rain (kessler.h; qr loads the
+// buoyancy and falls out through the floor), buoyancy / vorticity confinement /
+// diffusion, pressure projection. Optional Bryan & Fritsch reversible
+// thermodynamics (SimOptions::reversible_theta_e) advect and conserve theta_e.
 // Time steps are CFL-adaptive; a requested dt is split into equal substeps,
 // at most `max_substeps` of them, else step() throws atlas::Error.
 // Determinism: same inputs, same bytes for any TBB thread count.
