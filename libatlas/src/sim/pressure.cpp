@@ -72,27 +72,60 @@ struct Level {
     }
     void apply(const std::vector<double>& v, std::vector<double>& out) const {
         for_slices(nz, [&](int k) {
-            for (int j = 0; j < ny; ++j)
-                for (int i = 0; i < nx; ++i) out[id(i, j, k)] = diag[id(i, j, k)] * v[id(i, j, k)] - offdiag(v, i, j, k);
+            for (int j = 0; j < ny; ++j) {
+                const Row rw = row(v, j, k);
+                const size_t c0 = id(0, j, k);
+                for (int i = 0; i < nx; ++i) out[c0 + size_t(i)] = diag[c0 + size_t(i)] * v[c0 + size_t(i)] - off(rw, i, nx);
+            }
         });
+    }
+    // One row of cells (j, k) with its neighbour rows; a missing neighbour row
+    // gets coefficient 0 and points at the row itself (0 * finite adds nothing,
+    // so the sums equal offdiag() term by term, in the same order).
+    struct Row {
+        const double *c, *s, *n, *d, *u;
+        double ax, ay_s, ay_n, az_d, az_u;
+    };
+    Row row(const std::vector<double>& v, int j, int k) const {
+        const size_t c = id(0, j, k), pl = size_t(nx) * ny;
+        Row r;
+        r.c = &v[c];
+        r.ax = ax[size_t(k)];
+        r.s = j > 0 ? r.c - nx : r.c, r.ay_s = j > 0 ? ay[size_t(k)] : 0.0;
+        r.n = j < ny - 1 ? r.c + nx : r.c, r.ay_n = j < ny - 1 ? ay[size_t(k)] : 0.0;
+        r.d = k > 0 ? r.c - pl : r.c, r.az_d = k > 0 ? az[size_t(k)] : 0.0;
+        r.u = k < nz - 1 ? r.c + pl : r.c, r.az_u = k < nz - 1 ? az[size_t(k + 1)] : 0.0;
+        return r;
+    }
+    static double off(const Row& r, int i, int nx_) {
+        double s = 0;
+        if (i > 0) s += r.ax * r.c[i - 1];
+        if (i < nx_ - 1) s += r.ax * r.c[i + 1];
+        s += r.ay_s * r.s[i];
+        s += r.ay_n * r.n[i];
+        s += r.az_d * r.d[i];
+        s += r.az_u * r.u[i];
+        return s;
     }
     // One red-black Gauss-Seidel half sweep over cells with (i+j+k)%2 == color.
     void gs(int color) {
         for_slices(nz, [&](int k) {
-            for (int j = 0; j < ny; ++j)
-                for (int i = (color + j + k) & 1; i < nx; i += 2) {
-                    size_t c = id(i, j, k);
-                    x[c] = (b[c] + offdiag(x, i, j, k)) / diag[c];
-                }
+            for (int j = 0; j < ny; ++j) {
+                const Row rw = row(x, j, k);
+                double* xr = &x[id(0, j, k)];
+                const double* br = &b[id(0, j, k)];
+                const double* dg = &diag[id(0, j, k)];
+                for (int i = (color + j + k) & 1; i < nx; i += 2) xr[i] = (br[i] + off(rw, i, nx)) / dg[i];
+            }
         });
     }
     void residual() {
         for_slices(nz, [&](int k) {
-            for (int j = 0; j < ny; ++j)
-                for (int i = 0; i < nx; ++i) {
-                    size_t c = id(i, j, k);
-                    r[c] = b[c] - (diag[c] * x[c] - offdiag(x, i, j, k));
-                }
+            for (int j = 0; j < ny; ++j) {
+                const Row rw = row(x, j, k);
+                const size_t c0 = id(0, j, k);
+                for (int i = 0; i < nx; ++i) r[c0 + size_t(i)] = b[c0 + size_t(i)] - (diag[c0 + size_t(i)] * x[c0 + size_t(i)] - off(rw, i, nx));
+            }
         });
     }
 };
