@@ -10,7 +10,8 @@ using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
     d.doc("Unity HDRP cloud layer map: an RGBA lat-long texture of opacities R cumulus = coverage x w, G stratus = coverage x (1 - w) "
-          "(w = clamp(1.5 type, 0, 1)), B cirrus and A wispy from the optional maps. The set's XY map lies on a flat plane "
+          "(w = clamp(1.5 type, 0, 1)), B cirrus and A wispy from the optional maps (sampled at world XY by their own bounds, e.g. "
+          "ndf/cirrus with the weather map's bounds). The set's XY map lies on a flat plane "
           "`altitude` m above the eye; column x looks along azimuth 360 (x + 0.5) / W degrees from world +X toward +Y, row y at "
           "elevation -90 + 180 (y + 0.5) / H (or 90 (y + 0.5) / H with upper_hemisphere_only); below the horizon all 0. Output "
           "bounds are degrees (azimuth, elevation).");
@@ -23,8 +24,8 @@ void declare(NodeDeclaration& d) {
     d.param_float("altitude", 3000).with_unit("m").describe("height of the cloud plane above the eye (> 0)");
     d.param_float2("eye", {{30000, 30000}}).with_unit("m").describe("world XY of the viewer (default: the centre of a 60 km map)");
     d.param_bool("tileable", false).describe("true: the maps repeat beyond their bounds; false: nothing beyond them");
-    d.param_int("cirrus_channel", 0).range(0, 63).describe("channel of the cirrus map to use");
-    d.param_int("wispy_channel", 0).range(0, 63).describe("channel of the wispy map to use");
+    d.param_string("cirrus_channel", "0").describe("channel of the cirrus map to use, by name or index");
+    d.param_string("wispy_channel", "0").describe("channel of the wispy map to use, by name or index");
 }
 
 void cook(CookContext& ctx) {
@@ -39,8 +40,9 @@ void cook(CookContext& ctx) {
     o.eye = ctx.get_float2("eye");
     o.tileable = ctx.get_bool("tileable");
     try {
-        ctx.set_output("out", out2d(ndf::unity_cloud_layer(*in, cirrus.get(), int(ctx.get_int("cirrus_channel")), wispy.get(),
-                                                           int(ctx.get_int("wispy_channel")), o, &ctx.budget())));
+        const int cc = cirrus ? channel_param(ctx, *cirrus, "cirrus_channel") : 0;
+        const int wc = wispy ? channel_param(ctx, *wispy, "wispy_channel") : 0;
+        ctx.set_output("out", out2d(ndf::unity_cloud_layer(*in, cirrus.get(), cc, wispy.get(), wc, o, &ctx.budget())));
     } catch (const Error& e) {
         ctx.fail(e.what());
     }
@@ -48,5 +50,5 @@ void cook(CookContext& ctx) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "ndf/unity_cloud_layer", .version = 1, .declare = declare, .cook = cook});
+    registry.add({.name = "ndf/unity_cloud_layer", .version = 2, .declare = declare, .cook = cook});
 }

@@ -218,6 +218,20 @@ TEST(NdfGraphs, HzdWeatherWritesEveryEngineLayout) {
     const Field2DPtr sky = get("unity_sky");
     EXPECT_EQ(sky->channels(), 4);
     EXPECT_DOUBLE_EQ(sky->bounds().min[1], 0.0); // upper hemisphere
+    // B and A come from the cirrus node's 'cirrus' and 'cirrostratus' channels: the zenith texel sees the eye's spot.
+    const Field2DPtr cirrus = get("cirrus");
+    float bmax = 0, amax = 0;
+    for (size_t i = 0; i < sky->voxel_count(); ++i) {
+        bmax = std::max(bmax, sky->channel(2)[i]);
+        amax = std::max(amax, sky->channel(3)[i]);
+    }
+    EXPECT_GT(bmax, 0.0f);
+    EXPECT_GT(amax, 0.0f);
+    const int top = sky->height() - 1;
+    const double theta = 0.5 * std::numbers::pi * (top + 0.5) / sky->height(), phi = 2 * std::numbers::pi * 0.5 / sky->width();
+    const Vec2d p{{30000 + 3000 / std::tan(theta) * std::cos(phi), 30000 + 3000 / std::tan(theta) * std::sin(phi)}};
+    EXPECT_FLOAT_EQ(sky->at(2, 0, top), cirrus->sample_world(cirrus->find_channel("cirrus"), p, WrapMode::Wrap));
+    EXPECT_FLOAT_EQ(sky->at(3, 0, top), cirrus->sample_world(cirrus->find_channel("cirrostratus"), p, WrapMode::Wrap));
     // The file names say which engine each layout is for.
     const std::string yaml = read_file_bytes(dir / "hzd_weather.yaml");
     for (const char* f : {"hzd_weather_map_rgb_coverage_precip_type.png", "unity_hdrp_cloud_map_rgba_coverage_rain_type_maxheight.png",
