@@ -214,6 +214,18 @@ TEST(Cirrus, ExtremesAndDeterminism) {
     hb = CirrusHorizonSpec{};
     hb.cells_up = 0;
     expect_error([&] { cirrus_horizon(hb, nullptr); }, "cells_up");
+    // Bounds place the tile in the world; the texels do not depend on them.
+    CirrusSpec placed;
+    placed.resolution = {{32, 32}};
+    placed.bounds = Box2d{{{0, 0}}, {{60000, 60000}}};
+    const Field2D world = cirrus_texture(placed, nullptr);
+    EXPECT_EQ(world.bounds(), placed.bounds);
+    placed.bounds = Box2d{{{0, 0}}, {{1, 1}}};
+    const Field2D unit = cirrus_texture(placed, nullptr);
+    for (int c = 0; c < 3; ++c)
+        for (size_t i = 0; i < unit.voxel_count(); ++i) ASSERT_EQ(world.channel(c)[i], unit.channel(c)[i]);
+    placed.bounds = Box2d{{{5, 0}}, {{1, 1}}};
+    expect_error([&] { cirrus_texture(placed, nullptr); }, "bounds");
     // Same bytes on one thread and many.
     CirrusSpec d;
     d.resolution = {{128, 96}};

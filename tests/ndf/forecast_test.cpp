@@ -421,6 +421,13 @@ TEST(Forecast, Fc6GraphCooks) {
     EXPECT_EQ(table->height(), 3);
     EXPECT_EQ(std::get<Field2DPtr>(s.get("cirrus", "out", co))->channels(), 3);
     EXPECT_EQ(std::get<Field2DPtr>(s.get("cirrus_horizon", "out", co))->resolution(), (Vec2i{{2048, 128}}));
+    // The cirrus tile over the map feeds the Unity cloud layer: cirrus (B) and wispy (A) only.
+    const auto layer = std::get<Field2DPtr>(s.get("unity_cirrus_layer", "out", co));
+    ASSERT_EQ(layer->channels(), 4);
+    EXPECT_EQ(channel_stats(layer->channel(0)).max, 0.0);
+    EXPECT_EQ(channel_stats(layer->channel(1)).max, 0.0);
+    EXPECT_GT(channel_stats(layer->channel(2)).max, 0.5);
+    EXPECT_GT(channel_stats(layer->channel(3)).mean, 0.1);
 }
 
 TEST(Forecast, NodesHashTheirFilesAndReportErrors) {

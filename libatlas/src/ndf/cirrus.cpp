@@ -69,7 +69,9 @@ Field2D cirrus_texture(const CirrusSpec& spec, const MemoryBudget* budget) {
     const NoiseSpec puff_patches = make_spec(noise::Kernel::Value, {{2 * P, 2 * P}}, 2, noise::Combinator::Fbm, spec.seed + 7);
 
     const int W = spec.resolution[0], H = spec.resolution[1];
-    Field2D out(spec.resolution, 3, Box2d{{{0, 0}}, {{1, 1}}}, cirrus_channels(), budget);
+    if (!spec.bounds.valid() || !std::isfinite(spec.bounds.min[0] + spec.bounds.min[1] + spec.bounds.max[0] + spec.bounds.max[1]))
+        throw Error("cirrus: 'bounds' must be finite with max > min in x and y");
+    Field2D out(spec.resolution, 3, spec.bounds, cirrus_channels(), budget);
     tbb::parallel_for(0, H, [&](int y) {
         std::vector<Vec2d> p(static_cast<size_t>(W)), q(static_cast<size_t>(W));
         for (int x = 0; x < W; ++x) p[size_t(x)] = Vec2d{{(x + 0.5) / W, (y + 0.5) / H}};

@@ -27,6 +27,7 @@ struct CirrusSpec {
     int stretch = 6;                // [1, 64] streak length / width of the cirrus and cirrostratus looks
     double warp = 0.04;             // [0, 1] domain-warp displacement, in texture widths
     uint32_t seed = 0;
+    Box2d bounds{{{0, 0}}, {{1, 1}}}; // world box the texture covers (one tile); any valid box, e.g. a 60 km map for the Unity cloud layer
 };
 
 // Channel names: cirrostratus, cirrus, cirrocumulus.
