@@ -118,6 +118,7 @@ struct PairTables {
     std::vector<float> imin, imax;
     std::vector<uint8_t> six;
     std::vector<float> six_mask; // all bits set where six (SIMD blend)
+    std::vector<float> ent_lo[8], ent_hi[8]; // entry i of every pair, pair-contiguous (SIMD probes)
     float row_imin[256][2], row_imax[256][2];
     float c_lo = 0, c_hi = 1; // the 6-value mode's constants
 };
@@ -135,6 +136,7 @@ Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
     T.imax.resize(65536);
     T.six.resize(65536);
     T.six_mask.resize(65536);
+    for (int i = 0; i < 8; ++i) { T.ent_lo[i].resize(65536); T.ent_hi[i].resize(65536); }
     T.c_lo = snorm_ ? -1.0f : 0.0f;
     for (int r = 0; r < 256; ++r)
         for (int m = 0; m < 2; ++m) { T.row_imin[r][m] = INFINITY; T.row_imax[r][m] = -INFINITY; }
@@ -152,6 +154,7 @@ Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
         T.imin[size_t(k)] = imn;
         T.imax[size_t(k)] = imx;
         T.six[size_t(k)] = eight ? 0 : 1;
+        for (int i = 0; i < 8; ++i) { T.ent_lo[i][size_t(k)] = p.lo[i][0]; T.ent_hi[i][size_t(k)] = p.hi[i][0]; }
         const uint32_t all_bits = eight ? 0u : 0xffffffffu;
         std::memcpy(&T.six_mask[size_t(k)], &all_bits, 4);
         const int m = eight ? 0 : 1;
@@ -228,6 +231,20 @@ int search_all_pairs(const PairTables& T, const float src[16], bool os, detail::
                 const __m128 enabled = _mm_or_ps(_mm_and_ps(six, en6), _mm_andnot_ps(six, en8));
                 __m128 pass = _mm_and_ps(enabled, _mm_cmple_ps(lb, ve));
                 if (os) pass = _mm_and_ps(pass, _mm_cmple_ps(_mm_loadu_ps(&T.pal_min[row + size_t(b1)]), vsmin));
+                // Probe texels (median, quartiles) against the 8 entries of 4 pairs at
+                // once, with select_indices' error expression.
+                for (int pr = 0; pr < 3 && _mm_movemask_ps(pass); ++pr) {
+                    const __m128 vs = _mm_set1_ps(probe[pr]);
+                    __m128 ok = _mm_setzero_ps();
+                    for (int i = 0; i < 8; ++i) {
+                        const __m128 lo = _mm_loadu_ps(&T.ent_lo[i][row + size_t(b1)]), hi = _mm_loadu_ps(&T.ent_hi[i][row + size_t(b1)]);
+                        const __m128 e = _mm_max_ps(_mm_max_ps(_mm_sub_ps(hi, vs), _mm_sub_ps(vs, lo)), _mm_setzero_ps());
+                        __m128 fits = _mm_cmple_ps(e, ve);
+                        if (os) fits = _mm_andnot_ps(_mm_cmpgt_ps(hi, vs), fits);
+                        ok = _mm_or_ps(ok, fits);
+                    }
+                    pass = _mm_and_ps(pass, ok);
+                }
                 int bits = _mm_movemask_ps(pass);
                 for (int j = 0; j < 4; ++j)
                     if (bits & (1 << j)) cand[n++] = uint8_t(b1 + j);
@@ -296,7 +313,9 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
         for (int l = qlo0; l <= qlo1; ++l) {
             int a = clampi(h), b = clampi(l);
             if (a > b) consider(a, b);  // 8 interpolated values
-            if (options_.quality != Quality::Fast || options_.one_sided_below)
+            // Fast skips the 6-value mode, except for flat blocks (a == b) where the
+            // 8-value mode has no pair (else they would fall to the exhaustive search).
+            if (options_.quality != Quality::Fast || options_.one_sided_below || a == b)
                 consider(std::min(a, b), std::max(a, b)); // 6 values plus exact extremes
         }
     const bool missed = best_k < 0 || (options_.max_error >= 0 && best.max_err > options_.max_error);
