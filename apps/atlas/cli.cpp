@@ -30,7 +30,7 @@ const std::vector<Command>& commands() {
         {"compress", "IN -o OUT.dds --format FORMAT [options]",
          "encode a field file (EXR, PNG, TGA, VDB, STEM.001.tga) as a DDS texture with a guaranteed error bound",
          {{"--out", "OUT.dds", "output texture (also -o); OUT.dds.json (the manifest) is written beside it"},
-          {"--format", "FORMAT", "bc1, bc1-scalar, bc4, bc4-snorm, bc6h, r8, r16, r16f, r32f, rgba8, rgba16f, rgba4"},
+          {"--format", "FORMAT", "bc1, bc1-scalar, bc4, bc4-snorm, bc6h, bc6h-sf16, r8, r16, r16f, r32f, rgba8, rgba16f, rgba4"},
           {"--quality", "LEVEL", "fast, normal (default) or best (bc4: exhaustive, provably optimal)"},
           {"--max-error", "E", "guarantee |decoded - source| <= E (source units) for every texel, or fail listing the blocks"},
           {"--one-sided", "below", "guarantee decoded <= source (SDFs for sphere tracing); mips are min-reduced"},

@@ -36,7 +36,7 @@ float parse_float(const std::string& text, const std::string& option) {
 
 compress::CompressOptions parse_compress_options(const Args& a, const Field3D& field) {
     compress::CompressOptions o;
-    if (!a.has("--format")) throw UsageError{"--format is required (bc1, bc1-scalar, bc4, bc4-snorm, bc6h, r8, r16, r16f, r32f, rgba8, rgba16f, rgba4)", "compress"};
+    if (!a.has("--format")) throw UsageError{"--format is required (" + compress::format_names() + ")", "compress"};
     o.format = compress::parse_format(a.get("--format"));
     if (a.has("--quality")) o.quality = compress::parse_quality(a.get("--quality").c_str());
     if (a.has("--max-error")) {
@@ -104,6 +104,9 @@ void print_verify(const compress::CompressReport& v) {
 int run_compress(const Args& a) {
     if (a.positional.size() != 1) throw UsageError{"expected one input file", "compress"};
     const std::string in = a.positional[0];
+    // Usage errors before the (possibly long) read of the input.
+    if (!a.has("--format")) throw UsageError{"--format is required (" + compress::format_names() + ")", "compress"};
+    if (!a.has("--sweep") && !a.has("--out")) throw UsageError{"-o OUT.dds is required", "compress"};
     const MemoryBudget budget(a.has("--memory-budget") ? parse_byte_size(a.get("--memory-budget")) : MemoryBudget::kDefaultLimit);
     Field3DPtr field = io::as_field3d(io::read_field_file(in, &budget));
     compress::CompressOptions o = parse_compress_options(a, *field);

@@ -3,6 +3,7 @@
 #include "atlas/graph/node.h"
 #include "atlas/graph/node_docs.h"
 #include "atlas/core/files.h"
+#include "atlas/compress/texture.h"
 
 #include <gtest/gtest.h>
 
@@ -87,6 +88,23 @@ TEST(Cli, UsageErrorsExitTwo) {
     EXPECT_NE(r.err.find("unknown option '--jbos' for 'atlas cook' (did you mean '--jobs'?)"), std::string::npos) << r.err;
     EXPECT_EQ(run("frobnicate").status, 2);
     EXPECT_EQ(run("cook").status, 2);
+}
+
+// The help text and the missing-format message name every format the library takes.
+TEST(Cli, CompressNamesEveryFormat) {
+    const std::string names = atlas::compress::format_names();
+    CliRun help = run("compress --help");
+    CliRun missing = run("compress in.exr -o out.dds");
+    EXPECT_EQ(missing.status, 2);
+    size_t start = 0;
+    while (start < names.size()) {
+        size_t end = names.find(", ", start);
+        if (end == std::string::npos) end = names.size();
+        const std::string name = names.substr(start, end - start);
+        EXPECT_NE((help.out + help.err).find(name), std::string::npos) << "help lacks " << name;
+        EXPECT_NE(missing.err.find(name), std::string::npos) << "message lacks " << name;
+        start = end + 2;
+    }
 }
 
 TEST(Cli, MissingGraphFileIsNamed) {

@@ -34,12 +34,16 @@ const char* format_name(Format f) {
     return "?";
 }
 
+std::string format_names() {
+    std::string list;
+    for (const auto& r : kFormats) list += std::string(list.empty() ? "" : ", ") + r.name;
+    return list;
+}
+
 Format parse_format(const std::string& name) {
     for (const auto& r : kFormats)
         if (name == r.name) return r.format;
-    std::string list;
-    for (const auto& r : kFormats) list += std::string(list.empty() ? "" : ", ") + r.name;
-    throw Error("unknown texture format '" + name + "' (expected one of: " + list + ")");
+    throw Error("unknown texture format '" + name + "' (expected one of: " + format_names() + ")");
 }
 
 DxgiFormat dxgi_format(Format f) {

@@ -39,6 +39,7 @@ enum class Format {
 // "r32f", "rgba8", "rgba16f", "rgba4".
 const char* format_name(Format f);
 Format parse_format(const std::string& name); // throws atlas::Error listing the names
+std::string format_names();                   // "bc1, bc1-scalar, ...": every name parse_format takes
 DxgiFormat dxgi_format(Format f);
 
 struct CompressOptions {
