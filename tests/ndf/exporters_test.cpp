@@ -286,3 +286,61 @@ TEST(NdfGraphs, EngineTexturesAreLinearPngs) {
     }
     fs::remove_all(out);
 }
+
+TEST(Exporters, ExtremeInputsStayFiniteAndInRange) {
+    auto all_in_unit = [](const Field2D& f) {
+        for (int c = 0; c < f.channels(); ++c)
+            for (float v : f.channel(c))
+                if (!(v >= 0.0f && v <= 1.0f)) return false;
+        return true;
+    };
+    // 1 m and 1000 km maps, NaN and infinite values in the set.
+    for (double extent : {1.0, 1e6}) {
+        const Box2d box{{{-extent, -extent}}, {{extent, extent}}};
+        Field2D s = random_set({{9, 7}}, box);
+        s.at(Coverage, 2, 2) = std::numeric_limits<float>::quiet_NaN();
+        s.at(Type, 3, 3) = std::numeric_limits<float>::infinity();
+        s.at(MinHeight, 4, 4) = -std::numeric_limits<float>::infinity();
+        const Field2D u = unreal_weather_map(s, {0, 1e4}, nullptr);
+        for (int c : {2, 3})
+            for (float v : u.channel(c)) ASSERT_TRUE(v >= 0.0f && v <= 1.0f);
+        for (double altitude : {1e-3, 1.0, 1e9})
+            for (bool tile : {false, true}) {
+                UnityCloudLayerOptions o;
+                o.resolution = {{32, 16}};
+                o.altitude = altitude;
+                o.eye = {{1e12, -1e12}}; // far outside the map
+                o.tileable = tile;
+                const Field2D clean = random_set({{9, 7}}, box); // channels in [0, 1] (its one NaN is a height)
+                ASSERT_TRUE(all_in_unit(unity_cloud_layer(clean, &clean, 0, &clean, 7, o, nullptr)));
+                const Field2D sky = unity_cloud_layer(s, &s, 0, &s, 7, o, nullptr); // NaN coverage: NaN may spread, never Inf
+                for (int c = 0; c < 4; ++c)
+                    for (float v : sky.channel(c)) ASSERT_FALSE(std::isinf(v)) << c;
+            }
+    }
+    // A 1 x 1 set seen from its centre.
+    const Field2D one = random_set({{1, 1}}, {{{0, 0}}, {{1, 1}}});
+    UnityCloudLayerOptions o1;
+    o1.resolution = {{1, 1}};
+    o1.eye = {{0.5, 0.5}};
+    EXPECT_NO_THROW(unity_cloud_layer(one, nullptr, 0, nullptr, 0, o1, nullptr));
+    // A profile with no density anywhere: density 0, erosion 1, ambient 1 (nothing above occludes).
+    VerticalProfile empty;
+    for (auto& g : empty.types) g = {1, 1, 1, 1};
+    UnityCloudLutOptions small;
+    small.types = 2;
+    small.heights = 2;
+    const Field2D lut = unity_cloud_lut(empty, small, nullptr);
+    EXPECT_TRUE(all_in_unit(lut));
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+            EXPECT_EQ(lut.at(0, i, j), 0.0f);
+            EXPECT_EQ(lut.at(1, i, j), 1.0f);
+            EXPECT_EQ(lut.at(2, i, j), 1.0f);
+        }
+    UnityCloudLutOptions tall;
+    tall.types = 4;
+    tall.heights = 8192;
+    const Field2D big = unity_cloud_lut(VerticalProfile{}, tall, nullptr);
+    EXPECT_TRUE(all_in_unit(big));
+}
