@@ -24,6 +24,7 @@ GridSpec slab(int n) {
 
 // Uniform translation: the back-trace point is known exactly (p - v dt), so the
 // source cells and their min/max are computed here independently of the code.
+// Both limited schemes (MacCormack and the limited cubic) are checked.
 TEST(SimAdvection, LimitedMacCormackStaysWithinSourceCellsMinMax) {
     GridSpec s;
     s.nx = s.ny = s.nz = 16;
@@ -36,8 +37,9 @@ TEST(SimAdvection, LimitedMacCormackStaysWithinSourceCellsMinMax) {
     std::vector<float> q(l.size()), out(l.size());
     for (size_t n = 0; n < q.size(); ++n) q[n] = hash_to_unit(hash_coords(9, int32_t(n))) > 0.5f ? 1.f : 0.f; // rough field
     const double dt = 1.7;
-    advect(vel, l, q, out, dt, AdvectionScheme::MacCormack);
     int checked = 0;
+    for (AdvectionScheme scheme : {AdvectionScheme::MacCormack, AdvectionScheme::CubicLimited}) {
+    advect(vel, l, q, out, dt, scheme);
     for (int k = 0; k < 16; ++k)
         for (int j = 0; j < 16; ++j)
             for (int i = 0; i < 16; ++i) {
@@ -54,11 +56,12 @@ TEST(SimAdvection, LimitedMacCormackStaysWithinSourceCellsMinMax) {
                     hi = std::max(hi, v);
                 }
                 float o = out[(size_t(k) * 16 + j) * 16 + i];
-                EXPECT_GE(o, lo);
-                EXPECT_LE(o, hi);
+                EXPECT_GE(o, lo) << int(scheme) << " at " << i << " " << j << " " << k;
+                EXPECT_LE(o, hi) << int(scheme) << " at " << i << " " << j << " " << k;
                 ++checked;
             }
-    EXPECT_EQ(checked, 4096);
+    }
+    EXPECT_EQ(checked, 2 * 4096);
 }
 
 // Zalesak's slotted disk rotated once around the domain centre. Reports the L1
@@ -81,11 +84,13 @@ TEST(SimAdvection, ZalesakDiskErrorPerScheme) {
             bool slot = std::fabs(x - 32) < 2 && z < 52;
             q0[size_t(k) * n + i] = (in && !slot) ? 1.f : 0.f;
         }
-    double err[2];
-    for (int sc = 0; sc < 2; ++sc) {
+    double err[3];
+    const AdvectionScheme schemes[3] = {AdvectionScheme::SemiLagrangian, AdvectionScheme::MacCormack,
+                                        AdvectionScheme::CubicLimited};
+    for (int sc = 0; sc < 3; ++sc) {
         std::vector<float> q = q0, tmp(q.size());
         for (int step = 0; step < 200; ++step) {
-            advect(vel, l, q, tmp, 2.0, sc ? AdvectionScheme::MacCormack : AdvectionScheme::SemiLagrangian);
+            advect(vel, l, q, tmp, 2.0, schemes[sc]);
             q.swap(tmp);
         }
         double e = 0;
@@ -96,8 +101,10 @@ TEST(SimAdvection, ZalesakDiskErrorPerScheme) {
         }
         err[sc] = e / q.size();
     }
-    std::printf("[sim] Zalesak 64^2, 1 turn, 200 steps (CFL 1): L1 error SL %.4f, MacCormack %.4f\n", err[0], err[1]);
+    std::printf("[sim] Zalesak 64^2, 1 turn, 200 steps (CFL 1): L1 error SL %.4f, MacCormack %.4f, cubic limited %.4f\n",
+                err[0], err[1], err[2]);
     EXPECT_LT(err[1], 0.8 * err[0]);
+    EXPECT_LT(err[2], 0.8 * err[0]);
 }
 
 TEST(SimAdvection, RejectsBadSizesAndDt) {

@@ -40,9 +40,14 @@ inline Corners corners(const Lattice& l, const double p[3]) {
             continue;
         }
         double x = p[a] - l.offset[a];
-        x = x < 0 ? 0 : (x > n - 1 ? n - 1 : x);
-        int i = int(x);
-        if (i > n - 2) i = n - 2;
+        x = x < 0 ? 0 : x;
+        if (x >= n - 1) { // clamped at the upper edge: the last sample alone (no zero-weight neighbour)
+            c.f[a] = 0;
+            c.step[a] = 0;
+            c.base += size_t(n - 1) * stride[a];
+            continue;
+        }
+        const int i = int(x);
         c.f[a] = x - i;
         c.step[a] = stride[a];
         c.base += size_t(i) * stride[a];
@@ -75,6 +80,52 @@ inline void minmax_at(const float* q, const Corners& c, float& lo, float& hi) {
         lo = std::min(lo, b[o[k]]);
         hi = std::max(hi, b[o[k]]);
     }
+}
+
+// Catmull-Rom weights for samples i-1, i, i+1, i+2 at fraction t.
+inline void catmull_rom(double t, double w[4]) {
+    const double t2 = t * t, t3 = t2 * t;
+    w[0] = 0.5 * (-t3 + 2 * t2 - t);
+    w[1] = 0.5 * (3 * t3 - 5 * t2 + 2);
+    w[2] = 0.5 * (-3 * t3 + 4 * t2 + t);
+    w[3] = 0.5 * (t3 - t2);
+}
+
+// Tricubic Catmull-Rom read of q at p (edge indices clamped), limited to the
+// min/max of the 8 trilinear corners. Axes with one sample are skipped.
+float cubic_limited_at(const Lattice& l, const float* q, const double p[3]) {
+    int idx[3][4];
+    double w[3][4];
+    int cnt[3];
+    for (int a = 0; a < 3; ++a) {
+        const int n = l.n[a];
+        if (n <= 1) {
+            cnt[a] = 1, idx[a][0] = 0, w[a][0] = 1;
+            continue;
+        }
+        double x = p[a] - l.offset[a];
+        x = x < 0 ? 0 : (x > n - 1 ? n - 1 : x);
+        int i = int(x);
+        if (i > n - 2) i = n - 2;
+        catmull_rom(x - i, w[a]);
+        cnt[a] = 4;
+        for (int m = 0; m < 4; ++m) idx[a][m] = std::clamp(i - 1 + m, 0, n - 1);
+    }
+    const size_t sy = size_t(l.n[0]), sz = size_t(l.n[0]) * size_t(l.n[1]);
+    double v = 0;
+    for (int c = 0; c < cnt[2]; ++c) {
+        double vy = 0;
+        for (int b = 0; b < cnt[1]; ++b) {
+            const float* r = q + size_t(idx[2][c]) * sz + size_t(idx[1][b]) * sy;
+            double vx = 0;
+            for (int a = 0; a < cnt[0]; ++a) vx += w[0][a] * double(r[idx[0][a]]);
+            vy += w[1][b] * vx;
+        }
+        v += w[2][c] * vy;
+    }
+    float lo, hi;
+    minmax_at(q, corners(l, p), lo, hi);
+    return std::clamp(float(v), lo, hi);
 }
 
 // True when p lies within one cell of a domain edge along an axis with more than one cell.
@@ -168,6 +219,7 @@ void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::
     // MacCormack, for the limiter); the backward trace likewise. The scratch
     // keeps its capacity between calls (no per-step allocation).
     const bool mac = scheme == AdvectionScheme::MacCormack;
+    const bool cubic = scheme == AdvectionScheme::CubicLimited;
     std::vector<float>& fwd_pos = scratch.forward;
     std::vector<float>& back_pos = scratch.backward;
     fwd_pos.resize(l.size() * 3);
@@ -193,7 +245,7 @@ void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::
             for_lattice(l, [&](size_t id, const double p[3]) {
                 double src[3];
                 pos(fwd_pos, id, p, src);
-                out[id] = float(lerp_at(q.data(), corners(l, src)));
+                out[id] = cubic ? cubic_limited_at(l, q.data(), src) : float(lerp_at(q.data(), corners(l, src)));
             });
             continue;
         }
