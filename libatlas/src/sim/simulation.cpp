@@ -189,7 +189,8 @@ void SimOptions::validate(int nz) const {
 }
 
 uint64_t simulation_bytes(const GridSpec& spec, const SimOptions& options) {
-    return simulation_bytes(spec) + (options.rain ? uint64_t(spec.cells()) * kSimRainBytesPerCell : 0);
+    return simulation_bytes(spec) + (options.rain ? uint64_t(spec.cells()) * kSimRainBytesPerCell : 0) +
+           (options.advection_reflection ? uint64_t(spec.cells()) * kSimReflectionBytesPerCell : 0);
 }
 
 std::string StepReport::to_json() const {
@@ -214,9 +215,9 @@ std::string StepReport::to_json() const {
 static GridSpec checked(const GridSpec& s, const SimOptions& o, const MemoryBudget* budget) {
     s.validate();
     if (budget)
-        budget->check(simulation_bytes(s, o), "sim: simulation state (" +
-                                                  std::to_string(kSimBytesPerCell + (o.rain ? kSimRainBytesPerCell : 0)) +
-                                                  " B/cell)");
+        budget->check(simulation_bytes(s, o),
+                      "sim: simulation state (" + std::to_string(simulation_bytes(s, o) / std::max<uint64_t>(s.cells(), 1)) +
+                          " B/cell)");
     return s;
 }
 
@@ -230,6 +231,7 @@ Simulation::Simulation(const GridSpec& spec, const Sounding& sounding, const Sim
     qv_.resize(n);
     qc_.assign(n, 0.f);
     if (opt_.rain) qr_.assign(n, 0.f);
+    if (opt_.advection_reflection) vel_third_ = MacVelocity(spec);
     tmp_.resize(n);
     heat_src_.assign(n, 0.f);
     vap_src_.assign(n, 0.f);
@@ -441,6 +443,27 @@ void Simulation::substep(double dt, StepReport& rep) {
     auto t0 = Clock::now();
     // 1. Advection of scalars by the old velocity, then of the velocity itself.
     Lattice cl = cell_lattice(spec_);
+    const bool reflect = opt_.advection_reflection;
+    if (reflect) {
+        // Advection-reflection (Zehnder, Narain & Thomaszewski 2018): half a step
+        // of advection and buoyancy, projected to u_half; the projection's
+        // removed part is reflected (2 u_half - u~) and advected by u_half for the
+        // second half, which keeps the kinetic energy the plain split loses.
+        advect_velocity(vel_, vel_tmp_, 0.5 * dt, opt_.scheme, *scratch_);
+        std::swap(vel_, vel_tmp_);
+        buoyancy(0.5 * dt);
+        vel_tmp_ = vel_; // u~ before the projection
+        ProjectionReport pr = solver_.project(vel_, opt_.projection);
+        rep.pressure_iterations += pr.iterations;
+        rep.max_pressure_iterations = std::max(rep.max_pressure_iterations, pr.iterations);
+        rep.pressure_converged = rep.pressure_converged && pr.converged;
+        auto refl = [](std::vector<float>& r, const std::vector<float>& half) {
+            for (size_t n = 0; n < r.size(); ++n) r[n] = 2 * half[n] - r[n];
+        };
+        refl(vel_tmp_.u, vel_.u);
+        refl(vel_tmp_.v, vel_.v);
+        refl(vel_tmp_.w, vel_.w);
+    }
     // Reversible mode: theta_e (conserved by reversible moist adiabatic motion)
     // is what gets advected; theta is recovered afterwards at the new level.
     if (opt_.reversible_theta_e && opt_.moist) {
@@ -471,8 +494,23 @@ void Simulation::substep(double dt, StepReport& rep) {
                 theta_[c] = float(temperature_from_theta_e(theta_[c], p, qv_[c], double(qv_[c]) + qc_[c]) / pi);
         });
     }
-    advect_velocity(vel_, vel_tmp_, dt, opt_.scheme, *scratch_);
-    std::swap(vel_, vel_tmp_);
+    if (!reflect) {
+        advect_velocity(vel_, vel_tmp_, dt, opt_.scheme, *scratch_);
+        std::swap(vel_, vel_tmp_);
+    } else {
+        // Second half: the reflected field (vel_tmp_) advected by u_half (vel_).
+        const GridSpec& g = spec_;
+        auto one = [&](const Lattice& l, const std::vector<float>& q, std::vector<float>& o) {
+            std::span<const float> qs[1] = {q};
+            std::span<float> os[1] = {o};
+            advect_many(vel_, l, qs, os, 0.5 * dt, opt_.scheme, *scratch_);
+        };
+        if (g.nx > 1) one(u_lattice(g), vel_tmp_.u, vel_third_.u);
+        if (g.ny > 1) one(v_lattice(g), vel_tmp_.v, vel_third_.v);
+        if (g.nz > 1) one(w_lattice(g), vel_tmp_.w, vel_third_.w);
+        vel_third_.enforce_walls();
+        std::swap(vel_, vel_third_);
+    }
     rep.seconds_advect += seconds_since(t0);
     // 2. Sources.
     t0 = Clock::now();
@@ -533,7 +571,7 @@ void Simulation::substep(double dt, StepReport& rep) {
     }
     // 4. Forces.
     t0 = Clock::now();
-    buoyancy(dt);
+    buoyancy(reflect ? 0.5 * dt : dt);
     if (opt_.vorticity_confinement > 0) confinement(dt);
     if (opt_.viscosity > 0 || opt_.diffusivity > 0) diffuse(dt);
     rep.seconds_forces += seconds_since(t0);
