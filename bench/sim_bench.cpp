@@ -67,7 +67,8 @@ void BM_CumulusStep_256(benchmark::State& state) { CumulusStep(state, 256); }
 
 // Bryan & Fritsch (2002) dry: 20 km x 10 km, free-slip walls, 2 K cos^2
 // bubble (r = 2 km, z = 2 km) in a neutral theta0 = 300 K atmosphere, to 1000 s.
-void BryanFritschDry(benchmark::State& state, double dx, AdvectionScheme scheme, bool anelastic = true, double step = 5.0) {
+void BryanFritschDry(benchmark::State& state, double dx, AdvectionScheme scheme, bool anelastic = true, double step = 5.0,
+                     bool reflection = false) {
     GridSpec s;
     s.nx = int(std::lround(20000 / dx));
     s.ny = 1;
@@ -78,6 +79,7 @@ void BryanFritschDry(benchmark::State& state, double dx, AdvectionScheme scheme,
     o.scheme = scheme;
     o.anelastic = anelastic;
     o.max_substeps = 1000;
+    o.advection_reflection = reflection;
     StepReport r;
     int steps = 0;
     for (auto _ : state) {
@@ -101,6 +103,9 @@ void BM_BryanFritschDry_100m_Boussinesq(benchmark::State& state) { BryanFritschD
 void BM_BryanFritschDry_200m_Boussinesq(benchmark::State& state) { BryanFritschDry(state, 200, AdvectionScheme::MacCormack, false); }
 void BM_BryanFritschDry_100m_dt1(benchmark::State& state) { BryanFritschDry(state, 100, AdvectionScheme::MacCormack, true, 1.0); }
 void BM_BryanFritschDry_100m_Boussinesq_dt1(benchmark::State& state) { BryanFritschDry(state, 100, AdvectionScheme::MacCormack, false, 1.0); }
+void BM_BryanFritschDry_100m_Reflection(benchmark::State& state) { BryanFritschDry(state, 100, AdvectionScheme::MacCormack, true, 5.0, true); }
+void BM_BryanFritschDry_200m_Reflection(benchmark::State& state) { BryanFritschDry(state, 200, AdvectionScheme::MacCormack, true, 5.0, true); }
+void BM_BryanFritschDry_100m_Cubic(benchmark::State& state) { BryanFritschDry(state, 100, AdvectionScheme::CubicLimited); }
 void BM_BryanFritschDry_50m(benchmark::State& state) { BryanFritschDry(state, 50, AdvectionScheme::MacCormack, true, 2.5); }
 
 // Bryan & Fritsch (2002) moist: saturated moist-neutral atmosphere with
@@ -112,7 +117,8 @@ void BM_BryanFritschDry_50m(benchmark::State& state) { BryanFritschDry(state, 50
 // the initial buoyancy equals the dry case's (theta_e' is then ~3.9 K, not 2 K).
 // reversible = true: B&F's own thermodynamics (SimOptions::reversible_theta_e,
 // Sounding::theta_e = 320 K), the bubble found on the saturated branch by T.
-void BryanFritschMoist(benchmark::State& state, double dx, double step = 5.0, bool reversible = false) {
+void BryanFritschMoist(benchmark::State& state, double dx, double step = 5.0, bool reversible = false,
+                       bool reflection = false) {
     const double qt = 0.020;
     auto theta_e_at = [&](double thl, double p) {
         AdjustResult a = saturation_adjust(thl, qt, 0, p);
@@ -137,6 +143,7 @@ void BryanFritschMoist(benchmark::State& state, double dx, double step = 5.0, bo
         snd.theta_e = 320;
         o.reversible_theta_e = true;
     }
+    o.advection_reflection = reflection;
     StepReport r;
     double max_the = 0;
     for (auto _ : state) {
@@ -197,6 +204,8 @@ void BM_BryanFritschMoist_100m_dt1(benchmark::State& state) { BryanFritschMoist(
 void BM_BryanFritschMoistReversible_100m(benchmark::State& state) { BryanFritschMoist(state, 100, 5.0, true); }
 void BM_BryanFritschMoistReversible_100m_dt1(benchmark::State& state) { BryanFritschMoist(state, 100, 1.0, true); }
 void BM_BryanFritschMoistReversible_200m(benchmark::State& state) { BryanFritschMoist(state, 200, 5.0, true); }
+void BM_BryanFritschMoistReversible_100m_Reflection(benchmark::State& state) { BryanFritschMoist(state, 100, 5.0, true, true); }
+void BM_BryanFritschMoist_100m_Reflection(benchmark::State& state) { BryanFritschMoist(state, 100, 5.0, false, true); }
 
 // Robert (1993) dry rising thermal: 1000 m x 1000 m slab, theta0 = 300 K
 // neutral, 0.5 K bubble of radius 250 m with a Gaussian edge (e-folding 100 m)
@@ -248,6 +257,8 @@ BENCHMARK(BM_BryanFritschMoist_100m_dt1)->Unit(benchmark::kMillisecond)->Iterati
 BENCHMARK(BM_BryanFritschMoistReversible_100m)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschMoistReversible_100m_dt1)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschMoistReversible_200m)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BryanFritschMoistReversible_100m_Reflection)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BryanFritschMoist_100m_Reflection)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_CumulusStep_Smoke)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CumulusStep_64)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_CumulusStep_128)->Unit(benchmark::kMillisecond)->Iterations(2);
@@ -259,6 +270,9 @@ BENCHMARK(BM_BryanFritschDry_100m_Boussinesq)->Unit(benchmark::kMillisecond)->It
 BENCHMARK(BM_BryanFritschDry_200m_Boussinesq)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschDry_100m_dt1)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschDry_100m_Boussinesq_dt1)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BryanFritschDry_100m_Reflection)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BryanFritschDry_200m_Reflection)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BryanFritschDry_100m_Cubic)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BryanFritschDry_50m)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_MAIN();
