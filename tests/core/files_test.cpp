@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <thread>
+
+#include <sys/stat.h>
 
 using namespace atlas;
 
@@ -81,4 +84,23 @@ TEST(ReadFile, NamesTheMissingFile) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/f.yaml"), std::string::npos);
     }
+}
+
+// Regular files are read with one sized read, binary-exact (NUL and high bytes);
+// pipes (no size) fall back to streaming.
+TEST(ReadFile, ReadsBinaryFilesAndPipes) {
+    const fs::path d = temp_dir("read");
+    std::string bytes(100000, '\0');
+    for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = char((i * 131) & 0xff);
+    std::ofstream(d / "bin", std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    EXPECT_EQ(read_file_bytes(d / "bin"), bytes);
+    write(d / "empty", "");
+    EXPECT_EQ(read_file_bytes(d / "empty"), "");
+
+    const fs::path fifo = d / "fifo";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    std::thread writer([&] { std::ofstream(fifo, std::ios::binary) << "through a pipe"; });
+    const std::string got = read_file_bytes(fifo);
+    writer.join();
+    EXPECT_EQ(got, "through a pipe");
 }

@@ -155,6 +155,30 @@ TEST_F(Fixture, CorruptDiskCacheEntryIsAMissNotAnError) {
     EXPECT_EQ(r.nodes.at("gate").status, "cooked");
 }
 
+// Entries are streamed from disk with every length checked against the file's
+// size: an entry cut anywhere (a crash mid-write by another tool, a full disk)
+// is a miss, and the node cooks again with the same result.
+TEST_F(Fixture, TruncatedDiskCacheEntryIsAMiss) {
+    CookOptions o = options();
+    o.cache_dir = dir / "cache";
+    {
+        Session s = session();
+        s.cook(o);
+    }
+    std::vector<std::pair<fs::path, std::string>> entries;
+    for (const auto& e : fs::directory_iterator(dir / "cache")) entries.push_back({e.path(), read_file_bytes(e.path())});
+    ASSERT_FALSE(entries.empty());
+    for (double cut : {0.0, 0.001, 0.25, 0.5, 0.999}) {
+        for (const auto& [path, bytes] : entries) {
+            std::ofstream f(path, std::ios::binary | std::ios::trunc);
+            f.write(bytes.data(), std::streamsize(double(bytes.size()) * cut));
+        }
+        Session s2 = session();
+        CookResult r = s2.cook(o);
+        EXPECT_EQ(r.nodes.at("gate").status, "cooked") << "cut at " << cut;
+    }
+}
+
 TEST_F(Fixture, CheckedModeCatchesAnIncompleteHash) {
     const char* g = "atlas: 1\nnodes:\n  l:\n    type: test/leaky\noutputs:\n  - {node: l, file: l.exr}\n";
     Session s = session(g);

@@ -99,10 +99,22 @@ fs::path resolve_output_path(const fs::path& out_dir, const std::string& relativ
 std::string read_file_bytes(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path.string() + ": cannot open file for reading");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) throw Error(path.string() + ": read error");
-    return ss.str();
+    in.seekg(0, std::ios::end);
+    // One allocation of the file's size and one read (cache entries reach
+    // hundreds of MB; a stringstream would copy them twice).
+    const std::streamoff size = in.tellg();
+    if (size < 0) { // a pipe or device (e.g. /dev/stdin): no size, read it as a stream
+        in.clear();
+        std::ostringstream ss;
+        ss << in.rdbuf();
+        if (in.bad()) throw Error(path.string() + ": read error");
+        return ss.str();
+    }
+    std::string bytes(size_t(size), '\0');
+    in.seekg(0);
+    in.read(bytes.data(), size);
+    if (in.gcount() != size) throw Error(path.string() + ": read error (file shorter than its size)");
+    return bytes;
 }
 
 } // namespace atlas

@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <sstream>
 
 namespace atlas {
 
@@ -30,21 +31,26 @@ constexpr size_t kMagicSize = sizeof(kMagic) - 1;
 // Values are stored with fixed-width little-endian integers and raw floats;
 // Atlas only targets little-endian machines (x86-64, arm64).
 
+// Both sides stream: a cached NVDF set is hundreds of MB, and a whole-file
+// string in between would double the memory and the page faults.
 struct Writer {
-    std::string out;
-    void u64(uint64_t v) { out.append(reinterpret_cast<const char*>(&v), 8); }
-    void f64(double v) { out.append(reinterpret_cast<const char*>(&v), 8); }
-    void str(const std::string& s) { u64(s.size()); out += s; }
-    void raw(const void* p, size_t n) { u64(n); out.append(static_cast<const char*>(p), n); }
+    std::ostream& out;
+    void bytes(const void* p, size_t n) { out.write(static_cast<const char*>(p), std::streamsize(n)); }
+    void u64(uint64_t v) { bytes(&v, 8); }
+    void f64(double v) { bytes(&v, 8); }
+    void str(const std::string& s) { u64(s.size()); bytes(s.data(), s.size()); }
+    void raw(const void* p, size_t n) { u64(n); bytes(p, n); }
 };
 
 struct Reader {
-    const std::string& in;
-    size_t pos = 0;
+    std::istream& in;
+    uint64_t size; // bytes in the entry: every length is checked against what is left
+    uint64_t pos = 0;
     bool ok = true;
     bool take(void* dst, size_t n) {
-        if (!ok || in.size() - pos < n) return ok = false;
-        std::memcpy(dst, in.data() + pos, n);
+        if (!ok || size - pos < n) return ok = false;
+        in.read(static_cast<char*>(dst), std::streamsize(n));
+        if (uint64_t(in.gcount()) != n) return ok = false;
         pos += n;
         return true;
     }
@@ -52,15 +58,15 @@ struct Reader {
     double f64() { double v = 0; take(&v, 8); return v; }
     std::string str() {
         uint64_t n = u64();
-        if (!ok || n > in.size() - pos) { ok = false; return {}; }
-        std::string s = in.substr(pos, n);
-        pos += n;
+        if (!ok || n > size - pos) { ok = false; return {}; }
+        std::string s(n, '\0');
+        take(s.data(), n);
         return s;
     }
     template <typename T>
     void vec(std::vector<T>& v) {
         uint64_t n = u64();
-        if (!ok || n % sizeof(T) != 0 || n > in.size() - pos) { ok = false; return; }
+        if (!ok || n % sizeof(T) != 0 || n > size - pos) { ok = false; return; }
         v.resize(n / sizeof(T));
         take(v.data(), n);
     }
@@ -74,24 +80,23 @@ void write_storage(Writer& w, const detail::FieldStorage& f) {
     }
 }
 
+// Channel data goes straight from the file's bytes into the field (a cached
+// NVDF set is hundreds of MB; no intermediate copy).
 bool read_storage(Reader& r, detail::FieldStorage& f, int channels) {
     std::vector<std::string> names;
     for (int c = 0; c < channels && r.ok; ++c) {
         names.push_back(r.str());
-        std::vector<float> data;
-        r.vec(data);
-        if (!r.ok || data.size() != f.channel(c).size()) return false;
-        std::memcpy(f.channel(c).data(), data.data(), data.size() * sizeof(float));
+        const uint64_t n = r.u64();
+        if (!r.ok || n != f.channel(c).size_bytes() || !r.take(f.channel(c).data(), n)) return false;
     }
     if (!r.ok) return false;
     f.set_channel_names(names);
     return true;
 }
-} // namespace
 
-std::string serialize(const NodeOutputs& outputs) {
-    Writer w;
-    w.out.append(kMagic, kMagicSize);
+void serialize_to(std::ostream& out, const NodeOutputs& outputs) {
+    Writer w{out};
+    w.bytes(kMagic, kMagicSize);
     w.u64(outputs.size());
     for (const auto& [port, v] : outputs) {
         w.str(port);
@@ -113,16 +118,16 @@ std::string serialize(const NodeOutputs& outputs) {
             for (const auto& [name, vals] : (*p)->attributes) { w.str(name); w.raw(vals.data(), vals.size() * sizeof(float)); }
         }
     }
-    return std::move(w.out);
 }
 
-std::optional<NodeOutputs> deserialize(const std::string& bytes, std::string* why_not) {
+std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std::string* why_not) {
     auto fail = [&](const char* why) -> std::optional<NodeOutputs> {
         if (why_not) *why_not = why;
         return std::nullopt;
     };
-    if (bytes.size() < kMagicSize || bytes.compare(0, kMagicSize, kMagic, kMagicSize) != 0) return fail("not an Atlas cache file of this version");
-    Reader r{bytes, kMagicSize};
+    Reader r{in, size};
+    char magic[kMagicSize];
+    if (!r.take(magic, kMagicSize) || std::memcmp(magic, kMagic, kMagicSize) != 0) return fail("not an Atlas cache file of this version");
     NodeOutputs out;
     uint64_t n = r.u64();
     if (n > 1024) return fail("corrupt header");
@@ -135,7 +140,7 @@ std::optional<NodeOutputs> deserialize(const std::string& bytes, std::string* wh
                 Box2d b;
                 for (int k = 0; k < 2; ++k) { b.min[k] = r.f64(); b.max[k] = r.f64(); }
                 uint64_t ch = r.u64();
-                if (!r.ok || ch == 0 || ch > 64 || uint64_t(res[0]) * uint64_t(res[1]) * ch * 4 > bytes.size()) return fail("corrupt field");
+                if (!r.ok || ch == 0 || ch > 64 || uint64_t(res[0]) * uint64_t(res[1]) * ch * 4 > size) return fail("corrupt field");
                 auto f = std::make_shared<Field2D>(res, int(ch), b);
                 if (!read_storage(r, *f, int(ch))) return fail("truncated field");
                 out[port] = Field2DPtr(f);
@@ -144,7 +149,7 @@ std::optional<NodeOutputs> deserialize(const std::string& bytes, std::string* wh
                 Box3d b;
                 for (int k = 0; k < 3; ++k) { b.min[k] = r.f64(); b.max[k] = r.f64(); }
                 uint64_t ch = r.u64();
-                if (!r.ok || ch == 0 || ch > 64 || uint64_t(res[0]) * uint64_t(res[1]) * uint64_t(res[2]) * ch * 4 > bytes.size())
+                if (!r.ok || ch == 0 || ch > 64 || uint64_t(res[0]) * uint64_t(res[1]) * uint64_t(res[2]) * ch * 4 > size)
                     return fail("corrupt field");
                 auto f = std::make_shared<Field3D>(res, int(ch), b);
                 if (!read_storage(r, *f, int(ch))) return fail("truncated field");
@@ -172,8 +177,20 @@ std::optional<NodeOutputs> deserialize(const std::string& bytes, std::string* wh
         return fail("corrupt value");
     }
     if (!r.ok) return fail("truncated");
-    if (r.pos != bytes.size()) return fail("trailing bytes");
+    if (r.pos != size) return fail("trailing bytes");
     return out;
+}
+} // namespace
+
+std::string serialize(const NodeOutputs& outputs) {
+    std::ostringstream out;
+    serialize_to(out, outputs);
+    return std::move(out).str();
+}
+
+std::optional<NodeOutputs> deserialize(const std::string& bytes, std::string* why_not) {
+    std::istringstream in(bytes);
+    return deserialize_from(in, bytes.size(), why_not);
 }
 
 std::filesystem::path entry_path(const std::filesystem::path& dir, const Hash128& h) { return dir / (h.hex() + ".atlascache"); }
@@ -184,21 +201,21 @@ bool contains(const std::filesystem::path& dir, const Hash128& h) {
 }
 
 std::optional<NodeOutputs> load(const std::filesystem::path& dir, const Hash128& h, std::string* why_not) {
-    std::string bytes;
-    try {
-        bytes = read_file_bytes(entry_path(dir, h));
-    } catch (const Error& e) {
-        if (why_not) *why_not = e.what();
+    const std::filesystem::path path = entry_path(dir, h);
+    std::error_code ec;
+    const uint64_t size = std::filesystem::file_size(path, ec);
+    std::ifstream in(path, std::ios::binary);
+    if (ec || !in) {
+        if (why_not) *why_not = path.string() + ": cannot open cache entry";
         return std::nullopt;
     }
-    return deserialize(bytes, why_not);
+    return deserialize_from(in, size, why_not);
 }
 
 void store(const std::filesystem::path& dir, const Hash128& h, const NodeOutputs& outputs) {
-    std::string bytes = serialize(outputs);
     write_file_atomic(entry_path(dir, h), [&](const std::filesystem::path& tmp) {
         std::ofstream f(tmp, std::ios::binary);
-        f.write(bytes.data(), std::streamsize(bytes.size()));
+        serialize_to(f, outputs);
         f.close();
         if (!f) throw Error(tmp.string() + ": cannot write cache entry (disk full?)");
     });
