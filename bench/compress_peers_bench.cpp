@@ -238,12 +238,13 @@ int write_inputs(const std::string& dir) {
     int k = 0;
     for (const Image& im : images()) {
         const std::string base = dir + "/input" + std::to_string(k++);
-        std::vector<uint8_t> grey(size_t(im.w) * size_t(im.h) * 3);
-        for (size_t i = 0; i < size_t(im.w) * size_t(im.h); ++i) grey[3 * i] = grey[3 * i + 1] = grey[3 * i + 2] = im.grey(i);
+        // Grey images carry the value in alpha too: nvcompress 2.0's -bc4 encodes alpha.
+        std::vector<uint8_t> grey(size_t(im.w) * size_t(im.h) * 4);
+        for (size_t i = 0; i < size_t(im.w) * size_t(im.h); ++i) grey[4 * i] = grey[4 * i + 1] = grey[4 * i + 2] = grey[4 * i + 3] = im.grey(i);
         for (int g = 0; g < 2; ++g) {
             const std::string path = base + (g ? "_grey.png" : "_rgb.png");
             auto out = OIIO::ImageOutput::create(path);
-            OIIO::ImageSpec spec(im.w, im.h, 3, OIIO::TypeDesc::UINT8);
+            OIIO::ImageSpec spec(im.w, im.h, g ? 4 : 3, OIIO::TypeDesc::UINT8);
             if (!out || !out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, g ? grey.data() : im.rgb.data())) {
                 std::fprintf(stderr, "cannot write %s\n", path.c_str());
                 return 1;
@@ -263,11 +264,16 @@ int rmse_of(const std::string& dds, const std::string& png) {
     const atlas::Field3D f = read_dds(dds, Decoder::Reference);
     Errors err;
     const int ch = std::min(3, f.channels());
+    int wx = 0, wy = 0, wc = 0;
     for (int y = 0; y < src.h; ++y)
         for (int x = 0; x < src.w; ++x)
-            for (int c = 0; c < ch; ++c)
+            for (int c = 0; c < ch; ++c) {
+                const double before = err.max;
                 err.add(f.at(c, x, y, 0), src.rgb[(size_t(y) * size_t(src.w) + size_t(x)) * 3 + size_t(c)]);
-    std::printf("rmse_8bit %.4f max_err_8bit %.3f channels %d\n", err.rmse(), err.max, ch);
+                if (err.max > before) { wx = x; wy = y; wc = c; }
+            }
+    std::printf("rmse_8bit %.4f max_err_8bit %.3f channels %d worst (%d, %d) ch %d: decoded %.1f source %d\n", err.rmse(), err.max, ch,
+                wx, wy, wc, f.at(wc, wx, wy, 0) * 255.0, int(src.rgb[(size_t(wy) * size_t(src.w) + size_t(wx)) * 3 + size_t(wc)]));
     return 0;
 }
 
