@@ -6,7 +6,7 @@
 #   bench/compare_nvcompress.sh BUILD_DIR [WORK_DIR]
 #
 # NVTT 2.0 (Debian 12) has -fast and the default quality; -production does not exist
-# there (tried below, reported when refused). -nocuda: CPU compressor; -nomips: one level.
+# there (its usage text is checked; 2.0 silently ignores unknown options). -nocuda: CPU compressor; -nomips: one level.
 set -euo pipefail
 build=${1:?usage: compare_nvcompress.sh BUILD_DIR [WORK_DIR]}
 work=${2:-$(mktemp -d)}
@@ -23,6 +23,10 @@ while IFS=$'\t' read -r png name; do
     *) continue ;;
     esac
     for q in fast default production; do
+        if [ "$q" = production ] && ! nvcompress 2>&1 | grep -q -- -production; then
+            printf '%s\t%s\t%s\t-\tnot offered by this nvcompress (2.0 ignores the option)\n' "$fmt" "$q" "$name"
+            continue
+        fi
         flag=()
         [ "$q" = fast ] && flag=(-fast)
         [ "$q" = production ] && flag=(-production)
