@@ -38,8 +38,10 @@ Field3D rgb_volume(int nx, int ny, int nz) {
     return f;
 }
 
-void run(benchmark::State& state, const Field3D& f, Format fmt, Quality q, bool one_sided, DecoderSet decoders) {
+void run(benchmark::State& state, const Field3D& f, Format fmt, Quality q, bool one_sided, DecoderSet decoders,
+         double max_error = -1) {
     CompressOptions o;
+    if (max_error >= 0) o.max_error = max_error; // encode_texture reports misses, it does not throw
     o.format = fmt;
     o.quality = q;
     o.one_sided_below = one_sided;
@@ -55,10 +57,12 @@ void run(benchmark::State& state, const Field3D& f, Format fmt, Quality q, bool 
     state.counters["max_err_m"] = last.bound_max_error;
     state.counters["rmse_m"] = last.rmse.empty() ? 0 : last.rmse[0];
     state.counters["mean_under_m"] = last.per_decoder.empty() ? 0 : last.per_decoder[0].mean_under;
+    state.counters["blocks_over_bound"] = double(last.blocks_over_bound.size());
 }
 
 const Field3D& sdf_small() { static const Field3D f = sdf_volume(32, 32, 4); return f; }
 const Field3D& sdf_large() { static const Field3D f = sdf_volume(512, 512, 64); return f; }
+const Field3D& sdf_mid() { static const Field3D f = sdf_volume(128, 128, 32); return f; }
 const Field3D& rgb_small() { static const Field3D f = rgb_volume(32, 32, 4); return f; }
 const Field3D& rgb_mid() { static const Field3D f = rgb_volume(256, 256, 8); return f; }
 
@@ -72,6 +76,9 @@ void Bc4Fast_512x512x64(benchmark::State& s) { run(s, sdf_large(), Format::Bc4, 
 void Bc1ScalarOneSided_512x512x64(benchmark::State& s) { run(s, sdf_large(), Format::Bc1Scalar, Quality::Normal, true, kAllDecoders); }
 void Bc1ScalarOneSidedReference_512x512x64(benchmark::State& s) { run(s, sdf_large(), Format::Bc1Scalar, Quality::Normal, true, kReferenceOnly); }
 void Bc4OneSidedReference_512x512x64(benchmark::State& s) { run(s, sdf_large(), Format::Bc4, Quality::Normal, true, kReferenceOnly); }
+// Every block misses 0.01 m and falls back to the exhaustive BC4 search.
+void Bc4BoundedFallback_128x128x32(benchmark::State& s) { run(s, sdf_mid(), Format::Bc4, Quality::Normal, false, kAllDecoders, 0.01); }
+void Bc4Best_128x128x32(benchmark::State& s) { run(s, sdf_mid(), Format::Bc4, Quality::Best, false, kAllDecoders); }
 void Bc1Normal_256x256x8(benchmark::State& s) { run(s, rgb_mid(), Format::Bc1, Quality::Normal, false, kAllDecoders); }
 void Bc1Fast_256x256x8(benchmark::State& s) { run(s, rgb_mid(), Format::Bc1, Quality::Fast, false, kAllDecoders); }
 
@@ -86,6 +93,8 @@ BENCHMARK(Bc4NormalOneSided_512x512x64)->UseManualTime()->Unit(benchmark::kSecon
 BENCHMARK(Bc4OneSidedReference_512x512x64)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(Bc1ScalarOneSided_512x512x64)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(Bc1ScalarOneSidedReference_512x512x64)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(Bc4BoundedFallback_128x128x32)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(Bc4Best_128x128x32)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(Bc1Fast_256x256x8)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(Bc1Normal_256x256x8)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK_MAIN();
