@@ -52,7 +52,8 @@ struct GridSpec {
 // value (1), vorticity-confinement scratch (10, only when enabled): 31 floats
 // = 124 B. Pressure solver in double: diag, x, b, r, phi, res, z, d, q, rhs
 // (10 doubles = 80 B) plus about 1/7 of 7 doubles for coarse levels (8 B).
-// Total 212 B, rounded up to 216 B per cell.
+// Total 212 B, rounded up to 216 B per cell. Options add to it (simulation.h:
+// kSimRainBytesPerCell, kSimReflectionBytesPerCell; simulation_bytes(spec, options)).
 constexpr uint64_t kSimBytesPerCell = 216;
 uint64_t simulation_bytes(const GridSpec& spec);
 
