@@ -346,3 +346,40 @@ TEST(SimPhysics, AdvectionReflectionKeepsKineticEnergy) {
     EXPECT_LE(refl, e0 * (1 + 1e-3));
     EXPECT_LE(plain, e0 * (1 + 1e-3));
 }
+
+// Extremes with every option on (rain, reversible theta_e, advection-reflection,
+// limited cubic): a 200 m/s velocity spike is substepped and stays finite with
+// rain >= 0 and the projection converged; dt 100x past CFL with a small
+// substep budget is refused with an error naming max_substeps.
+TEST(SimPhysics, AllOptionsSurviveAVelocitySpikeAndRefuseAHugeStep) {
+    GridSpec s = slab(24, 24, 100.0);
+    Sounding snd;
+    snd.theta_e = 320;
+    snd.total_water = 0.015;
+    SimOptions o;
+    o.rain = true;
+    o.reversible_theta_e = true;
+    o.advection_reflection = true;
+    o.scheme = AdvectionScheme::CubicLimited;
+    o.max_substeps = 2000;
+    Simulation sim(s, snd, o);
+    sim.velocity().w[sim.velocity().iw(12, 0, 12)] = 200.f;
+    for (int n = 0; n < 3; ++n) {
+        StepReport r = sim.step(10.0);
+        ASSERT_TRUE(r.pressure_converged);
+        ASSERT_TRUE(std::isfinite(r.max_speed) && std::isfinite(r.max_theta_perturbation));
+        ASSERT_GT(r.substeps, 1);
+        for (float q : sim.qr()) ASSERT_GE(q, 0.f);
+        for (float q : sim.qc()) ASSERT_GE(q, 0.f);
+    }
+    SimOptions tight = o;
+    tight.max_substeps = 3;
+    Simulation small(s, snd, tight);
+    small.velocity().w[small.velocity().iw(12, 0, 12)] = 50.f;
+    try {
+        small.step(1000.0);
+        FAIL() << "a 1000 s step at 50 m/s on 100 m cells was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("max_substeps"), std::string::npos) << e.what();
+    }
+}
