@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace atlas::compress {
 namespace {
@@ -130,6 +131,59 @@ TEST(Bc4, BestIsOptimalAgainstNaiveSearch) {
             BlockResult r = enc.encode(src, blk);
             EXPECT_FLOAT_EQ(r.max_error, naive_best(src, os)) << "block " << k << " one-sided " << os;
         }
+    }
+}
+
+// The exhaustive search started from the normal candidates' incumbent (Best, and blocks
+// missing max_error) must write the very block a search from scratch writes: the
+// pruning bounds are true lower bounds and exact ties go to the lowest pair index.
+TEST(Bc4, SeededExhaustiveSearchEqualsSearchFromScratch) {
+    for (bool snorm : {false, true})
+        for (bool os : {false, true})
+            for (DecoderSet set : {kReferenceOnly, kAllDecoders}) {
+                BlockOptions o;
+                o.quality = Quality::Best;
+                o.one_sided_below = os;
+                o.decoders = set;
+                Bc4Encoder best(snorm, o);
+                BlockOptions ob = o;
+                ob.quality = Quality::Normal;
+                ob.max_error = 0.0f; // every non-exact block falls back to the exhaustive search
+                Bc4Encoder bounded(snorm, ob);
+                for (int k = 0; k < std::max(2, 120 / test::kExhaustiveDivisor); ++k) {
+                    float src[16];
+                    scalar_block(uint64_t(k) * 13 + 11, snorm ? -1.0f : 0.0f, 1.0f, src);
+                    uint8_t a[8], b[8], c[8];
+                    const BlockResult ra = best.encode(src, a);
+                    const BlockResult rb = best.encode_exhaustive(src, b);
+                    const BlockResult rc = bounded.encode(src, c);
+                    EXPECT_EQ(0, std::memcmp(a, b, 8)) << "block " << k << " snorm " << snorm << " one-sided " << os;
+                    EXPECT_EQ(ra.max_error, rb.max_error);
+                    EXPECT_EQ(ra.sum_sq, rb.sum_sq);
+                    if (rc.max_error > 0.0f) { // missed the bound: the exhaustive optimum
+                        EXPECT_EQ(0, std::memcmp(c, b, 8)) << "block " << k;
+                        EXPECT_EQ(rc.max_error, rb.max_error);
+                    }
+                }
+            }
+}
+
+// Flat blocks under fast (which tries their 6-value pair: the 8-value pair needs e0 > e1)
+// decode exactly to a representable level.
+TEST(Bc4, FastEncodesFlatBlocksWithTheirLevel) {
+    BlockOptions o;
+    o.quality = Quality::Fast;
+    o.decoders = kReferenceOnly;
+    Bc4Encoder fast(false, o);
+    for (int level : {0, 1, 77, 128, 254, 255}) {
+        float src[16];
+        std::fill(src, src + 16, float(level) / 255.0f);
+        uint8_t blk[8];
+        const BlockResult r = fast.encode(src, blk);
+        EXPECT_EQ(r.max_error, 0.0f) << "level " << level;
+        float v[16];
+        decode_bc4_block(blk, false, Decoder::Reference, v);
+        for (int t = 0; t < 16; ++t) EXPECT_EQ(v[t], src[t]);
     }
 }
 
