@@ -139,8 +139,8 @@ TEST(Bc1Scalar, WeightsReproduceNubisConstantsForEightBitDecoders) {
     EXPECT_LT(ref.endpoint_step, 1.0f / 60000.0f); // ~16-bit endpoint precision
 }
 
-void run_scalar(DecoderSet set, bool one_sided, Quality q, int blocks, double* mean_under) {
-    ScalarUnpack u = bc1_scalar_unpack(set);
+void run_scalar(DecoderSet set, bool one_sided, Quality q, int blocks, double* mean_under, const ScalarUnpack* custom = nullptr) {
+    ScalarUnpack u = custom ? *custom : bc1_scalar_unpack(set);
     BlockOptions o;
     o.decoders = set;
     o.one_sided_below = one_sided;
@@ -181,6 +181,16 @@ TEST(Bc1Scalar, RandomBlocksOneSidedAllDecoders) {
     std::printf("bc1-scalar one-sided (all decoders), mixed blocks: mean under-estimate %.6f\n", under);
 }
 TEST(Bc1Scalar, RandomBlocksOneSidedReferenceOnly) { run_scalar(kReferenceOnly, true, Quality::Best, kRandomBlocks / 20, nullptr); }
+
+// Weights other than bc1_scalar_unpack's use privately built palette tables (not the
+// shared per-set ones): the bounds must hold the same way.
+TEST(Bc1Scalar, CustomWeightsKeepTheBounds) {
+    ScalarUnpack u = bc1_scalar_unpack(kAllDecoders);
+    u.weights = {1.0f, 0.04f, 0.0009f};
+    u.max_value = u.weights[0] + u.weights[1] + u.weights[2];
+    run_scalar(kAllDecoders, true, Quality::Normal, 200, nullptr, &u);
+    run_scalar(kAllDecoders, false, Quality::Fast, 200, nullptr, &u);
+}
 
 TEST(Bc1Scalar, ConstantBlockReachesEndpointPrecision) {
     for (DecoderSet set : {kReferenceOnly, kAllDecoders}) {
