@@ -205,7 +205,12 @@ int search_all_pairs(const PairTables& T, const float src[16], bool os, detail::
     constexpr int kProbeOrder[16] = {7, 3, 11, 1, 5, 9, 13, 0, 2, 4, 6, 8, 10, 12, 14, 15};
     for (int t = 0; t < 16; ++t) probe[t] = sorted[kProbeOrder[t]];
     uint8_t cand[256];
-    for (int b0 = 0; b0 < 256; ++b0) {
+    // Rows outward from the incumbent's row: good pairs (a small E, strong bounds) come
+    // early. The order does not change the result (the minimum with index tie-break).
+    const int start = best_k >= 0 ? best_k >> 8 : 0;
+    for (int step = 0; step < 512; ++step) {
+        const int b0 = start + ((step & 1) ? (step + 1) / 2 : -(step / 2));
+        if (b0 < 0 || b0 > 255) continue;
         update_mid();
         const bool row8 = !(bound(T.row_imin[b0][0], T.row_imax[b0][0], smin, smax) > best.max_err);
         const bool row6 = !(bound(T.row_imin[b0][1], T.row_imax[b0][1], mid_lo, mid_hi) > best.max_err);
