@@ -167,8 +167,8 @@ Bc4Encoder::~Bc4Encoder() = default;
 
 namespace {
 
-// The exhaustive search over all 65,536 pairs, starting from an incumbent (seed_k
-// < 0: none). Returns the lexicographic minimum of (max error, squared error, pair
+// The exhaustive search over all 65,536 pairs, starting from an incumbent (`best` and
+// its pair `best_k`; best_k < 0: none). Returns the best pair's index (-1: none). Returns the lexicographic minimum of (max error, squared error, pair
 // index) over the feasible pairs, exactly what a plain scan in index order keeping
 // strict improvements returns: pairs are skipped only by true lower bounds.
 //   * A pair's entries other than the constants span [imin, imax]; every texel that
