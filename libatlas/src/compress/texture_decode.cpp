@@ -7,6 +7,8 @@
 #include "half.h"
 #include "texture_internal.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -208,14 +210,25 @@ CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* mani
         return c < source.channels() ? c : -1;
     };
     const size_t slice = size_t(tex.width) * size_t(tex.height);
-    for (Decoder d : decoders_in(decoders)) {
+    // Each decoder model is decoded and measured by one task (its sums run in a
+    // fixed order), so the report does not depend on the thread count; the
+    // models are independent, which keeps both cores busy on a large volume.
+    struct ModelResult {
         DecoderStats st;
+        std::vector<double> sq;
+    };
+    const std::vector<Decoder> models = decoders_in(decoders);
+    std::vector<ModelResult> results(models.size());
+    tbb::parallel_for(size_t(0), models.size(), [&](size_t k) {
+        const Decoder d = models[k];
+        DecoderStats& st = results[k].st;
+        std::vector<double>& sq = results[k].sq;
         st.decoder = d;
         st.max_error.assign(size_t(r.channels), 0.0);
         st.max_over = -INFINITY;
         double under = 0;
         uint64_t count = 0;
-        std::vector<double> sq(size_t(r.channels), 0.0);
+        sq.assign(size_t(r.channels), 0.0);
         for (int layer = 0; layer < tex.array_size; ++layer) {
             detail::DecodedLevel L = detail::decode_level(tex, layer, 0, d, scalar, unpack);
             for (int c = 0; c < r.channels; ++c) {
@@ -234,13 +247,16 @@ CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* mani
             }
         }
         st.mean_under = count ? under / double(count) : 0;
-        if (d == Decoder::Reference || r.max_error.empty()) {
+    });
+    for (ModelResult& m : results) {
+        DecoderStats& st = m.st;
+        if (st.decoder == Decoder::Reference || r.max_error.empty()) {
             r.max_error = st.max_error;
             r.rmse.assign(size_t(r.channels), 0.0);
             r.psnr.assign(size_t(r.channels), 0.0);
             const double range = map.kind == detail::MapKind::Float ? 1.0 : double(map.hi) - map.lo;
             for (int c = 0; c < r.channels; ++c) {
-                r.rmse[size_t(c)] = std::sqrt(sq[size_t(c)] / double(r.texels));
+                r.rmse[size_t(c)] = std::sqrt(m.sq[size_t(c)] / double(r.texels));
                 r.psnr[size_t(c)] = r.rmse[size_t(c)] > 0 ? 20.0 * std::log10(range / r.rmse[size_t(c)]) : INFINITY;
             }
         }

@@ -4,7 +4,11 @@
 #include "atlas/core/hash.h"
 #include "atlas/core/memory.h"
 
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace atlas {
 
@@ -17,13 +21,49 @@ std::vector<std::string> default_channel_names(int channels) {
 
 namespace detail {
 
+namespace {
+// Runs fill(begin, end) over [0, count) in fixed 1 Mi-float blocks, in parallel
+// when there is more than one block. Each block is written by one task, so
+// the bytes do not depend on the thread count.
+template <typename Fill>
+void fill_blocks(size_t count, Fill fill) {
+    constexpr size_t kBlock = size_t(1) << 20;
+    const size_t blocks = (count + kBlock - 1) / kBlock;
+    if (blocks <= 1) {
+        fill(size_t(0), count);
+        return;
+    }
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) { fill(b * kBlock, std::min(count, (b + 1) * kBlock)); });
+}
+
+ChannelData zeroed_channel(size_t count) {
+    ChannelData d(count);
+    fill_blocks(count, [&](size_t i0, size_t i1) { std::memset(d.data() + i0, 0, (i1 - i0) * sizeof(float)); });
+    return d;
+}
+} // namespace
+
+FieldStorage::FieldStorage(const FieldStorage& o) : count_(o.count_), names_(o.names_) {
+    data_.reserve(o.data_.size());
+    for (const ChannelData& src : o.data_) {
+        ChannelData& d = data_.emplace_back(src.size());
+        fill_blocks(src.size(), [&](size_t i0, size_t i1) { std::memcpy(d.data() + i0, src.data() + i0, (i1 - i0) * sizeof(float)); });
+    }
+}
+
+FieldStorage& FieldStorage::operator=(const FieldStorage& o) {
+    if (this != &o) *this = FieldStorage(o);
+    return *this;
+}
+
 FieldStorage::FieldStorage(size_t count, int channels, std::vector<std::string> names) : count_(count) {
     if (channels <= 0 || channels > 64) throw Error("field: channel count " + std::to_string(channels) + " out of range (expected 1..64)");
     if (names.empty()) names = default_channel_names(channels);
     if (names.size() != size_t(channels))
         throw Error("field: " + std::to_string(names.size()) + " channel names given for " + std::to_string(channels) + " channels");
     names_ = std::move(names);
-    data_.assign(size_t(channels), std::vector<float>(count, 0.0f));
+    data_.reserve(size_t(channels));
+    for (int c = 0; c < channels; ++c) data_.push_back(zeroed_channel(count));
 }
 
 int FieldStorage::find_channel(const std::string& name) const {

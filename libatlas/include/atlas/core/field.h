@@ -28,6 +28,29 @@ enum class WrapMode {
 };
 
 namespace detail {
+// Allocator that leaves floats uninitialised on resize, so FieldStorage can
+// zero and copy channels in parallel (first touch of hundreds of MB is the
+// dominant cost of a large field on a VM; see docs/DECISIONS.md).
+template <typename T>
+struct UninitialisedAllocator : std::allocator<T> {
+    template <typename U>
+    struct rebind {
+        using other = UninitialisedAllocator<U>;
+    };
+    UninitialisedAllocator() = default;
+    template <typename U>
+    UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
+    template <typename U>
+    void construct(U* p) noexcept {
+        ::new (static_cast<void*>(p)) U; // default-init: no write
+    }
+    template <typename U, typename... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+using ChannelData = std::vector<float, UninitialisedAllocator<float>>;
+
 // Shared by Field2D and Field3D: channels, names, storage.
 class FieldStorage {
 public:
@@ -44,11 +67,17 @@ public:
 
 protected:
     FieldStorage(size_t count, int channels, std::vector<std::string> names);
+    // Copies fill the new channels in parallel (same bytes as a serial copy).
+    FieldStorage(const FieldStorage& o);
+    FieldStorage& operator=(const FieldStorage& o);
+    FieldStorage(FieldStorage&&) noexcept = default;
+    FieldStorage& operator=(FieldStorage&&) noexcept = default;
+    ~FieldStorage() = default;
     void hash_storage(Hasher& h) const;
     bool same_storage(const FieldStorage& o) const { return names_ == o.names_ && data_ == o.data_; }
 
     size_t count_ = 0;
-    std::vector<std::vector<float>> data_;
+    std::vector<ChannelData> data_;
     std::vector<std::string> names_;
 };
 } // namespace detail
