@@ -3,6 +3,7 @@
 
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
+#include "atlas/sim/confinement.h"
 #include "atlas/sim/thermo.h"
 
 #include <tbb/blocked_range.h>
@@ -179,7 +180,7 @@ void SimOptions::validate(int nz) const {
     check_range(cfl, 0.1, 5, "options.cfl");
     check_range(max_substeps, 1, 10000, "options.max_substeps");
     check_range(condensation_rate, 0, 1e9, "options.condensation_rate (1/s)");
-    check_range(vorticity_confinement, 0, 2, "options.vorticity_confinement");
+    check_range(vorticity_confinement, 0, 0.5, "options.vorticity_confinement (dimensionless)");
     check_range(viscosity, 0, 1e4, "options.viscosity (m^2/s)");
     check_range(diffusivity, 0, 1e4, "options.diffusivity (m^2/s)");
     if (!wind.empty() && wind.size() != size_t(nz)) throw Error("sim: options.wind needs nz entries (one per cell row)");
@@ -338,65 +339,7 @@ void Simulation::buoyancy(double dt) {
     });
 }
 
-void Simulation::confinement(double dt) {
-    const int nx = spec_.nx, ny = spec_.ny, nz = spec_.nz;
-    const double h = spec_.dx, eps = opt_.vorticity_confinement;
-    const size_t n = spec_.cells();
-    std::vector<float> cu(n), cv(n), cw(n), ox(n), oy(n), oz(n), mag(n), fx(n), fy(n), fz(n);
-    for_slices(nz, [&](int k) {
-        for (int j = 0; j < ny; ++j)
-            for (int i = 0; i < nx; ++i) {
-                size_t c = vel_.ic(i, j, k);
-                cu[c] = 0.5f * (vel_.u[vel_.iu(i, j, k)] + vel_.u[vel_.iu(i + 1, j, k)]);
-                cv[c] = 0.5f * (vel_.v[vel_.iv(i, j, k)] + vel_.v[vel_.iv(i, j + 1, k)]);
-                cw[c] = 0.5f * (vel_.w[vel_.iw(i, j, k)] + vel_.w[vel_.iw(i, j, k + 1)]);
-            }
-    });
-    // Central differences with clamped neighbours (one-sided at the edges).
-    auto d = [&](const std::vector<float>& a, int i, int j, int k, int axis) -> double {
-        int lo[3] = {i, j, k}, hi[3] = {i, j, k};
-        const int nn[3] = {nx, ny, nz};
-        lo[axis] = std::max(lo[axis] - 1, 0);
-        hi[axis] = std::min(hi[axis] + 1, nn[axis] - 1);
-        int span = hi[axis] - lo[axis];
-        if (span == 0) return 0.0;
-        return (double(a[vel_.ic(hi[0], hi[1], hi[2])]) - a[vel_.ic(lo[0], lo[1], lo[2])]) / (span * h);
-    };
-    for_slices(nz, [&](int k) {
-        for (int j = 0; j < ny; ++j)
-            for (int i = 0; i < nx; ++i) {
-                size_t c = vel_.ic(i, j, k);
-                ox[c] = float(d(cw, i, j, k, 1) - d(cv, i, j, k, 2));
-                oy[c] = float(d(cu, i, j, k, 2) - d(cw, i, j, k, 0));
-                oz[c] = float(d(cv, i, j, k, 0) - d(cu, i, j, k, 1));
-                mag[c] = std::sqrt(ox[c] * ox[c] + oy[c] * oy[c] + oz[c] * oz[c]);
-            }
-    });
-    for_slices(nz, [&](int k) {
-        for (int j = 0; j < ny; ++j)
-            for (int i = 0; i < nx; ++i) {
-                size_t c = vel_.ic(i, j, k);
-                double gx = d(mag, i, j, k, 0), gy = d(mag, i, j, k, 1), gz = d(mag, i, j, k, 2);
-                double gl = std::sqrt(gx * gx + gy * gy + gz * gz) + 1e-20;
-                gx /= gl, gy /= gl, gz /= gl;
-                fx[c] = float(eps * h * (gy * oz[c] - gz * oy[c]));
-                fy[c] = float(eps * h * (gz * ox[c] - gx * oz[c]));
-                fz[c] = float(eps * h * (gx * oy[c] - gy * ox[c]));
-            }
-    });
-    for_slices(nz, [&](int k) {
-        for (int j = 0; j < ny; ++j) {
-            for (int i = 1; i < nx; ++i)
-                vel_.u[vel_.iu(i, j, k)] += float(dt * 0.5 * (fx[vel_.ic(i - 1, j, k)] + fx[vel_.ic(i, j, k)]));
-            if (j > 0)
-                for (int i = 0; i < nx; ++i)
-                    vel_.v[vel_.iv(i, j, k)] += float(dt * 0.5 * (fy[vel_.ic(i, j - 1, k)] + fy[vel_.ic(i, j, k)]));
-            if (k > 0)
-                for (int i = 0; i < nx; ++i)
-                    vel_.w[vel_.iw(i, j, k)] += float(dt * 0.5 * (fz[vel_.ic(i, j, k - 1)] + fz[vel_.ic(i, j, k)]));
-        }
-    });
-}
+void Simulation::confinement(double dt) { add_confinement(vel_, opt_.vorticity_confinement, dt); }
 
 namespace {
 // q += dt * coef * lap(q - ref) on lattice l, zero-gradient edges.
