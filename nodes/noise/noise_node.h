@@ -33,7 +33,7 @@ inline void declare_common(NodeDeclaration& d, Vec3i period = {{4, 4, 4}}) {
 }
 
 // Reads the common parameters into `spec` (kernel-specific fields already
-// set), fills a new field and sets "out". Library errors name the node.
+// set), fills a new field and sets "out".
 inline void cook_noise(CookContext& ctx, noise::NoiseSpec spec) {
     spec.period = ctx.get_int3("period");
     spec.frequency = ctx.get_float("frequency");
@@ -56,28 +56,21 @@ inline void cook_noise(CookContext& ctx, noise::NoiseSpec spec) {
     const Vec3d lo = ctx.get_float3("bounds_min"), hi = ctx.get_float3("bounds_max");
     const Vec3i res = ctx.get_int3("resolution");
     const bool two_d = ctx.get_string("dimensions") == "2d";
-    try {
-        spec.validate(two_d ? 2 : 3);
-        const int comps = noise::noise_components(spec.kernel, two_d ? 2 : 3);
-        if (two_d) {
-            Box2d box{{{lo[0], lo[1]}}, {{hi[0], hi[1]}}};
-            if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in x and y");
-            auto f = ctx.make_field2d({{res[0], res[1]}}, comps, box);
-            noise::fill_noise(*f, 0, spec, &ctx.progress_sink());
-            ctx.set_output("out", Field2DPtr(f));
-        } else {
-            Box3d box{lo, hi};
-            if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in every axis");
-            auto f = ctx.make_field3d(res, comps, box);
-            noise::fill_noise(*f, 0, spec, &ctx.progress_sink());
-            ctx.set_output("out", Field3DPtr(f));
-        }
-    } catch (const CancelledError&) {
-        throw;
-    } catch (const MemoryBudgetError&) {
-        throw;
-    } catch (const Error& e) {
-        ctx.fail(e.what());
+    // Library errors need no wrapping: the evaluator prefixes them with the node.
+    spec.validate(two_d ? 2 : 3);
+    const int comps = noise::noise_components(spec.kernel, two_d ? 2 : 3);
+    if (two_d) {
+        Box2d box{{{lo[0], lo[1]}}, {{hi[0], hi[1]}}};
+        if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in x and y");
+        auto f = ctx.make_field2d({{res[0], res[1]}}, comps, box);
+        noise::fill_noise(*f, 0, spec, &ctx.progress_sink());
+        ctx.set_output("out", Field2DPtr(f));
+    } else {
+        Box3d box{lo, hi};
+        if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in every axis");
+        auto f = ctx.make_field3d(res, comps, box);
+        noise::fill_noise(*f, 0, spec, &ctx.progress_sink());
+        ctx.set_output("out", Field3DPtr(f));
     }
 }
 

@@ -4,6 +4,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
 #include "io_common.h"
+#include "vdb_internal.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
@@ -13,7 +14,7 @@
 
 namespace atlas::io {
 
-namespace {
+namespace detail {
 
 void init_openvdb() {
     // openvdb::initialize() is idempotent and thread-safe; call_once only
@@ -38,18 +39,6 @@ void add_atlas_meta(openvdb::GridBase& g, const Field3D& f) {
     g.insertMeta("atlas_resolution", openvdb::Vec3IMetadata(openvdb::Vec3i(f.nx(), f.ny(), f.nz())));
 }
 
-// The name of a vector grid: the channels' shared "NAME." prefix (vel.x,
-// vel.y, vel.z -> vel), else "vector".
-std::string vector_grid_name(const Field3D& f) {
-    const std::string& a = f.channel_name(0);
-    const size_t dot = a.rfind('.');
-    if (dot != std::string::npos && dot > 0) {
-        const std::string prefix = a.substr(0, dot + 1);
-        if (f.channel_name(1).rfind(prefix, 0) == 0 && f.channel_name(2).rfind(prefix, 0) == 0) return a.substr(0, dot);
-    }
-    return "vector";
-}
-
 // OpenVDB writes a random UUID into every archive header. Replace it with one
 // derived from what was written, so the same field gives the same bytes.
 void make_uuid_deterministic(const fs::path& path, const Hash128& content) {
@@ -68,6 +57,27 @@ void make_uuid_deterministic(const fs::path& path, const Hash128& content) {
     file.write(det.data(), std::streamsize(len));
     file.flush();
     if (!file) throw Error(path.string() + ": cannot finish the VDB header");
+}
+
+} // namespace detail
+
+namespace {
+using detail::add_atlas_meta;
+using detail::field_transform;
+using detail::init_openvdb;
+using detail::make_uuid_deterministic;
+
+
+// The name of a vector grid: the channels' shared "NAME." prefix (vel.x,
+// vel.y, vel.z -> vel), else "vector".
+std::string vector_grid_name(const Field3D& f) {
+    const std::string& a = f.channel_name(0);
+    const size_t dot = a.rfind('.');
+    if (dot != std::string::npos && dot > 0) {
+        const std::string prefix = a.substr(0, dot + 1);
+        if (f.channel_name(1).rfind(prefix, 0) == 0 && f.channel_name(2).rfind(prefix, 0) == 0) return a.substr(0, dot);
+    }
+    return "vector";
 }
 
 std::string list_names(const std::vector<std::string>& names) {

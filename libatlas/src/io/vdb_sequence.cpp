@@ -9,14 +9,13 @@
 #include "atlas/core/hash.h"
 #include "atlas/io/output_options.h"
 #include "format_table.h"
+#include "vdb_internal.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 
 #include <cstdio>
-#include <fstream>
 #include <limits>
-#include <mutex>
 
 namespace atlas::io::detail {
 
@@ -87,37 +86,10 @@ std::vector<Frame> frames_of(const Field3D& f, const OptionReader& o) {
     return frames;
 }
 
-void add_meta(openvdb::GridBase& g, const Field3D& f) {
-    const auto& b = f.bounds();
-    g.insertMeta("atlas_bounds_min", openvdb::Vec3DMetadata(openvdb::Vec3d(b.min[0], b.min[1], b.min[2])));
-    g.insertMeta("atlas_bounds_max", openvdb::Vec3DMetadata(openvdb::Vec3d(b.max[0], b.max[1], b.max[2])));
-    g.insertMeta("atlas_resolution", openvdb::Vec3IMetadata(openvdb::Vec3i(f.nx(), f.ny(), f.nz())));
-}
-
-// Replaces OpenVDB's random archive UUID by one derived from the content (as vdb.cpp does).
-void deterministic_uuid(const fs::path& path, const Hash128& content) {
-    constexpr size_t at = 21, len = 36;
-    std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
-    std::string head(at + len, '\0');
-    file.read(head.data(), std::streamsize(head.size()));
-    if (!file) throw Error(path.string() + ": cannot finish the VDB header (file too short)");
-    if (head[at + 8] != '-' || head[at + 13] != '-' || head[at + 18] != '-' || head[at + 23] != '-') return;
-    const std::string hex = content.hex();
-    const std::string det = hex.substr(0, 8) + "-" + hex.substr(8, 4) + "-" + hex.substr(12, 4) + "-" + hex.substr(16, 4) + "-" + hex.substr(20, 12);
-    file.seekp(std::streamoff(at));
-    file.write(det.data(), std::streamsize(len));
-    file.flush();
-    if (!file) throw Error(path.string() + ": cannot finish the VDB header");
-}
-
 void write_frame(const Field3D& f, const Frame& fr, const fs::path& path, float tolerance, const OptionReader& o) {
-    const Vec3d v = f.voxel_size();
-    openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
-    m.setToScale(openvdb::Vec3d(v[0], v[1], v[2]));
-    m.setTranslation(openvdb::Vec3d(f.bounds().min[0] + 0.5 * v[0], f.bounds().min[1] + 0.5 * v[1], f.bounds().min[2] + 0.5 * v[2]));
     openvdb::math::Transform::Ptr xf;
     try {
-        xf = openvdb::math::Transform::createLinearTransform(m);
+        xf = field_transform(f);
     } catch (const std::exception& e) {
         throw Error(o.prefix() + "OpenVDB cannot represent the voxel size (" + e.what() + ")");
     }
@@ -150,7 +122,7 @@ void write_frame(const Field3D& f, const Frame& fr, const fs::path& path, float 
         base->setName(g.name);
         base->setTransform(xf->copy());
         base->setGridClass(openvdb::GRID_FOG_VOLUME);
-        add_meta(*base, f);
+        add_atlas_meta(*base, f);
         grids.push_back(base);
     }
     try {
@@ -160,7 +132,7 @@ void write_frame(const Field3D& f, const Frame& fr, const fs::path& path, float 
     } catch (const std::exception& e) {
         throw Error(o.prefix() + "cannot write " + path.filename().string() + ": " + e.what());
     }
-    deterministic_uuid(path, h.finish());
+    make_uuid_deterministic(path, h.finish());
 }
 
 } // namespace
@@ -170,8 +142,7 @@ std::vector<fs::path> write_vdb_sequence_output(const Value& v, const fs::path& 
     if (p.extension() == ".vdb" || p.extension() == ".VDB")
         throw Error(o.prefix() + "format 'vdb-sequence' takes DIR/STEM (it writes STEM.0001.vdb, STEM.0002.vdb, ...), not a .vdb file name");
     const float tolerance = o.number("tolerance", 0.0f, 0.0f, std::numeric_limits<float>::infinity());
-    static std::once_flag once;
-    std::call_once(once, [] { openvdb::initialize(); });
+    init_openvdb();
     const Field3D& f = *std::get<Field3DPtr>(v);
     const std::vector<Frame> frames = frames_of(f, o);
     std::vector<fs::path> written;

@@ -2,6 +2,7 @@
 #include "atlas/ndf/ndf_set.h"
 
 #include "atlas/core/error.h"
+#include "atlas/core/memory.h"
 
 #include "parallel.h"
 
@@ -47,8 +48,8 @@ Field2D apply_precipitation_rule(const Field2D& set, const PrecipitationRule& ru
         throw Error("precipitation rule: 'rain_full' must be greater than 'rain_start' (both finite)");
     if (!(rule.min_coverage >= 0 && rule.min_coverage <= 1)) throw Error("precipitation rule: 'min_coverage' must be in [0, 1]");
     if (!(rule.storm_type >= 0 && rule.storm_type <= 1)) throw Error("precipitation rule: 'storm_type' must be in [0, 1]");
+    if (budget) budget->check(set.byte_size(), "the precipitation rule's copy of the NDF set");
     Field2D out = set;
-    (void)budget;
     auto cov = out.channel(Coverage);
     auto type = out.channel(Type);
     auto top = out.channel(TopType);
