@@ -17,7 +17,7 @@ using namespace atlas;
 const std::vector<std::string> kSequenceGrids = {"density", "temperature", "vapor", "vel"};
 
 void declare(NodeDeclaration& d) {
-    d.doc("Grows clouds by simulating rising moist air (anelastic, MAC grid, MacCormack or semi-Lagrangian advection, "
+    d.doc("Grows clouds by simulating rising moist air (anelastic, MAC grid, MacCormack or semi-Lagrangian or limited cubic advection, optional Kessler warm rain, "
           "multigrid-preconditioned CG projection, saturation adjustment; see docs/solver.md). The grid has 'resolution' "
           "cubic cells of 'dx' metres with its minimum corner at 'origin'. Runs ceil(duration / frame_dt) steps of frame_dt, "
           "each split into CFL-limited substeps. Sources: the optional 'emitter' field (sim/emitter; sampled at cell "
@@ -26,13 +26,14 @@ void declare(NodeDeclaration& d) {
           "velocity at cell centres, and 'sequence': every sequence_every-th frame's chosen grids as channels "
           "'NNNN:GRID' for the 'vdb-sequence' format. Each step's divergence (L2, max), pressure iterations, water "
           "and theta_l drift across the saturation adjustment and seconds per stage go into the cook report as "
-          "'step_NNNN.*' metrics, with totals and maxima, and the cloud base and top (m above the floor, qc > 1e-5; -1: no cloud). Memory (216 B per cell plus outputs) is checked before allocating.");
+          "'step_NNNN.*' metrics, with totals and maxima, and the cloud base and top (m above the floor, qc > 1e-5; -1: no cloud). Memory (simulation_bytes: 216 B per cell, +8 with rain, +12 with advection_reflection, plus outputs) is checked before allocating.");
     d.input("sounding", PortType::Field2D, "sim/sounding record (default: the sim/sounding defaults)").optional = true;
     d.input("emitter", PortType::Field3D, "heat (K/s) and vapour (kg/kg/s) rates, e.g. sim/emitter; channels 'heat' and 'vapour' or 0 and 1").optional = true;
     d.output("out", PortType::Field3D, "cloud water mixing ratio after the last step, channel 'density', kg/kg");
     d.output("temperature", PortType::Field3D, "absolute temperature after the last step, channel 'temperature', K");
     d.output("vapour", PortType::Field3D, "water-vapour mixing ratio after the last step, channel 'vapor', kg/kg");
     d.output("velocity", PortType::Field3D, "velocity at cell centres after the last step, channels 'vel.x', 'vel.y', 'vel.z', m/s");
+    d.output("rain", PortType::Field3D, "rain-water mixing ratio after the last step, channel 'rain', kg/kg (zeros unless 'rain' is on)");
     d.output("sequence", PortType::Field3D, "frames for the 'vdb-sequence' format: channels 'NNNN:GRID', NNNN = 1, 2, ...");
     d.param_int3("resolution", {{64, 64, 64}}).range(1, 4096).with_unit("cells").describe("cells along x, y, z (at least 2 along two axes)");
     d.param_float("dx", 40).range(1e-3, 1e5).with_unit("m").describe("cubic cell edge");
@@ -43,7 +44,24 @@ void declare(NodeDeclaration& d) {
     d.param_float("frame_dt", 10).range(1e-6, 1e5).with_unit("s").describe("time per step (one report row, one potential sequence frame)");
     d.param_float("cfl", 1).range(0.1, 5).with_unit("cells").describe("max cells travelled per substep");
     d.param_int("max_substeps", 64).range(1, 10000).describe("substep budget per step (more is an error naming the node)");
-    d.param_enum("scheme", {"maccormack", "semi_lagrangian"}, "maccormack").describe("advection scheme (MacCormack is limited)");
+    d.param_enum("scheme", {"maccormack", "semi_lagrangian", "cubic_limited"}, "maccormack")
+        .describe("advection scheme: maccormack (limited), semi_lagrangian (trilinear, most diffusive), cubic_limited "
+                  "(Catmull-Rom read clamped to its 8 neighbours: one read, less smearing)");
+    d.param_bool("advection_reflection", false)
+        .describe("advection-reflection stepping (Zehnder et al. 2018): keeps kinetic energy; a second projection per "
+                  "substep and 12 B more per cell");
+    d.param_bool("reversible_theta_e", false)
+        .describe("Bryan & Fritsch reversible thermodynamics: the saturation adjustment keeps theta_e (liquid heat "
+                  "capacity counted) instead of theta_l; a saturated sounding (total_water > 0) is built with the "
+                  "linearised adjustment, so it is not exactly neutral in this mode");
+    d.param_bool("rain", false)
+        .describe("Kessler warm rain (needs moist): autoconversion, accretion, evaporation and fallout through the floor; "
+                  "rain loads the buoyancy; 8 B more per cell; output 'rain'");
+    d.param_float("rain_autoconversion_rate", 1e-3).range(0, 1).with_unit("1/s").describe("Kessler k1: cloud water to rain above the threshold");
+    d.param_float("rain_autoconversion_threshold", 1e-3).range(0, 0.01).with_unit("kg/kg").describe("Kessler a: cloud water needed before rain forms");
+    d.param_float("rain_accretion_rate", 2.2).range(0, 100).with_unit("1/s").describe("Kessler k2: collection of cloud water by rain");
+    d.param_bool("rain_evaporation", true).describe("rain evaporates in subsaturated air (cooling it)");
+    d.param_bool("rain_sedimentation", true).describe("rain falls at its terminal speed and leaves through the floor");
     d.param_bool("anelastic", true).describe("false: Boussinesq (constant reference density)");
     d.param_bool("moist", true).describe("false: dry (vapour and cloud water are passive)");
     d.param_float("pressure_tolerance", 1e-6).range(1e-12, 0.1).describe("relative residual of the pressure solve");
@@ -92,7 +110,18 @@ sim::SimOptions options_from(const CookContext& ctx, int nz, double dx) {
     sim::SimOptions o;
     o.anelastic = ctx.get_bool("anelastic");
     o.moist = ctx.get_bool("moist");
-    o.scheme = ctx.get_string("scheme") == "maccormack" ? sim::AdvectionScheme::MacCormack : sim::AdvectionScheme::SemiLagrangian;
+    const std::string& scheme = ctx.get_string("scheme");
+    o.scheme = scheme == "maccormack"      ? sim::AdvectionScheme::MacCormack
+               : scheme == "cubic_limited" ? sim::AdvectionScheme::CubicLimited
+                                           : sim::AdvectionScheme::SemiLagrangian;
+    o.advection_reflection = ctx.get_bool("advection_reflection");
+    o.reversible_theta_e = ctx.get_bool("reversible_theta_e");
+    o.rain = ctx.get_bool("rain");
+    o.kessler.autoconversion_rate = ctx.get_float("rain_autoconversion_rate");
+    o.kessler.autoconversion_threshold = ctx.get_float("rain_autoconversion_threshold");
+    o.kessler.accretion_rate = ctx.get_float("rain_accretion_rate");
+    o.kessler.evaporation = ctx.get_bool("rain_evaporation");
+    o.kessler.sedimentation = ctx.get_bool("rain_sedimentation");
     o.cfl = ctx.get_float("cfl");
     o.max_substeps = int(ctx.get_int("max_substeps"));
     o.condensation_rate = ctx.get_float("condensation_rate");
@@ -249,9 +278,11 @@ void cook(CookContext& ctx) {
 
     // Everything this cook holds at its peak, checked before anything is allocated.
     const uint64_t cells = spec.cells();
-    const uint64_t state = sim::simulation_bytes(spec);
-    const uint64_t outputs = field_bytes(cells, 6 + uint64_t(frames) * uint64_t(per_frame));
-    ctx.check_memory(state + outputs, "the simulation (" + std::to_string(sim::kSimBytesPerCell) + " B per cell) and its outputs");
+    const sim::SimOptions opt = options_from(ctx, spec.nz, spec.dx);
+    const uint64_t state = sim::simulation_bytes(spec, opt);
+    const uint64_t outputs = field_bytes(cells, 7 + uint64_t(frames) * uint64_t(per_frame));
+    ctx.check_memory(state + outputs, "the simulation (" + std::to_string(state / std::max<uint64_t>(cells, 1)) +
+                                          " B per cell with these options) and its outputs");
     ctx.metric("simulation_bytes", double(state));
 
     sim::Sounding snd;
@@ -266,7 +297,6 @@ void cook(CookContext& ctx) {
         snd.rh_lapse = -1e-4;
         snd.rh_above = 0.3;
     }
-    const sim::SimOptions opt = options_from(ctx, spec.nz, spec.dx);
     sim::Simulation sim = sim_nodes::naming_node(ctx, [&] {
         opt.validate(spec.nz);
         return sim::Simulation(spec, snd, opt, &ctx.budget());
@@ -320,7 +350,7 @@ void cook(CookContext& ctx) {
         }
     };
 
-    double div_l2 = 0, div_max = 0, water = 0, theta_l = 0, max_w = 0, max_qc = 0;
+    double div_l2 = 0, div_max = 0, water = 0, theta_l = 0, max_w = 0, max_qc = 0, max_qr = 0, fallout = 0;
     double s_adv = 0, s_src = 0, s_thermo = 0, s_forces = 0, s_proj = 0;
     int substeps = 0, iterations = 0, unconverged = 0;
     for (int step = 1; step <= steps; ++step) {
@@ -333,6 +363,8 @@ void cook(CookContext& ctx) {
         theta_l = std::max(theta_l, r.theta_l_drift);
         max_w = std::max(max_w, r.max_w);
         max_qc = std::max(max_qc, r.max_qc);
+        max_qr = std::max(max_qr, r.max_qr);
+        fallout += r.rain_fallout;
         s_adv += r.seconds_advect;
         s_src += r.seconds_sources;
         s_thermo += r.seconds_thermo;
@@ -357,6 +389,10 @@ void cook(CookContext& ctx) {
     ctx.metric("theta_l_drift_max", theta_l);
     ctx.metric("max_w", max_w);
     ctx.metric("max_qc", max_qc);
+    if (opt.rain) {
+        ctx.metric("max_qr", max_qr);
+        ctx.metric("rain_fallout_kg", fallout);
+    }
     ctx.metric("seconds_advect", s_adv);
     ctx.metric("seconds_sources", s_src);
     ctx.metric("seconds_thermo", s_thermo);
@@ -371,10 +407,11 @@ void cook(CookContext& ctx) {
     ctx.set_output("temperature", Field3DPtr(placed(ctx, sim.temperature(), box, {"temperature"})));
     ctx.set_output("vapour", Field3DPtr(placed(ctx, sim.vapour(), box, {"vapor"})));
     ctx.set_output("velocity", Field3DPtr(placed(ctx, sim.velocity_field(), box, {"vel.x", "vel.y", "vel.z"})));
+    ctx.set_output("rain", Field3DPtr(placed(ctx, sim.rain_water(), box, {"rain"})));
     ctx.set_output("sequence", Field3DPtr(std::move(sequence)));
 }
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "sim/cloud_growth", .version = 1, .declare = declare, .cook = cook});
+    registry.add({.name = "sim/cloud_growth", .version = 2, .declare = declare, .cook = cook});
 }

@@ -148,18 +148,13 @@ TEST(SimNodes, EmitterGroundPatchShapeAndSeed) {
     EXPECT_TRUE(*as<Field3D>(s.get("patch", "out", values_only())) == *noisy);
 }
 
-TEST(SimNodes, CloudGrowthMatchesTheLibraryRunByHand) {
-    Session s(builtin_nodes());
-    s.load_text(kGraph, "sim.yaml", fs::temp_directory_path());
-    const auto patch = as<Field3D>(s.get("patch", "out", values_only()));
-    const auto density = as<Field3D>(s.get("cloud", "out", values_only()));
-
+// The test graph's run done by hand with the library: same grid, sounding,
+// emitter cells and bubble, 4 steps of 10 s.
+std::unique_ptr<sim::Simulation> library_run(const Field3D& patch, const sim::SimOptions& o) {
     sim::GridSpec spec;
     spec.nx = spec.ny = spec.nz = 16;
     spec.dx = 40;
-    sim::SimOptions o;
-    o.projection.tolerance = 1e-7;
-    sim::Simulation sim(spec, graph_sounding(), o);
+    auto sim = std::make_unique<sim::Simulation>(spec, graph_sounding(), o);
     // The emitter grid has the same cell centres in x, y; in z it covers the lowest 4 cells.
     std::vector<float> heat(spec.cells(), 0.f), vap(spec.cells(), 0.f), bubble(spec.cells(), 0.f);
     for (int k = 0; k < 16; ++k)
@@ -167,16 +162,36 @@ TEST(SimNodes, CloudGrowthMatchesTheLibraryRunByHand) {
             for (int i = 0; i < 16; ++i) {
                 const size_t n = (size_t(k) * 16 + j) * 16 + i;
                 if (k < 4) {
-                    heat[n] = patch->at(0, i, j, k);
-                    vap[n] = patch->at(1, i, j, k);
+                    heat[n] = patch.at(0, i, j, k);
+                    vap[n] = patch.at(1, i, j, k);
                 }
                 const double l = std::sqrt(std::pow((i + 0.5) * 40 - 320, 2) + std::pow((j + 0.5) * 40 - 320, 2) +
                                            std::pow((k + 0.5) * 40 - 150, 2)) / 150;
                 if (l < 1) bubble[n] = float(2 * std::pow(std::cos(0.5 * M_PI * l), 2));
             }
-    sim.set_sources(heat, vap);
-    sim.add_theta(bubble);
-    for (int step = 0; step < 4; ++step) sim.step(10);
+    sim->set_sources(heat, vap);
+    sim->add_theta(bubble);
+    for (int step = 0; step < 4; ++step) sim->step(10);
+    return sim;
+}
+
+void expect_same(const Field3D& node, const Field3D& lib, const char* what) {
+    ASSERT_EQ(node.voxel_count(), lib.voxel_count()) << what;
+    ASSERT_EQ(node.channels(), lib.channels()) << what;
+    for (int c = 0; c < lib.channels(); ++c)
+        for (size_t i = 0; i < lib.voxel_count(); ++i) ASSERT_EQ(node.channel(c)[i], lib.channel(c)[i]) << what << " " << c << " " << i;
+}
+
+TEST(SimNodes, CloudGrowthMatchesTheLibraryRunByHand) {
+    Session s(builtin_nodes());
+    s.load_text(kGraph, "sim.yaml", fs::temp_directory_path());
+    const auto patch = as<Field3D>(s.get("patch", "out", values_only()));
+    const auto density = as<Field3D>(s.get("cloud", "out", values_only()));
+
+    sim::SimOptions o;
+    o.projection.tolerance = 1e-7;
+    const auto run = library_run(*patch, o);
+    const sim::Simulation& sim = *run;
     const Field3D qc = sim.cloud_water();
     ASSERT_EQ(density->channel_name(0), "density");
     ASSERT_EQ(density->voxel_count(), qc.voxel_count());
@@ -208,6 +223,51 @@ TEST(SimNodes, CloudGrowthMatchesTheLibraryRunByHand) {
     EXPECT_LT(m.at("div_max_max"), 1e-4);
     EXPECT_LT(m.at("water_drift_max"), 1e-5);
     EXPECT_GT(m.at("pressure_iterations"), 0.0);
+}
+
+// The options the node passes through (rain with no threshold and k1 = 1/s so rain
+// forms within 40 s, the cubic scheme, advection-reflection, reversible
+// theta_e): the node equals the library run bit for bit, and rain is >= 0.
+TEST(SimNodes, CloudGrowthWithRainAndSchemeOptionsMatchesTheLibrary) {
+    Session s(builtin_nodes());
+    s.load_text(kGraph, "sim.yaml", fs::temp_directory_path());
+    s.set("cloud", "rain", true);
+    s.set("cloud", "rain_autoconversion_threshold", 0.0);
+    s.set("cloud", "rain_autoconversion_rate", 1.0);
+    const auto patch = as<Field3D>(s.get("patch", "out", values_only()));
+    sim::SimOptions o;
+    o.projection.tolerance = 1e-7;
+    o.rain = true;
+    o.kessler.autoconversion_threshold = 0;
+    o.kessler.autoconversion_rate = 1.0;
+    {
+        const auto run = library_run(*patch, o);
+        const auto rain = as<Field3D>(s.get("cloud", "rain", values_only()));
+        ASSERT_EQ(rain->channel_name(0), "rain");
+        expect_same(*rain, run->rain_water(), "rain");
+        expect_same(*as<Field3D>(s.get("cloud", "out", values_only())), run->cloud_water(), "qc");
+        expect_same(*as<Field3D>(s.get("cloud", "velocity", values_only())), run->velocity_field(), "velocity");
+        double max_qr = 0;
+        for (float q : rain->channel(0)) {
+            ASSERT_GE(q, 0.f);
+            ASSERT_TRUE(std::isfinite(q));
+            max_qr = std::max(max_qr, double(q));
+        }
+        EXPECT_GT(max_qr, 1e-7) << "the case should rain: max qr " << max_qr;
+    }
+    s.set("cloud", "scheme", std::string("cubic_limited"));
+    s.set("cloud", "advection_reflection", true);
+    s.set("cloud", "reversible_theta_e", true);
+    o.scheme = sim::AdvectionScheme::CubicLimited;
+    o.advection_reflection = true;
+    o.reversible_theta_e = true;
+    const auto run = library_run(*patch, o);
+    expect_same(*as<Field3D>(s.get("cloud", "rain", values_only())), run->rain_water(), "rain (all options)");
+    expect_same(*as<Field3D>(s.get("cloud", "out", values_only())), run->cloud_water(), "qc (all options)");
+    expect_same(*as<Field3D>(s.get("cloud", "temperature", values_only())), run->temperature(), "T (all options)");
+    // Without rain the port still exists and is all zeros.
+    s.set("cloud", "rain", false);
+    for (float q : as<Field3D>(s.get("cloud", "rain", values_only()))->channel(0)) ASSERT_EQ(q, 0.f);
 }
 
 TEST(SimNodes, SequenceWritesReadableVdbFrames) {
