@@ -100,6 +100,27 @@ TEST(SimConfinement, ForceMatchesFormulaOnLambOseenVortex) {
     EXPECT_LT(worst, 0.05) << "relative error of the force against the formula";
 }
 
+// The same vortex in millimetre and 100 km cells (velocities scaled with the
+// size, so omega is the same): the same relative force, finite, no guard misfire.
+TEST(SimConfinement, ForceIsScaleFreeAtExtremeCellSizes) {
+    for (double scale : {1e-4, 1e4}) {
+        const int n = 48;
+        const double dx = 10 * scale, a = 100 * scale, G = M_PI * a * a * 0.1;
+        MacVelocity ref = lamb_oseen(n, 10, G / (scale * scale), 100), v = lamb_oseen(n, dx, G, a);
+        std::vector<float> rx, ry, rz, fx, fy, fz;
+        confinement_force(ref, 0.2, rx, ry, rz);
+        confinement_force(v, 0.2, fx, fy, fz);
+        double peak = 0;
+        for (float f : rx) peak = std::max(peak, double(std::fabs(f)));
+        ASSERT_GT(peak, 0);
+        for (size_t c = 0; c < fx.size(); ++c) {
+            ASSERT_TRUE(std::isfinite(fx[c]) && std::isfinite(fy[c]));
+            ASSERT_NEAR(fx[c] / scale, rx[c], 1e-3 * peak) << scale << " cell " << c;
+            ASSERT_NEAR(fy[c] / scale, ry[c], 1e-3 * peak) << scale << " cell " << c;
+        }
+    }
+}
+
 // Linear in eps and in dx for the same physical vortex (the force vanishes under refinement).
 TEST(SimConfinement, ForceScalesWithEpsAndCellSize) {
     const double a = 150, G = M_PI * a * a * 0.1;

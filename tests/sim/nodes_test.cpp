@@ -265,6 +265,21 @@ TEST(SimNodes, CloudGrowthWithRainAndSchemeOptionsMatchesTheLibrary) {
     expect_same(*as<Field3D>(s.get("cloud", "rain", values_only())), run->rain_water(), "rain (all options)");
     expect_same(*as<Field3D>(s.get("cloud", "out", values_only())), run->cloud_water(), "qc (all options)");
     expect_same(*as<Field3D>(s.get("cloud", "temperature", values_only())), run->temperature(), "T (all options)");
+    // The memory estimate the node checks and reports counts the options' extra fields.
+    {
+        Session fresh(builtin_nodes());
+        fresh.load_text(kGraph, "sim.yaml", fs::temp_directory_path());
+        fresh.set("cloud", "rain", true);
+        fresh.set("cloud", "advection_reflection", true);
+        CookOptions co = values_only();
+        co.outputs = {"final.vdb"};
+        const CookResult r = fresh.cook(co);
+        const auto& m = r.nodes.at("cloud").metrics;
+        EXPECT_EQ(m.at("simulation_bytes"), double(sim::simulation_bytes(run->spec(), o)));
+        EXPECT_EQ(m.at("simulation_bytes"), double(16 * 16 * 16 * (sim::kSimBytesPerCell + sim::kSimRainBytesPerCell +
+                                                                    sim::kSimReflectionBytesPerCell)));
+        EXPECT_TRUE(m.count("max_qr") && m.count("rain_fallout_kg"));
+    }
     // Without rain the port still exists and is all zeros.
     s.set("cloud", "rain", false);
     for (float q : as<Field3D>(s.get("cloud", "rain", values_only()))->channel(0)) ASSERT_EQ(q, 0.f);
