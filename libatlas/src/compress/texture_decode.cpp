@@ -19,28 +19,41 @@ namespace detail {
 
 MapKind map_kind(DxgiFormat f) {
     switch (f) {
-    case DxgiFormat::R16_FLOAT: case DxgiFormat::R32_FLOAT: case DxgiFormat::R16G16B16A16_FLOAT:
-    case DxgiFormat::BC6H_UF16: case DxgiFormat::BC6H_SF16: return MapKind::Float;
-    case DxgiFormat::BC4_SNORM: return MapKind::Snorm;
-    default: return MapKind::Unorm;
+    case DxgiFormat::R16_FLOAT:
+    case DxgiFormat::R32_FLOAT:
+    case DxgiFormat::R16G16B16A16_FLOAT:
+    case DxgiFormat::BC6H_UF16:
+    case DxgiFormat::BC6H_SF16:
+        return MapKind::Float;
+    case DxgiFormat::BC4_SNORM:
+        return MapKind::Snorm;
+    default:
+        return MapKind::Unorm;
     }
 }
 
-DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder decoder, bool bc1_scalar,
-                          const ScalarUnpack& unpack) {
+DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder decoder, bool bc1_scalar, const ScalarUnpack& unpack, int z0,
+                          int z1) {
     DecodedLevel L;
     L.w = tex.level_width(mip);
     L.h = tex.level_height(mip);
-    L.d = tex.level_depth(mip);
+    const int depth = tex.level_depth(mip);
+    if (z1 < 0) z1 = depth;
+    if (z0 < 0 || z0 > z1 || z1 > depth)
+        throw Error("decode_level: slices [" + std::to_string(z0) + ", " + std::to_string(z1) + ") outside the level's depth " +
+                    std::to_string(depth));
+    L.d = z1 - z0;
     L.channels = bc1_scalar ? 1 : format_channels(tex.format);
     const size_t n = size_t(L.w) * size_t(L.h) * size_t(L.d);
     L.lo.assign(size_t(L.channels), std::vector<float>(n));
     L.hi.assign(size_t(L.channels), std::vector<float>(n));
-    const uint8_t* base = tex.data.data() + tex.offset(layer, mip);
+    const size_t slice_texels = size_t(L.w) * size_t(L.h);
     const DxgiFormat f = tex.format;
+    const uint8_t* const level = tex.data.data() + tex.offset(layer, mip);
     if (is_block_compressed(f)) {
         const int bw = std::max(1, (L.w + 3) / 4), bh = std::max(1, (L.h + 3) / 4);
         const int unit = format_unit_bytes(f);
+        const uint8_t* base = level + size_t(z0) * size_t(bh) * size_t(bw) * size_t(unit);
         for (int z = 0; z < L.d; ++z)
             for (int by = 0; by < bh; ++by)
                 for (int bx = 0; bx < bw; ++bx) {
@@ -52,8 +65,12 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
                         std::copy(lo, lo + 48, hi);
                     } else if (f == DxgiFormat::BC4_UNORM || f == DxgiFormat::BC4_SNORM) {
                         const bool sn = f == DxgiFormat::BC4_SNORM;
-                        if (decoder == Decoder::Conformant) decode_bc4_interval(blk, sn, decoder_bit(decoder), lo, hi);
-                        else { decode_bc4_block(blk, sn, decoder, lo); std::copy(lo, lo + 16, hi); }
+                        if (decoder == Decoder::Conformant)
+                            decode_bc4_interval(blk, sn, decoder_bit(decoder), lo, hi);
+                        else {
+                            decode_bc4_block(blk, sn, decoder, lo);
+                            std::copy(lo, lo + 16, hi);
+                        }
                     } else { // BC1
                         float rgb[48];
                         decode_bc1_block(blk, decoder, rgb);
@@ -66,7 +83,8 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
                                 for (int c = 0; c < 3; ++c)
                                     tol[i][c] = (c0 <= c1 && i == 3) ? 0.0f : bc1_conformant_tolerance(ref[0][c], ref[1][c]);
                         }
-                        const uint32_t bits = uint32_t(blk[4]) | (uint32_t(blk[5]) << 8) | (uint32_t(blk[6]) << 16) | (uint32_t(blk[7]) << 24);
+                        const uint32_t bits =
+                            uint32_t(blk[4]) | (uint32_t(blk[5]) << 8) | (uint32_t(blk[6]) << 16) | (uint32_t(blk[7]) << 24);
                         for (int t = 0; t < 16; ++t) {
                             const int i = int((bits >> (2 * t)) & 3);
                             if (bc1_scalar) {
@@ -76,7 +94,8 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
                                     tv += tol[i][c] * unpack.weights[size_t(c)];
                                 }
                                 // same summation order as decode_bc1_scalar_block
-                                v = rgb[3 * t] * unpack.weights[0] + rgb[3 * t + 1] * unpack.weights[1] + rgb[3 * t + 2] * unpack.weights[2];
+                                v = rgb[3 * t] * unpack.weights[0] + rgb[3 * t + 1] * unpack.weights[1] +
+                                    rgb[3 * t + 2] * unpack.weights[2];
                                 lo[t] = v - tv;
                                 hi[t] = v + tv;
                             } else
@@ -99,17 +118,30 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
         return L;
     }
     const int unit = format_unit_bytes(f);
+    const uint8_t* base = level + size_t(z0) * slice_texels * size_t(unit);
     for (size_t i = 0; i < n; ++i) {
         const uint8_t* p = base + i * size_t(unit);
         float v[4] = {0, 0, 0, 0};
         auto u16 = [&](int k) { return uint16_t(p[2 * k] | (p[2 * k + 1] << 8)); };
         switch (f) {
-        case DxgiFormat::R8_UNORM: v[0] = float(p[0]) / 255.0f; break;
-        case DxgiFormat::R16_UNORM: v[0] = float(u16(0)) / 65535.0f; break;
-        case DxgiFormat::R16_FLOAT: v[0] = half_to_float(u16(0)); break;
-        case DxgiFormat::R32_FLOAT: std::memcpy(&v[0], p, 4); break;
-        case DxgiFormat::R8G8B8A8_UNORM: for (int c = 0; c < 4; ++c) v[c] = float(p[c]) / 255.0f; break;
-        case DxgiFormat::R16G16B16A16_FLOAT: for (int c = 0; c < 4; ++c) v[c] = half_to_float(u16(c)); break;
+        case DxgiFormat::R8_UNORM:
+            v[0] = float(p[0]) / 255.0f;
+            break;
+        case DxgiFormat::R16_UNORM:
+            v[0] = float(u16(0)) / 65535.0f;
+            break;
+        case DxgiFormat::R16_FLOAT:
+            v[0] = half_to_float(u16(0));
+            break;
+        case DxgiFormat::R32_FLOAT:
+            std::memcpy(&v[0], p, 4);
+            break;
+        case DxgiFormat::R8G8B8A8_UNORM:
+            for (int c = 0; c < 4; ++c) v[c] = float(p[c]) / 255.0f;
+            break;
+        case DxgiFormat::R16G16B16A16_FLOAT:
+            for (int c = 0; c < 4; ++c) v[c] = half_to_float(u16(c));
+            break;
         case DxgiFormat::B4G4R4A4_UNORM: {
             const uint16_t w = u16(0);
             v[2] = float(w & 15) / 15.0f;
@@ -118,7 +150,8 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
             v[3] = float((w >> 12) & 15) / 15.0f;
             break;
         }
-        default: break;
+        default:
+            break;
         }
         for (int c = 0; c < L.channels; ++c) L.lo[size_t(c)][i] = L.hi[size_t(c)][i] = v[c];
     }
@@ -147,15 +180,18 @@ Field3D decode_texture(const DdsTexture& tex, const TextureManifest* manifest, D
     }
     detail::Mapping map;
     map.kind = detail::map_kind(tex.format);
-    if (manifest) { map.lo = manifest->range_lo; map.hi = manifest->range_hi; }
-    else if (map.kind != detail::MapKind::Float) map.kind = detail::MapKind::Float; // normalized values as stored
+    if (manifest) {
+        map.lo = manifest->range_lo;
+        map.hi = manifest->range_hi;
+    } else if (map.kind != detail::MapKind::Float)
+        map.kind = detail::MapKind::Float; // normalized values as stored
     const int layers = tex.array_size, depth = tex.depth;
     const int nz = tex.volume ? depth : layers;
     const int channels = scalar ? 1 : format_channels(tex.format);
-    std::vector<std::string> names = manifest && int(manifest->channel_meanings.size()) == channels ? manifest->channel_meanings
-                                                                                                    : default_channel_names(channels);
-    Field3D out(Vec3i{{tex.width, tex.height, nz}}, channels,
-                Box3d{{{0, 0, 0}}, {{double(tex.width), double(tex.height), double(nz)}}}, names);
+    std::vector<std::string> names =
+        manifest && int(manifest->channel_meanings.size()) == channels ? manifest->channel_meanings : default_channel_names(channels);
+    Field3D out(Vec3i{{tex.width, tex.height, nz}}, channels, Box3d{{{0, 0, 0}}, {{double(tex.width), double(tex.height), double(nz)}}},
+                names);
     for (int layer = 0; layer < layers; ++layer) {
         detail::DecodedLevel L = detail::decode_level(tex, layer, 0, decoder, scalar, unpack);
         const size_t slice = size_t(tex.width) * size_t(tex.height);
@@ -182,29 +218,40 @@ CompressReport verify_dds(const fs::path& path, const Field3D& source, DecoderSe
     return r;
 }
 
-CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* manifest, const Field3D& source,
-                              DecoderSet decoders, const std::vector<int>& channels, const std::string& what) {
+CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* manifest, const Field3D& source, DecoderSet decoders,
+                              const std::vector<int>& channels, const std::string& what) {
     const fs::path path(what);
     const int nz = tex.volume ? tex.depth : tex.array_size;
     if (source.nx() != tex.width || source.ny() != tex.height || source.nz() != nz)
         throw Error(path.string() + ": texture is " + std::to_string(tex.width) + "x" + std::to_string(tex.height) + "x" +
-                    std::to_string(nz) + " but the source field is " + std::to_string(source.nx()) + "x" +
-                    std::to_string(source.ny()) + "x" + std::to_string(source.nz()));
+                    std::to_string(nz) + " but the source field is " + std::to_string(source.nx()) + "x" + std::to_string(source.ny()) +
+                    "x" + std::to_string(source.nz()));
     const bool scalar = manifest && manifest->encoding == "bc1-scalar";
     CompressReport r;
     r.file = path.string();
     r.format = manifest ? manifest->encoding : dxgi_format_name(tex.format);
-    r.width = tex.width; r.height = tex.height; r.depth = tex.depth; r.array_size = tex.array_size; r.mip_levels = tex.mip_levels;
+    r.width = tex.width;
+    r.height = tex.height;
+    r.depth = tex.depth;
+    r.array_size = tex.array_size;
+    r.mip_levels = tex.mip_levels;
     r.channels = scalar ? 1 : format_channels(tex.format);
     r.texels = uint64_t(tex.width) * uint64_t(tex.height) * uint64_t(nz);
     r.bytes = tex.data.size();
-    if (manifest) { r.value_range = {manifest->range_lo, manifest->range_hi}; r.requested_max_error = manifest->max_error; r.one_sided_below = manifest->one_sided_below; }
+    if (manifest) {
+        r.value_range = {manifest->range_lo, manifest->range_hi};
+        r.requested_max_error = manifest->max_error;
+        r.one_sided_below = manifest->one_sided_below;
+    }
     ScalarUnpack unpack;
     if (scalar) unpack.weights = manifest->unpack_weights;
     detail::Mapping map;
     map.kind = detail::map_kind(tex.format);
-    if (manifest) { map.lo = manifest->range_lo; map.hi = manifest->range_hi; }
-    else map.kind = detail::MapKind::Float;
+    if (manifest) {
+        map.lo = manifest->range_lo;
+        map.hi = manifest->range_hi;
+    } else
+        map.kind = detail::MapKind::Float;
     auto src_channel = [&](int c) -> int {
         if (!channels.empty()) return c < int(channels.size()) ? channels[size_t(c)] : -1;
         return c < source.channels() ? c : -1;
@@ -229,20 +276,27 @@ CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* mani
         double under = 0;
         uint64_t count = 0;
         sq.assign(size_t(r.channels), 0.0);
+        const int depth0 = tex.level_depth(0);
+        constexpr int kSlabSlices = 4;
         for (int layer = 0; layer < tex.array_size; ++layer) {
-            detail::DecodedLevel L = detail::decode_level(tex, layer, 0, d, scalar, unpack);
-            for (int c = 0; c < r.channels; ++c) {
-                const int sc = src_channel(c);
-                for (size_t i = 0; i < L.lo[size_t(c)].size(); ++i) {
-                    const float s = sc >= 0 ? source.channel(sc)[size_t(layer) * slice + i] : map.to_src(c == 3 ? 1.0f : 0.0f); // missing: stored constants
-                    const double lo = map.to_src(L.lo[size_t(c)][i]), hi = map.to_src(L.hi[size_t(c)][i]);
-                    st.max_error[size_t(c)] = std::max(st.max_error[size_t(c)], std::max(hi - s, s - lo));
-                    st.max_over = std::max(st.max_over, hi - s);
-                    if (hi > s) ++st.one_sided_violations;
-                    const double mid = map.to_src(0.5f * (L.lo[size_t(c)][i] + L.hi[size_t(c)][i]));
-                    under += s - mid;
-                    sq[size_t(c)] += (mid - s) * (mid - s);
-                    ++count;
+            for (int z0 = 0; z0 < depth0; z0 += kSlabSlices) {
+                const int z1 = std::min(depth0, z0 + kSlabSlices);
+                detail::DecodedLevel L = detail::decode_level(tex, layer, 0, d, scalar, unpack, z0, z1);
+                const size_t first = (size_t(layer) * size_t(depth0) + size_t(z0)) * slice;
+                for (int c = 0; c < r.channels; ++c) {
+                    const int sc = src_channel(c);
+                    for (size_t i = 0; i < L.lo[size_t(c)].size(); ++i) {
+                        const float s =
+                            sc >= 0 ? source.channel(sc)[first + i] : map.to_src(c == 3 ? 1.0f : 0.0f); // missing: stored constants
+                        const double lo = map.to_src(L.lo[size_t(c)][i]), hi = map.to_src(L.hi[size_t(c)][i]);
+                        st.max_error[size_t(c)] = std::max(st.max_error[size_t(c)], std::max(hi - s, s - lo));
+                        st.max_over = std::max(st.max_over, hi - s);
+                        if (hi > s) ++st.one_sided_violations;
+                        const double mid = map.to_src(0.5f * (L.lo[size_t(c)][i] + L.hi[size_t(c)][i]));
+                        under += s - mid;
+                        sq[size_t(c)] += (mid - s) * (mid - s);
+                        ++count;
+                    }
                 }
             }
         }

@@ -35,7 +35,10 @@ struct DecodedLevel {
     int w = 0, h = 0, d = 0, channels = 0;
     std::vector<std::vector<float>> lo, hi;
 };
+// Slices [z0, z1) of one level (z1 < 0: to the last slice); `d` is z1 - z0.
+// A verify pass decodes a volume a few slices at a time, so its buffers stay
+// small and are reused instead of touching a whole volume's fresh memory.
 DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder decoder, bool bc1_scalar,
-                          const ScalarUnpack& unpack);
+                          const ScalarUnpack& unpack, int z0 = 0, int z1 = -1);
 
 } // namespace atlas::compress::detail
