@@ -21,7 +21,7 @@ void decode_bc4_block(const uint8_t block[8], bool snorm, Decoder d, float out[1
 void decode_bc4_interval(const uint8_t block[8], bool snorm, DecoderSet set, float lo[16], float hi[16]);
 
 // Encodes BC4 blocks. Construction precomputes the palettes of all 65,536 endpoint
-// pairs for the decoder set (about 6 MB); encode() is const and thread-safe.
+// pairs for the decoder set (about 12 MB with the search-pruning tables); encode() is const and thread-safe.
 // Objective: minimise the block's max error under the decoder set (subject to
 // decoded <= source when one-sided), then the squared Reference error.
 // Quality::Best (and any block missing options.max_error) searches all pairs and is
