@@ -259,7 +259,7 @@ void cook(CookContext& ctx) {
         spec.boundary = sim::all_open();
         spec.boundary[4] = sim::Boundary::Closed;
     }
-    sim_nodes::naming_node(ctx, [&] { spec.validate(); });
+    spec.validate(); // library errors: the evaluator prefixes the node
     const Vec3d origin = ctx.get_float3("origin");
     const Box3d box{origin, {{origin[0] + res[0] * spec.dx, origin[1] + res[1] * spec.dx, origin[2] + res[2] * spec.dx}}};
     if (!box.valid()) ctx.fail("origin + resolution * dx is not a valid box (too large or non-finite)");
@@ -297,29 +297,25 @@ void cook(CookContext& ctx) {
         snd.rh_lapse = -1e-4;
         snd.rh_above = 0.3;
     }
-    sim::Simulation sim = sim_nodes::naming_node(ctx, [&] {
-        opt.validate(spec.nz);
-        return sim::Simulation(spec, snd, opt, &ctx.budget());
-    });
-    sim_nodes::naming_node(ctx, [&] {
-        if (ctx.has_input("emitter")) apply_emitter(ctx, sim, origin);
-        if (ctx.get_float("patch_radius") > 0) {
-            sim::GroundPatch g;
-            const Vec2d c = ctx.get_float2("patch_center");
-            g.center_x = c[0] - origin[0];
-            g.center_y = c[1] - origin[1];
-            g.radius = ctx.get_float("patch_radius");
-            g.depth = ctx.get_float("patch_depth");
-            g.heat_rate = ctx.get_float("patch_heat_rate");
-            g.vapour_rate = ctx.get_float("patch_vapour_rate");
-            g.noise_scale = ctx.get_float("patch_noise_scale");
-            g.noise_amount = ctx.get_float("patch_noise_amount");
-            g.seed = uint32_t(ctx.get_int("seed"));
-            sim.add_ground_patch(g);
-        }
-        if (const double a = ctx.get_float("bubble_theta"); a != 0)
-            sim.add_theta(bubble(spec, origin, a, ctx.get_float3("bubble_center"), ctx.get_float("bubble_radius")));
-    });
+    opt.validate(spec.nz);
+    sim::Simulation sim(spec, snd, opt, &ctx.budget());
+    if (ctx.has_input("emitter")) apply_emitter(ctx, sim, origin);
+    if (ctx.get_float("patch_radius") > 0) {
+        sim::GroundPatch g;
+        const Vec2d c = ctx.get_float2("patch_center");
+        g.center_x = c[0] - origin[0];
+        g.center_y = c[1] - origin[1];
+        g.radius = ctx.get_float("patch_radius");
+        g.depth = ctx.get_float("patch_depth");
+        g.heat_rate = ctx.get_float("patch_heat_rate");
+        g.vapour_rate = ctx.get_float("patch_vapour_rate");
+        g.noise_scale = ctx.get_float("patch_noise_scale");
+        g.noise_amount = ctx.get_float("patch_noise_amount");
+        g.seed = uint32_t(ctx.get_int("seed"));
+        sim.add_ground_patch(g);
+    }
+    if (const double a = ctx.get_float("bubble_theta"); a != 0)
+        sim.add_theta(bubble(spec, origin, a, ctx.get_float3("bubble_center"), ctx.get_float("bubble_radius")));
 
     std::vector<std::string> seq_names;
     for (int f = 1; f <= frames; ++f) {
@@ -355,7 +351,7 @@ void cook(CookContext& ctx) {
     int substeps = 0, iterations = 0, unconverged = 0;
     for (int step = 1; step <= steps; ++step) {
         ctx.progress(double(step - 1) / steps);
-        const sim::StepReport r = sim_nodes::naming_node(ctx, [&] { return sim.step(frame_dt); });
+        const sim::StepReport r = sim.step(frame_dt);
         record_step(ctx, step, r, sim);
         div_l2 = std::max(div_l2, r.divergence.l2);
         div_max = std::max(div_max, r.divergence.max);

@@ -61,19 +61,4 @@ inline sim::Sounding sounding_from_record(const CookContext& ctx, const Field2D&
     return s;
 }
 
-// Runs f(); a solver error (not a cancel or budget refusal, which already say
-// what they are) is rethrown prefixed with the node's name.
-template <typename F>
-auto naming_node(const CookContext& ctx, F&& f) -> decltype(f()) {
-    try {
-        return f();
-    } catch (const CancelledError&) {
-        throw;
-    } catch (const MemoryBudgetError&) {
-        throw;
-    } catch (const Error& e) {
-        ctx.fail(e.what());
-    }
-}
-
 } // namespace atlas::sim_nodes

@@ -39,10 +39,8 @@ void cook(CookContext& ctx) {
     for (size_t c = 0; c < names.size(); ++c) *members[c] = ctx.get_float(names[c]);
     const int levels = int(ctx.get_int("levels"));
     const double dz = ctx.get_float("dz");
-    const sim::ReferenceProfile ref = sim_nodes::naming_node(ctx, [&] {
-        s.validate();
-        return sim::make_reference(s, levels, dz);
-    });
+    s.validate();
+    const sim::ReferenceProfile ref = sim::make_reference(s, levels, dz);
     auto profile = ctx.make_field2d({{1, levels}}, 6, Box2d{{{0, 0}}, {{dz, levels * dz}}},
                                     {"theta", "temperature", "pressure", "rho", "qv", "rh"});
     for (int k = 0; k < levels; ++k) {
