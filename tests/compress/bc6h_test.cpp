@@ -690,6 +690,13 @@ TEST(Bc6hTexture, VolumeRoundTripThroughDdsWithMips) {
         EXPECT_EQ(man.encoding, format_name(fmt));
         EXPECT_EQ(man.dxgi_format, fmt == Format::Bc6hSf16 ? "BC6H_SF16" : "BC6H_UF16");
         EXPECT_FALSE(man.max_error.has_value());
+        // Identity mapping: value_range is the data's own min and max (not a rescale).
+        float lo = INFINITY, hi = -INFINITY;
+        for (int c = 0; c < 3; ++c)
+            for (float x : src.channel(c)) lo = std::min(lo, x), hi = std::max(hi, x);
+        EXPECT_EQ(man.range_lo, lo);
+        EXPECT_EQ(man.range_hi, hi);
+        EXPECT_GT(hi, 1.0f); // the HDR test volume: a [0, 1] range would be wrong
     }
 }
 

@@ -308,7 +308,10 @@ CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* mani
             r.max_error = st.max_error;
             r.rmse.assign(size_t(r.channels), 0.0);
             r.psnr.assign(size_t(r.channels), 0.0);
-            const double range = map.kind == detail::MapKind::Float ? 1.0 : double(map.hi) - map.lo;
+            // PSNR peak: the mapped range, or for identity-mapped (float) formats the
+            // data range the manifest records (1 without a manifest).
+            const double span = double(map.hi) - map.lo;
+            const double range = span > 0 ? span : 1.0;
             for (int c = 0; c < r.channels; ++c) {
                 r.rmse[size_t(c)] = std::sqrt(m.sq[size_t(c)] / double(r.texels));
                 r.psnr[size_t(c)] = r.rmse[size_t(c)] > 0 ? 20.0 * std::log10(range / r.rmse[size_t(c)]) : INFINITY;

@@ -318,8 +318,19 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     man.mapping = map.kind == MapKind::Float ? "identity" : map.kind == MapKind::Snorm ? "snorm: value = lo + (n + 1) / 2 * (hi - lo)"
                                                                                         : "unorm: value = lo + n * (hi - lo)";
     if (scalar) man.mapping = "bc1-scalar: n = dot(rgb, unpack_weights); value = lo + n * (hi - lo)";
-    man.range_lo = map.kind == MapKind::Float ? 0.0f : map.lo;
-    man.range_hi = map.kind == MapKind::Float ? 1.0f : map.hi;
+    if (map.kind == MapKind::Float) {
+        // Identity mapping: the range is the data's own min and max, for the
+        // importer's information (and the PSNR's peak); nothing is rescaled.
+        float lo = INFINITY, hi = -INFINITY;
+        for (int c : chans)
+            for (float v : field.channel(c)) { lo = std::min(lo, v); hi = std::max(hi, v); }
+        if (chans.empty() || !(hi >= lo)) { lo = 0; hi = 1; }
+        man.range_lo = lo;
+        man.range_hi = hi;
+    } else {
+        man.range_lo = map.lo;
+        man.range_hi = map.hi;
+    }
     man.max_error = o.max_error;
     man.one_sided_below = o.one_sided_below;
     for (Decoder d : decoders_in(bo.decoders)) man.decoders.push_back(decoder_name(d));
