@@ -31,6 +31,14 @@ struct BlockOutcome {
     bool one_sided_ok = true;
 };
 
+// Min and max over the encoded channels ({+inf, -inf} when there are none).
+std::pair<float, float> data_range(const Field3D& field, const std::vector<int>& chans) {
+    float lo = INFINITY, hi = -INFINITY;
+    for (int c : chans)
+        for (float v : field.channel(c)) { lo = std::min(lo, v); hi = std::max(hi, v); }
+    return {lo, hi};
+}
+
 std::string texel_name(const Field3D& f, int c, size_t i) {
     const size_t x = i % size_t(f.nx()), y = (i / size_t(f.nx())) % size_t(f.ny()), z = i / (size_t(f.nx()) * size_t(f.ny()));
     return "texel (" + std::to_string(x) + ", " + std::to_string(y) + ", " + std::to_string(z) + ") channel '" + f.channel_name(c) + "'";
@@ -179,9 +187,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
             if (!(map.hi > map.lo) || !std::isfinite(map.lo) || !std::isfinite(map.hi))
                 throw Error("compress: value_range must be finite with lo < hi");
         } else {
-            float lo = INFINITY, hi = -INFINITY;
-            for (int c : chans)
-                for (float v : field.channel(c)) { lo = std::min(lo, v); hi = std::max(hi, v); }
+            auto [lo, hi] = data_range(field, chans);
             if (chans.empty()) { lo = 0; hi = 1; }
             if (!(hi > lo)) hi = lo + 1.0f;
             map.lo = lo;
@@ -321,9 +327,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     if (map.kind == MapKind::Float) {
         // Identity mapping: the range is the data's own min and max, for the
         // importer's information (and the PSNR's peak); nothing is rescaled.
-        float lo = INFINITY, hi = -INFINITY;
-        for (int c : chans)
-            for (float v : field.channel(c)) { lo = std::min(lo, v); hi = std::max(hi, v); }
+        auto [lo, hi] = data_range(field, chans);
         if (chans.empty() || !(hi >= lo)) { lo = 0; hi = 1; }
         man.range_lo = lo;
         man.range_hi = hi;
