@@ -3,8 +3,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
 #include "atlas/core/memory.h"
-
-#include <tbb/parallel_for.h>
+#include "parallel_blocks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -22,23 +21,12 @@ std::vector<std::string> default_channel_names(int channels) {
 namespace detail {
 
 namespace {
-// Runs fill(begin, end) over [0, count) in fixed 1 Mi-float blocks, in parallel
-// when there is more than one block. Each block is written by one task, so
-// the bytes do not depend on the thread count.
-template <typename Fill>
-void fill_blocks(size_t count, Fill fill) {
-    constexpr size_t kBlock = size_t(1) << 20;
-    const size_t blocks = (count + kBlock - 1) / kBlock;
-    if (blocks <= 1) {
-        fill(size_t(0), count);
-        return;
-    }
-    tbb::parallel_for(size_t(0), blocks, [&](size_t b) { fill(b * kBlock, std::min(count, (b + 1) * kBlock)); });
-}
+// Channels are zeroed and copied in fixed 1 Mi-float blocks (parallel_blocks.h).
+constexpr size_t kFillBlock = size_t(1) << 20;
 
 ChannelData zeroed_channel(size_t count) {
     ChannelData d(count);
-    fill_blocks(count, [&](size_t i0, size_t i1) { std::memset(d.data() + i0, 0, (i1 - i0) * sizeof(float)); });
+    parallel_blocks(count, kFillBlock, [&](size_t i0, size_t i1) { std::memset(d.data() + i0, 0, (i1 - i0) * sizeof(float)); });
     return d;
 }
 } // namespace
@@ -47,7 +35,7 @@ FieldStorage::FieldStorage(const FieldStorage& o) : count_(o.count_), names_(o.n
     data_.reserve(o.data_.size());
     for (const ChannelData& src : o.data_) {
         ChannelData& d = data_.emplace_back(src.size());
-        fill_blocks(src.size(), [&](size_t i0, size_t i1) { std::memcpy(d.data() + i0, src.data() + i0, (i1 - i0) * sizeof(float)); });
+        parallel_blocks(src.size(), kFillBlock, [&](size_t i0, size_t i1) { std::memcpy(d.data() + i0, src.data() + i0, (i1 - i0) * sizeof(float)); });
     }
 }
 

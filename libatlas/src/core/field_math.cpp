@@ -1,6 +1,7 @@
 #include "atlas/core/field_math.h"
 
 #include "atlas/core/error.h"
+#include "parallel_blocks.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -56,11 +57,6 @@ int operand_step(const Value& a, const Value& b, const char* name) {
     return cb == ca ? 1 : 0;
 }
 
-template <typename Fn>
-void parallel_blocks(size_t n, Fn&& fn) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kBlock), [&](const tbb::blocked_range<size_t>& r) { fn(r.begin(), r.end()); },
-                      tbb::simple_partitioner());
-}
 
 // One operand of a per-voxel operation: a field channel, or a constant when
 // the operand is not connected.
@@ -89,7 +85,7 @@ Value apply_per_voxel(const Value& a, const Value& x, double xc, const char* x_n
         auto pa = sa.channel(c);
         auto po = o.channel(c);
         const Operand ox = operand(x, step_x, c, xc), oy = operand(y, step_y, c, yc);
-        parallel_blocks(pa.size(), [&](size_t i0, size_t i1) {
+        detail::parallel_blocks(pa.size(), kBlock, [&](size_t i0, size_t i1) {
             for (size_t i = i0; i < i1; ++i) po[i] = op(pa[i], ox.at(i), oy.at(i));
         });
     }
