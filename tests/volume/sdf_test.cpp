@@ -235,3 +235,65 @@ TEST(SdfDegenerate, ThinGrids) {
         }
     }
 }
+
+// OpenVDB's sweep ignores neighbour distances >= 1000 world units; Atlas must
+// still give every distance the grid holds. A 40^3 grid of 40 m voxels (1.6 km
+// side) with a small cloud in one corner: the far field reaches ~2.5 km.
+TEST(SdfFastSweeping, FarFieldBeyond1000mMatchesBruteForce) {
+    const Vec3i res{{40, 40, 40}};
+    const double h = 40;
+    const Field3D d = sphere_density(res, cube_box(res, h), {{220, 260, 180}}, 130);
+    for (double far : {0.0, 1e6}) {
+        SdfOptions o;
+        o.far_distance = far; // a large far_distance must not change distances where there is a surface
+        const Field3D fs = sdf_from_density_fast_sweeping(d, o);
+        o.border_is_outside = true;
+        const Field3D ref = sdf_brute_force(d, o);
+        float ref_max = 0, fs_max = 0;
+        for (size_t i = 0; i < ref.voxel_count(); ++i) ref_max = std::max(ref_max, ref.channel(0)[i]), fs_max = std::max(fs_max, fs.channel(0)[i]);
+        ASSERT_GT(ref_max, 2000.0f) << "the test grid must reach far beyond 1000 m";
+        const SdfError err = compare_sdf(fs, ref);
+        EXPECT_EQ(err.sign_mismatches, 0u);
+        // First order: the error grows with the distance from a small cloud
+        // (measured 0.3 voxel within 400 m, 1.5 voxels at 2 km; max 1.57, rms 0.83).
+        EXPECT_LT(err.max_abs_voxels, 2.0) << "far " << far << ": max " << err.max_abs_m << " m, fast sweeping max distance " << fs_max;
+        EXPECT_LT(err.rms_voxels, 1.0) << "far " << far;
+        uint64_t beyond = 0;
+        for (size_t i = 0; i < ref.voxel_count(); ++i) beyond += ref.channel(0)[i] > 1000.0f;
+        EXPECT_GT(beyond, ref.voxel_count() / 2);
+        // The EDT honours the same range exactly.
+        const SdfError eerr = compare_sdf(sdf_from_density_edt(d, o), ref);
+        EXPECT_LT(eerr.max_abs_voxels, 1e-3);
+    }
+    // The same grid at 1 m voxels (all distances below 1000): the sweep is
+    // homogeneous in the voxel size, so the 40 m result is 40x the 1 m one.
+    Field3D unit(res, 1, cube_box(res, 1));
+    std::copy(d.channel(0).begin(), d.channel(0).end(), unit.channel(0).begin());
+    const Field3D a = sdf_from_density_fast_sweeping(d, {}), b = sdf_from_density_fast_sweeping(unit, {});
+    for (size_t i = 0; i < a.voxel_count(); ++i) ASSERT_NEAR(a.channel(0)[i] / h, b.channel(0)[i], 1e-4 * (1 + std::abs(b.channel(0)[i]))) << i;
+    // No surface: far_distance everywhere, however large.
+    Field3D empty(res, 1, cube_box(res, h));
+    SdfOptions o;
+    o.far_distance = 1e6;
+    const Field3D none = sdf_from_density_fast_sweeping(empty, o);
+    for (float v : none.channel(0)) ASSERT_EQ(v, 1e6f);
+}
+
+// A grid whose diagonal exceeds 1000 voxels (the cap in index units too), at
+// 10 m voxels: distances up to ~12 km, against brute force.
+TEST(SdfFastSweeping, LongGridBeyond1000VoxelsMatchesBruteForce) {
+    const Vec3i res{{1200, 3, 3}};
+    Field3D d(res, 1, cube_box(res, 10));
+    for (int z = 0; z < 3; ++z)
+        for (int y = 0; y < 3; ++y)
+            for (int x = 0; x < 4; ++x) d.at(0, x, y, z) = x < 3 ? 1.0f : 0.25f;
+    const Field3D fs = sdf_from_density_fast_sweeping(d, {});
+    SdfOptions o;
+    o.border_is_outside = true;
+    const Field3D ref = sdf_brute_force(d, o);
+    EXPECT_GT(ref.at(0, 1199, 1, 1), 11000.0f);
+    const SdfError err = compare_sdf(fs, ref);
+    EXPECT_EQ(err.sign_mismatches, 0u);
+    EXPECT_LT(err.max_abs_voxels, 2.0) << "max " << err.max_abs_m << " m; at the far end " << fs.at(0, 1199, 1, 1) << " vs " << ref.at(0, 1199, 1, 1);
+}
+

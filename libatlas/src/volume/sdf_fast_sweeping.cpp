@@ -49,21 +49,34 @@ Field3D sdf_from_density_fast_sweeping(const Field3D& density, const SdfOptions&
         // LayoutXYZ: x fastest, matching Field3D.
         openvdb::tools::Dense<const float, openvdb::tools::LayoutXYZ> in(box, dens.data());
         auto fog = openvdb::FloatGrid::create(0.0f);
-        auto xf = openvdb::math::Transform::createLinearTransform(h[0]);
-        const Vec3d lo = density.bounds().min;
-        xf->postTranslate(openvdb::Vec3d(lo[0] + 0.5 * h[0], lo[1] + 0.5 * h[1], lo[2] + 0.5 * h[2]));
+        // OpenVDB's sweep treats any neighbour distance >= 1000 (world units)
+        // as unknown (FastSweeping.h, NN::operator bool), so in metres every
+        // distance beyond ~1000 m was left at its initial value. Sweep in
+        // scaled index units instead - a power of two small enough that the
+        // grid diagonal stays below 500 - and scale to metres afterwards. The
+        // scheme is homogeneous in the voxel size, so only rounding changes.
+        const double diag_voxels = std::sqrt(double(res[0]) * res[0] + double(res[1]) * res[1] + double(res[2]) * res[2]);
+        double unit = 1.0;
+        while (diag_voxels * unit >= 500.0) unit *= 0.5;
+        auto xf = openvdb::math::Transform::createLinearTransform(unit);
         fog->setTransform(xf);
         // Negative tolerance keeps every voxel active (no value equals background within it).
         openvdb::tools::copyFromDense(in, *fog, -1.0f);
         auto sdf = openvdb::tools::fogToSdf(*fog, iso, sweeps);
         openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dst(box, out.channel(0).data());
         openvdb::tools::copyToDense(*sdf, dst);
-        // Keep the sign convention exact (density > iso is inside) even where
-        // the sweep left a zero.
+        // Back to metres; keep the sign convention exact (density > iso is
+        // inside) even where the sweep left a zero.
         auto s = out.channel(0);
+        const double to_metres = h[0] / unit;
         for (size_t i = 0; i < count; ++i) {
             const bool inside = detail::is_inside(dens[i], iso);
-            if (inside != (s[i] < 0)) s[i] = inside ? -std::abs(s[i]) : std::abs(s[i]);
+            if (!std::isfinite(s[i]) || std::abs(double(s[i])) >= 1000.0)
+                throw Error("sdf (fast sweeping): OpenVDB left voxel (" + std::to_string(i % size_t(res[0])) + ", " +
+                            std::to_string((i / size_t(res[0])) % size_t(res[1])) + ", " + std::to_string(i / (size_t(res[0]) * size_t(res[1]))) +
+                            ") without a distance (use the edt method)");
+            const float m = float(double(std::abs(s[i])) * to_metres);
+            s[i] = inside ? -m : m;
         }
         for (int z = 0; z < res[2]; ++z)
             for (int y = 0; y < res[1]; ++y)
