@@ -10,7 +10,10 @@ PACKAGES=(
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev libboost-iostreams-dev
   libtet1.5-dev libtbb-dev libyaml-cpp-dev zlib1g-dev libblosc-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev
-  libsquish-dev
+  libsquish-dev libcgal-demo
+  # Independent readers for the engine-import test (tests/engine_import/): OpenImageIO's
+  # and OpenVDB's own Python bindings for the system Python 3.11, and pytest.
+  python3-openimageio python3-openvdb python3-numpy python3-pytest
 )
 
 missing=()

@@ -31,6 +31,9 @@ void cook(CookContext& ctx) {
     }();
     ctx.metric("seconds", st.seconds);
     ctx.metric("line_hits", double(st.line_hits));
+    ctx.metric("winding_fallback_voxels", double(st.winding_fallback_voxels));
+    ctx.metric("buried_triangles", double(st.buried_triangles));
+    ctx.metric("straddling_triangles", double(st.straddling_triangles));
     auto density = std::make_shared<Field3D>(volume::density_from_sdf(sdf));
     ctx.set_output("sdf", Field3DPtr(std::make_shared<Field3D>(std::move(sdf))));
     ctx.set_output("density", Field3DPtr(density));
@@ -38,5 +41,5 @@ void cook(CookContext& ctx) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "volume/mesh_to_sdf", .version = 1, .declare = declare, .cook = cook});
+    registry.add({.name = "volume/mesh_to_sdf", .version = 2, .declare = declare, .cook = cook});
 }

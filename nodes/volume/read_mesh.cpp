@@ -29,5 +29,5 @@ void hash_extra(const NodeParams& p, Hasher& h) { hash_file(h, p.get_path("file"
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "volume/read_mesh", .version = 1, .declare = declare, .cook = cook, .hash_extra = hash_extra});
+    registry.add({.name = "volume/read_mesh", .version = 2, .declare = declare, .cook = cook, .hash_extra = hash_extra});
 }

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <random>
 
@@ -265,4 +267,238 @@ TEST(MeshSdf, SameBytesForAnyThreadCount) {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 1);
     EXPECT_TRUE(mesh_to_sdf(m, {{32, 32, 32}}, grid_box(32)) == many);
     EXPECT_TRUE(mesh_winding_field(m, {{32, 32, 32}}, grid_box(32)) == many_w);
+}
+
+namespace {
+
+Mesh merged(Mesh a, const Mesh& b) {
+    const uint32_t off = uint32_t(a.vertices.size());
+    a.vertices.insert(a.vertices.end(), b.vertices.begin(), b.vertices.end());
+    for (auto t : b.triangles) a.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+    return a;
+}
+
+// Distance from p to the boundary of the union of two true spheres: for each
+// sphere, the nearest point of its surface outside the other sphere is the
+// radial point if that is outside, else on the intersection circle (distance
+// on a sphere grows with the angle from the radial point).
+double union_of_spheres_distance(Vec3d p, Vec3d c1, double r1, Vec3d c2, double r2) {
+    auto part = [&](Vec3d ci, double ri, Vec3d cj, double rj) {
+        const Vec3d d = p - ci;
+        const double l = length(d);
+        const Vec3d radial = l > 0 ? ci + d * (ri / l) : ci + Vec3d{{ri, 0, 0}};
+        if (length(radial - cj) >= rj) return std::abs(l - ri);
+        // Intersection circle: on the axis at distance s from ci, radius rho.
+        const Vec3d axis = (cj - ci) / length(cj - ci);
+        const double D = length(cj - ci);
+        const double s = (D * D + ri * ri - rj * rj) / (2 * D);
+        const double rho = std::sqrt(std::max(0.0, ri * ri - s * s));
+        const double along = dot(d, axis) - s;
+        const double across = length(d - axis * dot(d, axis));
+        return std::hypot(along, across - rho);
+    };
+    const double in = std::min(length(p - c1) - r1, length(p - c2) - r2) < 0 ? -1 : 1;
+    return in * std::min(part(c1, r1, c2, r2), part(c2, r2, c1, r1));
+}
+
+std::string error_of(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+void write_text(const std::filesystem::path& p, const std::string& s) {
+    std::FILE* f = std::fopen(p.c_str(), "w");
+    std::fputs(s.c_str(), f);
+    std::fclose(f);
+}
+
+// The CGAL demo data's Stanford bunny (libcgal-demo, scripts/setup.sh), extracted once.
+std::filesystem::path bunny_file() {
+    static const std::filesystem::path out = [] {
+        const auto dir = std::filesystem::temp_directory_path() / ("atlas_bunny_" + std::to_string(::getpid()));
+        std::filesystem::create_directories(dir);
+        const std::string cmd = "tar -xzf /usr/share/doc/libcgal-demo/data.tar.gz -C " + dir.string() + " data/meshes/bunny00.off";
+        EXPECT_EQ(std::system(cmd.c_str()), 0) << "needs libcgal-demo (scripts/setup.sh)";
+        return dir / "data/meshes/bunny00.off";
+    }();
+    return out;
+}
+
+} // namespace
+
+// Two overlapping closed spheres: distances are to the union's boundary, not
+// to the faces buried inside the other sphere (analytic reference).
+TEST(MeshSdf, OverlappingSpheresDistanceToUnion) {
+    const Vec3d c1{{9.2, 12.1, 11.9}}, c2{{14.6, 11.7, 12.3}};
+    const double r1 = 6, r2 = 5;
+    // A third, small sphere wholly inside the first: no surface of the union.
+    const Mesh m = merged(merged(uv_sphere(c1, r1, 32, 64), uv_sphere(c2, r2, 32, 64)), uv_sphere({{7.5, 12, 12}}, 2, 8, 16));
+    MeshSdfStats st;
+    const Field3D s = mesh_to_sdf(m, {{24, 24, 24}}, grid_box(24), {}, nullptr, &st);
+    EXPECT_GT(st.buried_triangles, 0u);
+    EXPECT_GT(st.straddling_triangles, 0u);
+    double worst_band = 0, worst = 0;
+    for (int z = 0; z < 24; ++z)
+        for (int y = 0; y < 24; ++y)
+            for (int x = 0; x < 24; ++x) {
+                const Vec3d p = s.voxel_center(x, y, z);
+                const double ref = union_of_spheres_distance(p, c1, r1, c2, r2);
+                const double got = s.at(0, x, y, z);
+                if (std::abs(ref) > 0.05) {
+                    ASSERT_EQ(got < 0, ref < 0) << x << "," << y << "," << z;
+                }
+                const double e = std::abs(got - ref);
+                (std::abs(ref) <= 1.5 ? worst_band : worst) = std::max(std::abs(ref) <= 1.5 ? worst_band : worst, e);
+            }
+    // Tessellation (32 x 64 sphere: chord sag < 0.03 m) plus the method's bound.
+    EXPECT_LT(worst_band, 0.04);
+    EXPECT_LT(worst, 0.5);
+}
+
+TEST(MeshWinding, FastWindingNumberMatchesExact) {
+    Mesh m = uv_sphere({{0.2, -0.1, 0.3}}, 5, 24, 48);
+    m.triangles.erase(m.triangles.begin() + 100, m.triangles.begin() + 130); // a hole
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-8, 8);
+    std::vector<Vec3d> pts(2000);
+    for (auto& p : pts) p = {{u(rng), u(rng), u(rng)}};
+    const std::vector<double> fast = fast_winding_numbers(m, pts);
+    double worst = 0;
+    for (size_t i = 0; i < pts.size(); ++i) worst = std::max(worst, std::abs(fast[i] - winding_number(m, pts[i])));
+    EXPECT_LT(worst, 0.02);
+}
+
+// The bunny with 171 faces deleted: the fallback runs (and is reported) only
+// where the six rays disagree, and the inside test still matches the closed
+// bunny away from the surface.
+TEST(MeshSdf, OpenBunnyReportsWindingFallback) {
+    const Mesh closed = read_mesh(bunny_file());
+    ASSERT_GT(closed.triangles.size(), 70000u);
+    Mesh open = closed;
+    const size_t step = open.triangles.size() / 171;
+    std::vector<std::array<uint32_t, 3>> kept;
+    for (size_t i = 0; i < open.triangles.size(); ++i)
+        if (i % step != step / 2 || i / step >= 171) kept.push_back(open.triangles[i]);
+    ASSERT_EQ(kept.size(), open.triangles.size() - 171);
+    open.triangles = kept;
+    const Vec3i res{{48, 48, 48}};
+    const Box3d box{{{-0.55, -0.55, -0.55}}, {{0.55, 0.55, 0.55}}};
+    MeshSdfStats sc, so;
+    const Field3D a = mesh_to_sdf(closed, res, box, {}, nullptr, &sc);
+    const Field3D b = mesh_to_sdf(open, res, box, {}, nullptr, &so);
+    EXPECT_EQ(sc.winding_fallback_voxels, 0u);
+    EXPECT_GT(so.winding_fallback_voxels, 0u);
+    const double h = a.voxel_size()[0];
+    int wrong = 0;
+    for (size_t i = 0; i < a.voxel_count(); ++i)
+        if (std::abs(a.channel(0)[i]) > h) wrong += (a.channel(0)[i] < 0) != (b.channel(0)[i] < 0);
+    EXPECT_EQ(wrong, 0);
+}
+
+TEST(MeshIo, TextErrorsNameLineAndIndex) {
+    const auto dir = std::filesystem::temp_directory_path() / ("atlas_mesh_text_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string verts = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+    auto obj = [&](const std::string& name, const std::string& text) {
+        write_text(dir / name, text);
+        return error_of([&] { read_mesh(dir / name); });
+    };
+    auto has = [](const std::string& msg, std::initializer_list<const char*> parts) {
+        for (const char* p : parts)
+            if (msg.find(p) == std::string::npos) return false;
+        return true;
+    };
+    // A face line cut mid-way.
+    std::string e = obj("cut.obj", verts + "f 1 2 3\nf 1 2 4\nf 1 3");
+    EXPECT_TRUE(has(e, {"cut.obj:7", "face 3", "at least 3"})) << e;
+    e = obj("cutcorner.obj", verts + "f 1 2 3\nf 1 2 3/");
+    EXPECT_TRUE(has(e, {"cutcorner.obj:6", "face 2 corner 3", "'3/'"})) << e;
+    // A face past the vertices (the vertex list was cut).
+    e = obj("past.obj", verts + "f 1 2 3\nf 2 3 9\n");
+    EXPECT_TRUE(has(e, {"past.obj:6", "face 2 corner 3", "vertex 9", "4 vertices"})) << e;
+    e = obj("vert.obj", "v 0 0 0\nv 1 0\n");
+    EXPECT_TRUE(has(e, {"vert.obj:2", "vertex 2", "'v x y z'"})) << e;
+    e = obj("word.obj", "v 0 0 0\nv 1 zero 0\n");
+    EXPECT_TRUE(has(e, {"word.obj:2", "vertex 2", "'zero'"})) << e;
+    // One vertex at 1e30: a range error naming it, not "degenerate".
+    e = obj("far.obj", verts + "v 1e30 0 0\nf 1 2 3\nf 1 2 5\n");
+    EXPECT_TRUE(has(e, {"far.obj:5", "vertex 5", "supported range"})) << e;
+    // OFF: truncated vertex and face lists, bad indices.
+    e = obj("short.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n");
+    EXPECT_TRUE(has(e, {"short.off", "4 vertices", "after 3", "vertex 3"})) << e;
+    const std::string off_v = "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
+    e = obj("fewfaces.off", off_v + "3 0 1 2\n");
+    EXPECT_TRUE(has(e, {"fewfaces.off", "2 faces", "after 1", "face 1"})) << e;
+    e = obj("badidx.off", off_v + "3 0 1 2\n3 0 1 7\n");
+    EXPECT_TRUE(has(e, {"badidx.off:8", "face 1 corner 2", "vertex 7", "4 vertices"})) << e;
+    e = obj("cutface.off", off_v + "3 0 1 2\n3 0 1\n");
+    EXPECT_TRUE(has(e, {"cutface.off:8", "face 1", "3 corners"})) << e;
+    e = obj("nan.off", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n");
+    EXPECT_TRUE(has(e, {"nan.off:4", "vertex 1", "not finite"})) << e;
+    // Valid files with comments, relative indices, texture/normal references and colours still read.
+    write_text(dir / "ok.obj", "# tetra\n" + verts + "vn 0 0 1\nvt 0 0\nf 1/1/1 3//1 2\nf -4 -3 -1\nf 1 4 3\nf 2 3 4\n");
+    EXPECT_EQ(read_mesh(dir / "ok.obj").triangles.size(), 4u);
+    write_text(dir / "ok.off", "OFF # tetra\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1 255 0 0\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+    EXPECT_EQ(read_mesh(dir / "ok.off").triangles.size(), 4u);
+    // In memory: a far vertex and far grid bounds are refused with the reason.
+    Mesh far = box_mesh({{1, 1, 1}}, {{2, 2, 2}});
+    far.vertices[5][2] = 1e30f;
+    e = error_of([&] { mesh_to_sdf(far, {{4, 4, 4}}, grid_box(4)); });
+    EXPECT_TRUE(has(e, {"vertex 5", "z = 1.00000002e+30", "supported range"})) << e;
+    e = error_of([&] { mesh_to_sdf(box_mesh({{1, 1, 1}}, {{2, 2, 2}}), {{4, 4, 4}}, grid_box(1e19)); });
+    EXPECT_TRUE(has(e, {"1e18"})) << e;
+    // Within the range, distances near 1e18 m are finite and right (no float overflow).
+    const Field3D big = mesh_to_sdf(box_mesh({{0, 0, 0}}, {{1e15, 1e15, 1e15}}), {{4, 4, 4}}, Box3d{{{-9e17, -9e17, -9e17}}, {{9e17, 9e17, 9e17}}});
+    for (float v : big.channel(0)) EXPECT_TRUE(std::isfinite(v) && v > 1e17f && v < 1.6e18f) << v;
+    std::filesystem::remove_all(dir);
+}
+
+// docs/volumes.md states the measured accuracy of the EDT far field (beyond
+// the exact band) against brute-force distances to every triangle: closed
+// surfaces inside the grid, open rims, and surfaces that leave the grid.
+TEST(MeshSdf, AccuracyNearOpenRimsAndGridEdges) {
+    struct Case {
+        const char* name;
+        Mesh mesh;
+        double bound; // voxels, as stated in docs/volumes.md
+    };
+    Mesh cap = uv_sphere({{12.3, 11.6, 12.4}}, 7.3, 24, 48);
+    std::erase_if(cap.triangles, [&](const std::array<uint32_t, 3>& t) {
+        return cap.vertices[t[0]][2] + cap.vertices[t[1]][2] + cap.vertices[t[2]][2] > 3 * (12.4 + 3.1);
+    });
+    Mesh sheet; // an open, wavy sheet crossing the whole grid and beyond
+    for (int j = 0; j <= 20; ++j)
+        for (int i = 0; i <= 20; ++i)
+            sheet.vertices.push_back({{float(-4 + 1.6 * i), float(-4 + 1.6 * j), float(11 + 3 * std::sin(0.4 * i) * std::cos(0.3 * j))}});
+    for (uint32_t j = 0; j < 20; ++j)
+        for (uint32_t i = 0; i < 20; ++i) {
+            const uint32_t a = j * 21 + i;
+            sheet.triangles.push_back({a, a + 1, a + 22});
+            sheet.triangles.push_back({a, a + 22, a + 21});
+        }
+    const Case cases[] = {
+        {"closed sphere", uv_sphere({{12.3, 11.6, 12.4}}, 7.3, 24, 48), 0.5},
+        {"open cap (rim)", cap, 1.25},
+        {"sphere leaving the grid", uv_sphere({{21.3, 20.6, 12.4}}, 7.3, 24, 48), 1.25},
+        {"sheet leaving the grid", sheet, 1.25},
+    };
+    for (const Case& c : cases) {
+        const Field3D s = mesh_to_sdf(c.mesh, {{24, 24, 24}}, grid_box(24));
+        double over = 0, under = 0;
+        for (int z = 0; z < 24; ++z)
+            for (int y = 0; y < 24; ++y)
+                for (int x = 0; x < 24; ++x) {
+                    const double ref = closest_distance(c.mesh, s.voxel_center(x, y, z));
+                    const double e = std::abs(s.at(0, x, y, z)) - ref; // 1 m voxels
+                    over = std::max(over, e);
+                    under = std::max(under, -e);
+                }
+        std::printf("%s: max over-estimate %.3f voxel, max under-estimate %.2g voxel\n", c.name, over, under);
+        EXPECT_LT(over, c.bound) << c.name;
+        EXPECT_LT(under, 1e-4) << c.name; // distances to surface points never fall short
+    }
 }

@@ -9,7 +9,11 @@
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
 
 #include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <fstream>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -25,6 +29,12 @@ using Polygon = std::vector<std::size_t>;
 namespace PMP = CGAL::Polygon_mesh_processing;
 
 Vec3d to_d(const Point& p) { return {{p.x(), p.y(), p.z()}}; }
+
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    return buf;
+}
 
 uint32_t find_root(std::vector<uint32_t>& parent, uint32_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
@@ -46,18 +56,14 @@ Mesh repair_soup(std::vector<Point> points, std::vector<Polygon> polygons, MeshR
     // duplicate polygons (any orientation), removes unused points.
     PMP::repair_polygon_soup(points, tris, CGAL::parameters::erase_all_duplicates(false).require_same_orientation(false));
     rep.merged_vertices = points_in > points.size() ? points_in - points.size() : 0;
-    // Collinear (zero-area) triangles.
-    double diag2 = 0;
-    if (!points.empty()) {
-        Vec3d lo = to_d(points[0]), hi = lo;
-        for (const Point& p : points)
-            for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
-        diag2 = dot(hi - lo, hi - lo);
-    }
+    // Collinear (zero-area) triangles: area tiny against the triangle's own
+    // longest edge squared (scale-free, so one far vertex does not make every
+    // other triangle "degenerate").
     const size_t before_area = tris.size();
     std::erase_if(tris, [&](const Polygon& t) {
         const Vec3d a = to_d(points[t[0]]), b = to_d(points[t[1]]), c = to_d(points[t[2]]);
-        return length(cross(b - a, c - a)) * 0.5 <= 1e-12 * diag2;
+        const double e2 = std::max({dot(b - a, b - a), dot(c - b, c - b), dot(a - c, a - c)});
+        return length(cross(b - a, c - a)) * 0.5 <= 1e-12 * e2;
     });
     const size_t after = tris.size();
     rep.removed_degenerate = before_area - after;
@@ -107,6 +113,171 @@ Mesh repair_soup(std::vector<Point> points, std::vector<Polygon> polygons, MeshR
     return out;
 }
 
+
+// Text OBJ and OFF are parsed here (not by CGAL) so that every error names
+// file:line, the vertex or face, and what was expected; CGAL's readers accept
+// truncated files silently.
+struct TextReader {
+    std::string file;
+    std::ifstream in;
+    std::string line;
+    size_t line_no = 0;
+
+    explicit TextReader(const std::filesystem::path& f) : file(f.string()), in(f) {
+        if (!in) throw Error(file + ": cannot open mesh file");
+    }
+    // Next line split into tokens, '#' comments removed; false at the end.
+    bool next(std::vector<std::string>& tok) {
+        while (std::getline(in, line)) {
+            ++line_no;
+            if (const size_t h = line.find('#'); h != std::string::npos) line.resize(h);
+            tok.clear();
+            size_t i = 0;
+            while (i < line.size()) {
+                while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+                size_t j = i;
+                while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
+                if (j > i) tok.push_back(line.substr(i, j - i));
+                i = j;
+            }
+            if (!tok.empty()) return true;
+        }
+        return false;
+    }
+    [[noreturn]] void fail(const std::string& what) const { throw Error(file + ":" + std::to_string(line_no) + ": " + what); }
+    double real(const std::string& t, const std::string& what) const {
+        double v = 0;
+        const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+        if (r.ec != std::errc() || r.ptr != t.data() + t.size()) fail(what + ": expected a number, got '" + t + "'");
+        return v;
+    }
+    long long integer(const std::string& t, const std::string& what) const {
+        long long v = 0;
+        const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+        if (r.ec != std::errc() || r.ptr != t.data() + t.size()) fail(what + ": expected an integer, got '" + t + "'");
+        return v;
+    }
+    Point vertex(const std::vector<std::string>& tok, size_t first, const std::string& what) const {
+        double c[3];
+        for (int a = 0; a < 3; ++a) {
+            c[a] = real(tok[first + size_t(a)], what);
+            if (!std::isfinite(c[a])) fail(what + ": " + "xyz"[a] + " is not finite ('" + tok[first + size_t(a)] + "')");
+            if (std::abs(c[a]) > kMaxMeshCoordinate)
+                fail(what + ": " + "xyz"[a] + " = " + tok[first + size_t(a)] + " is outside the supported range +-1e18 m");
+        }
+        return Point(c[0], c[1], c[2]);
+    }
+};
+
+void read_obj(const std::filesystem::path& f, std::vector<Point>& points, std::vector<Polygon>& polys) {
+    TextReader r(f);
+    std::vector<std::string> tok;
+    struct Pending {
+        size_t line, face;
+        size_t corner;
+        long long index; // 1-based as written
+    };
+    std::vector<Pending> forward; // positive indices checked once all vertices are known
+    while (r.next(tok)) {
+        const std::string& k = tok[0];
+        if (k == "v") {
+            const std::string what = "vertex " + std::to_string(points.size() + 1);
+            if (tok.size() < 4) r.fail(what + ": expected 'v x y z', got " + std::to_string(tok.size() - 1) + " coordinate(s)");
+            points.push_back(r.vertex(tok, 1, what));
+        } else if (k == "vn" || k == "vt" || k == "vp") {
+            const size_t need = k == "vn" ? 3 : 1;
+            if (tok.size() < need + 1) r.fail("'" + k + "': expected " + std::to_string(need) + " number(s), got " + std::to_string(tok.size() - 1));
+            for (size_t i = 1; i < tok.size(); ++i) r.real(tok[i], "'" + k + "'");
+        } else if (k == "f") {
+            const std::string what = "face " + std::to_string(polys.size() + 1);
+            if (tok.size() < 4)
+                r.fail(what + ": expected at least 3 corners 'f v1 v2 v3', got " + std::to_string(tok.size() - 1));
+            Polygon poly;
+            for (size_t i = 1; i < tok.size(); ++i) {
+                const std::string& t = tok[i];
+                const std::string corner = what + " corner " + std::to_string(i);
+                // v, v/vt, v//vn or v/vt/vn
+                const size_t s1 = t.find('/');
+                const std::string vs = t.substr(0, s1);
+                if (s1 != std::string::npos) {
+                    const std::string rest = t.substr(s1 + 1);
+                    const size_t s2 = rest.find('/');
+                    const std::string vt = rest.substr(0, s2), vn = s2 == std::string::npos ? std::string() : rest.substr(s2 + 1);
+                    if ((vt.empty() && s2 == std::string::npos) || (s2 != std::string::npos && vn.empty()) ||
+                        (vn.find('/') != std::string::npos))
+                        r.fail(corner + ": expected v, v/vt, v//vn or v/vt/vn, got '" + t + "'");
+                    if (!vt.empty()) r.integer(vt, corner);
+                    if (!vn.empty()) r.integer(vn, corner);
+                }
+                const long long v = r.integer(vs, corner);
+                if (v == 0) r.fail(corner + ": vertex index 0 (OBJ counts from 1)");
+                if (v < 0) {
+                    if (-v > static_cast<long long>(points.size()))
+                        r.fail(corner + ": relative vertex index " + std::to_string(v) + " but only " + std::to_string(points.size()) +
+                               " vertices precede this line");
+                    poly.push_back(size_t(static_cast<long long>(points.size()) + v));
+                } else {
+                    forward.push_back({r.line_no, polys.size() + 1, i, v});
+                    poly.push_back(size_t(v - 1));
+                }
+            }
+            polys.push_back(std::move(poly));
+        }
+        // Other statements (g, o, s, usemtl, mtllib, l, p, ...) carry no geometry we use.
+    }
+    if (r.in.bad()) throw Error(r.file + ": read error after line " + std::to_string(r.line_no));
+    for (const Pending& p : forward)
+        if (size_t(p.index) > points.size())
+            throw Error(r.file + ":" + std::to_string(p.line) + ": face " + std::to_string(p.face) + " corner " + std::to_string(p.corner) +
+                        " uses vertex " + std::to_string(p.index) + " but the file has " + std::to_string(points.size()) +
+                        " vertices (1.." + std::to_string(points.size()) + "); truncated file?");
+}
+
+void read_off(const std::filesystem::path& f, std::vector<Point>& points, std::vector<Polygon>& polys) {
+    TextReader r(f);
+    std::vector<std::string> tok;
+    if (!r.next(tok)) throw Error(r.file + ": empty file, expected an OFF header");
+    const std::string head = tok[0];
+    static const char* kHeads[] = {"OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCOFF", "STNOFF", "STCNOFF"};
+    if (std::find(std::begin(kHeads), std::end(kHeads), head) == std::end(kHeads))
+        r.fail("expected an OFF header (OFF, COFF, NOFF, ...), got '" + head + "'");
+    tok.erase(tok.begin());
+    if (tok.empty() && !r.next(tok)) r.fail("expected the counts 'vertices faces edges' after the header");
+    const size_t counts_line = r.line_no;
+    if (tok.size() < 2) r.fail("expected the counts 'vertices faces edges', got '" + r.line + "'");
+    const long long nv = r.integer(tok[0], "vertex count"), nf = r.integer(tok[1], "face count");
+    if (nv < 0 || nf < 0) r.fail("negative vertex or face count");
+    points.reserve(size_t(std::min(nv, 1LL << 26)));
+    for (long long i = 0; i < nv; ++i) {
+        const std::string what = "vertex " + std::to_string(i);
+        if (!r.next(tok))
+            throw Error(r.file + ": truncated: line " + std::to_string(counts_line) + " announces " + std::to_string(nv) +
+                        " vertices, the file ends after " + std::to_string(i) + " (at " + what + ")");
+        if (tok.size() < 3) r.fail(what + ": expected 'x y z', got " + std::to_string(tok.size()) + " number(s)");
+        points.push_back(r.vertex(tok, 0, what));
+    }
+    for (long long i = 0; i < nf; ++i) {
+        const std::string what = "face " + std::to_string(i);
+        if (!r.next(tok))
+            throw Error(r.file + ": truncated: line " + std::to_string(counts_line) + " announces " + std::to_string(nf) +
+                        " faces, the file ends after " + std::to_string(i) + " (at " + what + ")");
+        const long long n = r.integer(tok[0], what + " corner count");
+        if (n < 3) r.fail(what + ": expected at least 3 corners, got " + std::to_string(n));
+        if (static_cast<long long>(tok.size()) < n + 1)
+            r.fail(what + ": announces " + std::to_string(n) + " corners but lists " + std::to_string(tok.size() - 1) + "; truncated?");
+        Polygon poly;
+        for (long long c = 0; c < n; ++c) {
+            const long long v = r.integer(tok[size_t(c + 1)], what + " corner " + std::to_string(c));
+            if (v < 0 || v >= nv)
+                r.fail(what + " corner " + std::to_string(c) + " uses vertex " + std::to_string(v) + " but the file has " + std::to_string(nv) +
+                       " vertices (0.." + std::to_string(nv - 1) + ")");
+            poly.push_back(size_t(v));
+        }
+        polys.push_back(std::move(poly)); // tokens after the corners: an optional colour
+    }
+    if (r.in.bad()) throw Error(r.file + ": read error after line " + std::to_string(r.line_no));
+}
+
 } // namespace
 
 void validate_mesh(const Mesh& m, const char* who) {
@@ -115,6 +286,9 @@ void validate_mesh(const Mesh& m, const char* who) {
         for (int a = 0; a < 3; ++a)
             if (!std::isfinite(m.vertices[i][a]))
                 throw Error(std::string(who) + ": vertex " + std::to_string(i) + " is not finite (" + std::to_string(m.vertices[i][a]) + ")");
+            else if (std::abs(m.vertices[i][a]) > kMaxMeshCoordinate)
+                throw Error(std::string(who) + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " + number(m.vertices[i][a]) +
+                            ", outside the supported range +-1e18 m");
     for (size_t t = 0; t < m.triangles.size(); ++t)
         for (uint32_t v : m.triangles[t])
             if (v >= m.vertices.size())
@@ -140,20 +314,34 @@ Mesh read_mesh(const std::filesystem::path& file, MeshRepairReport* report) {
     std::vector<Point> points;
     std::vector<Polygon> polys;
     if (!std::filesystem::exists(file)) throw Error(file.string() + ": no such mesh file");
-    bool ok = false;
-    try {
-        ok = CGAL::IO::read_polygon_soup(file.string(), points, polys, CGAL::parameters::verbose(false));
-    } catch (const std::exception& e) {
-        throw Error(file.string() + ": cannot read mesh (" + e.what() + ")");
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext == ".obj") read_obj(file, points, polys);
+    else if (ext == ".off") read_off(file, points, polys);
+    else {
+        bool ok = false;
+        try {
+            ok = CGAL::IO::read_polygon_soup(file.string(), points, polys, CGAL::parameters::verbose(false));
+        } catch (const std::exception& e) {
+            throw Error(file.string() + ": cannot read mesh (" + e.what() + ")");
+        }
+        if (!ok) throw Error(file.string() + ": cannot read mesh (expected OBJ, OFF, PLY or STL)");
     }
-    if (!ok) throw Error(file.string() + ": cannot read mesh (expected OBJ, OFF, PLY or STL)");
     if (polys.empty()) throw Error(file.string() + ": the mesh has no faces");
     for (size_t i = 0; i < points.size(); ++i)
-        for (int a = 0; a < 3; ++a)
+        for (int a = 0; a < 3; ++a) {
             if (!std::isfinite(points[i][a])) throw Error(file.string() + ": vertex " + std::to_string(i) + " is not finite");
-    for (size_t f = 0; f < polys.size(); ++f)
+            if (std::abs(points[i][a]) > kMaxMeshCoordinate)
+                throw Error(file.string() + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " + number(points[i][a]) +
+                            ", outside the supported range +-1e18 m");
+        }
+    for (size_t f = 0; f < polys.size(); ++f) {
+        if (polys[f].size() < 3) throw Error(file.string() + ": face " + std::to_string(f) + " has " + std::to_string(polys[f].size()) + " corners, expected at least 3");
         for (size_t v : polys[f])
-            if (v >= points.size()) throw Error(file.string() + ": face " + std::to_string(f) + " uses a vertex that does not exist");
+            if (v >= points.size())
+                throw Error(file.string() + ": face " + std::to_string(f) + " uses vertex " + std::to_string(v) + " but the file has " +
+                            std::to_string(points.size()));
+    }
     MeshRepairReport rep;
     Mesh out;
     try {

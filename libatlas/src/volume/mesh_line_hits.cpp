@@ -105,6 +105,9 @@ MeshLineHits mesh_line_hits(const Mesh& m, Vec3i res, Box3d bounds) {
     validate_mesh(m, "mesh voxelisation");
     if (!bounds.valid()) throw Error("mesh voxelisation: bounds must be finite with max > min on every axis");
     for (int a = 0; a < 3; ++a)
+        if (std::abs(bounds.min[a]) > kMaxMeshCoordinate || std::abs(bounds.max[a]) > kMaxMeshCoordinate)
+            throw Error("mesh voxelisation: grid bounds must lie within +-1e18 m (distances beyond ~1.8e19 m overflow float)");
+    for (int a = 0; a < 3; ++a)
         if (res[a] < 1) throw Error("mesh voxelisation: resolution must be >= 1 on every axis");
     // Vertices in continuous voxel index space: voxel centres at integers.
     std::vector<Vec3d> pv(m.vertices.size());
@@ -120,7 +123,7 @@ MeshLineHits mesh_line_hits(const Mesh& m, Vec3i res, Box3d bounds) {
     return out;
 }
 
-std::vector<float> ray_winding_vote(const MeshLineHits& hits, Vec3i res, const Mesh& mesh, Box3d bounds, uint64_t* exact_used) {
+std::vector<float> ray_winding_vote(const MeshLineHits& hits, Vec3i res, const Mesh& mesh, Box3d bounds, uint64_t* fallback_voxels) {
     const size_t stride[3] = {1, size_t(res[0]), size_t(res[0]) * size_t(res[1])};
     const size_t count = stride[2] * size_t(res[2]);
     std::vector<float> sum(count, 0.0f);
@@ -160,24 +163,24 @@ std::vector<float> ray_winding_vote(const MeshLineHits& hits, Vec3i res, const M
     for (float& s : sum) s /= 6.0f;
     uint64_t n_disagree = 0;
     for (uint8_t d : disagree) n_disagree += d;
-    if (exact_used) *exact_used = 0;
-    if (n_disagree == 0 || double(n_disagree) * double(mesh.triangles.size()) > kExactWindingBudget) return sum;
+    if (fallback_voxels) *fallback_voxels = n_disagree;
+    if (n_disagree == 0) return sum;
     std::vector<size_t> todo;
     todo.reserve(n_disagree);
     for (size_t v = 0; v < count; ++v)
         if (disagree[v]) todo.push_back(v);
     Vec3d h;
     for (int a = 0; a < 3; ++a) h[a] = (bounds.max[a] - bounds.min[a]) / res[a];
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+    const FastWindingNumber wn(mesh);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t k = r.begin(); k < r.end(); ++k) {
             const size_t v = todo[k];
             const size_t x = v % stride[1], y = (v / stride[1]) % size_t(res[1]), z = v / stride[2];
             const Vec3d p{{bounds.min[0] + (double(x) + 0.5) * h[0], bounds.min[1] + (double(y) + 0.5) * h[1],
                            bounds.min[2] + (double(z) + 0.5) * h[2]}};
-            sum[v] = float(winding_number(mesh, p));
+            sum[v] = float(wn(p));
         }
     });
-    if (exact_used) *exact_used = n_disagree;
     return sum;
 }
 

@@ -43,6 +43,13 @@ Vec3d closest_on_triangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const 
 
 double diagonal(const Box3d& b) { return length(b.size()); }
 
+Vec3d closest_on_segment(const Vec3d& p, const Vec3d& a, const Vec3d& b) {
+    const Vec3d e = b - a;
+    const double ee = dot(e, e);
+    if (!(ee > 0)) return a;
+    return a + e * std::clamp(dot(p - a, e) / ee, 0.0, 1.0);
+}
+
 } // namespace
 
 double winding_number(const Mesh& m, Vec3d p) {
@@ -72,10 +79,13 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
     const auto t0 = std::chrono::steady_clock::now();
     if (!(o.exact_band_voxels >= 0) || !std::isfinite(o.exact_band_voxels))
         throw Error("mesh_to_sdf: exact_band_voxels must be finite and >= 0");
-    if (!std::isfinite(o.far_distance)) throw Error("mesh_to_sdf: far_distance must be finite");
+    if (!std::isfinite(o.far_distance) || std::abs(o.far_distance) > kMaxMeshCoordinate)
+        throw Error("mesh_to_sdf: far_distance must be finite and within 1e18 m");
     const uint64_t count = uint64_t(res[0]) * res[1] * res[2];
     if (budget) budget->check(field_bytes(count, 5), "mesh_to_sdf: output, winding, band and two EDT grids");
     const detail::MeshLineHits hits = detail::mesh_line_hits(m, res, bounds);
+    // Overlapping parts: distances go to the union's surface only.
+    const detail::UnionSurface us = detail::union_surface(m);
     Field3D out(res, 1, bounds, {"sdf"}, budget);
     const Vec3d h = out.voxel_size();
     const size_t stride[3] = {1, size_t(res[0]), size_t(res[0]) * size_t(res[1])};
@@ -87,26 +97,40 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
         const size_t ib = (base / stride[b]) % size_t(res[b]), ic = (base / stride[c]) % size_t(res[c]);
         const uint32_t l = uint32_t(ib) + uint32_t(ic) * uint32_t(res[b]);
         const auto& ah = hits.axis[a];
-        s.assign(ah.t.begin() + ah.offsets[l], ah.t.begin() + ah.offsets[l + 1]);
+        if (us.trivial()) s.assign(ah.t.begin() + ah.offsets[l], ah.t.begin() + ah.offsets[l + 1]);
+        else detail::union_boundary_hits(ah, l, s);
     };
     std::vector<float> d2 = detail::squared_distance_to_line_seeds(res, h, seeds);
 
-    // Near field: exact point-triangle distances within the band (serial over
-    // triangles, min is order-independent).
+    // Near field: exact distances to the union's surface within the band.
+    // Triangles wholly on the surface: point-triangle distance (serial over
+    // triangles; min is order-independent). Buried triangles: none.
+    // Straddling triangles: the nearest point of their unburied part, which
+    // is the triangle's closest point if unburied, else on an edge, a corner
+    // or an intersection segment (parallel per triangle, merged in order).
     const double vmin = std::min({h[0], h[1], h[2]});
     const double band = o.exact_band_voxels * vmin;
+    auto voxel_range = [&](const Vec3d& a, const Vec3d& b, const Vec3d& c, int lo[3], int hi[3]) {
+        bool empty = false;
+        for (int k = 0; k < 3; ++k) {
+            const double mn = std::min({a[k], b[k], c[k]}) - band, mx = std::max({a[k], b[k], c[k]}) + band;
+            lo[k] = std::max(0, int(std::ceil((mn - bounds.min[k]) / h[k] - 0.5)));
+            hi[k] = std::min(res[k] - 1, int(std::floor((mx - bounds.min[k]) / h[k] - 0.5)));
+            empty |= lo[k] > hi[k];
+        }
+        return !empty;
+    };
+    std::vector<uint32_t> straddling;
     if (band > 0) {
-        for (const auto& t : m.triangles) {
+        for (uint32_t ti = 0; ti < m.triangles.size(); ++ti) {
+            if (!us.trivial() && us.state[ti] != detail::UnionSurface::kSurface) {
+                if (us.state[ti] == detail::UnionSurface::kStraddling) straddling.push_back(ti);
+                continue;
+            }
+            const auto& t = m.triangles[ti];
             const Vec3d a = to_d(m.vertices[t[0]]), b = to_d(m.vertices[t[1]]), c = to_d(m.vertices[t[2]]);
             int lo[3], hi[3];
-            bool empty = false;
-            for (int k = 0; k < 3; ++k) {
-                const double mn = std::min({a[k], b[k], c[k]}) - band, mx = std::max({a[k], b[k], c[k]}) + band;
-                lo[k] = std::max(0, int(std::ceil((mn - bounds.min[k]) / h[k] - 0.5)));
-                hi[k] = std::min(res[k] - 1, int(std::floor((mx - bounds.min[k]) / h[k] - 0.5)));
-                empty |= lo[k] > hi[k];
-            }
-            if (empty) continue;
+            if (!voxel_range(a, b, c, lo, hi)) continue;
             for (int z = lo[2]; z <= hi[2]; ++z)
                 for (int y = lo[1]; y <= hi[1]; ++y)
                     for (int x = lo[0]; x <= hi[0]; ++x) {
@@ -118,7 +142,39 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
                     }
         }
     }
-    const std::vector<float> vote = detail::ray_winding_vote(hits, res, m, bounds);
+    if (!straddling.empty()) {
+        std::vector<std::vector<std::pair<size_t, float>>> found(straddling.size());
+        tbb::parallel_for(size_t(0), straddling.size(), [&](size_t si) {
+            const uint32_t ti = straddling[si];
+            const auto& t = m.triangles[ti];
+            const Vec3d v[3] = {to_d(m.vertices[t[0]]), to_d(m.vertices[t[1]]), to_d(m.vertices[t[2]])};
+            int lo[3], hi[3];
+            if (!voxel_range(v[0], v[1], v[2], lo, hi)) return;
+            const auto& segs = us.segments[ti];
+            for (int z = lo[2]; z <= hi[2]; ++z)
+                for (int y = lo[1]; y <= hi[1]; ++y)
+                    for (int x = lo[0]; x <= hi[0]; ++x) {
+                        const Vec3d p = out.voxel_center(x, y, z);
+                        double best = std::numeric_limits<double>::infinity();
+                        auto offer = [&](const Vec3d& q) { best = std::min(best, dot(q - p, q - p)); };
+                        const Vec3d q = closest_on_triangle(p, v[0], v[1], v[2]);
+                        if (!us.point_buried(m, ti, q)) offer(q);
+                        else {
+                            for (int k = 0; k < 3; ++k) {
+                                if (!us.corner_buried[ti][size_t(k)]) offer(v[k]);
+                                const Vec3d qe = closest_on_segment(p, v[k], v[(k + 1) % 3]);
+                                if (dot(qe - p, qe - p) < best && !us.point_buried(m, ti, qe)) offer(qe);
+                            }
+                            for (const auto& sg : segs) offer(closest_on_segment(p, sg[0], sg[1]));
+                        }
+                        if (best < std::numeric_limits<double>::infinity()) found[si].push_back({out.index(x, y, z), float(best)});
+                    }
+        });
+        for (const auto& f : found)
+            for (const auto& [i, e] : f) d2[i] = std::min(d2[i], e);
+    }
+    uint64_t fallback = 0;
+    const std::vector<float> vote = detail::ray_winding_vote(hits, res, m, bounds, &fallback);
     const float far = float(o.far_distance > 0 ? o.far_distance : diagonal(bounds));
     auto sdf = out.channel(0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(count), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
@@ -129,6 +185,9 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
     });
     if (stats) {
         stats->line_hits = hits.total;
+        stats->winding_fallback_voxels = fallback;
+        stats->buried_triangles = us.buried;
+        stats->straddling_triangles = us.straddling;
         stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     return out;

@@ -30,16 +30,22 @@ Field3D mesh_to_sdf_openvdb(const Mesh& m, Vec3i res, Box3d bounds, const Memory
     std::vector<openvdb::Vec3s> pts;
     pts.reserve(m.vertices.size());
     for (const Vec3f& v : m.vertices) pts.emplace_back(v[0], v[1], v[2]); // world space
+    // Overlapping parts: triangles wholly buried in another part are left out
+    // (straddling ones are kept whole: near the seams distances may be short
+    // by up to a triangle's size).
+    const detail::UnionSurface us = detail::union_surface(m);
     std::vector<openvdb::Vec3I> tris;
     tris.reserve(m.triangles.size());
-    for (const auto& t : m.triangles) tris.emplace_back(t[0], t[1], t[2]);
+    for (size_t i = 0; i < m.triangles.size(); ++i)
+        if (us.trivial() || us.state[i] != detail::UnionSurface::kBuried) tris.emplace_back(m.triangles[i][0], m.triangles[i][1], m.triangles[i][2]);
     std::vector<openvdb::Vec4I> quads;
     // Exact unsigned distances in a narrow band (3 voxels), signed by the
     // ray-winding vote (OpenVDB's own sign needs a watertight mesh), then
     // extended over the whole grid by OpenVDB's fast sweeping (maskSdf).
     const float bandwidth = 3.0f;
     auto grid = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xf, pts, tris, quads, bandwidth);
-    const std::vector<float> vote = detail::ray_winding_vote(hits, res, m, bounds);
+    uint64_t fallback = 0;
+    const std::vector<float> vote = detail::ray_winding_vote(hits, res, m, bounds, &fallback);
     const openvdb::CoordBBox box(openvdb::Coord(0, 0, 0), openvdb::Coord(res[0] - 1, res[1] - 1, res[2] - 1));
     for (auto it = grid->beginValueOn(); it; ++it) {
         const openvdb::Coord c = it.getCoord();
@@ -65,6 +71,9 @@ Field3D mesh_to_sdf_openvdb(const Mesh& m, Vec3i res, Box3d bounds, const Memory
     }
     if (stats) {
         stats->line_hits = hits.total;
+        stats->winding_fallback_voxels = fallback;
+        stats->buried_triangles = us.buried;
+        stats->straddling_triangles = us.straddling;
         stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     return out;

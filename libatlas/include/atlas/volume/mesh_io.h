@@ -22,9 +22,13 @@ struct MeshRepairReport {
     uint64_t components = 0;           // edge-connected components after repair
 };
 
+// Largest |coordinate| (metres) of a vertex or a grid bound. Distances then
+// stay below ~3.5e18 m; beyond ~1.8e19 m their squares overflow float.
+inline constexpr double kMaxMeshCoordinate = 1e18;
+
 // Throws atlas::Error (naming `who` and the problem) when the mesh has no
-// triangles, a vertex that is NaN or infinite (naming its index), or an
-// index out of range.
+// triangles, a vertex that is NaN or infinite or beyond +-kMaxMeshCoordinate
+// (naming its index and coordinate), or an index out of range.
 void validate_mesh(const Mesh& mesh, const char* who = "mesh");
 
 // Repair for voxelisation: merge duplicate vertices (exact positions), drop

@@ -24,6 +24,7 @@
 #include "atlas/core/geometry.h"
 
 #include <cstdint>
+#include <vector>
 
 namespace atlas {
 class MemoryBudget;
@@ -34,6 +35,12 @@ namespace atlas::volume {
 // Exact generalized winding number (sum of signed solid angles / 4 pi) of the
 // mesh at p. O(triangles); the reference for tests and sparse queries.
 double winding_number(const Mesh& mesh, Vec3d p);
+
+// Generalized winding numbers at many points, fast (Barill et al. 2018: a
+// triangle hierarchy, far nodes by their dipole term, near triangles exact);
+// absolute error < 0.02 against winding_number in the tests (0.012 measured). Parallel,
+// deterministic.
+std::vector<double> fast_winding_numbers(const Mesh& mesh, const std::vector<Vec3d>& points);
 
 // Mean of the six axis-ray winding counts per voxel; channel "winding".
 // Inside where > 0.5.
@@ -49,7 +56,10 @@ struct MeshSdfOptions {
 };
 
 struct MeshSdfStats {
-    uint64_t line_hits = 0; // ray/triangle crossings on the grid lines
+    uint64_t line_hits = 0;               // ray/triangle crossings on the grid lines
+    uint64_t winding_fallback_voxels = 0; // voxels whose six ray counts disagreed: generalized winding number used
+    uint64_t buried_triangles = 0;        // triangles wholly inside another part (no distance to them)
+    uint64_t straddling_triangles = 0;    // triangles crossing another part (distance to their unburied part)
     double seconds = 0;
 };
 
