@@ -8,9 +8,10 @@ namespace {
 using namespace atlas;
 
 void declare(NodeDeclaration& d) {
-    d.doc("Reads a stack of TGA slices (NAME.001.tga, NAME.002.tga, ...; one per z) as a 3D field with 8-bit values mapped to 0..1.");
+    d.doc("Reads a stack of TGA slices (NAME.001.tga, NAME.002.tga, ... or the Nubis pack's NAME(0).tga, NAME(1).tga, ...; one per z; "
+          "uncompressed or RLE, 8-bit grey, 24 or 32 bits) as a 3D field with 8-bit values mapped to 0..1 (channels r, g, b, a).");
     d.output("out", PortType::Field3D, "the stack as a 3D field (x = column, y = row from the bottom, z = slice)");
-    d.param_path("file").describe("the first slice (NAME.001.tga), relative to the graph file");
+    d.param_path("file").describe("the first slice (NAME.001.tga or NAME(0).tga), a pattern or DIR/NAME, relative to the graph file");
     d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");
     d.param_float3("bounds_max", {{4096, 4096, 512}}).with_unit("m").describe("world-space maximum corner");
     d.param_int("channels", 4).range(1, 4).describe("channels to keep (R, RG, RGB or RGBA)");
@@ -29,5 +30,5 @@ void hash_extra(const NodeParams& p, Hasher& h) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "import/tga_slices", .version = 1, .declare = declare, .cook = cook, .hash_extra = hash_extra});
+    registry.add({.name = "import/tga_slices", .version = 2, .declare = declare, .cook = cook, .hash_extra = hash_extra});
 }

@@ -67,7 +67,7 @@ TEST(Nvdf, PackTgaLayoutsRoundTrip) {
         ds.channel(0)[i] = 0.25f + float(i % 3) / 4.0f;
     }
     const Field3D nvdf = assemble_modeling_nvdf(dp, dt, ds);
-    const auto files = write_nubis_modeling_tga(nvdf, dir.path, "modeling");
+    const auto files = write_nubis_modeling_tga(nvdf, dir.path, "modeling", {io::SliceNaming::atlas, false});
     ASSERT_EQ(files.size(), 8u);
     // Raw layout, from the file's bytes: BGRA pixels after an 18-byte header, A = 0.
     {
@@ -124,4 +124,55 @@ TEST(Nvdf, PackVdbRoundTrip) {
     }
     Field3D wrong({{4, 4, 4}}, 1, kBox);
     EXPECT_THROW(assemble_modeling_nvdf(dp, wrong, ds), Error);
+}
+
+// The pack's own naming and RLE (the default encoding): the same values come back.
+TEST(Nvdf, PackTgaNubisNamingAndRle) {
+    TempDir dir;
+    const Field3D sdf = sphere_sdf();
+    Field3D dt(sdf.resolution(), 1, kBox), ds(sdf.resolution(), 1, kBox);
+    for (size_t i = 0; i < sdf.voxel_count(); ++i) {
+        dt.channel(0)[i] = float(i % 5) / 4.0f;
+        ds.channel(0)[i] = 0.5f;
+    }
+    const Field3D nvdf = assemble_modeling_nvdf(dimensional_profile(sdf), dt, ds);
+    const auto files = write_nubis_modeling_tga(nvdf, dir.path, "modeling_data", {io::SliceNaming::nubis, true});
+    ASSERT_EQ(files.size(), 8u);
+    EXPECT_EQ(files[7].filename(), "modeling_data(7).tga");
+    std::ifstream in(files[3], std::ios::binary);
+    std::vector<unsigned char> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_GE(b.size(), 18u);
+    EXPECT_EQ(b[2], 10); // RLE true colour
+    EXPECT_EQ(b[16], 32);
+    const Field3D back = read_nubis_modeling_tga(dir.path / "modeling_data(0).tga", kBox);
+    for (size_t i = 0; i < back.voxel_count(); ++i)
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(back.channel(c)[i], nvdf.channel(c)[i], 0.5 / 255 + 1e-6);
+    const auto fd = write_nubis_field_data_tga(sdf, dir.path, "field_data", {io::SliceNaming::nubis, true});
+    const Field3D fback = read_nubis_field_data_tga(dir.path / "field_data", kBox);
+    for (size_t i = 0; i < fback.voxel_count(); ++i) ASSERT_NEAR(fback.channel(0)[i], sdf.channel(0)[i], 4352.0 / 255 / 2 + 1e-2);
+}
+
+TEST(Nvdf, AssembleTakesEachInputsChannel) {
+    const Field3D sdf = sphere_sdf();
+    const Field3D dp = dimensional_profile(sdf);
+    Field3D rgba(sdf.resolution(), 4, kBox);
+    for (size_t i = 0; i < sdf.voxel_count(); ++i)
+        for (int c = 0; c < 4; ++c) rgba.channel(c)[i] = float((i + size_t(c) * 3) % 11) / 10.0f;
+    ModelingChannels mc;
+    mc.detail_type = 1;
+    mc.density_scale = 2;
+    const Field3D m = assemble_modeling_nvdf(dp, rgba, rgba, nullptr, mc);
+    for (size_t i = 0; i < sdf.voxel_count(); ++i) {
+        ASSERT_EQ(m.channel(1)[i], rgba.channel(1)[i]);
+        ASSERT_EQ(m.channel(2)[i], rgba.channel(2)[i]);
+    }
+    mc.density_scale = 4;
+    try {
+        assemble_modeling_nvdf(dp, rgba, rgba, nullptr, mc);
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        const std::string w = e.what();
+        EXPECT_NE(w.find("density_scale"), std::string::npos) << w;
+        EXPECT_NE(w.find("channel 4"), std::string::npos) << w;
+    }
 }

@@ -127,16 +127,39 @@ std::vector<fs::path> write_vdb_output(const Value& v, const fs::path& p, const 
 std::vector<fs::path> write_tga_slices_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
     const OptionReader o(opts, p);
     if (lower_extension(p) == ".tga")
-        throw Error(o.prefix() + "format 'tga-slices' takes DIR/STEM (it writes STEM.001.tga, STEM.002.tga, ...), not a .tga file name");
+        throw Error(o.prefix() + "format 'tga-slices' takes DIR/STEM (it writes STEM.001.tga, STEM.002.tga, ... or STEM(0).tga, ...), not a .tga file name");
     SliceOptions so;
     std::tie(so.range_min, so.range_max) = o.range("range", 0.0f, 1.0f);
     so.default_alpha = uint8_t(o.integer("alpha", 255, 0, 255));
-    if (o.list("channels").size() > 4) o.bad("channels", "at most 4 names (R, G, B, A)");
+    if (o.has("naming")) {
+        const std::string& n = o.text("naming");
+        if (n == "atlas") so.naming = SliceNaming::atlas;
+        else if (n == "nubis") so.naming = SliceNaming::nubis;
+        else o.bad("naming", "atlas (STEM.001.tga ...) or nubis (STEM(0).tga ...)");
+    }
+    if (o.has("compression")) {
+        const std::string& c = o.text("compression");
+        if (c == "rle") so.rle = true;
+        else if (c == "none") so.rle = false;
+        else o.bad("compression", "rle or none");
+    }
+    int holds = 4;
+    if (o.has("pixels")) {
+        const std::string& px = o.text("pixels");
+        if (px == "rgba") so.pixels = SlicePixels::rgba;
+        else if (px == "rgb") so.pixels = SlicePixels::rgb, holds = 3;
+        else if (px == "gray") so.pixels = SlicePixels::gray, holds = 1;
+        else o.bad("pixels", "rgba (32-bit), rgb (24-bit) or gray (8-bit)");
+    }
+    if (holds < 4 && o.has("alpha")) throw Error(o.prefix() + "option 'alpha' needs pixels 'rgba' (these slices have no alpha)");
+    const std::string kind = holds == 4 ? "RGBA" : (holds == 3 ? "RGB" : "gray");
+    if (int(o.list("channels").size()) > holds)
+        o.bad("channels", "at most " + std::to_string(holds) + (holds == 1 ? " name (" : " names (") + kind + ")");
     const Field3DPtr f = std::get<Field3DPtr>(selected(v, o));
-    for (int k = 0; k < 4; ++k) so.channel_map.push_back(k < f->channels() ? k : -1);
-    if (f->channels() > 4 && !o.has("channels"))
-        throw Error(o.prefix() + "a TGA slice holds 4 channels (RGBA), the value has " + std::to_string(f->channels()) +
-                    "; choose them with option 'channels'");
+    for (int k = 0; k < 4; ++k) so.channel_map.push_back(k < f->channels() && k < holds ? k : -1);
+    if (f->channels() > holds && !o.has("channels"))
+        throw Error(o.prefix() + "a" + (holds == 4 ? "n " : " ") + kind + " TGA slice holds " + std::to_string(holds) + " channel" +
+                    (holds == 1 ? "" : "s") + ", the value has " + std::to_string(f->channels()) + "; choose them with option 'channels'");
     return write_tga_slices(*f, p.parent_path(), p.filename().string(), so);
 }
 

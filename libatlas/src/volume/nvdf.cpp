@@ -10,7 +10,9 @@
 namespace atlas::volume {
 namespace {
 void check_channel(const Field3D& f, int c, const char* who) {
-    if (c < 0 || c >= f.channels()) throw Error(std::string(who) + ": channel " + std::to_string(c) + " does not exist");
+    if (c < 0 || c >= f.channels())
+        throw Error(std::string(who) + ": channel " + std::to_string(c) + " does not exist (the input has " + std::to_string(f.channels()) +
+                    " channel" + (f.channels() == 1 ? "" : "s") + ")");
 }
 void check_range(double lo, double hi, const char* who) {
     if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo))
@@ -51,13 +53,16 @@ Field3D decode_field_data(const Field3D& enc, double lo, double hi, int channel,
     return map_channel(enc, channel, "sdf", budget, [=](double v) { return float(lo + v * (hi - lo)); });
 }
 
-Field3D assemble_modeling_nvdf(const Field3D& dp, const Field3D& dt, const Field3D& ds, const MemoryBudget* budget) {
+Field3D assemble_modeling_nvdf(const Field3D& dp, const Field3D& dt, const Field3D& ds, const MemoryBudget* budget, const ModelingChannels& ch) {
     for (const Field3D* f : {&dt, &ds})
         if (f->resolution() != dp.resolution() || !(f->bounds() == dp.bounds()))
             throw Error("modeling NVDF: detail_type and density_scale must have the dimensional profile's resolution and bounds");
-    Field3D out(dp.resolution(), 3, dp.bounds(), {"dimensional_profile", "detail_type", "density_scale"}, budget);
     const Field3D* src[3] = {&dp, &dt, &ds};
-    for (int c = 0; c < 3; ++c) std::copy(src[c]->channel(0).begin(), src[c]->channel(0).end(), out.channel(c).begin());
+    const int sel[3] = {ch.dimensional_profile, ch.detail_type, ch.density_scale};
+    const char* names[3] = {"modeling NVDF (dimensional_profile)", "modeling NVDF (detail_type)", "modeling NVDF (density_scale)"};
+    for (int c = 0; c < 3; ++c) check_channel(*src[c], sel[c], names[c]);
+    Field3D out(dp.resolution(), 3, dp.bounds(), {"dimensional_profile", "detail_type", "density_scale"}, budget);
+    for (int c = 0; c < 3; ++c) std::copy(src[c]->channel(sel[c]).begin(), src[c]->channel(sel[c]).end(), out.channel(c).begin());
     return out;
 }
 

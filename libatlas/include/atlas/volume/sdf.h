@@ -31,9 +31,17 @@ struct ProgressSink;
 
 namespace atlas::volume {
 
+// Default iso levels. A density's surface is its half-way level. A
+// dimensional profile (saturate(-sdf / depth) ^ exponent: 0 outside, rising
+// inside) has its surface where it leaves 0; on 8-bit pack data 2/255 is the
+// level that reproduces the Nubis pack's own field data best (measured on the
+// real pack; 0.5 put the surface depth/2 inside). docs/volumes.md.
+inline constexpr double kDensityIso = 0.5;
+inline constexpr double kDimensionalProfileIso = 2.0 / 255.0;
+
 struct SdfOptions {
     int channel = 0;        // density channel to read
-    double iso = 0.5;       // iso level: density > iso is inside
+    double iso = kDensityIso; // iso level: density > iso is inside
     // Distance written where the grid has no surface at all, in metres; <= 0
     // means "the diagonal of the grid's bounds".
     double far_distance = 0;
@@ -58,7 +66,10 @@ Field3D sdf_from_density_edt(const Field3D& density, const SdfOptions& options, 
                              SdfStats* stats = nullptr, const ProgressSink* progress = nullptr);
 
 // OpenVDB's fast sweeping (openvdb::tools::fogToSdf) over the whole dense grid
-// (every voxel active). Requires cubic voxels (throws otherwise). `sweeps` is
+// (every voxel active). Requires cubic voxels (throws otherwise). The sweep
+// runs in scaled index units (OpenVDB ignores neighbour distances >= 1000
+// world units), so every distance the grid holds is computed, at any voxel
+// size; a voxel OpenVDB leaves without a distance is an error. `sweeps` is
 // fogToSdf's iteration count (>= 1). OpenVDB sees the space beyond the grid
 // as its inactive background (empty), so this method always behaves as if
 // border_is_outside were true (the option is ignored). Deterministic per OpenVDB's own
