@@ -482,3 +482,26 @@ TEST(TgaSlices, FailedStackLeavesNothing) {
     expect_error_containing([&] { write_tga_slices(f, dir.path(), "n"); }, {"n.004.tga", "NaN"});
     EXPECT_TRUE(names_in(dir.path()).empty());
 }
+
+// 16-bit (A1R5G5B5) true colour: colour as OpenImageIO expands it (bit
+// replication), the attribute bit as alpha 0 or 255.
+TEST(TgaRle, SixteenBitTrueColourReadsLikeOpenImageIO) {
+    TempDir dir;
+    for (int type : {2, 10}) {
+        std::vector<uint8_t> b = tga_header(type, 32, 2, 16, 1);
+        for (int i = 0; i < 64; ++i) {
+            if (type == 10) b.push_back(0x00); // one raw pixel per packet
+            const int c = i % 32, v = (c << 10) | ((31 - c) << 5) | (c ^ 7) | (i % 3 ? 0x8000 : 0);
+            b.push_back(uint8_t(v & 255)), b.push_back(uint8_t(v >> 8));
+        }
+        const fs::path p = dir / ("s" + std::to_string(type) + ".tga");
+        write_bytes(p, str(b));
+        const TgaImage mine = read_tga(p), other = oiio_read(p);
+        ASSERT_EQ(mine.channels, 4);
+        ASSERT_GE(other.channels, 3);
+        for (size_t i = 0; i < 64; ++i) {
+            for (int c = 0; c < 3; ++c) ASSERT_EQ(mine.pixels[i * 4 + size_t(c)], other.pixels[i * size_t(other.channels) + size_t(c)]) << p << " " << i;
+            ASSERT_EQ(mine.pixels[i * 4 + 3], i % 3 ? 255 : 0);
+        }
+    }
+}
