@@ -7,9 +7,11 @@ using namespace atlas;
 
 void declare(NodeDeclaration& d) {
     d.doc("Signed distance (metres, negative inside) to a mesh over the whole grid, inside decided by the six-ray winding "
-          "vote with exact generalized winding numbers where the rays disagree (survives holes and self-intersections). "
-          "method 'edt': exact point-triangle distance within `exact_band` voxels, exact EDT to the surface's grid-line "
-          "crossings beyond (< 0.5 voxel error); 'openvdb': OpenVDB meshToUnsignedDistanceField (cubic voxels).");
+          "vote with (fast) generalized winding numbers where the rays disagree (survives holes and self-intersections; "
+          "metric winding_fallback_voxels). Distances go to the surface of the union of overlapping parts (buried faces "
+          "are skipped). method 'edt': exact point-triangle distance within `exact_band` voxels (4 around open rims and "
+          "the grid's faces), exact EDT to the surface's grid-line crossings beyond (over by < 0.5 voxel on closed "
+          "surfaces, up to 0.75 measured beyond open rims); 'openvdb': OpenVDB meshToUnsignedDistanceField (cubic voxels).");
     d.input("mesh", PortType::Mesh, "the mesh (repair foreign meshes with volume/read_mesh)");
     d.output("sdf", PortType::Field3D, "signed distance, metres, channel 'sdf'");
     d.output("density", PortType::Field3D, "1 inside, 0 outside, one-voxel linear edge (0.5 on the surface), channel 'density'");
@@ -32,6 +34,7 @@ void cook(CookContext& ctx) {
     ctx.metric("seconds", st.seconds);
     ctx.metric("line_hits", double(st.line_hits));
     ctx.metric("winding_fallback_voxels", double(st.winding_fallback_voxels));
+    ctx.metric("wide_band_triangles", double(st.wide_band_triangles));
     ctx.metric("buried_triangles", double(st.buried_triangles));
     ctx.metric("straddling_triangles", double(st.straddling_triangles));
     auto density = std::make_shared<Field3D>(volume::density_from_sdf(sdf));

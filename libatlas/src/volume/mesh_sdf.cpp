@@ -43,6 +43,9 @@ Vec3d closest_on_triangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const 
 
 double diagonal(const Box3d& b) { return length(b.size()); }
 
+// Exact band (voxels) around rims and near the grid's faces.
+constexpr double kWideBandVoxels = 4;
+
 Vec3d closest_on_segment(const Vec3d& p, const Vec3d& a, const Vec3d& b) {
     const Vec3d e = b - a;
     const double ee = dot(e, e);
@@ -110,10 +113,37 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
     // or an intersection segment (parallel per triangle, merged in order).
     const double vmin = std::min({h[0], h[1], h[2]});
     const double band = o.exact_band_voxels * vmin;
-    auto voxel_range = [&](const Vec3d& a, const Vec3d& b, const Vec3d& c, int lo[3], int hi[3]) {
+    // Where grid-line crossings are sparse - beyond an open rim, and where the
+    // surface leaves the grid (no grid lines out there) - the EDT over-estimates
+    // by up to ~0.8 voxel next to the band; triangles with a boundary edge or
+    // near the grid's faces get a wider exact band, where the over-estimate
+    // has decayed (roughly gap^2 / 2d) below 0.5 voxel (docs/volumes.md).
+    const double wide = band > 0 ? std::max(band, kWideBandVoxels * vmin) : 0;
+    std::vector<uint8_t> needs_wide(m.triangles.size(), 0);
+    if (band > 0) {
+        std::vector<std::pair<uint64_t, uint32_t>> edges;
+        edges.reserve(m.triangles.size() * 3);
+        for (uint32_t t = 0; t < m.triangles.size(); ++t)
+            for (int e = 0; e < 3; ++e) {
+                const uint64_t a = m.triangles[t][size_t(e)], b = m.triangles[t][size_t((e + 1) % 3)];
+                edges.push_back({std::min(a, b) << 32 | std::max(a, b), t});
+            }
+        std::sort(edges.begin(), edges.end());
+        for (size_t i = 0; i < edges.size(); ++i) {
+            const bool alone = (i == 0 || edges[i - 1].first != edges[i].first) && (i + 1 == edges.size() || edges[i + 1].first != edges[i].first);
+            if (alone) needs_wide[edges[i].second] = 1;
+        }
+        for (uint32_t t = 0; t < m.triangles.size(); ++t)
+            for (uint32_t v : m.triangles[t])
+                for (int k = 0; k < 3; ++k)
+                    if (m.vertices[v][k] < bounds.min[k] + wide || m.vertices[v][k] > bounds.max[k] - wide) needs_wide[t] = 1;
+    }
+    uint64_t wide_triangles = 0;
+    for (uint8_t w : needs_wide) wide_triangles += w;
+    auto voxel_range = [&](const Vec3d& a, const Vec3d& b, const Vec3d& c, int lo[3], int hi[3], double bw) {
         bool empty = false;
         for (int k = 0; k < 3; ++k) {
-            const double mn = std::min({a[k], b[k], c[k]}) - band, mx = std::max({a[k], b[k], c[k]}) + band;
+            const double mn = std::min({a[k], b[k], c[k]}) - bw, mx = std::max({a[k], b[k], c[k]}) + bw;
             lo[k] = std::max(0, int(std::ceil((mn - bounds.min[k]) / h[k] - 0.5)));
             hi[k] = std::min(res[k] - 1, int(std::floor((mx - bounds.min[k]) / h[k] - 0.5)));
             empty |= lo[k] > hi[k];
@@ -130,7 +160,7 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
             const auto& t = m.triangles[ti];
             const Vec3d a = to_d(m.vertices[t[0]]), b = to_d(m.vertices[t[1]]), c = to_d(m.vertices[t[2]]);
             int lo[3], hi[3];
-            if (!voxel_range(a, b, c, lo, hi)) continue;
+            if (!voxel_range(a, b, c, lo, hi, needs_wide[ti] ? wide : band)) continue;
             for (int z = lo[2]; z <= hi[2]; ++z)
                 for (int y = lo[1]; y <= hi[1]; ++y)
                     for (int x = lo[0]; x <= hi[0]; ++x) {
@@ -149,7 +179,7 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
             const auto& t = m.triangles[ti];
             const Vec3d v[3] = {to_d(m.vertices[t[0]]), to_d(m.vertices[t[1]]), to_d(m.vertices[t[2]])};
             int lo[3], hi[3];
-            if (!voxel_range(v[0], v[1], v[2], lo, hi)) return;
+            if (!voxel_range(v[0], v[1], v[2], lo, hi, needs_wide[ti] ? wide : band)) return;
             const auto& segs = us.segments[ti];
             for (int z = lo[2]; z <= hi[2]; ++z)
                 for (int y = lo[1]; y <= hi[1]; ++y)
@@ -186,6 +216,7 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
     if (stats) {
         stats->line_hits = hits.total;
         stats->winding_fallback_voxels = fallback;
+        stats->wide_band_triangles = wide_triangles;
         stats->buried_triangles = us.buried;
         stats->straddling_triangles = us.straddling;
         stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

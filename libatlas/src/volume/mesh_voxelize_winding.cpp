@@ -149,28 +149,34 @@ UnionSurface union_surface(const Mesh& m) {
     using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, uint32_t>;
     UnionSurface us;
     const uint32_t n = uint32_t(m.triangles.size());
-    // Edge-connected components (union-find over sorted edge keys).
-    std::vector<uint32_t> parent(n);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto root = [&](uint32_t i) {
-        while (parent[i] != i) i = parent[i] = parent[parent[i]];
-        return i;
+    std::vector<std::pair<uint64_t, uint32_t>> edges; // (sorted vertex pair, triangle), sorted
+    edges.reserve(size_t(n) * 3);
+    for (uint32_t t = 0; t < n; ++t)
+        for (int e = 0; e < 3; ++e) {
+            const uint64_t a = m.triangles[t][size_t(e)], b = m.triangles[t][size_t((e + 1) % 3)];
+            edges.push_back({std::min(a, b) << 32 | std::max(a, b), t});
+        }
+    std::sort(edges.begin(), edges.end());
+    // Edge-connected regions (union-find), optionally not joining through `cut` triangles.
+    auto regions = [&](const std::vector<uint8_t>* cut) {
+        std::vector<uint32_t> parent(n);
+        std::iota(parent.begin(), parent.end(), 0u);
+        auto root = [&](uint32_t i) {
+            while (parent[i] != i) i = parent[i] = parent[parent[i]];
+            return i;
+        };
+        for (size_t i = 1; i < edges.size(); ++i) {
+            const uint32_t s0 = edges[i - 1].second, s1 = edges[i].second;
+            if (edges[i].first != edges[i - 1].first || (cut && ((*cut)[s0] || (*cut)[s1]))) continue;
+            parent[root(s1)] = root(s0);
+        }
+        for (uint32_t t = 0; t < n; ++t) parent[t] = root(t);
+        return parent;
     };
     {
-        std::vector<std::pair<uint64_t, uint32_t>> edges;
-        edges.reserve(size_t(n) * 3);
-        for (uint32_t t = 0; t < n; ++t)
-            for (int e = 0; e < 3; ++e) {
-                const uint64_t a = m.triangles[t][size_t(e)], b = m.triangles[t][size_t((e + 1) % 3)];
-                edges.push_back({std::min(a, b) << 32 | std::max(a, b), t});
-            }
-        std::sort(edges.begin(), edges.end());
-        for (size_t i = 1; i < edges.size(); ++i)
-            if (edges[i].first == edges[i - 1].first) parent[root(edges[i].second)] = root(edges[i - 1].second);
+        const std::vector<uint32_t> comp = regions(nullptr);
+        for (uint32_t t = 0; t < n; ++t) us.components += comp[t] == t;
     }
-    std::vector<uint32_t> comp(n);
-    for (uint32_t t = 0; t < n; ++t) comp[t] = root(t);
-    for (uint32_t t = 0; t < n; ++t) us.components += comp[t] == t;
 
     // Crossing pairs of triangles that share no vertex.
     std::vector<K::Triangle_3> tri(n);
@@ -226,12 +232,9 @@ UnionSurface union_surface(const Mesh& m) {
     us.state.assign(n, UnionSurface::kSurface);
     for (uint32_t t = 0; t < n; ++t)
         if (hit[t]) us.state[t] = UnionSurface::kStraddling;
-    // Wholly buried or not: one test per component without crossings, one
-    // per triangle in components with crossings (their crossing-free parts
-    // may lie on either side).
-    std::vector<uint8_t> comp_cross(n, 0);
-    for (uint32_t t = 0; t < n; ++t)
-        if (hit[t]) comp_cross[comp[t]] = 1;
+    // A connected region of triangles that cross nothing lies wholly on one
+    // side of every other part: one test per region (at its largest triangle).
+    const std::vector<uint32_t> region = regions(&hit);
     auto centre_buried = [&](uint32_t t) {
         const auto& v = m.triangles[t];
         const Vec3d a = to_d(m.vertices[v[0]]), b = to_d(m.vertices[v[1]]), c = to_d(m.vertices[v[2]]);
@@ -240,22 +243,21 @@ UnionSurface union_surface(const Mesh& m) {
         if (!(l > 0)) return false;
         return (*us.winding)((a + b + c) / 3.0 + nn * (us.eps / l)) > 0.5;
     };
-    // Per component without crossings: its largest triangle decides.
     std::vector<uint32_t> rep(n, UINT32_MAX);
     std::vector<double> rep_area(n, -1);
     for (uint32_t t = 0; t < n; ++t) {
-        if (comp_cross[comp[t]]) continue;
+        if (hit[t]) continue;
         const double a = tri[t].squared_area();
-        if (a > rep_area[comp[t]]) rep_area[comp[t]] = a, rep[comp[t]] = t;
+        if (a > rep_area[region[t]]) rep_area[region[t]] = a, rep[region[t]] = t;
     }
-    std::vector<uint8_t> comp_buried(n, 0);
-    for (uint32_t c = 0; c < n; ++c)
-        if (rep[c] != UINT32_MAX) comp_buried[c] = centre_buried(rep[c]);
+    std::vector<uint32_t> reps;
+    for (uint32_t r = 0; r < n; ++r)
+        if (rep[r] != UINT32_MAX) reps.push_back(r);
+    std::vector<uint8_t> region_buried(n, 0);
+    tbb::parallel_for(size_t(0), reps.size(), [&](size_t i) { region_buried[reps[i]] = centre_buried(rep[reps[i]]); });
     std::vector<uint8_t> own(n, 0);
-    tbb::parallel_for(uint32_t(0), n, [&](uint32_t t) {
-        if (us.state[t] == UnionSurface::kStraddling) return;
-        own[t] = comp_cross[comp[t]] ? centre_buried(t) : comp_buried[comp[t]];
-    });
+    for (uint32_t t = 0; t < n; ++t)
+        if (!hit[t]) own[t] = region_buried[region[t]];
     for (uint32_t t = 0; t < n; ++t) {
         if (own[t]) us.state[t] = UnionSurface::kBuried, ++us.buried;
         if (us.state[t] == UnionSurface::kStraddling) ++us.straddling;

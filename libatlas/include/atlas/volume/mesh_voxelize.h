@@ -7,10 +7,10 @@
 // winding number. A hole only corrupts the rays that pass through it, and a
 // self-intersection (overlapping closed parts) gives counts of 2, so the mean
 // of the six counts, thresholded at 0.5, survives both. Where the six counts
-// disagree (only voxels whose rays meet a hole or a flipped face), the exact
-// generalized winding number (Jacobson et al. 2013) replaces the mean, as long
-// as disagreeing voxels x triangles <= 2e9 (else the mean stands); it degrades
-// gracefully with holes (docs/volumes.md).
+// disagree (only voxels whose rays meet a hole or a flipped face), the
+// generalized winding number (Jacobson et al. 2013), evaluated fast
+// (Barill et al. 2018, fast_winding_numbers), replaces the mean; it degrades
+// gracefully with holes (docs/volumes.md). MeshSdfStats counts those voxels.
 // Ray/triangle tests use a top-left tie rule in the projection plane so a ray
 // through a shared edge or vertex counts it once.
 //
@@ -58,13 +58,22 @@ struct MeshSdfOptions {
 struct MeshSdfStats {
     uint64_t line_hits = 0;               // ray/triangle crossings on the grid lines
     uint64_t winding_fallback_voxels = 0; // voxels whose six ray counts disagreed: generalized winding number used
+    uint64_t wide_band_triangles = 0;     // triangles on an open rim or near the grid's faces: exact band widened to 4 voxels
     uint64_t buried_triangles = 0;        // triangles wholly inside another part (no distance to them)
     uint64_t straddling_triangles = 0;    // triangles crossing another part (distance to their unburied part)
     double seconds = 0;
 };
 
 // Signed distance (metres, negative inside by the ray winding vote) to the
-// mesh over the whole grid; channel "sdf".
+// surface of the union of the mesh's parts over the whole grid; channel "sdf".
+// Faces buried inside another (overlapping) part are not surface: distances
+// go to the unburied parts of faces and to the intersection curves.
+// Accuracy against brute force (docs/volumes.md): exact (< 1e-4 voxel) within
+// the exact band (widened to 4 voxels around open rims and near the grid's
+// faces); beyond, never short, and over by < 0.5 voxel for closed surfaces
+// (measured 0.14 inside the grid, 0.12 leaving it), by up to 0.75 voxel
+// measured beyond open rims and where an open surface leaves the grid.
+// Vertices and bounds must lie within +-kMaxMeshCoordinate (mesh_io.h).
 Field3D mesh_to_sdf(const Mesh& mesh, Vec3i res, Box3d bounds, const MeshSdfOptions& options = {},
                     const MemoryBudget* budget = nullptr, MeshSdfStats* stats = nullptr);
 
