@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include "atlas/compress/texture.h"
 #include "atlas/graph/graph.h"
 
 #include <sstream>
@@ -30,12 +31,12 @@ const std::vector<Command>& commands() {
         {"compress", "IN -o OUT.dds --format FORMAT [options]",
          "encode a field file (EXR, PNG, TGA, VDB, STEM.001.tga) as a DDS texture with a guaranteed error bound",
          {{"--out", "OUT.dds", "output texture (also -o); OUT.dds.json (the manifest) is written beside it"},
-          {"--format", "FORMAT", "bc1, bc1-scalar, bc4, bc4-snorm, bc6h, bc6h-sf16, r8, r16, r16f, r32f, rgba8, rgba16f, rgba4"},
+          {"--format", "FORMAT", compress::format_names()},
           {"--quality", "LEVEL", "fast, normal (default) or best (bc4: exhaustive, provably optimal)"},
           {"--max-error", "E", "guarantee |decoded - source| <= E (source units) for every texel, or fail listing the blocks"},
           {"--one-sided", "below", "guarantee decoded <= source (SDFs for sphere tracing); mips are min-reduced"},
           {"--allow-over-bound", "", "write the texture even when some blocks miss --max-error (they are listed)"},
-          {"--decoders", "LIST", "decoder models the bounds hold for: reference,nvidia,amd,tool8,conformant (default all)"},
+          {"--decoders", "LIST", "comma-separated decoder models the bounds hold for: " + compress::decoder_names() + " (default all)"},
           {"--mips", "N|full", "mip levels (default 1)"},
           {"--range", "LO,HI", "source values mapped to the format's 0..1 (default: the data's min and max)"},
           {"--channels", "NAMES", "comma-separated input channels to store"},
@@ -50,7 +51,7 @@ const std::vector<Command>& commands() {
          run_compress},
         {"decompress", "IN.dds -o OUT.exr [--decoder MODEL]", "decode a DDS texture to float (EXR, PNG, VDB, ...)",
          {{"--out", "OUT", "output file; the format follows the extension"},
-          {"--decoder", "MODEL", "reference (default), nvidia, amd, tool8"}},
+          {"--decoder", "MODEL", "decoder model: " + compress::decoder_names() + " (default reference)"}},
          run_decompress},
         {"info", "FILE...", "describe EXR, VDB, image or TGA-slice files: size, channels, value statistics", {}, run_info},
         {"preview", "(GRAPH | FILES...) -o OUT.png [options]", "render the NVDF set a graph writes (or NVDF files) with the cloud preview ray-marcher",

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sys/wait.h>
@@ -176,4 +177,94 @@ outputs:
     EXPECT_EQ(bad.status, 1);
     EXPECT_FALSE(fs::exists(out / "x.dds"));
     fs::remove_all(out);
+}
+
+// What an engine or a texture artist sees: OpenImageIO (oiiotool), not Atlas's own
+// decoder, reads the DDS files `atlas compress` writes. `oiiotool --diff` exits
+// non-zero when two images differ by more than --fail anywhere.
+namespace {
+int sh(const std::string& cmd) {
+    const int st = std::system((cmd + " >/dev/null 2>&1").c_str());
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+} // namespace
+
+TEST(CliForeign, DdsShowsWhatThePngShows) {
+    fs::path dir = fs::temp_directory_path() / ("atlas_cli_orient_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string in = (dir / "in.png").string();
+    // Four different corners: any flip or transpose changes the picture.
+    ASSERT_EQ(sh("oiiotool --pattern fill:topleft=1,0,0:topright=0,1,0:bottomleft=0,0,1:bottomright=1,1,1 32x16 3 -d uint8 -o " + in), 0);
+    // OIIO 2.4 reads 2D BC1 and BC4 DDS files (BC4 as one channel it names Y: compare channel 0).
+    for (const std::string fmt : {"bc1", "bc4"}) {
+        const std::string ch = fmt == "bc1" ? "R,G,B" : "0";
+        const std::string dds = (dir / ("a_" + fmt + ".dds")).string(), back = (dir / ("back_" + fmt + ".png")).string(),
+                          ref = (dir / ("ref_" + fmt + ".png")).string(), flipped = (dir / "flipped.png").string();
+        CliRun c = run("compress " + in + " --format " + fmt + " --range 0,1 --quiet -o " + dds);
+        ASSERT_EQ(c.status, 0) << c.err;
+        ASSERT_EQ(sh("oiiotool " + in + " --ch " + ch + " -o " + ref), 0);
+        ASSERT_EQ(sh("oiiotool " + dds + " --ch " + ch + " -d uint8 -o " + back), 0) << fmt;
+        EXPECT_EQ(sh("oiiotool --fail 0.1 --diff " + ref + " " + back), 0) << fmt << ": OpenImageIO shows the DDS differently from the PNG";
+        // The check can fail: the same picture upside down does.
+        ASSERT_EQ(sh("oiiotool " + back + " --flip -o " + flipped), 0);
+        EXPECT_NE(sh("oiiotool --fail 0.1 --diff " + ref + " " + flipped), 0);
+    }
+    fs::remove_all(dir);
+}
+
+TEST(CliForeign, RgbExrFromAnotherToolKeepsRedInRed) {
+    fs::path dir = fs::temp_directory_path() / ("atlas_cli_rgbexr_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string exr = (dir / "in.exr").string(), ref = (dir / "ref.png").string(), dds = (dir / "a.dds").string(),
+                      back = (dir / "back.png").string();
+    // OpenEXR lists these channels as B, G, R.
+    ASSERT_EQ(sh("oiiotool --pattern fill:top=0.9,0.2,0.05:bottom=0.8,0.3,0.1 16x16 3 -d float -o " + exr), 0);
+    ASSERT_EQ(sh("oiiotool " + exr + " -d uint8 -o " + ref), 0);
+    CliRun c = run("compress " + exr + " --format bc1 --range 0,1 --quiet -o " + dds);
+    ASSERT_EQ(c.status, 0) << c.err;
+    ASSERT_EQ(sh("oiiotool " + dds + " --ch R,G,B -d uint8 -o " + back), 0);
+    EXPECT_EQ(sh("oiiotool --fail 0.06 --diff " + ref + " " + back), 0) << "BC1 of an RGB EXR does not look like the EXR";
+    fs::remove_all(dir);
+}
+
+TEST(CliForeign, DecompressRestoresWorldBounds) {
+    auto g = write_graph("bounds.yaml", R"(atlas: 1
+nodes:
+  n:
+    type: noise/value
+    params: {resolution: [16, 8, 2], octaves: 2, bounds_min: [-2000, 500, 0], bounds_max: [6000, 4500, 512]}
+outputs:
+  - {node: n, file: n.exr}
+)");
+    fs::path out = fs::temp_directory_path() / ("atlas_cli_bounds_" + std::to_string(::getpid()));
+    fs::remove_all(out);
+    ASSERT_EQ(run("cook " + g.string() + " --out " + out.string() + " --quiet").status, 0);
+    ASSERT_EQ(run("compress " + (out / "n.exr").string() + " --format bc4 --quiet -o " + (out / "n.dds").string()).status, 0);
+    CliRun d = run("decompress " + (out / "n.dds").string() + " -o " + (out / "back.exr").string());
+    ASSERT_EQ(d.status, 0) << d.err;
+    // oiiotool prints the EXR's atlas:bounds attributes; both files must carry the same.
+    auto bounds_lines = [](const fs::path& p) {
+        FILE* f = popen(("oiiotool --info -v " + p.string() + " 2>&1 | grep atlas:bounds").c_str(), "r");
+        std::string s;
+        std::array<char, 512> buf;
+        size_t n;
+        while ((n = fread(buf.data(), 1, buf.size(), f)) > 0) s.append(buf.data(), n);
+        pclose(f);
+        return s;
+    };
+    const std::string a = bounds_lines(out / "n.exr"), b = bounds_lines(out / "back.exr");
+    EXPECT_NE(a.find("-2000"), std::string::npos) << a;
+    EXPECT_EQ(a, b);
+    fs::remove_all(out);
+}
+
+TEST(CliForeign, CompressHelpNamesEveryDecoder) {
+    CliRun help = run("compress --help");
+    const std::string text = help.out + help.err;
+    for (int i = 0; i < atlas::compress::kDecoderCount; ++i) {
+        const std::string name = atlas::compress::decoder_name(static_cast<atlas::compress::Decoder>(i));
+        EXPECT_TRUE(text.find(name + ",") != std::string::npos || text.find(name + " ") != std::string::npos) << name << " is missing from:\n" << text;
+    }
 }

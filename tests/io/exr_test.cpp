@@ -13,6 +13,8 @@
 #include <ImfVecAttribute.h>
 #include <Imath/half.h>
 
+#include <cstdlib>
+
 using namespace atlas;
 using namespace atlas::io;
 using namespace atlas::io::test;
@@ -190,4 +192,63 @@ TEST(Exr, WriteErrorsNameTheFile) {
     TempDir dir;
     Field2D f({{2, 2}}, 1, Box2d{{{0, 0}}, {{1, 1}}});
     expect_error_containing([&] { write_exr(f, dir / "no" / "such" / "dir" / "f.exr"); }, {"f.exr"});
+}
+
+// EXRs written by another tool (oiiotool): OpenEXR lists channels alphabetically
+// (B, G, R), but standard names must come back in their conventional order.
+namespace {
+Field2D read_foreign(const fs::path& dir, const std::string& name, const std::string& oiiotool_args) {
+    const fs::path p = dir / name;
+    const std::string cmd = "oiiotool " + oiiotool_args + " -d float -o '" + p.string() + "' >/dev/null 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    Value v = read_exr(p);
+    return *std::get<Field2DPtr>(v);
+}
+} // namespace
+
+TEST(ExrForeign, RgbFromOiiotoolReadsAsRgb) {
+    TempDir dir;
+    const Field2D f = read_foreign(dir.path(), "rgb.exr", "--pattern constant:color=0.1,0.5,0.9 8x4 3");
+    EXPECT_EQ(f.channel_names(), (std::vector<std::string>{"R", "G", "B"}));
+    EXPECT_FLOAT_EQ(f.at(0, 3, 2), 0.1f);
+    EXPECT_FLOAT_EQ(f.at(1, 3, 2), 0.5f);
+    EXPECT_FLOAT_EQ(f.at(2, 3, 2), 0.9f);
+}
+
+TEST(ExrForeign, RgbaAndLayersAndVectors) {
+    TempDir dir;
+    const Field2D rgba = read_foreign(dir.path(), "rgba.exr", "--pattern constant:color=0.1,0.5,0.9,0.7 4x4 4");
+    EXPECT_EQ(rgba.channel_names(), (std::vector<std::string>{"R", "G", "B", "A"}));
+    EXPECT_FLOAT_EQ(rgba.at(3, 0, 0), 0.7f);
+    const Field2D xyz = read_foreign(dir.path(), "xyz.exr", "--pattern constant:color=1,2,3 4x4 3 --chnames X,Y,Z");
+    EXPECT_EQ(xyz.channel_names(), (std::vector<std::string>{"X", "Y", "Z"}));
+    EXPECT_FLOAT_EQ(xyz.at(2, 1, 1), 3.0f);
+    const Field2D ya = read_foreign(dir.path(), "ya.exr", "--pattern constant:color=0.25,0.75 4x4 2 --chnames Y,A");
+    EXPECT_EQ(ya.channel_names(), (std::vector<std::string>{"Y", "A"}));
+    EXPECT_FLOAT_EQ(ya.at(0, 1, 1), 0.25f);
+    // Layers keep the file's order; channels inside each take the conventional order;
+    // non-standard names follow alphabetically.
+    const Field2D layered = read_foreign(dir.path(), "layers.exr",
+                                         "--pattern constant:color=1,2,3,4,5,6 4x4 6 --chnames diffuse.R,diffuse.G,diffuse.B,normal.X,normal.Y,normal.Z");
+    EXPECT_EQ(layered.channel_names(),
+              (std::vector<std::string>{"diffuse.R", "diffuse.G", "diffuse.B", "normal.X", "normal.Y", "normal.Z"}));
+    EXPECT_FLOAT_EQ(layered.at(4, 0, 0), 5.0f);
+    const Field2D named = read_foreign(dir.path(), "named.exr", "--pattern constant:color=1,2,3 4x4 3 --chnames density,B,R");
+    EXPECT_EQ(named.channel_names(), (std::vector<std::string>{"R", "B", "density"}));
+    EXPECT_FLOAT_EQ(named.at(0, 0, 0), 3.0f);
+}
+
+TEST(ExrForeign, LuminanceChromaIsRefusedNamingTheChannel) {
+    TempDir dir;
+    const fs::path p = dir / "ryby.exr";
+    ASSERT_EQ(std::system(("oiiotool --pattern constant:color=0.1,0.5,0.9 4x4 3 --chnames RY,Y,BY -d float -o '" + p.string() + "' >/dev/null 2>&1").c_str()), 0);
+    try {
+        read_exr(p);
+        FAIL() << "an RY/BY image was accepted";
+    } catch (const Error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("ryby.exr"), std::string::npos) << m;
+        EXPECT_NE(m.find("luminance/chroma"), std::string::npos) << m;
+        EXPECT_TRUE(m.find("'BY'") != std::string::npos || m.find("'RY'") != std::string::npos) << m;
+    }
 }

@@ -16,10 +16,16 @@ const char* decoder_name(Decoder d) {
     return "?";
 }
 
+std::string decoder_names() {
+    std::string s;
+    for (int i = 0; i < kDecoderCount; ++i) s += (i ? ", " : "") + std::string(decoder_name(static_cast<Decoder>(i)));
+    return s;
+}
+
 Decoder parse_decoder(const std::string& name) {
     for (int i = 0; i < kDecoderCount; ++i)
         if (name == decoder_name(static_cast<Decoder>(i))) return static_cast<Decoder>(i);
-    throw Error("unknown decoder model '" + name + "' (expected reference, nvidia, amd, tool8, tool8-round or conformant)");
+    throw Error("unknown decoder model '" + name + "' (expected one of: " + decoder_names() + ")");
 }
 
 std::vector<Decoder> decoders_in(DecoderSet set) {

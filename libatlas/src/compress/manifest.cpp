@@ -3,6 +3,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+
 namespace atlas::compress {
 
 std::string TextureManifest::to_json() const {
@@ -24,6 +26,9 @@ std::string TextureManifest::to_json() const {
     j["one_sided"] = one_sided_below ? "below" : "none";
     j["decoders"] = decoders;
     j["mip_filter"] = mip_filter;
+    if (world_bounds)
+        j["world_bounds"] = {{"min", {world_bounds->min[0], world_bounds->min[1], world_bounds->min[2]}},
+                             {"max", {world_bounds->max[0], world_bounds->max[1], world_bounds->max[2]}}};
     if (encoding == "bc1-scalar") j["unpack_weights"] = {unpack_weights[0], unpack_weights[1], unpack_weights[2]};
     return j.dump(2) + "\n";
 }
@@ -48,6 +53,16 @@ TextureManifest TextureManifest::from_json(const std::string& text, const std::s
         m.one_sided_below = j.value("one_sided", std::string("none")) == "below";
         m.decoders = j.value("decoders", std::vector<std::string>{});
         m.mip_filter = j.value("mip_filter", std::string("box"));
+        if (j.contains("world_bounds")) {
+            Box3d b;
+            for (size_t i = 0; i < 3; ++i) {
+                b.min[i] = j["world_bounds"].at("min").at(i).get<double>();
+                b.max[i] = j["world_bounds"].at("max").at(i).get<double>();
+                if (!(b.max[i] > b.min[i]) || !std::isfinite(b.min[i]) || !std::isfinite(b.max[i]))
+                    throw Error(what + ": invalid texture manifest: world_bounds axis " + std::to_string(i) + " must be finite with min < max");
+            }
+            m.world_bounds = b;
+        }
         if (j.contains("unpack_weights"))
             for (int i = 0; i < 3; ++i) m.unpack_weights[size_t(i)] = j["unpack_weights"].at(size_t(i)).get<float>();
     } catch (const nlohmann::json::exception& e) {

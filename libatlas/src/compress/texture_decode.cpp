@@ -190,15 +190,17 @@ Field3D decode_texture(const DdsTexture& tex, const TextureManifest* manifest, D
     const int channels = scalar ? 1 : format_channels(tex.format);
     std::vector<std::string> names =
         manifest && int(manifest->channel_meanings.size()) == channels ? manifest->channel_meanings : default_channel_names(channels);
-    Field3D out(Vec3i{{tex.width, tex.height, nz}}, channels, Box3d{{{0, 0, 0}}, {{double(tex.width), double(tex.height), double(nz)}}},
-                names);
+    const Box3d bounds = manifest && manifest->world_bounds ? *manifest->world_bounds
+                                                            : Box3d{{{0, 0, 0}}, {{double(tex.width), double(tex.height), double(nz)}}};
+    Field3D out(Vec3i{{tex.width, tex.height, nz}}, channels, bounds, names);
     for (int layer = 0; layer < layers; ++layer) {
         detail::DecodedLevel L = detail::decode_level(tex, layer, 0, decoder, scalar, unpack);
         const size_t slice = size_t(tex.width) * size_t(tex.height);
         for (int c = 0; c < channels; ++c) {
             auto dst = out.channel(c);
-            for (size_t i = 0; i < L.lo[size_t(c)].size(); ++i)
-                dst[size_t(layer) * slice + i] = map.to_src(0.5f * (L.lo[size_t(c)][i] + L.hi[size_t(c)][i]));
+            for (size_t i = 0; i < L.lo[size_t(c)].size(); ++i) // DDS rows top-down -> field rows y-up
+                dst[size_t(layer) * slice + detail::dds_row_flip(i, L.w, L.h)] =
+                    map.to_src(0.5f * (L.lo[size_t(c)][i] + L.hi[size_t(c)][i]));
         }
     }
     return out;
@@ -286,8 +288,9 @@ CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* mani
                 for (int c = 0; c < r.channels; ++c) {
                     const int sc = src_channel(c);
                     for (size_t i = 0; i < L.lo[size_t(c)].size(); ++i) {
-                        const float s =
-                            sc >= 0 ? source.channel(sc)[first + i] : map.to_src(c == 3 ? 1.0f : 0.0f); // missing: stored constants
+                        // The decoded slab is in DDS row order (top-down); the source is y-up.
+                        const float s = sc >= 0 ? source.channel(sc)[first + detail::dds_row_flip(i, L.w, L.h)]
+                                                : map.to_src(c == 3 ? 1.0f : 0.0f); // missing: stored constants
                         const double lo = map.to_src(L.lo[size_t(c)][i]), hi = map.to_src(L.hi[size_t(c)][i]);
                         st.max_error[size_t(c)] = std::max(st.max_error[size_t(c)], std::max(hi - s, s - lo));
                         st.max_over = std::max(st.max_over, hi - s);

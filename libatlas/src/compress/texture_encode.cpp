@@ -225,11 +225,14 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
             }
             auto s = field.channel(chans[size_t(c)]);
             for (size_t i = 0; i < slice; ++i) {
-                const float v = s[size_t(l) * slice + i];
+                // DDS rows run top-down (row 0 is the top of the picture, as every viewer
+                // and engine shows it); field rows run y-up. See docs/formats.md.
+                const size_t src_i = size_t(l) * slice + detail::dds_row_flip(i, L0.w, L0.h);
+                const float v = s[src_i];
                 float n = map.to_norm(v);
                 if (map.kind != MapKind::Float) {
                     if (n < nmin - 1e-6f || n > 1.0f + 1e-6f)
-                        throw Error("compress: source " + texel_name(field, chans[size_t(c)], size_t(l) * slice + i) + " = " +
+                        throw Error("compress: source " + texel_name(field, chans[size_t(c)], src_i) + " = " +
                                     std::to_string(v) + " lies outside value_range [" + std::to_string(map.lo) + ", " +
                                     std::to_string(map.hi) + "]");
                     n = std::clamp(n, nmin, 1.0f);
@@ -267,6 +270,9 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     // BC6H decoding is integer-exact in the specification: every decoder model gives the
     // same values, so one decode measures the guarantee for all of them.
     if (bc6h) bo.decoders = kReferenceOnly;
+    // Uncompressed formats have one decoding too (every model reads the stored
+    // value), so the guarantee for all of `decoders` is verified with one decode.
+    const DecoderSet verify_decoders = is_block_compressed(dx) ? bo.decoders : kReferenceOnly;
     const double scale = map.scale();
     bo.max_error = o.max_error ? float(*o.max_error / scale) : -1.0f;
     std::unique_ptr<Bc4Encoder> bc4;
@@ -340,9 +346,10 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     for (Decoder d : decoders_in(bo.decoders)) man.decoders.push_back(decoder_name(d));
     man.mip_filter = o.one_sided_below ? "min" : "box";
     man.unpack_weights = unpack.weights;
+    man.world_bounds = field.bounds();
 
     // Level-0 errors under every decoder, from the encoded bytes.
-    CompressReport v = verify_texture(tex, &man, field, bo.decoders, chans, "encoded texture");
+    CompressReport v = verify_texture(tex, &man, field, verify_decoders, chans, "encoded texture");
     v.blocks_over_bound = std::move(rep.blocks_over_bound);
     rep = std::move(v);
     rep.format = man.encoding;

@@ -28,6 +28,16 @@ struct Mapping {
 
 MapKind map_kind(DxgiFormat f);
 
+// DDS stores rows top-down (row 0 is the image's top); Atlas fields are y-up
+// (y = 0 is the bottom row, as in EXR/PNG/TGA output where the top row is y = h-1).
+// Maps a texel index (x fastest, then row, then slice) of a w x h x d level between
+// the two orders; the map is its own inverse.
+inline size_t dds_row_flip(size_t i, int w, int h) {
+    const size_t W = size_t(w), H = size_t(h);
+    const size_t x = i % W, y = (i / W) % H, z = i / (W * H);
+    return (z * H + (H - 1 - y)) * W + x;
+}
+
 // Level `mip` of array element `layer`, decoded to normalized channel planes
 // (x fastest, then y, then z); lo/hi give the decoder's interval (equal except
 // for the Conformant model).

@@ -16,6 +16,7 @@
 #include <Imath/half.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <vector>
 
@@ -88,8 +89,24 @@ void write_planes(const fs::path& path, const Planes& p, const std::vector<std::
     }
 }
 
+// Rank of a standard channel name within its layer (OpenEXR's conventions):
+// colour R, G, B, A; vectors X, Y, Z; other names after them, alphabetically.
+// A lone luminance Y comes before its alpha (Y, A).
+int standard_rank(const std::string& suffix, bool luminance) {
+    static const char* const kOrder[] = {"R", "G", "B", "A", "X", "Y", "Z"};
+    std::string u = suffix;
+    for (char& ch : u) ch = char(std::toupper(static_cast<unsigned char>(ch)));
+    if (luminance && u == "Y") return -1;
+    for (int i = 0; i < 7; ++i)
+        if (u == kOrder[i]) return i;
+    return 100;
+}
+
 // Channel order: the atlas:channels attribute when it names exactly the file's
-// channels, else the file's (alphabetical) order.
+// channels; else each layer ("diffuse.R": layer "diffuse.") in the file's
+// (alphabetical) order with its channels in conventional order, so an RGB EXR
+// from another tool reads as R, G, B and not as OpenEXR's alphabetical B, G, R.
+// Luminance/chroma images (RY, BY) are refused: they are not RGB.
 std::vector<std::string> channel_order(const Imf::Header& hd) {
     std::vector<std::string> names;
     for (auto it = hd.channels().begin(); it != hd.channels().end(); ++it) names.emplace_back(it.name());
@@ -99,6 +116,31 @@ std::vector<std::string> channel_order(const Imf::Header& hd) {
         std::sort(b.begin(), b.end());
         if (a == b && std::adjacent_find(a.begin(), a.end()) == a.end()) return order->value();
     }
+    auto layer_of = [](const std::string& n) { const size_t dot = n.rfind('.'); return dot == std::string::npos ? std::string() : n.substr(0, dot + 1); };
+    auto suffix_of = [](const std::string& n) { const size_t dot = n.rfind('.'); return dot == std::string::npos ? n : n.substr(dot + 1); };
+    for (const auto& n : names)
+        if (suffix_of(n) == "RY" || suffix_of(n) == "BY")
+            throw Error("channel '" + n + "' is luminance/chroma (RY, BY); only RGB(A), XYZ, Y and named data channels are supported "
+                        "(convert the image to RGB first)");
+    // A layer is luminance when it has Y but no colour or vector partner.
+    auto luminance_layer = [&](const std::string& layer) {
+        bool y = false, other = false;
+        for (const auto& n : names) {
+            if (layer_of(n) != layer) continue;
+            const int r = standard_rank(suffix_of(n), false);
+            if (r == 5) y = true;
+            else if (r != 3 && r != 100) other = true;
+        }
+        return y && !other;
+    };
+    std::stable_sort(names.begin(), names.end(), [&](const std::string& a, const std::string& b) {
+        const std::string la = layer_of(a), lb = layer_of(b);
+        if (la != lb) return la < lb;
+        const bool lum = luminance_layer(la);
+        const int ra = standard_rank(suffix_of(a), lum), rb = standard_rank(suffix_of(b), lum);
+        if (ra != rb) return ra < rb;
+        return suffix_of(a) < suffix_of(b);
+    });
     return names;
 }
 

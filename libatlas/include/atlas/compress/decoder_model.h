@@ -53,6 +53,8 @@ inline float bc1_conformant_tolerance(float ref0, float ref1) {
 const char* decoder_name(Decoder d);
 // Parses a name above; throws atlas::Error naming the accepted values.
 Decoder parse_decoder(const std::string& name);
+// "reference, nvidia, amd, tool8, conformant, tool8-round": every name parse_decoder takes.
+std::string decoder_names();
 // The decoders in a set, in enum order.
 std::vector<Decoder> decoders_in(DecoderSet set);
 

@@ -72,8 +72,10 @@ struct CompressOptions {
     std::vector<std::string> channel_meanings;
 };
 
-// One 4x4 block (per slice) that misses the bound: its texel origin and the best
-// error the encoder reached (source units).
+// One 4x4 block (per slice) that misses the bound: its texel origin in DDS
+// coordinates (x = column, y = row counted from the TOP of the image as the DDS
+// stores it, z = slice) and the best error the encoder reached (source units).
+// Field texel (x, y_field) lies in DDS row height - 1 - y_field.
 struct BlockMiss {
     int x = 0, y = 0, z = 0, array_index = 0, mip = 0;
     float best_error = 0;
@@ -135,6 +137,9 @@ struct TextureManifest {
     std::vector<std::string> decoders;
     std::string mip_filter; // "box" or "min"
     std::array<float, 3> unpack_weights{1, 0, 0}; // bc1-scalar: n = dot(rgb, weights)
+    // The field's world box (metres), so a decoded texture comes back where it was;
+    // absent in manifests written before it existed (decoding then uses 1 m texels at 0).
+    std::optional<Box3d> world_bounds;
     std::string to_json() const;
     static TextureManifest from_json(const std::string& text, const std::string& what);
 };

@@ -41,9 +41,12 @@ void write_exr(const Field3D& field, const fs::path& path, const ExrOptions& opt
 // A Field2DPtr or Field3DPtr (3D when the header has atlas:resolution). A
 // plain EXR reads as a 2D field over [0, width] x [0, height] (any data
 // window; half and uint channels convert to float). Channels keep their file
-// names, in atlas:channels order when present, else the file's (alphabetical)
-// order. Only the first part of a multi-part file is read; deep and
-// subsampled (luminance/chroma) images are refused. Allocations are checked
+// names, in atlas:channels order when present, else in conventional order:
+// layers ("diffuse.R") in the file's order, within a layer R, G, B, A, then X,
+// Y, Z (a lone luminance Y before its A), then other names alphabetically (so
+// an RGB file from another tool is R, G, B, not OpenEXR's listing B, G, R).
+// Only the first part of a multi-part file is read; deep, subsampled and
+// luminance/chroma (RY, BY) images are refused. Allocations are checked
 // against `budget` (default: MemoryBudget's default limit), so a corrupt
 // header cannot exhaust memory. Throws atlas::Error naming the file on
 // anything unreadable (missing, not EXR, truncated, size mismatch).
