@@ -29,7 +29,7 @@ const std::vector<Command>& commands() {
          {{"--markdown", "", "print the whole reference as Markdown (docs/nodes.md)"}},
          run_nodes},
         {"compress", "IN -o OUT.dds --format FORMAT [options]",
-         "encode a field file (EXR, PNG, TGA, VDB, STEM.001.tga) as a DDS texture with a guaranteed error bound",
+         "encode a field file (EXR, PNG, TGA, VDB, a slice stack STEM.001.tga or STEM(0).tga) as a DDS texture with a guaranteed error bound",
          {{"--out", "OUT.dds", "output texture (also -o); OUT.dds.json (the manifest) is written beside it"},
           {"--format", "FORMAT", compress::format_names()},
           {"--quality", "LEVEL", "fast, normal (default) or best (bc4: exhaustive, provably optimal)"},

@@ -1,4 +1,5 @@
 #include "atlas/io/tga_slices.h"
+#include "atlas/io/readers.h"
 #include "atlas/io/writers.h"
 
 #include "io_test_util.h"
@@ -437,6 +438,12 @@ TEST(TgaSlices, NubisNamingWritesAndFindsTheStack) {
     const Field3D g = read_tga_slices(dir / "modeling_data(0).tga", f.bounds(), 4);
     for (int c = 0; c < 4; ++c)
         for (size_t i = 0; i < f.voxel_count(); ++i) ASSERT_EQ(g.channel(c)[i], float(byte_of(f.channel(c)[i])) / 255.0f);
+    // The generic reader (atlas compress / info) takes the pack's first slice as a stack too.
+    const Value v = read_field_file(dir / "modeling_data(0).tga");
+    ASSERT_TRUE(std::holds_alternative<Field3DPtr>(v));
+    const Field3D& h = *std::get<Field3DPtr>(v);
+    ASSERT_EQ(h.nz(), 12);
+    for (size_t i = 0; i < f.voxel_count(); ++i) ASSERT_EQ(h.channel(1)[i], g.channel(1)[i]);
     expect_error_containing([&] { find_tga_slices(dir / "modeling_data(1).tga"); }, {"modeling_data(1).tga", "modeling_data(0).tga"});
     // A gap names the missing slice; both namings at once is ambiguous.
     fs::remove(dir / "modeling_data(4).tga");

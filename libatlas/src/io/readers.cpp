@@ -16,7 +16,9 @@ Value read_field_file(const std::filesystem::path& path, const MemoryBudget* bud
     const std::string name = path.filename().string();
     if (ext == ".exr") return read_exr(path, budget);
     if (ext == ".vdb") return Field3DPtr(std::make_shared<Field3D>(read_vdb(path, {}, budget)));
-    if (ext == ".tga" && name.size() > 8 && name.compare(name.size() - 8, 8, ".001.tga") == 0) {
+    auto ends_with = [&](const std::string& tail) { return name.size() > tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0; };
+    // The first slice of a stack in either naming: Atlas's STEM.001.tga or the pack's STEM(0).tga.
+    if (ext == ".tga" && (ends_with(".001.tga") || ends_with("(0).tga"))) {
         const auto slices = find_tga_slices(path);
         Field2D first = read_image(slices[0]);
         Box3d b{{{0, 0, 0}}, {{double(first.width()), double(first.height()), double(slices.size())}}};
@@ -24,7 +26,7 @@ Value read_field_file(const std::filesystem::path& path, const MemoryBudget* bud
     }
     if (ext == ".png" || ext == ".tga" || ext == ".tif" || ext == ".tiff" || ext == ".jpg" || ext == ".jpeg")
         return Field2DPtr(std::make_shared<Field2D>(read_image(path, {}, budget)));
-    throw Error(path.string() + ": unknown file type '" + ext + "' (expected .exr, .vdb, .png, .tga, .tif, .jpg or STEM.001.tga)");
+    throw Error(path.string() + ": unknown file type '" + ext + "' (expected .exr, .vdb, .png, .tga, .tif, .jpg, or the first slice of a stack: STEM.001.tga or STEM(0).tga)");
 }
 
 Field3DPtr as_field3d(const Value& v) {

@@ -9,7 +9,7 @@
 namespace atlas::io {
 
 // .exr (2D or Atlas 3D), .vdb (all float grids), .png/.tga/.tif/.jpg (2D),
-// STEM.001.tga (a TGA slice stack, 4 channels, bounds [0,n] per axis).
+// STEM.001.tga or STEM(0).tga (a TGA slice stack in either naming, 4 channels, bounds [0,n] per axis).
 // Returns a Field2DPtr or Field3DPtr; throws atlas::Error naming the file.
 Value read_field_file(const std::filesystem::path& path, const MemoryBudget* budget = nullptr);
 
