@@ -597,10 +597,12 @@ void compare_with_oiio(const DdsTexture& tex, const std::string& name, int& mism
     std::vector<float> px(size_t(tex.width) * size_t(tex.height) * 3);
     ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, px.data()));
     in->close();
-    for (int y = 0; y < tex.height; ++y)
+    // OIIO's row `row` (from the top) is field row height - 1 - row (fields are y-up).
+    for (int row = 0; row < tex.height; ++row)
         for (int x = 0; x < tex.width; ++x)
             for (int c = 0; c < 3; ++c) {
-                const float theirs = px[(size_t(y) * size_t(tex.width) + size_t(x)) * 3 + size_t(c)];
+                const int y = tex.height - 1 - row;
+                const float theirs = px[(size_t(row) * size_t(tex.width) + size_t(x)) * 3 + size_t(c)];
                 const float mine = ours.at(c, x, y, 0);
                 if (std::isinf(mine)) ++infinities;
                 if (!(theirs == mine) && !(std::isnan(theirs) && std::isnan(mine))) {
@@ -674,13 +676,17 @@ TEST(Bc6hTexture, VolumeRoundTripThroughDdsWithMips) {
                     decode_bc6h_block(base + ((size_t(z) * 4 + size_t(by)) * 4 + size_t(bx)) * 16, fmt == Format::Bc6hSf16, dec);
                     for (int t = 0; t < 16; ++t)
                         for (int c = 0; c < 3; ++c) {
-                            const int x = bx * 4 + t % 4, y = by * 4 + t / 4;
+                            // DDS rows run top-down: mip row `row` is field row h - 1 - row.
+                            const int x = bx * 4 + t % 4, row = by * 4 + t / 4, y = h - 1 - row;
                             double sum = 0;
                             for (int k = 0; k < 8; ++k) sum += src.at(c, 2 * x + (k & 1), 2 * y + (k >> 1 & 1), 2 * z + (k >> 2));
                             mip_worst = std::max(mip_worst, std::fabs(dec[3 * t + c] - sum / 8));
                         }
                 }
-        EXPECT_LE(mip_worst, 0.06 * 200.0);
+        // Sanity, like level 0's: a few percent of the largest value. Measured 5.8% (uf16) and
+        // 6.8% (sf16) since DDS rows became top-down (each block holds its rows in the other
+        // order, so the partition search lands elsewhere; it was under 6% before).
+        EXPECT_LE(mip_worst, 0.075 * 200.0);
         std::printf("%s volume: level 0 max error %.4g, mip 1 max error %.4g\n", format_name(fmt), worst, mip_worst);
         // The manifest states the format and the (absent) bound.
         std::ifstream mf(p.string() + ".json");
@@ -745,7 +751,10 @@ TEST(Bc6hTexture, BoundMissesAreReportedWithPositionAndBestError) {
     EXPECT_FALSE(r.blocks_over_bound.empty());
     float worst_miss = 0;
     for (const BlockMiss& m : r.blocks_over_bound) worst_miss = std::max(worst_miss, m.best_error);
-    EXPECT_EQ(double(worst_miss), r.bound_max_error);
+    // The block search measures |decoded - source| in float, the verification in double:
+    // equal up to float rounding (a few ulps), never smaller.
+    EXPECT_NEAR(double(worst_miss), r.bound_max_error, r.bound_max_error * 1e-6);
+    EXPECT_GE(double(worst_miss), r.bound_max_error) << "the search must not under-state a miss";
     // A reachable bound passes.
     o.max_error = float(r.bound_max_error) * 1.01f;
     o.allow_over_bound = false;
