@@ -1,20 +1,11 @@
 #include "atlas/render/renderer.h"
 
-#include "cloud_sampler.h"
 #include "light_grid.h"
-
-#include "atlas/core/error.h"
-#include "atlas/core/hash.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include "render_common.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <memory>
-#include <numbers>
 #include <optional>
 
 namespace atlas::render {
@@ -35,13 +26,7 @@ std::vector<std::string> RenderReport::active_features() const {
     return f;
 }
 
-namespace {
-
-constexpr int kTile = 16;
-
-bool finite3(const Vec3d& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
-
-Vec3d normalized(const Vec3d& v) { return v / length(v); }
+namespace detail {
 
 void check_settings(const RenderSettings& s) {
     auto bad = [](const std::string& what) { throw Error("render: " + what); };
@@ -77,16 +62,11 @@ void check_settings(const RenderSettings& s) {
     for (size_t i = 0; i < s.lights.size(); ++i) validate_light(s.lights[i], "lights[" + std::to_string(i) + "]");
 }
 
-double hg(double cos_theta, double g) {
-    // Normalised so that the isotropic phase (g = 0) is 1 rather than 1/(4 pi).
-    const double denom = 1 + g * g - 2 * g * cos_theta;
-    return (1 - g * g) / (denom * std::sqrt(denom));
-}
+} // namespace detail
 
-double remap(double v, double a, double b, double c, double d) {
-    const double t = detail::saturate((v - a) / (b - a));
-    return c + (d - c) * t;
-}
+namespace {
+
+using detail::remap;
 
 // Entry and exit distances of a ray in the box; nullopt on a miss.
 std::optional<std::pair<double, double>> clip_ray(const Box3d& b, const Vec3d& o, const Vec3d& d) {
@@ -119,9 +99,7 @@ struct Integrator {
     const std::vector<PointLight>& lights;
     double light_core2;               // squared core radius of the inverse-square falloff
 
-    double phase(double cos_theta) const {
-        return s.hg_forward_weight * hg(cos_theta, s.hg_forward) + (1 - s.hg_forward_weight) * hg(cos_theta, s.hg_back);
-    }
+    double phase(double cos_theta) const { return detail::dual_hg(s, cos_theta); }
 
     double march_density(const Vec3d& p, const Vec3d& dir, double step, double max_len = 1e300) const {
         const double len = std::min(max_len, detail::exit_distance(cloud.bounds(), p, dir));
@@ -202,10 +180,7 @@ struct Integrator {
         trans = 1;
         const auto hit = clip_ray(cloud.bounds(), o, dir);
         if (!hit) return;
-        const double cos_theta = dot(dir, sun);
-        const double sun_phase = phase(cos_theta);
-        const double powder_mix = 0.5 + 0.5 * cos_theta; // no powder darkening looking toward the sun
-        const double ms_sun = std::clamp(cos_theta, 0.0, 0.9);
+        const detail::SunTerms st = detail::sun_terms(s, dot(dir, sun));
         const double ext = s.extinction;
         const double min_t = s.min_transmittance;
         double t = hit->first;
@@ -238,15 +213,9 @@ struct Integrator {
                 if (sigma > 0) {
                     double sun_sum, sky_sum;
                     light_depths(p, sun_sum, sky_sum);
-                    const double tau = ext * sun_sum;
-                    const double beer = std::exp(-tau);
-                    const double powder = 1 - std::exp(-2 * tau);
-                    const double direct = beer * (powder + (1 - powder) * powder_mix) * sun_phase;
-                    const double dp = detail::saturate(v.profile);
-                    const double ms = dp * std::exp(-tau * remap(ms_sun, 0.0, 0.9, 0.25, remap(v.sdf, -128.0, 0.0, 0.05, 0.25)));
-                    const double amb = std::sqrt(1 - dp) * std::exp(-ext * sky_sum);
-                    const double sun_w = direct + s.multiple_scattering * ms;
-                    const double sky_w = s.ambient_strength * amb;
+                    double sun_w, sky_w;
+                    detail::shade(s, st, ext * sun_sum, detail::saturate(v.profile), remap(v.sdf, -128.0, 0.0, 0.05, 0.25), ext * sky_sum,
+                                  sun_w, sky_w);
                     // Energy-conserving step integral: (1 - exp(-sigma dt)) of the
                     // light is scattered toward the eye (albedo 1).
                     const double absorbed = -std::expm1(-sigma * dt);
@@ -269,19 +238,17 @@ struct Integrator {
 } // namespace
 
 RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settings, const ProgressSink* progress) {
-    check_settings(settings);
+    detail::check_settings(settings);
     detail::CloudSampler cloud(scene);
     const bool fast = settings.mode == RenderMode::Fast;
-    const Vec3d sun = normalized(settings.sun_direction);
+    const Vec3d sun = detail::normalized(settings.sun_direction);
     // Lights: the given ones, then each light field's flash in order.
     std::vector<PointLight> lights = settings.lights;
     for (const LightField& f : settings.light_fields) {
         auto flash = flash_lights(f);
         lights.insert(lights.end(), flash.begin(), flash.end());
     }
-    // Sky: zenith and horizon; the same colour twice is the uniform sky
-    // (h + (z - h) * t == h exactly, so the uniform look keeps its bytes).
-    const Vec3f zenith = settings.sky_colour, horizon = settings.sky_horizon.value_or(settings.sky_colour);
+    const detail::Sky sky(settings);
 
     RenderReport report;
     report.point_lights = !lights.empty();
@@ -306,18 +273,10 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     const Vec3d vox = cloud.voxel_size();
     const double vmin = std::min({vox[0], vox[1], vox[2]});
     std::unique_ptr<detail::LightGrid> grid;
-    auto run = [&](auto&& f) {
-        if (settings.threads > 0) {
-            tbb::task_arena arena(settings.threads);
-            arena.execute(f);
-        } else {
-            f();
-        }
-    };
     // The light grid never needs to be finer than the volume itself.
     Vec3i grid_res = settings.light_grid;
     for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], scene.modeling->resolution()[a]);
-    if (fast) run([&] { grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun); });
+    if (fast) detail::run_in_arena(settings.threads, [&] { grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun); });
 
     Integrator in{cloud,
                   grid.get(),
@@ -328,66 +287,23 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
                   grid ? 0.5 * grid->voxel_min() : 0.0,
                   settings.reference_step > 0 ? settings.reference_step : 0.25 * vmin,
                   report.near_camera_detail,
-                  {double(horizon[0]) + (double(zenith[0]) - double(horizon[0])) * (2.0 / 3.0),
-                   double(horizon[1]) + (double(zenith[1]) - double(horizon[1])) * (2.0 / 3.0),
-                   double(horizon[2]) + (double(zenith[2]) - double(horizon[2])) * (2.0 / 3.0)},
+                  {sky.ambient[0], sky.ambient[1], sky.ambient[2]},
                   lights,
                   0.25 * vmin * vmin};
 
     const int w = settings.width, h = settings.height;
     Field2D image({{w, h}}, 4, Box2d{{{0, 0}}, {{double(w), double(h)}}}, {"r", "g", "b", "transmittance"});
-    const Vec3d fwd = normalized(settings.camera.look_at - settings.camera.position);
-    const Vec3d right = normalized(cross(fwd, settings.camera.up));
-    const Vec3d up = cross(right, fwd);
-    const double half_h = std::tan(0.5 * settings.camera.fov_deg * std::numbers::pi / 180);
-    const double half_w = half_h * double(w) / double(h);
-
-    const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
-    const int tiles = tiles_x * tiles_y;
-    std::vector<uint64_t> tile_samples(size_t(tiles), 0);
-    std::atomic<int> done{0};
-    std::atomic<bool> cancelled{false};
-    run([&] {
-        tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
-            for (int ti = r.begin(); ti != r.end(); ++ti) {
-                if (cancelled.load(std::memory_order_relaxed)) return;
-                if (progress && progress->cancelled()) {
-                    cancelled = true;
-                    return;
-                }
-                const int x0 = (ti % tiles_x) * kTile, y0 = (ti / tiles_x) * kTile;
-                uint64_t samples = 0;
-                for (int y = y0; y < std::min(h, y0 + kTile); ++y)
-                    for (int x = x0; x < std::min(w, x0 + kTile); ++x) {
-                        const double u = (2 * (x + 0.5) / w - 1) * half_w;
-                        const double v = (2 * (y + 0.5) / h - 1) * half_h;
-                        const Vec3d dir = normalized(fwd + right * u + up * v);
-                        const float jitter = hash_to_unit(hash_coords(settings.seed, x, y));
-                        double rgb[3], trans;
-                        if (lights.empty()) in.trace<false>(settings.camera.position, dir, jitter, rgb, trans, samples);
-                        else in.trace<true>(settings.camera.position, dir, jitter, rgb, trans, samples);
-                        const double up_t = detail::saturate(dir[2]);
-                        for (int c = 0; c < 3; ++c) {
-                            const double sky = double(horizon[c]) + (double(zenith[c]) - double(horizon[c])) * up_t;
-                            image.at(c, x, y) = static_cast<float>(rgb[c] + trans * sky);
-                        }
-                        image.at(3, x, y) = static_cast<float>(trans);
-                    }
-                tile_samples[size_t(ti)] = samples;
-                const int n = ++done;
-                if (progress && progress->on_progress) {
-                    ProgressEvent e;
-                    e.task = fast ? "render" : "render (reference)";
-                    e.done = n;
-                    e.total = tiles;
-                    e.fraction = double(n) / tiles;
-                    progress->on_progress(e);
-                }
-            }
+    const detail::Pinhole cam(settings);
+    report.density_samples =
+        detail::for_each_pixel(settings, progress, fast ? "render" : "render (reference)", [&](int x, int y, float jitter, uint64_t& samples) {
+            const Vec3d dir = cam.dir(x, y);
+            double rgb[3], trans;
+            if (lights.empty()) in.trace<false>(settings.camera.position, dir, jitter, rgb, trans, samples);
+            else in.trace<true>(settings.camera.position, dir, jitter, rgb, trans, samples);
+            const double up_t = detail::saturate(dir[2]);
+            for (int c = 0; c < 3; ++c) image.at(c, x, y) = static_cast<float>(rgb[c] + trans * sky.at(c, up_t));
+            image.at(3, x, y) = static_cast<float>(trans);
         });
-    });
-    if (cancelled) throw CancelledError();
-    for (uint64_t s : tile_samples) report.density_samples += s;
     return {std::move(image), report};
 }
 

@@ -1,0 +1,168 @@
+// Internal: what the voxel ray-marcher (renderer.cpp) and the 2.5D layer
+// ray-marcher (layer.cpp) share: settings checks, the phase function, the
+// Nubis lighting of one sample (Beer-powder, dual HG, ambient, multiple
+// scattering), the pinhole camera and the deterministic 16x16-tile TBB loop.
+#pragma once
+
+#include "cloud_sampler.h"
+
+#include "atlas/core/error.h"
+#include "atlas/core/hash.h"
+#include "atlas/core/progress.h"
+#include "atlas/render/renderer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+namespace atlas::render::detail {
+
+inline bool finite3(const Vec3d& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+
+inline Vec3d normalized(const Vec3d& v) { return v / length(v); }
+
+// Throws atlas::Error ("render: ...") naming the first bad setting.
+void check_settings(const RenderSettings& s);
+
+inline double hg(double cos_theta, double g) {
+    // Normalised so that the isotropic phase (g = 0) is 1 rather than 1/(4 pi).
+    const double denom = 1 + g * g - 2 * g * cos_theta;
+    return (1 - g * g) / (denom * std::sqrt(denom));
+}
+
+inline double remap(double v, double a, double b, double c, double d) {
+    const double t = saturate((v - a) / (b - a));
+    return c + (d - c) * t;
+}
+
+inline double dual_hg(const RenderSettings& s, double cos_theta) {
+    return s.hg_forward_weight * hg(cos_theta, s.hg_forward) + (1 - s.hg_forward_weight) * hg(cos_theta, s.hg_back);
+}
+
+// Per-ray constants of the sun lighting (cos = dot(view, sun)).
+struct SunTerms {
+    double sun_phase;  // dual-lobe HG
+    double powder_mix; // 0.5 + 0.5 cos: no powder darkening looking toward the sun
+    double ms_sun;     // clamp(cos, 0, 0.9)
+};
+
+inline SunTerms sun_terms(const RenderSettings& s, double cos_theta) {
+    return {dual_hg(s, cos_theta), 0.5 + 0.5 * cos_theta, std::clamp(cos_theta, 0.0, 0.9)};
+}
+
+// The Nubis lighting of one sample: weights of the sun colour and of the
+// ambient sky colour in the in-scattered radiance.
+//   tau         optical depth toward the sun
+//   dp          the sample's profile (in-scatter probability), [0, 1]
+//   ms_relax    Beer relaxation deep inside (0.05 deep .. 0.25 at the surface)
+//   sky_tau     optical depth toward the sky
+inline void shade(const RenderSettings& s, const SunTerms& st, double tau, double dp, double ms_relax, double sky_tau, double& sun_w,
+                  double& sky_w) {
+    const double beer = std::exp(-tau);
+    const double powder = 1 - std::exp(-2 * tau);
+    const double direct = beer * (powder + (1 - powder) * st.powder_mix) * st.sun_phase;
+    const double ms = dp * std::exp(-tau * remap(st.ms_sun, 0.0, 0.9, 0.25, ms_relax));
+    const double amb = std::sqrt(1 - dp) * std::exp(-sky_tau);
+    sun_w = direct + s.multiple_scattering * ms;
+    sky_w = s.ambient_strength * amb;
+}
+
+// The sky: zenith and horizon colour; the same colour twice is the uniform
+// sky (h + (z - h) * t == h exactly, so the uniform look keeps its bytes).
+struct Sky {
+    Vec3f zenith, horizon;
+    double ambient[3]; // cosine-weighted upper-hemisphere mean
+
+    explicit Sky(const RenderSettings& s) : zenith(s.sky_colour), horizon(s.sky_horizon.value_or(s.sky_colour)) {
+        for (int c = 0; c < 3; ++c) ambient[c] = double(horizon[c]) + (double(zenith[c]) - double(horizon[c])) * (2.0 / 3.0);
+    }
+    double at(int c, double up_t) const { return double(horizon[c]) + (double(zenith[c]) - double(horizon[c])) * up_t; }
+};
+
+// The pinhole camera of the settings: the view direction of pixel (x, y),
+// y = 0 the bottom row.
+struct Pinhole {
+    Vec3d fwd, right, up;
+    double half_w, half_h;
+    int w, h;
+
+    explicit Pinhole(const RenderSettings& s) : w(s.width), h(s.height) {
+        fwd = normalized(s.camera.look_at - s.camera.position);
+        right = normalized(cross(fwd, s.camera.up));
+        up = cross(right, fwd);
+        half_h = std::tan(0.5 * s.camera.fov_deg * std::numbers::pi / 180);
+        half_w = half_h * double(w) / double(h);
+    }
+    Vec3d dir(int x, int y) const {
+        const double u = (2 * (x + 0.5) / w - 1) * half_w;
+        const double v = (2 * (y + 0.5) / h - 1) * half_h;
+        return normalized(fwd + right * u + up * v);
+    }
+};
+
+// Runs f in an arena of `threads` threads (0 = TBB default).
+template <class F>
+void run_in_arena(int threads, F&& f) {
+    if (threads > 0) {
+        tbb::task_arena arena(threads);
+        arena.execute(f);
+    } else {
+        f();
+    }
+}
+
+constexpr int kTile = 16;
+
+// The deterministic tile loop: fixed 16x16 tiles over TBB; pixel(x, y,
+// jitter, samples) is called once per pixel with jitter =
+// hash_to_unit(hash_coords(seed, x, y)) and must depend only on its
+// arguments. Returns the summed per-tile sample counts (fixed order).
+// Progress per tile under `task`; throws CancelledError on cancel.
+template <class PixelFn>
+uint64_t for_each_pixel(const RenderSettings& s, const ProgressSink* progress, const std::string& task, PixelFn&& pixel) {
+    const int w = s.width, h = s.height;
+    const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
+    const int tiles = tiles_x * tiles_y;
+    std::vector<uint64_t> tile_samples(size_t(tiles), 0);
+    std::atomic<int> done{0};
+    std::atomic<bool> cancelled{false};
+    run_in_arena(s.threads, [&] {
+        tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
+            for (int ti = r.begin(); ti != r.end(); ++ti) {
+                if (cancelled.load(std::memory_order_relaxed)) return;
+                if (progress && progress->cancelled()) {
+                    cancelled = true;
+                    return;
+                }
+                const int x0 = (ti % tiles_x) * kTile, y0 = (ti / tiles_x) * kTile;
+                uint64_t samples = 0;
+                for (int y = y0; y < std::min(h, y0 + kTile); ++y)
+                    for (int x = x0; x < std::min(w, x0 + kTile); ++x)
+                        pixel(x, y, hash_to_unit(hash_coords(s.seed, x, y)), samples);
+                tile_samples[size_t(ti)] = samples;
+                const int n = ++done;
+                if (progress && progress->on_progress) {
+                    ProgressEvent e;
+                    e.task = task;
+                    e.done = n;
+                    e.total = tiles;
+                    e.fraction = double(n) / tiles;
+                    progress->on_progress(e);
+                }
+            }
+        });
+    });
+    if (cancelled) throw CancelledError();
+    uint64_t total = 0;
+    for (uint64_t v : tile_samples) total += v;
+    return total;
+}
+
+} // namespace atlas::render::detail
