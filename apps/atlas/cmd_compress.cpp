@@ -80,7 +80,8 @@ void print_report(const compress::CompressReport& r) {
         std::printf("  channel %zu: max error %.6g  RMSE %.6g  PSNR %.2f dB\n", c, r.max_error[c], r.rmse[c], r.psnr[c]);
     std::printf("  guaranteed max error over all decoders: %.6g%s\n", r.bound_max_error,
                 r.requested_max_error ? (" (requested " + std::to_string(*r.requested_max_error) + ")").c_str() : "");
-    std::printf("  blocks over the bound: %zu\n", r.blocks_over_bound.size());
+    std::printf("  blocks over the bound: %zu%s\n", r.blocks_over_bound.size(),
+                r.blocks_over_bound.empty() ? "" : " (DDS texel of the block's corner: x column, y row from the top, z slice)");
     for (size_t i = 0; i < r.blocks_over_bound.size() && i < 20; ++i) {
         const auto& b = r.blocks_over_bound[i];
         std::printf("    block at (%d, %d, %d) mip %d: best error %.6g%s\n", b.x, b.y, b.z, b.mip, b.best_error,
