@@ -54,6 +54,7 @@ std::string general_help();
 // Subcommand entry points (one file each).
 int run_cook(const Args&);
 int run_validate(const Args&);
+int run_cache(const Args&);
 int run_nodes(const Args&);
 int run_info(const Args&);
 int run_preview(const Args&);

@@ -6,20 +6,26 @@
 #include "atlas/core/memory.h"
 #include "atlas/graph/evaluator.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <set>
 
 namespace atlas::cli {
 
 namespace {
-void apply_sets(Session& s, const Args& a, const std::string& cmd) {
+// With several graphs (`matched` given), a --set applies to the graphs that
+// have its node; the caller checks that each one matched some graph.
+void apply_sets(Session& s, const Args& a, const std::string& cmd, std::set<std::string>* matched = nullptr) {
     for (const auto& kv : a.all("--set")) {
         auto eq = kv.find('=');
         auto dot = kv.find('.');
         if (eq == std::string::npos || dot == std::string::npos || dot > eq)
             throw UsageError{"--set expects NODE.PARAM=VALUE, got '" + kv + "'", cmd};
+        if (matched && !s.graph().find(kv.substr(0, dot))) continue;
         s.set_text(kv.substr(0, dot), kv.substr(dot + 1, eq - dot - 1), kv.substr(eq + 1));
+        if (matched) matched->insert(kv);
     }
 }
 
@@ -29,18 +35,38 @@ std::string one_graph(const Args& a, const std::string& cmd) {
 }
 } // namespace
 
+namespace {
+// Make/Ninja depfile escaping: spaces and '#' with a backslash, '$' doubled.
+std::string depfile_escape(const std::string& path) {
+    std::string out;
+    for (char c : path) {
+        if (c == ' ' || c == '#' || c == '\\') out += '\\';
+        if (c == '$') out += '$';
+        out += c;
+    }
+    return out;
+}
+
+void write_text_atomic(const std::string& path, const std::string& text, const std::string& what) {
+    write_file_atomic(path, [&](const std::filesystem::path& tmp) {
+        try {
+            write_file_checked(tmp, text.data(), text.size());
+        } catch (const Error& e) {
+            throw Error(path + ": cannot write " + what + " (" + e.what() + ")");
+        }
+    });
+}
+} // namespace
+
 int run_cook(const Args& a) {
-    const std::string file = one_graph(a, "cook");
+    if (a.positional.empty()) throw UsageError{"expected a graph file (or several)", "cook"};
     const bool quiet = a.has("--quiet");
-    Session session(builtin_nodes());
-    session.load(file);
-    apply_sets(session, a, "cook");
 
     CookOptions o;
     o.out_dir = a.get("--out", ".");
-    o.outputs = a.all("--output");
     o.checked = a.has("--checked");
     o.allow_outside_out = a.has("--allow-outside-out");
+    o.reuse_outputs = !a.has("--rewrite");
     if (a.has("--jobs")) {
         try {
             o.jobs = std::stoi(a.get("--jobs"));
@@ -53,31 +79,109 @@ int run_cook(const Args& a) {
     if (a.has("--cache") && a.has("--no-cache")) throw UsageError{"--cache and --no-cache contradict each other", "cook"};
     if (a.has("--cache")) o.cache_dir = a.get("--cache");
     else if (const char* env = std::getenv("ATLAS_CACHE_DIR"); env && *env && !a.has("--no-cache")) o.cache_dir = env;
+    if (a.has("--cache-max-size")) {
+        if (!o.cache_dir) throw UsageError{"--cache-max-size needs a cache (--cache DIR or ATLAS_CACHE_DIR)", "cook"};
+        o.cache_max_bytes = parse_byte_size(a.get("--cache-max-size"));
+    }
 
+    // Every graph cooks in its own session (one graph's nodes never see
+    // another's) with the same options, so they share the disk cache.
+    std::vector<std::pair<std::string, CookResult>> cooks;
+    std::vector<std::string> requested = a.all("--output");
+    std::set<std::string> matched, sets_matched;
+    std::string failure;
+    bool cancelled = false;
     ProgressBar bar(!quiet);
-    o.progress = bar.sink();
-    CookResult r = session.cook(o);
+    for (const std::string& file : a.positional) {
+        Session session(builtin_nodes());
+        try {
+            session.load(file);
+            apply_sets(session, a, "cook", a.positional.size() > 1 ? &sets_matched : nullptr);
+            CookOptions go = o;
+            go.progress = bar.sink();
+            // --output names apply to the graphs that have them.
+            for (const auto& name : requested)
+                for (const auto& out : session.graph().outputs)
+                    if (out.file == name || out.node == name) {
+                        if (std::find(go.outputs.begin(), go.outputs.end(), name) == go.outputs.end()) go.outputs.push_back(name);
+                        matched.insert(name);
+                    }
+            if (a.positional.size() == 1) go.outputs = requested; // one graph: unknown names are its error
+            else if (!requested.empty() && go.outputs.empty()) {
+                cooks.emplace_back(file, CookResult{});
+                cooks.back().second.status = "ok";
+                continue; // nothing requested from this graph
+            }
+            cooks.emplace_back(file, session.cook(go));
+        } catch (const UsageError&) {
+            throw;
+        } catch (const std::exception& e) {
+            CookResult r = session.last_result();
+            r.status = dynamic_cast<const CancelledError*>(&e) ? "cancelled" : "failed";
+            r.error = e.what();
+            if (auto pe = dynamic_cast<const ParseError*>(&e)) r.error_where = pe->where().str();
+            cooks.emplace_back(file, r);
+            cancelled = r.status == "cancelled";
+            failure = e.what();
+            break; // a failed graph stops the call, as one failed graph stops a build
+        }
+    }
     bar.finish();
+    if (failure.empty() && a.positional.size() > 1)
+        for (const auto& name : requested)
+            if (!matched.count(name)) failure = "unknown output '" + name + "': none of the graphs writes it";
+    if (failure.empty() && a.positional.size() > 1)
+        for (const auto& kv : a.all("--set"))
+            if (!sets_matched.count(kv)) failure = "--set " + kv + ": none of the graphs has that node";
 
     if (a.has("--report")) {
-        std::string json = r.to_json(file);
-        write_file_atomic(a.get("--report"), [&](const std::filesystem::path& tmp) {
-            std::ofstream f(tmp);
-            f << json;
-            if (!f) throw Error(a.get("--report") + ": cannot write report");
-        });
+        const std::string json = cooks.size() == 1 && a.positional.size() == 1 ? cooks[0].second.to_json(cooks[0].first) : combined_report_json(cooks);
+        write_text_atomic(a.get("--report"), json, "the report");
     }
-    size_t files = 0;
-    for (const auto& out : r.outputs) files += out.written.size();
-    // stdout: one summary line, then the written files (data for scripts).
-    std::cout << "cooked " << r.with_status("cooked").size() << ", cached " << r.with_status("cached").size() << ", skipped "
-              << r.with_status("skipped").size() << " nodes in " << r.seconds << " s; wrote " << files << " files to "
-              << o.out_dir.string() << "\n";
-    for (const auto& out : r.outputs)
-        for (const auto& p : out.written) std::cout << p.string() << "\n";
-    if (!quiet)
+    if (cancelled) throw CancelledError();
+    if (!failure.empty()) throw Error(failure);
+
+    if (a.has("--depfile")) {
+        // TARGETS: DEPENDENCIES, in Make syntax (Ninja reads it as well).
+        std::string targets, deps;
+        std::set<std::string> seen_t, seen_d;
+        for (const auto& [file, r] : cooks) {
+            for (const auto& out : r.outputs)
+                for (const auto& f : out.files)
+                    if (seen_t.insert(f.path.string()).second) targets += (targets.empty() ? "" : " ") + depfile_escape(f.path.string());
+            for (const auto& d : r.depends(file))
+                if (seen_d.insert(d.string()).second) deps += " \\\n  " + depfile_escape(d.string());
+        }
+        write_text_atomic(a.get("--depfile"), targets + ":" + deps + "\n", "the depfile");
+    }
+
+    size_t files = 0, current = 0;
+    size_t cooked = 0, cached = 0, skipped = 0;
+    double seconds = 0;
+    std::vector<std::string> warnings;
+    for (const auto& [file, r] : cooks) {
+        for (const auto& out : r.outputs) {
+            files += out.written.size();
+            if (out.status == "up to date") current += out.files.size();
+        }
+        cooked += r.with_status("cooked").size();
+        cached += r.with_status("cached").size();
+        skipped += r.with_status("skipped").size();
+        seconds += r.seconds;
+        for (const auto& w : r.warnings) warnings.push_back(file + ": warning: " + w);
         for (const auto& [name, nr] : r.nodes)
-            for (const auto& w : nr.warnings) std::cerr << file << ": warning: node '" << name << "': " << w << "\n";
+            for (const auto& w : nr.warnings) warnings.push_back(file + ": warning: node '" + name + "': " + w);
+    }
+    // stdout: one summary line, then the written files (data for scripts).
+    std::cout << "cooked " << cooked << ", cached " << cached << ", skipped " << skipped << " nodes in " << seconds << " s; wrote " << files
+              << " files to " << o.out_dir.string() << "\n";
+    for (const auto& [file, r] : cooks)
+        for (const auto& out : r.outputs)
+            for (const auto& p : out.written) std::cout << p.string() << "\n";
+    if (!quiet) {
+        if (current) std::cerr << current << " file" << (current == 1 ? "" : "s") << " already up to date (not rewritten)\n";
+        for (const auto& w : warnings) std::cerr << w << "\n";
+    }
     return 0;
 }
 

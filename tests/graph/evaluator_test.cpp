@@ -1,14 +1,19 @@
 // Evaluation order, laziness, caching (memory and disk), checked mode,
 // determinism across thread counts, atomic outputs, budgets, cancellation.
 #include "atlas/core/files.h"
+#include "atlas/graph/disk_cache.h"
 #include "atlas/graph/evaluator.h"
 #include "../support/test_nodes.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cctype>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <sys/wait.h>
+#include <unistd.h>
 
 using namespace atlas;
 namespace fs = std::filesystem;
@@ -56,6 +61,13 @@ struct Fixture : ::testing::Test {
         o.out_dir = dir / "out";
         return o;
     }
+    // For tests of the value caches: every output is written, so the nodes
+    // behind it are needed (up-to-date outputs would need nothing).
+    CookOptions writing_options() {
+        CookOptions o = options();
+        o.reuse_outputs = false;
+        return o;
+    }
 };
 
 std::string slurp(const fs::path& p) { return read_file_bytes(p); }
@@ -92,13 +104,13 @@ TEST_F(Fixture, RequestedOutputLimitsTheCook) {
 
 TEST_F(Fixture, SecondCookCooksNothingAndParameterChangeRecooksDownstreamOnly) {
     Session s = session();
-    s.cook(options());
-    CookResult second = s.cook(options());
+    s.cook(writing_options());
+    CookResult second = s.cook(writing_options());
     EXPECT_TRUE(second.with_status("cooked").empty());
     EXPECT_EQ(second.nodes.at("sum").status, "cached");
     EXPECT_EQ(second.nodes.at("a").status, "skipped"); // not even loaded: sum came from cache
     s.set("b", "value", 5.0);
-    CookResult third = s.cook(options());
+    CookResult third = s.cook(writing_options());
     EXPECT_EQ(third.with_status("cooked"), (std::vector<std::string>{"b", "gate", "sum"}));
     EXPECT_EQ(third.nodes.at("a").status, "cached");
     EXPECT_EQ(log->count("a"), 1);
@@ -124,7 +136,7 @@ TEST_F(Fixture, HashCoversParametersInputsAndTypeButNotUnusedNodes) {
 }
 
 TEST_F(Fixture, DiskCacheServesANewSession) {
-    CookOptions o = options();
+    CookOptions o = writing_options();
     o.cache_dir = dir / "cache";
     {
         Session s = session();
@@ -140,7 +152,7 @@ TEST_F(Fixture, DiskCacheServesANewSession) {
 }
 
 TEST_F(Fixture, CorruptDiskCacheEntryIsAMissNotAnError) {
-    CookOptions o = options();
+    CookOptions o = writing_options();
     o.cache_dir = dir / "cache";
     {
         Session s = session();
@@ -159,7 +171,7 @@ TEST_F(Fixture, CorruptDiskCacheEntryIsAMissNotAnError) {
 // size: an entry cut anywhere (a crash mid-write by another tool, a full disk)
 // is a miss, and the node cooks again with the same result.
 TEST_F(Fixture, TruncatedDiskCacheEntryIsAMiss) {
-    CookOptions o = options();
+    CookOptions o = writing_options();
     o.cache_dir = dir / "cache";
     {
         Session s = session();
@@ -182,7 +194,7 @@ TEST_F(Fixture, TruncatedDiskCacheEntryIsAMiss) {
 TEST_F(Fixture, CheckedModeCatchesAnIncompleteHash) {
     const char* g = "atlas: 1\nnodes:\n  l:\n    type: test/leaky\noutputs:\n  - {node: l, file: l.exr}\n";
     Session s = session(g);
-    CookOptions o = options();
+    CookOptions o = writing_options();
     s.cook(o);
     CookOptions checked = o;
     checked.checked = true;
@@ -402,4 +414,267 @@ outputs:
     auto j = nlohmann::json::parse(r.to_json("t.yaml"));
     EXPECT_TRUE(j["outputs"][0]["metrics"].contains("bound_max_error"));
     EXPECT_TRUE(fs::exists(dir / "out" / "n.dds.json"));
+}
+
+// ------------------------------------------------- unattended cooks (issue 17)
+
+namespace {
+int64_t mtime_ns(const fs::path& p) {
+    return int64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(fs::last_write_time(p).time_since_epoch()).count());
+}
+const OutputReport& output_named(const CookResult& r, const std::string& file) {
+    for (const auto& o : r.outputs)
+        if (o.file == file) return o;
+    throw std::runtime_error("no output " + file);
+}
+const char* kTwoOutputs = "atlas: 1\nnodes:\n  a:\n    type: test/source\n    params: {value: 2}\n  b:\n    type: test/source\n"
+                          "    params: {value: 3}\noutputs:\n  - {node: a, file: a.exr}\n  - {node: b, file: sub/b.png, options: {slice: 1}}\n";
+} // namespace
+
+// An output whose key and file are unchanged is not written again (the file's
+// mtime and bytes stay) and nothing cooks or loads for it, in a new session
+// (as a new process would) with or without a disk cache.
+TEST_F(Fixture, UnchangedOutputsAreNotRewrittenAndNothingCooks) {
+    CookOptions o = options();
+    Session s1 = session(kTwoOutputs);
+    CookResult r1 = s1.cook(o);
+    EXPECT_EQ(output_named(r1, "a.exr").status, "written");
+    ASSERT_EQ(output_named(r1, "a.exr").files.size(), 1u);
+    const fs::path a = dir / "out" / "a.exr", b = dir / "out" / "sub" / "b.png";
+    const int64_t ta = mtime_ns(a), tb = mtime_ns(b);
+    const std::string bytes_a = slurp(a);
+    EXPECT_EQ(output_named(r1, "a.exr").files[0].hash, file_content_hash(a).hex());
+    EXPECT_EQ(output_named(r1, "a.exr").files[0].bytes, bytes_a.size());
+
+    Session s2 = session(kTwoOutputs);
+    CookResult r2 = s2.cook(o);
+    EXPECT_EQ(log->count("a"), 1);
+    EXPECT_EQ(log->count("b"), 1);
+    EXPECT_EQ(r2.nodes.at("a").status, "skipped");
+    EXPECT_EQ(r2.nodes.at("a").reason, "not needed: the outputs it feeds are up to date");
+    EXPECT_EQ(output_named(r2, "a.exr").status, "up to date");
+    EXPECT_TRUE(output_named(r2, "a.exr").written.empty());
+    ASSERT_EQ(output_named(r2, "a.exr").files.size(), 1u);
+    EXPECT_EQ(output_named(r2, "a.exr").files[0].hash, output_named(r1, "a.exr").files[0].hash);
+    EXPECT_EQ(mtime_ns(a), ta);
+    EXPECT_EQ(mtime_ns(b), tb);
+
+    // One parameter edit: only that output is written again.
+    s2.set_text("b", "value", "4");
+    CookResult r3 = s2.cook(o);
+    EXPECT_EQ(log->count("a"), 1);
+    EXPECT_EQ(log->count("b"), 2);
+    EXPECT_EQ(output_named(r3, "a.exr").status, "up to date");
+    EXPECT_EQ(output_named(r3, "sub/b.png").status, "written");
+    EXPECT_EQ(mtime_ns(a), ta);
+    EXPECT_EQ(slurp(a), bytes_a);
+
+    // Output options are part of the key.
+    Session s4 = session(std::string(kTwoOutputs).replace(std::string(kTwoOutputs).find("{slice: 1}"), 10, "{slice: 2}"));
+    s4.set_text("b", "value", "4");
+    EXPECT_EQ(output_named(s4.cook(o), "sub/b.png").status, "written");
+}
+
+// The file on disk decides: a deleted, resized or edited output is written
+// again; a touched one with the same bytes is not (its mtime stays the touched one).
+TEST_F(Fixture, OutputChangedOnDiskIsWrittenAgain) {
+    CookOptions o = options();
+    session(kTwoOutputs).cook(o);
+    const fs::path a = dir / "out" / "a.exr";
+    const std::string good = slurp(a);
+
+    fs::remove(a);
+    EXPECT_EQ(output_named(session(kTwoOutputs).cook(o), "a.exr").status, "written");
+    EXPECT_EQ(slurp(a), good);
+
+    { std::ofstream(a, std::ios::binary | std::ios::app) << "x"; }
+    EXPECT_EQ(output_named(session(kTwoOutputs).cook(o), "a.exr").status, "written");
+    EXPECT_EQ(slurp(a), good);
+
+    std::string edited = good;
+    edited[edited.size() / 2] ^= 0x40; // same size, different bytes, new mtime
+    { std::ofstream(a, std::ios::binary | std::ios::trunc) << edited; }
+    EXPECT_EQ(output_named(session(kTwoOutputs).cook(o), "a.exr").status, "written");
+    EXPECT_EQ(slurp(a), good);
+
+    const auto touched = fs::file_time_type::clock::now() - std::chrono::hours(5);
+    fs::last_write_time(a, touched);
+    EXPECT_EQ(output_named(session(kTwoOutputs).cook(o), "a.exr").status, "up to date");
+    EXPECT_EQ(fs::last_write_time(a), touched);
+
+    // --rewrite (reuse_outputs = false) writes everything.
+    CookOptions all = o;
+    all.reuse_outputs = false;
+    EXPECT_EQ(output_named(session(kTwoOutputs).cook(all), "a.exr").status, "written");
+}
+
+// A bit flipped anywhere in a cache entry is detected: the entry is discarded
+// with a warning and the node cooks again, giving the same output bytes.
+TEST_F(Fixture, FlippedBitInCacheEntryIsDetectedAndRecooked) {
+    CookOptions o = options();
+    o.cache_dir = dir / "cache";
+    o.reuse_outputs = false;
+    session().cook(o);
+    const std::string good = slurp(dir / "out" / "sum.exr");
+    std::vector<fs::path> entries;
+    for (const auto& e : fs::directory_iterator(dir / "cache"))
+        if (e.path().extension() == ".atlascache") entries.push_back(e.path());
+    ASSERT_EQ(entries.size(), 4u); // a, b, sum, gate
+    for (double at : {0.5, 0.97}) {
+        for (const auto& p : entries) {
+            std::string bytes = slurp(p);
+            bytes[size_t(double(bytes.size()) * at)] ^= 0x01;
+            std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
+        }
+        const int before = log->count("sum");
+        CookResult r = session().cook(o);
+        EXPECT_EQ(log->count("sum"), before + 1) << at;
+        EXPECT_EQ(r.nodes.at("gate").status, "cooked");
+        ASSERT_FALSE(r.warnings.empty());
+        EXPECT_NE(r.warnings[0].find("checksum mismatch"), std::string::npos) << r.warnings[0];
+        EXPECT_EQ(slurp(dir / "out" / "sum.exr"), good);
+        // The re-cooked entries replaced the damaged ones: the next cook is clean.
+        CookResult again = session().cook(o);
+        EXPECT_TRUE(again.warnings.empty());
+        EXPECT_EQ(again.nodes.at("gate").status, "cached");
+    }
+}
+
+// An unwritable cache (here: a plain file where the directory should be)
+// degrades to cooking without it, with a warning.
+TEST_F(Fixture, UnwritableCacheDegradesToCookingWithoutIt) {
+    CookOptions o = options();
+    { std::ofstream(dir / "cache") << "not a directory"; }
+    o.cache_dir = dir / "cache";
+    CookResult r;
+    ASSERT_NO_THROW(r = session().cook(o));
+    ASSERT_EQ(r.warnings.size(), 1u); // once, not per node
+    EXPECT_NE(r.warnings[0].find("without writing the cache"), std::string::npos) << r.warnings[0];
+    EXPECT_TRUE(fs::exists(dir / "out" / "sum.exr"));
+}
+
+TEST_F(Fixture, PruneRemovesLeastRecentlyUsedFirst) {
+    const fs::path c = dir / "cache";
+    fs::create_directories(c);
+    const auto now = fs::file_time_type::clock::now();
+    for (int i = 0; i < 5; ++i) {
+        const fs::path p = c / ("entry" + std::to_string(i) + ".atlascache");
+        std::ofstream(p) << std::string(1000, 'x');
+        fs::last_write_time(p, now - std::chrono::hours(10 - i)); // entry0 is the oldest
+    }
+    std::ofstream(c / "notes.txt") << std::string(5000, 'y'); // not an entry: never touched
+    const auto r = disk_cache::prune(c, 2500);
+    EXPECT_EQ(r.bytes_before, 5000u);
+    EXPECT_EQ(r.removed_files, 3u);
+    EXPECT_EQ(r.bytes_after, 2000u);
+    for (int i = 0; i < 5; ++i) EXPECT_EQ(fs::exists(c / ("entry" + std::to_string(i) + ".atlascache")), i >= 3) << i;
+    EXPECT_TRUE(fs::exists(c / "notes.txt"));
+}
+
+// A cache hit refreshes the entry, so a cook's working set survives a prune
+// to its own size; cache_max_bytes prunes after the cook.
+TEST_F(Fixture, CacheSizeLimitKeepsWhatTheCookUsed) {
+    CookOptions o = options();
+    o.cache_dir = dir / "cache";
+    o.reuse_outputs = false;
+    session().cook(o);
+    uint64_t used = 0;
+    for (const auto& e : fs::directory_iterator(dir / "cache")) used += e.file_size();
+    // An old, unrelated entry.
+    const fs::path stale = dir / "cache" / "00000000000000000000000000000000.atlascache";
+    std::ofstream(stale) << std::string(4000, 'z');
+    fs::last_write_time(stale, fs::file_time_type::clock::now() - std::chrono::hours(48));
+    o.cache_max_bytes = used;
+    CookResult r = session().cook(o);
+    EXPECT_EQ(r.nodes.at("gate").status, "cached");
+    EXPECT_FALSE(fs::exists(stale));
+    uint64_t left = 0;
+    for (const auto& e : fs::directory_iterator(dir / "cache")) left += e.file_size();
+    EXPECT_EQ(left, used);
+}
+
+// Staging folders of a killed cook (its process is gone) are removed by the
+// next cook, in --out and in the cache; a running process's are not.
+TEST_F(Fixture, StagingLeftByAKilledCookIsRemoved) {
+    // A real process that has exited: its pid is free.
+    const pid_t dead = fork();
+    if (dead == 0) _exit(0);
+    waitpid(dead, nullptr, 0);
+    char host[256] = {};
+    gethostname(host, sizeof host - 1);
+    std::string h(host);
+    for (char& ch : h)
+        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+    const std::string killed = ".atlas-staging-" + h + "-" + std::to_string(dead) + "-0123456789abcdef";
+    const std::string alive = ".atlas-staging-" + h + "-" + std::to_string(::getpid()) + "-0123456789abcdef";
+    for (const fs::path& root : {dir / "out", dir / "cache"}) {
+        fs::create_directories(root / killed / "nvdf");
+        std::ofstream(root / killed / "nvdf" / "big.tga") << std::string(10000, 'k');
+        fs::create_directories(root / alive);
+    }
+    CookOptions o = options();
+    o.cache_dir = dir / "cache";
+    session().cook(o);
+    for (const fs::path& root : {dir / "out", dir / "cache"}) {
+        EXPECT_FALSE(fs::exists(root / killed)) << root;
+        EXPECT_TRUE(fs::exists(root / alive)) << root;
+    }
+}
+
+// Inputs a node reads (through hash_file) are listed with their hashes; a
+// failed cook still leaves a result naming the node and its line.
+TEST_F(Fixture, ReportListsInputsAndFailures) {
+    CookOptions o = options();
+    session(kTwoOutputs).cook(o); // writes out/a.exr, an input for the next graph
+    const std::string g = "atlas: 1\nnodes:\n  in:\n    type: import/exr\n    params: {file: out/a.exr}\noutputs:\n  - {node: in, file: copy.exr}\n";
+    CookOptions o2 = o;
+    o2.out_dir = dir / "out2";
+    CookResult r = session(g).cook(o2);
+    ASSERT_EQ(r.inputs.size(), 1u);
+    EXPECT_EQ(r.inputs[0].path, dir / "out" / "a.exr");
+    EXPECT_EQ(r.inputs[0].node, "in");
+    EXPECT_EQ(r.inputs[0].hash, file_content_hash(dir / "out" / "a.exr").hex());
+    const auto deps = r.depends("g.yaml");
+    ASSERT_EQ(deps.size(), 2u);
+    EXPECT_EQ(deps[1], dir / "out" / "a.exr");
+    auto j = nlohmann::json::parse(r.to_json("g.yaml"));
+    EXPECT_EQ(j["status"], "ok");
+    EXPECT_EQ(j["inputs"][0]["hash"], r.inputs[0].hash);
+    EXPECT_EQ(j["outputs"][0]["files"][0]["hash"], file_content_hash(dir / "out2" / "copy.exr").hex());
+
+    Session s = session();
+    log->fail = true;
+    EXPECT_THROW(s.cook(options()), Error);
+    const CookResult& f = s.last_result();
+    EXPECT_EQ(f.status, "failed");
+    EXPECT_EQ(f.error_node, "gate");
+    EXPECT_EQ(f.error_where, "test.yaml:14:3");
+    EXPECT_EQ(f.nodes.at("gate").status, "failed");
+    EXPECT_NE(f.error.find("simulated failure"), std::string::npos);
+    auto jf = nlohmann::json::parse(f.to_json("test.yaml"));
+    EXPECT_EQ(jf["status"], "failed");
+    EXPECT_EQ(jf["error"]["node"], "gate");
+    EXPECT_EQ(jf["error"]["where"], "test.yaml:14:3");
+}
+
+// DDS textures are costly to encode: their files are kept in the disk cache
+// by output key, so a deleted texture comes back without cooking or encoding.
+TEST_F(Fixture, EncodedTextureIsRestoredFromTheCache) {
+    const char* g = "atlas: 1\nnodes:\n  a:\n    type: test/source\n    params: {value: 0.5}\noutputs:\n"
+                    "  - {node: a, file: a.dds, options: {encoding: bc4}}\n";
+    CookOptions o = options();
+    o.cache_dir = dir / "cache";
+    CookResult r1 = session(g).cook(o);
+    const std::string good = slurp(dir / "out" / "a.dds");
+    fs::remove(dir / "out" / "a.dds");
+    fs::remove(dir / "out" / "a.dds.json");
+    // Nothing may cook or load: remove the node entries.
+    for (const auto& e : fs::directory_iterator(dir / "cache"))
+        if (e.path().extension() == ".atlascache") fs::remove(e.path());
+    CookResult r2 = session(g).cook(o);
+    EXPECT_EQ(log->count("a"), 1);
+    EXPECT_EQ(output_named(r2, "a.dds").status, "restored");
+    EXPECT_EQ(slurp(dir / "out" / "a.dds"), good);
+    EXPECT_TRUE(fs::exists(dir / "out" / "a.dds.json"));
+    EXPECT_EQ(output_named(r2, "a.dds").metrics, output_named(r1, "a.dds").metrics);
 }

@@ -5,9 +5,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
+#include <cerrno>
 #include <chrono>
+#include <csignal>
+#include <cstring>
+#include <fcntl.h>
 #include <fstream>
 #include <sstream>
+#include <sys/stat.h>
 #include <system_error>
 #include <unistd.h>
 #include <vector>
@@ -15,17 +21,108 @@
 namespace atlas {
 
 namespace {
-// A staging name unique within the process and across processes.
+constexpr char kStagingPrefix[] = ".atlas-staging-";
+
+std::string host_name() {
+    char buf[256] = {};
+    if (::gethostname(buf, sizeof buf - 1) != 0 || !buf[0]) return "host";
+    std::string h(buf);
+    for (char& c : h)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_'; // '-' separates the name's parts
+    return h;
+}
+
+// A staging name unique within the process and across processes; it names
+// the host and process so that the next cook can tell a killed cook's
+// leftovers from a running cook's work (remove_stale_staging).
 std::string staging_name() {
     static std::atomic<uint64_t> counter{0};
     uint64_t n = counter.fetch_add(1);
     uint64_t t = uint64_t(std::chrono::steady_clock::now().time_since_epoch().count());
     uint64_t h = mix64(t ^ mix64(uint64_t(::getpid()) ^ (n << 32)));
-    char buf[40];
-    std::snprintf(buf, sizeof buf, ".atlas-staging-%016llx", static_cast<unsigned long long>(h));
-    return buf;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "-%lld-%016llx", static_cast<long long>(::getpid()), static_cast<unsigned long long>(h));
+    return kStagingPrefix + host_name() + buf;
+}
+
+uint64_t tree_bytes(const fs::path& dir) {
+    uint64_t total = 0;
+    std::error_code ec;
+    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        std::error_code e2;
+        if (it->is_regular_file(e2)) total += it->file_size(e2);
+    }
+    return total;
 }
 } // namespace
+
+uint64_t remove_stale_staging(const fs::path& dir) {
+    uint64_t removed = 0;
+    std::error_code ec;
+    const std::string host = host_name();
+    const auto now = fs::file_time_type::clock::now();
+    for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.rfind(kStagingPrefix, 0) != 0) continue;
+        std::error_code e2;
+        if (!it->is_directory(e2)) continue;
+        bool stale = false;
+        // HOST-PID-HEX: parts from the end (older names have only HEX).
+        const std::string rest = name.substr(sizeof kStagingPrefix - 1);
+        const auto last = rest.rfind('-');
+        const auto mid = last == std::string::npos || last == 0 ? std::string::npos : rest.rfind('-', last - 1);
+        if (mid != std::string::npos && rest.substr(0, mid) == host) {
+            const long long pid = std::atoll(rest.substr(mid + 1, last - mid - 1).c_str());
+            stale = pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH;
+        }
+        if (!stale) {
+            const auto t = fs::last_write_time(it->path(), e2);
+            stale = !e2 && now - t > std::chrono::hours(24);
+        }
+        if (!stale) continue;
+        const uint64_t bytes = tree_bytes(it->path());
+        fs::remove_all(it->path(), e2);
+        if (!e2) removed += bytes;
+    }
+    return removed;
+}
+
+void write_file_checked(const fs::path& path, const void* data, size_t size) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) throw Error(path.string() + ": cannot create the file: " + std::strerror(errno));
+    const auto* p = static_cast<const char*>(data);
+    size_t left = size;
+    while (left > 0) {
+        const ssize_t n = ::write(fd, p, std::min<size_t>(left, size_t(1) << 30));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            const int err = n < 0 ? errno : ENOSPC;
+            ::close(fd);
+            throw Error(path.string() + ": write failed after " + std::to_string(size - left) + " of " + std::to_string(size) +
+                        " bytes: " + std::strerror(err));
+        }
+        p += n;
+        left -= size_t(n);
+    }
+    if (::close(fd) != 0) throw Error(path.string() + ": write failed when closing the file: " + std::strerror(errno));
+}
+
+Hash128 file_content_hash(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path.string() + ": cannot open file for reading");
+    Hasher h;
+    std::vector<char> buf(1 << 20);
+    uint64_t total = 0;
+    while (in) {
+        in.read(buf.data(), std::streamsize(buf.size()));
+        const auto n = size_t(in.gcount());
+        if (n) h.add_bytes(buf.data(), n);
+        total += n;
+    }
+    if (in.bad()) throw Error(path.string() + ": read error");
+    h.add(total);
+    return h.finish();
+}
 
 StagedOutputs::StagedOutputs(fs::path root) : root_(std::move(root)) {
     std::error_code ec;
@@ -120,18 +217,38 @@ std::string read_file_bytes(const fs::path& path) {
 } // namespace atlas
 
 namespace atlas {
+namespace {
+thread_local std::vector<FileRead>* t_file_reads = nullptr;
+} // namespace
+
+FileReadRecorder::FileReadRecorder(std::vector<FileRead>* sink) : previous_(t_file_reads) { t_file_reads = sink; }
+FileReadRecorder::~FileReadRecorder() { t_file_reads = previous_; }
+
 void hash_file(Hasher& h, const fs::path& path) {
+    std::error_code ec;
+    const auto st = fs::status(path, ec);
+    if (!ec && fs::exists(st) && !fs::is_regular_file(st))
+        throw Error(path.string() + ": not a regular file (" + (fs::is_directory(st) ? "a directory" : "a device, FIFO or socket") +
+                    "); input files must be regular files");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path.string() + ": cannot open input file (does it exist?)");
     h.add(path.filename().string());
+    // The same chunking as file_content_hash, so the recorded hash equals it.
+    Hasher content;
     std::vector<char> buf(1 << 20);
     uint64_t total = 0;
     while (in) {
         in.read(buf.data(), std::streamsize(buf.size()));
         const auto n = size_t(in.gcount());
-        if (n) h.add_bytes(buf.data(), n);
+        if (n) {
+            h.add_bytes(buf.data(), n);
+            content.add_bytes(buf.data(), n);
+        }
         total += n;
     }
+    if (in.bad()) throw Error(path.string() + ": read error");
     h.add(total);
+    content.add(total);
+    if (t_file_reads) t_file_reads->push_back({path, total, content.finish()});
 }
 } // namespace atlas

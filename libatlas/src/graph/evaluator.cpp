@@ -5,6 +5,7 @@
 
 #include "atlas/core/files.h"
 #include "atlas/io/writers.h"
+#include "output_records.h"
 #include "value_cache.h"
 
 #include <tbb/parallel_for.h>
@@ -45,6 +46,12 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
         throw Error("node '" + name + "' (" + type + "): " + e.what());
     }
 }
+
+// Bump when any writer changes the bytes it writes for the same value and
+// options: every output is written again on the next cook.
+constexpr int kOutputFormatVersion = 1;
+// Formats whose encoded files the disk cache keeps (costly to encode).
+const std::set<std::string> kCachedOutputFormats = {"dds"};
 
 struct NodeState {
     const GraphNode* node = nullptr;
@@ -147,7 +154,28 @@ std::map<std::string, Hash128> Session::node_hashes() const {
     return hashes;
 }
 
-CookResult Session::cook(const CookOptions& options) { return run(options, nullptr, nullptr); }
+CookResult Session::cook(const CookOptions& options) {
+    try {
+        return run(options, nullptr, nullptr);
+    } catch (const CancelledError& e) {
+        last_.status = "cancelled";
+        last_.error = e.what();
+        throw;
+    } catch (const std::exception& e) {
+        last_.status = "failed";
+        last_.error = e.what();
+        if (!last_.error_node.empty()) {
+            NodeReport& r = last_.nodes[last_.error_node];
+            if (graph_)
+                if (const GraphNode* n = graph_->find(last_.error_node)) r.type = n->type;
+            if (r.status.empty() || r.status == "cooked") {
+                r.status = "failed";
+                r.reason = e.what();
+            }
+        }
+        throw;
+    }
+}
 
 Value Session::get(const std::string& node, const std::string& port, const CookOptions& options) {
     CookOptions o = options;
@@ -161,6 +189,10 @@ Value Session::get(const std::string& node, const std::string& port, const CookO
 CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std::string, std::string>>* want_value,
                         std::vector<Value>* values_out) {
     const auto t_start = std::chrono::steady_clock::now();
+    // Filled as the cook goes, so that a failed cook still reports what happened.
+    last_ = CookResult{};
+    CookResult& result = last_;
+    result.checked = opt.checked;
     const Graph& g = graph();
     const int jobs = opt.jobs > 0 ? opt.jobs : int(tbb::info::default_concurrency());
     const MemoryBudget budget(opt.memory_budget);
@@ -216,9 +248,95 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     std::map<std::string, Hash128> hashes;
     for (const GraphNode* n : order) {
         NodeState& s = state.at(n->name);
-        s.hash = node_hash(g, registry_, *n, *s.type, hashes);
+        std::vector<FileRead> reads;
+        {
+            FileReadRecorder recorder(&reads); // what hash_extra reads: the cook's input files
+            try {
+                s.hash = node_hash(g, registry_, *n, *s.type, hashes);
+            } catch (...) {
+                result.error_node = n->name;
+                result.error_where = n->where.str();
+                throw;
+            }
+        }
+        for (const auto& r : reads) result.inputs.push_back({r.path, r.bytes, r.hash.hex(), n->name});
         hashes[n->name] = s.hash;
     }
+
+    // 3b. Outputs already on disk: an output whose key is unchanged and whose
+    //     files still match needs no value (nothing cooks or loads for it);
+    //     one whose encoded files the disk cache holds is copied from there.
+    const bool reuse = opt.write_outputs && opt.reuse_outputs && !opt.checked;
+    bool cache_writable = bool(opt.cache_dir);
+    auto warn = [&](std::string message) { result.warnings.push_back(std::move(message)); };
+    struct OutputPlan {
+        const GraphOutput* out = nullptr;
+        std::filesystem::path root, rel;
+        std::string name; // the record's name: rel, generic form
+        Hash128 key;
+        enum { write, current, restore } action = write;
+        const OutputRecord* record = nullptr;
+        std::optional<disk_cache::CachedFiles> cached;
+    };
+    std::vector<OutputPlan> plans;
+    std::map<std::filesystem::path, std::unique_ptr<OutputRecords>> records;
+    if (opt.write_outputs && !outputs.empty()) {
+        if (opt.cache_dir) remove_stale_staging(*opt.cache_dir);
+        for (const GraphOutput* o : outputs) {
+            OutputPlan p;
+            p.out = o;
+            try {
+                std::filesystem::path final_path = resolve_output_path(opt.out_dir, o->file, opt.allow_outside_out);
+                p.root = opt.out_dir;
+                p.rel = std::filesystem::path(o->file).lexically_normal();
+                if (std::filesystem::path(o->file).is_absolute() || p.rel.begin()->string() == "..") {
+                    p.root = final_path.parent_path();
+                    p.rel = final_path.filename();
+                }
+            } catch (const std::exception& e) {
+                result.error_node = o->node;
+                result.error_where = o->where.str();
+                throw Error(o->where.str() + ": " + e.what());
+            }
+            p.name = p.rel.generic_string();
+            Hasher h;
+            h.add("atlas-output").add(int64_t(kOutputFormatVersion)).add(state.at(o->node).hash).add(o->port).add(o->format).add(p.name);
+            for (const auto& [k, v] : o->options) h.add(k).add(v);
+            p.key = h.finish();
+            auto& rec = records[p.root];
+            if (!rec) {
+                remove_stale_staging(p.root); // what killed cooks left
+                rec = std::make_unique<OutputRecords>(p.root);
+            }
+            if (reuse) {
+                if ((p.record = rec->current(p.name, p.key.hex()))) {
+                    p.action = OutputPlan::current;
+                } else if (opt.cache_dir && kCachedOutputFormats.count(o->format) &&
+                           std::filesystem::exists(disk_cache::files_entry_path(*opt.cache_dir, p.key))) {
+                    std::string why;
+                    if ((p.cached = disk_cache::load_files(*opt.cache_dir, p.key, &why))) {
+                        p.action = OutputPlan::restore;
+                    } else {
+                        std::error_code ec;
+                        std::filesystem::remove(disk_cache::files_entry_path(*opt.cache_dir, p.key), ec);
+                        warn("disk cache: the encoded files of output '" + o->file + "' (" + disk_cache::files_entry_path(*opt.cache_dir, p.key).string() +
+                             ") are unusable (" + why + "); discarded, the output is written again");
+                    }
+                }
+            }
+            plans.push_back(std::move(p));
+        }
+        // Only the outputs to write need values.
+        targets.clear();
+        for (const auto& p : plans)
+            if (p.action == OutputPlan::write) targets.emplace_back(p.out->node, p.out->port);
+    }
+    std::set<std::string> feeds_writes; // nodes some output to write depends on
+    std::function<void(const std::string&)> mark_writes = [&](const std::string& name) {
+        if (!feeds_writes.insert(name).second) return;
+        for (const auto& [port, b] : state.at(name).node->inputs) mark_writes(b.node);
+    };
+    for (const auto& t : targets) mark_writes(t.first);
 
     // 4. Decide, consumers before producers, what must be present and cooked.
     for (const auto& t : targets) state.at(t.first).required = true;
@@ -229,10 +347,18 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             s.cached = hit;
             s.cache_source = "memory cache";
         } else if (opt.cache_dir && disk_cache::contains(*opt.cache_dir, s.hash)) {
-            if (auto loaded = disk_cache::load(*opt.cache_dir, s.hash)) {
+            std::string why;
+            if (auto loaded = disk_cache::load(*opt.cache_dir, s.hash, &why)) {
                 s.cached = std::make_shared<const NodeOutputs>(std::move(*loaded));
                 s.cache_source = "disk cache";
                 cache_->put(s.hash, s.cached);
+            } else {
+                // A damaged entry is never used: remove it and cook again.
+                const auto path = disk_cache::entry_path(*opt.cache_dir, s.hash);
+                std::error_code ec;
+                std::filesystem::remove(path, ec);
+                warn("disk cache: entry " + path.string() + " of node '" + (*it)->name + "' is unusable (" + why +
+                     "); discarded, the node cooks again");
             }
         }
         s.cook = opt.checked || !s.cached;
@@ -257,9 +383,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     int total = 0;
     for (const auto& l : levels) total += int(l.size());
 
-    CookResult result;
     result.jobs = jobs;
-    result.checked = opt.checked;
     std::map<std::string, std::shared_ptr<const NodeOutputs>> values;
     for (const GraphNode* n : order) {
         const NodeState& s = state.at(n->name);
@@ -312,21 +436,36 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         });
         // Deterministic error choice: the first failing node in level order.
         for (size_t i = 0; i < level.size(); ++i)
-            if (errors[i]) rethrow_for_node(level[i]->name, level[i]->type, errors[i]);
+            if (errors[i]) {
+                result.error_node = level[i]->name;
+                result.error_where = level[i]->where.str();
+                rethrow_for_node(level[i]->name, level[i]->type, errors[i]);
+            }
         for (size_t i = 0; i < level.size(); ++i) {
             const GraphNode& n = *level[i];
             NodeState& s = state.at(n.name);
             if (opt.checked && s.cached) {
                 for (const auto& [port, v] : *s.cached) {
                     auto it = produced[i]->find(port);
-                    if (it == produced[i]->end() || !values_equal(v, it->second))
+                    if (it == produced[i]->end() || !values_equal(v, it->second)) {
+                        result.error_node = n.name;
+                        result.error_where = n.where.str();
                         throw Error("checked mode: node '" + n.name + "' (" + n.type + "): output '" + port +
                                     "' differs from the cached result with the same hash; the node's hash misses something its cook reads");
+                    }
                 }
             }
             values[n.name] = produced[i];
             cache_->put(s.hash, produced[i]);
-            if (opt.cache_dir) disk_cache::store(*opt.cache_dir, s.hash, *produced[i]);
+            if (cache_writable) {
+                try {
+                    disk_cache::store(*opt.cache_dir, s.hash, *produced[i]);
+                } catch (const std::exception& e) {
+                    // A full or unwritable cache disk costs speed, not the cook.
+                    cache_writable = false;
+                    warn("disk cache: cannot store node '" + n.name + "' (" + e.what() + "); cooking on without writing the cache");
+                }
+            }
             NodeReport& r = reports[i];
             r.status = "cooked";
             r.reason = opt.checked && s.cached ? "checked mode: re-cooked and matched the " + s.cache_source : "";
@@ -353,6 +492,9 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         } else if (s.required) {
             r.status = "cached";
             r.reason = s.cache_source;
+        } else if (!feeds_writes.count(n.name) && !want_value) {
+            r.status = "skipped";
+            r.reason = "not needed: the outputs it feeds are up to date";
         } else {
             r.status = "skipped";
             r.reason = "not needed: everything downstream came from the cache";
@@ -371,37 +513,111 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         for (const auto& t : targets) values_out->push_back(values.at(t.first)->at(t.second));
     if (opt.write_outputs && !outputs.empty()) {
         std::map<std::filesystem::path, std::unique_ptr<StagedOutputs>> staging;
-        for (const GraphOutput* o : outputs) {
+        struct Written {
+            size_t report;     // index into result.outputs
+            OutputPlan* plan;
+            StagedOutputs* stage;
+            std::vector<std::filesystem::path> staged;
+        };
+        std::vector<Written> written;
+        for (OutputPlan& p : plans) {
+            const GraphOutput* o = p.out;
+            OutputReport orep{o->node, o->port, o->file, o->format, {}, {}, {}, {}};
+            if (p.action == OutputPlan::current) {
+                orep.status = "up to date";
+                orep.metrics = p.record->metrics;
+                for (const auto& f : p.record->files) orep.files.push_back({p.root / f.path, f.bytes, f.hash});
+                result.outputs.push_back(orep);
+                continue;
+            }
             try {
                 opt.progress.poll();
-                std::filesystem::path final_path = resolve_output_path(opt.out_dir, o->file, opt.allow_outside_out);
-                std::filesystem::path root = opt.out_dir, rel = std::filesystem::path(o->file).lexically_normal();
-                if (std::filesystem::path(o->file).is_absolute() || rel.begin()->string() == "..") {
-                    root = final_path.parent_path();
-                    rel = final_path.filename();
-                }
-                auto& st = staging[root];
-                if (!st) st = std::make_unique<StagedOutputs>(root);
+                auto& st = staging[p.root];
+                if (!st) st = std::make_unique<StagedOutputs>(p.root);
                 if (opt.progress.on_progress) opt.progress.on_progress({"writing " + o->file, 1.0, total, total});
-                OutputReport orep{o->node, o->port, o->file, o->format, {}, {}};
-                for (const auto& staged : io::write_value(values.at(o->node)->at(o->port), st->stage(rel), o->format, o->options, &orep.metrics))
-                    orep.written.push_back(st->final_path(staged));
+                Written w{result.outputs.size(), &p, st.get(), {}};
+                if (p.action == OutputPlan::restore) {
+                    orep.status = "restored";
+                    orep.metrics = p.cached->metrics;
+                    for (const auto& [name, bytes] : p.cached->files) {
+                        const auto staged = st->stage(name);
+                        write_file_checked(staged, bytes.data(), bytes.size());
+                        w.staged.push_back(staged);
+                    }
+                    p.cached.reset();
+                } else {
+                    orep.status = "written";
+                    w.staged = io::write_value(values.at(o->node)->at(o->port), st->stage(p.rel), o->format, o->options, &orep.metrics);
+                }
+                for (const auto& staged : w.staged) {
+                    // What is on disk is what gets reported and recorded.
+                    std::error_code ec;
+                    const uint64_t bytes = std::filesystem::file_size(staged, ec);
+                    if (ec) throw Error("'" + staged.string() + "' was not written: " + ec.message());
+                    const auto final_path = st->final_path(staged);
+                    orep.written.push_back(final_path);
+                    orep.files.push_back({final_path, bytes, file_content_hash(staged).hex()});
+                }
+                if (p.action == OutputPlan::write && cache_writable && kCachedOutputFormats.count(o->format)) {
+                    std::vector<std::pair<std::string, std::filesystem::path>> files;
+                    for (size_t k = 0; k < w.staged.size(); ++k)
+                        files.emplace_back(orep.files[k].path.lexically_relative(p.root).generic_string(), w.staged[k]);
+                    try {
+                        disk_cache::store_files(*opt.cache_dir, p.key, files, orep.metrics);
+                    } catch (const std::exception& e) {
+                        cache_writable = false;
+                        warn("disk cache: cannot store the encoded files of output '" + o->file + "' (" + e.what() +
+                             "); cooking on without writing the cache");
+                    }
+                }
                 result.outputs.push_back(orep);
+                written.push_back(std::move(w));
             } catch (const CancelledError&) {
                 throw;
             } catch (const std::exception& e) {
                 // Writers already name the output ("output 'x.png': ..."); add the graph position.
                 const std::string msg = e.what();
+                result.error_node = o->node;
+                result.error_where = o->where.str();
                 throw Error(o->where.str() + ": " + (msg.rfind("output '", 0) == 0 ? msg : "output '" + o->file + "': " + msg));
             }
         }
         // Everything written: move it into place.
         for (auto& [root, st] : staging) st->commit();
+        // Record what is on disk now (renames keep the mtime).
+        for (const auto& w : written) {
+            OutputRecord rec;
+            rec.key = w.plan->key.hex();
+            const OutputReport& orep = result.outputs[w.report];
+            rec.metrics = orep.metrics;
+            for (const auto& f : orep.files)
+                rec.files.push_back({f.path.lexically_relative(w.plan->root).generic_string(), f.bytes, file_mtime_ns(f.path), f.hash});
+            records.at(w.plan->root)->set(w.plan->name, std::move(rec));
+        }
+        for (auto& [root, rec] : records) {
+            try {
+                rec->save();
+            } catch (const std::exception& e) {
+                warn("cannot record the outputs written in '" + root.string() + "' (" + e.what() + "); the next cook writes them again");
+            }
+        }
     } else {
-        for (const GraphOutput* o : outputs) result.outputs.push_back({o->node, o->port, o->file, o->format, {}, {}});
+        for (const GraphOutput* o : outputs) result.outputs.push_back({o->node, o->port, o->file, o->format, {}, {}, {}, {}});
     }
+    if (opt.cache_dir && opt.cache_max_bytes > 0) disk_cache::prune(*opt.cache_dir, opt.cache_max_bytes);
     result.seconds = seconds_since(t_start);
     return result;
+}
+
+std::vector<std::filesystem::path> CookResult::depends(const std::filesystem::path& graph_file) const {
+    std::vector<std::filesystem::path> v;
+    std::set<std::filesystem::path> seen;
+    auto add = [&](const std::filesystem::path& p) {
+        if (!p.empty() && seen.insert(p.lexically_normal()).second) v.push_back(p);
+    };
+    add(graph_file);
+    for (const auto& in : inputs) add(in.path);
+    return v;
 }
 
 std::vector<std::string> CookResult::with_status(const std::string& status) const {

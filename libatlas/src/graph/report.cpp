@@ -8,11 +8,52 @@
 
 namespace atlas {
 
-std::string CookResult::to_json(const std::string& graph_file) const {
+namespace {
+nlohmann::json report_doc(const CookResult& r, const std::string& graph_file);
+} // namespace
+
+std::string CookResult::to_json(const std::string& graph_file) const { return report_doc(*this, graph_file).dump(2) + "\n"; }
+
+std::string combined_report_json(const std::vector<std::pair<std::string, CookResult>>& cooks) {
     using nlohmann::json;
     json doc;
     doc["atlas_report_version"] = 1;
+    std::string status = "ok";
+    double seconds = 0;
+    json graphs = json::array();
+    json summary{{"cooked", 0}, {"cached", 0}, {"skipped", 0}};
+    for (const auto& [file, r] : cooks) {
+        graphs.push_back(report_doc(r, file));
+        if (r.status != "ok" && status == "ok") status = r.status;
+        seconds += r.seconds;
+        for (const char* k : {"cooked", "cached", "skipped"}) summary[k] = summary[k].get<size_t>() + r.with_status(k).size();
+    }
+    doc["status"] = status;
+    doc["seconds"] = seconds;
+    doc["graphs"] = graphs;
+    doc["summary"] = summary;
+    return doc.dump(2) + "\n";
+}
+
+namespace {
+nlohmann::json report_doc(const CookResult& self, const std::string& graph_file) {
+    using nlohmann::json;
+    const CookResult& cr = self;
+    const auto& nodes = cr.nodes;
+    const auto& outputs = cr.outputs;
+    json doc;
+    doc["atlas_report_version"] = 1;
     doc["graph"] = graph_file;
+    doc["status"] = cr.status;
+    if (cr.status != "ok") {
+        json e{{"message", cr.error}};
+        if (!cr.error_node.empty()) e["node"] = cr.error_node;
+        if (!cr.error_where.empty()) e["where"] = cr.error_where;
+        doc["error"] = e;
+    }
+    const double seconds = cr.seconds;
+    const int jobs = cr.jobs;
+    const bool checked = cr.checked;
     doc["seconds"] = seconds;
     doc["jobs"] = jobs;
     doc["checked"] = checked;
@@ -38,18 +79,30 @@ std::string CookResult::to_json(const std::string& graph_file) const {
         json files = json::array();
         for (const auto& p : o.written) files.push_back(p.string());
         jo["written"] = files;
+        if (!o.status.empty()) jo["status"] = o.status;
+        json all = json::array();
+        for (const auto& f : o.files) all.push_back({{"path", f.path.string()}, {"bytes", f.bytes}, {"hash", f.hash}});
+        jo["files"] = all;
         json om = json::object();
         for (const auto& [k, v] : o.metrics) om[k] = std::isfinite(v) ? json(v) : json(nullptr);
         jo["metrics"] = om;
         outs.push_back(jo);
     }
     doc["outputs"] = outs;
+    json ins = json::array();
+    for (const auto& in : cr.inputs) ins.push_back({{"path", in.path.string()}, {"bytes", in.bytes}, {"hash", in.hash}, {"node", in.node}});
+    doc["inputs"] = ins;
+    json deps = json::array();
+    for (const auto& p : cr.depends(graph_file)) deps.push_back(p.string());
+    doc["depends"] = deps;
+    doc["warnings"] = cr.warnings;
     json summary;
-    summary["cooked"] = with_status("cooked").size();
-    summary["cached"] = with_status("cached").size();
-    summary["skipped"] = with_status("skipped").size();
+    summary["cooked"] = self.with_status("cooked").size();
+    summary["cached"] = self.with_status("cached").size();
+    summary["skipped"] = self.with_status("skipped").size();
     doc["summary"] = summary;
-    return doc.dump(2) + "\n";
+    return doc;
 }
+} // namespace
 
 } // namespace atlas

@@ -3,6 +3,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -26,7 +27,10 @@ void ValueCache::retain_only(const std::unordered_set<Hash128, Hash128Hasher>& k
 namespace disk_cache {
 
 namespace {
-constexpr char kMagic[] = "ATLASCACHE\x01";
+// Version 2: the body is followed by its Hash128 checksum (16 bytes), so a
+// flipped bit is a detected miss instead of a silently different output.
+constexpr char kMagic[] = "ATLASCACHE\x02";
+constexpr size_t kChecksumSize = 16;
 constexpr size_t kMagicSize = sizeof(kMagic) - 1;
 // Values are stored with fixed-width little-endian integers and raw floats;
 // Atlas only targets little-endian machines (x86-64, arm64).
@@ -35,7 +39,16 @@ constexpr size_t kMagicSize = sizeof(kMagic) - 1;
 // string in between would double the memory and the page faults.
 struct Writer {
     std::ostream& out;
-    void bytes(const void* p, size_t n) { out.write(static_cast<const char*>(p), std::streamsize(n)); }
+    Hasher sum{};
+    void bytes(const void* p, size_t n) {
+        sum.add_bytes(p, n);
+        out.write(static_cast<const char*>(p), std::streamsize(n));
+    }
+    void checksum() {
+        const Hash128 h = sum.finish();
+        out.write(reinterpret_cast<const char*>(&h.hi), 8);
+        out.write(reinterpret_cast<const char*>(&h.lo), 8);
+    }
     void u64(uint64_t v) { bytes(&v, 8); }
     void f64(double v) { bytes(&v, 8); }
     void str(const std::string& s) { u64(s.size()); bytes(s.data(), s.size()); }
@@ -47,12 +60,22 @@ struct Reader {
     uint64_t size; // bytes in the entry: every length is checked against what is left
     uint64_t pos = 0;
     bool ok = true;
+    Hasher sum{};
     bool take(void* dst, size_t n) {
         if (!ok || size - pos < n) return ok = false;
         in.read(static_cast<char*>(dst), std::streamsize(n));
         if (uint64_t(in.gcount()) != n) return ok = false;
+        sum.add_bytes(dst, n); // the same calls, in the same order, as Writer::bytes
         pos += n;
         return true;
+    }
+    // After the body: the stored checksum must match what was read.
+    bool checksum_matches() {
+        uint64_t stored[2] = {0, 0};
+        in.read(reinterpret_cast<char*>(stored), 16);
+        if (in.gcount() != 16) return false;
+        const Hash128 h = sum.finish();
+        return stored[0] == h.hi && stored[1] == h.lo;
     }
     uint64_t u64() { uint64_t v = 0; take(&v, 8); return v; }
     double f64() { double v = 0; take(&v, 8); return v; }
@@ -118,6 +141,7 @@ void serialize_to(std::ostream& out, const NodeOutputs& outputs) {
             for (const auto& [name, vals] : (*p)->attributes) { w.str(name); w.raw(vals.data(), vals.size() * sizeof(float)); }
         }
     }
+    w.checksum();
 }
 
 std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std::string* why_not) {
@@ -125,7 +149,8 @@ std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std
         if (why_not) *why_not = why;
         return std::nullopt;
     };
-    Reader r{in, size};
+    if (size < kMagicSize + kChecksumSize) return fail("truncated");
+    Reader r{in, size - kChecksumSize};
     char magic[kMagicSize];
     if (!r.take(magic, kMagicSize) || std::memcmp(magic, kMagic, kMagicSize) != 0) return fail("not an Atlas cache file of this version");
     NodeOutputs out;
@@ -177,7 +202,8 @@ std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std
         return fail("corrupt value");
     }
     if (!r.ok) return fail("truncated");
-    if (r.pos != size) return fail("trailing bytes");
+    if (r.pos != r.size) return fail("trailing bytes");
+    if (!r.checksum_matches()) return fail("checksum mismatch (the entry is corrupt)");
     return out;
 }
 } // namespace
@@ -209,7 +235,14 @@ std::optional<NodeOutputs> load(const std::filesystem::path& dir, const Hash128&
         if (why_not) *why_not = path.string() + ": cannot open cache entry";
         return std::nullopt;
     }
-    return deserialize_from(in, size, why_not);
+    auto v = deserialize_from(in, size, why_not);
+    if (v) touch(path);
+    return v;
+}
+
+void touch(const std::filesystem::path& entry) {
+    std::error_code ec;
+    std::filesystem::last_write_time(entry, std::filesystem::file_time_type::clock::now(), ec);
 }
 
 void store(const std::filesystem::path& dir, const Hash128& h, const NodeOutputs& outputs) {
@@ -219,6 +252,112 @@ void store(const std::filesystem::path& dir, const Hash128& h, const NodeOutputs
         f.close();
         if (!f) throw Error(tmp.string() + ": cannot write cache entry (disk full?)");
     });
+}
+
+// ------------------------------------------------------------ output files
+
+namespace {
+constexpr char kFilesMagic[] = "ATLASFILES\x01";
+constexpr size_t kFilesMagicSize = sizeof(kFilesMagic) - 1;
+} // namespace
+
+std::filesystem::path files_entry_path(const std::filesystem::path& dir, const Hash128& key) { return dir / (key.hex() + ".atlasout"); }
+
+void store_files(const std::filesystem::path& dir, const Hash128& key,
+                 const std::vector<std::pair<std::string, std::filesystem::path>>& files, const std::map<std::string, double>& metrics) {
+    write_file_atomic(files_entry_path(dir, key), [&](const std::filesystem::path& tmp) {
+        std::ofstream f(tmp, std::ios::binary);
+        Writer w{f};
+        w.bytes(kFilesMagic, kFilesMagicSize);
+        w.u64(metrics.size());
+        for (const auto& [k, v] : metrics) { w.str(k); w.f64(v); }
+        w.u64(files.size());
+        for (const auto& [name, path] : files) {
+            w.str(name);
+            w.str(read_file_bytes(path));
+        }
+        w.checksum();
+        f.close();
+        if (!f) throw Error(tmp.string() + ": cannot write cache entry (disk full?)");
+    });
+}
+
+std::optional<CachedFiles> load_files(const std::filesystem::path& dir, const Hash128& key, std::string* why_not) {
+    const std::filesystem::path path = files_entry_path(dir, key);
+    std::error_code ec;
+    const uint64_t size = std::filesystem::file_size(path, ec);
+    std::ifstream in(path, std::ios::binary);
+    auto fail = [&](const std::string& why) -> std::optional<CachedFiles> {
+        if (why_not) *why_not = why;
+        return std::nullopt;
+    };
+    if (ec || !in) return fail("cannot open cache entry");
+    if (size < kFilesMagicSize + kChecksumSize) return fail("truncated");
+    Reader r{in, size - kChecksumSize};
+    char magic[kFilesMagicSize];
+    if (!r.take(magic, kFilesMagicSize) || std::memcmp(magic, kFilesMagic, kFilesMagicSize) != 0) return fail("not an Atlas output cache entry");
+    CachedFiles out;
+    const uint64_t nm = r.u64();
+    if (nm > 4096) return fail("corrupt header");
+    for (uint64_t i = 0; i < nm && r.ok; ++i) {
+        std::string k = r.str();
+        out.metrics[k] = r.f64();
+    }
+    const uint64_t nf = r.u64();
+    if (nf > 100000) return fail("corrupt header");
+    for (uint64_t i = 0; i < nf && r.ok; ++i) {
+        std::string name = r.str();
+        out.files.emplace_back(name, r.str());
+    }
+    if (!r.ok) return fail("truncated");
+    if (r.pos != r.size) return fail("trailing bytes");
+    if (!r.checksum_matches()) return fail("checksum mismatch (the entry is corrupt)");
+    // Names come from the file: only plain relative paths inside the output.
+    for (const auto& [name, bytes] : out.files) {
+        const std::filesystem::path p(name);
+        if (p.empty() || p.is_absolute() || p.lexically_normal().begin()->string() == "..") return fail("corrupt file name");
+    }
+    touch(path);
+    return out;
+}
+
+// ------------------------------------------------------------ pruning
+
+PruneResult prune(const std::filesystem::path& dir, uint64_t max_bytes) {
+    namespace fs = std::filesystem;
+    PruneResult res;
+    res.stale_staging_bytes = remove_stale_staging(dir);
+    struct Entry {
+        fs::file_time_type time;
+        uint64_t bytes;
+        fs::path path;
+    };
+    std::vector<Entry> entries;
+    std::error_code ec;
+    for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        const std::string ext = it->path().extension().string();
+        if (ext != ".atlascache" && ext != ".atlasout") continue;
+        std::error_code e2;
+        if (!it->is_regular_file(e2)) continue;
+        Entry e{it->last_write_time(e2), it->file_size(e2), it->path()};
+        if (e2) continue;
+        entries.push_back(e);
+        res.bytes_before += e.bytes;
+    }
+    // Least recently used first (loads refresh an entry's time); ties by name, for a fixed order.
+    std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.time != b.time ? a.time < b.time : a.path < b.path; });
+    uint64_t total = res.bytes_before;
+    for (const auto& e : entries) {
+        if (total <= max_bytes) break;
+        std::error_code e2;
+        if (fs::remove(e.path, e2)) {
+            total -= e.bytes;
+            res.removed_files += 1;
+            res.removed_bytes += e.bytes;
+        }
+    }
+    res.bytes_after = total;
+    return res;
 }
 
 } // namespace disk_cache

@@ -3,12 +3,15 @@
 
 #include "atlas/core/hash.h"
 #include "atlas/core/value.h"
+#include "atlas/graph/disk_cache.h"
 
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -30,13 +33,30 @@ private:
 };
 
 // On-disk cache: one file per node result, DIR/<hash>.atlascache, written
-// atomically. A file that cannot be read back (truncated, other version) is
-// a miss, never an error.
+// atomically and ending in a checksum of its bytes. A file that cannot be
+// read back (truncated, corrupt, other version) is a miss, never an error;
+// `why_not` says why. A successful load refreshes the entry's mtime, which
+// prune() uses as its last use.
 namespace disk_cache {
 std::filesystem::path entry_path(const std::filesystem::path& dir, const Hash128& h);
 bool contains(const std::filesystem::path& dir, const Hash128& h);
 std::optional<NodeOutputs> load(const std::filesystem::path& dir, const Hash128& h, std::string* why_not = nullptr);
+// Throws atlas::Error when the entry cannot be written (full disk); nothing partial remains.
 void store(const std::filesystem::path& dir, const Hash128& h, const NodeOutputs& outputs);
+void touch(const std::filesystem::path& entry);
+
+// Encoded output files (e.g. a DDS texture) by output key, DIR/<key>.atlasout:
+// the files' relative names and bytes plus the writer's metrics, checksummed.
+struct CachedFiles {
+    std::vector<std::pair<std::string, std::string>> files; // relative name, bytes
+    std::map<std::string, double> metrics;
+};
+std::filesystem::path files_entry_path(const std::filesystem::path& dir, const Hash128& key);
+void store_files(const std::filesystem::path& dir, const Hash128& key,
+                 const std::vector<std::pair<std::string, std::filesystem::path>>& files, const std::map<std::string, double>& metrics);
+std::optional<CachedFiles> load_files(const std::filesystem::path& dir, const Hash128& key, std::string* why_not = nullptr);
+
+
 // Serialisation (exposed for tests).
 std::string serialize(const NodeOutputs& outputs);
 std::optional<NodeOutputs> deserialize(const std::string& bytes, std::string* why_not = nullptr);

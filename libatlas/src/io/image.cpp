@@ -2,8 +2,10 @@
 #include "atlas/io/image.h"
 
 #include "atlas/core/error.h"
+#include "atlas/core/files.h"
 #include "io_common.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cctype>
@@ -44,8 +46,14 @@ void write_image(const Field2D& f, const fs::path& path, const ImageOptions& o) 
                 if (std::isnan(v)) throw Error(where + "NaN at texel " + texel_name(x, y) + " of channel '" + f.channel_name(c) + "'");
                 q[(size_t(h - 1 - y) * size_t(w) + size_t(x)) * size_t(nc) + size_t(c)] = quantise(v);
             }
+    // Encoded in memory, then written with every write checked: OpenImageIO's
+    // PNG writer does not report a short write (a full disk gave a truncated
+    // file and success).
+    std::vector<unsigned char> encoded;
+    OIIO::Filesystem::IOVecOutput proxy(encoded);
     auto out = OIIO::ImageOutput::create(path.string());
     if (!out) throw Error(where + "no image writer for the extension '" + ext + "' (" + OIIO::geterror() + ")");
+    if (!out->supports("ioproxy") || !out->set_ioproxy(&proxy)) throw Error(where + "the image writer cannot encode in memory");
     const OIIO::TypeDesc type = o.bits == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16;
     OIIO::ImageSpec spec(w, h, nc, type);
     if (ext == ".tga") spec.attribute("compression", "none"); // plain 8-bit TGA, as game pipelines expect
@@ -61,6 +69,13 @@ void write_image(const Field2D& f, const fs::path& path, const ImageOptions& o) 
     }
     ok = out->close() && ok;
     if (!ok) throw Error(where + out->geterror());
+    try {
+        write_file_checked(path, encoded.data(), encoded.size());
+    } catch (const Error& e) {
+        std::error_code ec;
+        fs::remove(path, ec);
+        throw Error(where + e.what());
+    }
 }
 
 Field2D read_image(const fs::path& path, std::optional<Box2d> bounds, const MemoryBudget* budget) {

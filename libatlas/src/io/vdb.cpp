@@ -9,6 +9,8 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 
@@ -173,10 +175,19 @@ void write_vdb(const Field3D& f, const fs::path& path, const VdbOptions& o) {
         }
     }
     try {
-        openvdb::io::File file(path.string());
-        file.write(grids);
+        // openvdb::io::File::write does not check its stream: a full disk gave
+        // a truncated file and success. Same bytes through a checked stream.
+        struct CheckedArchive : openvdb::io::Archive {
+            void write_to(std::ostream& os, const openvdb::GridPtrVec& g) const { Archive::write(os, g, /*seekable=*/true); }
+        };
+        std::ofstream file(path, std::ios::out | std::ios::binary | std::ios::trunc);
+        if (!file) throw Error("cannot create the file");
+        CheckedArchive().write_to(file, grids);
         file.close();
+        if (!file) throw Error(std::string("write failed (") + std::strerror(errno) + "; disk full?)");
     } catch (const std::exception& e) {
+        std::error_code ec;
+        fs::remove(path, ec);
         throw Error(where + e.what());
     }
     Hasher h;

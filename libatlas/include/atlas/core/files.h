@@ -7,6 +7,9 @@
 // fails, or the object is destroyed without commit(), nothing is touched.
 #pragma once
 
+#include "atlas/core/hash.h"
+
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -58,12 +61,49 @@ fs::path resolve_output_path(const fs::path& out_dir, const std::string& relativ
 // Reads a whole file; throws atlas::Error naming the file on failure.
 std::string read_file_bytes(const fs::path& path);
 
+// Writes `size` bytes to `path` (created or truncated) with every write and
+// the close checked: a full disk or a file-size limit throws atlas::Error
+// naming the file and the system's reason, never a silently short file.
+// Not atomic by itself (write into a StagedOutputs path).
+void write_file_checked(const fs::path& path, const void* data, size_t size);
+
+// Content hash of a file's bytes (read in fixed 1 MiB chunks, so the hash
+// depends only on the bytes). Throws atlas::Error naming the file.
+Hash128 file_content_hash(const fs::path& path);
+
+// Staging directories (".atlas-staging-HOST-PID-N") that a killed process
+// left in `dir`: those of this host whose process no longer runs, and any
+// older than a day. Removes them and returns how many bytes they held.
+// Never throws (a directory that cannot be listed holds nothing to clean).
+uint64_t remove_stale_staging(const fs::path& dir);
+
 } // namespace atlas
 
 namespace atlas {
 class Hasher;
 // Adds a file's size and contents to a hash (import nodes use it so that
 // editing an input file re-cooks what depends on it). Throws atlas::Error
-// naming the file when it cannot be read.
+// naming the file when it cannot be read or is not a regular file (a FIFO or
+// a device would never end).
 void hash_file(Hasher& h, const fs::path& path);
+
+// A file hash_file() read: what a cook depends on (--depfile, the report).
+struct FileRead {
+    fs::path path;
+    uint64_t bytes = 0;
+    Hash128 hash; // file_content_hash of the bytes read
+};
+
+// While alive, every hash_file() call on this thread appends to `sink`.
+// Thread-local: nodes hash on the evaluator's thread. Nests (the innermost wins).
+class FileReadRecorder {
+public:
+    explicit FileReadRecorder(std::vector<FileRead>* sink);
+    ~FileReadRecorder();
+    FileReadRecorder(const FileReadRecorder&) = delete;
+    FileReadRecorder& operator=(const FileReadRecorder&) = delete;
+
+private:
+    std::vector<FileRead>* previous_;
+};
 } // namespace atlas

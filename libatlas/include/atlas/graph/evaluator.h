@@ -8,6 +8,7 @@
 // results do not depend on the thread count.
 #pragma once
 
+#include "atlas/core/files.h"
 #include "atlas/core/hash.h"
 #include "atlas/core/progress.h"
 #include "atlas/graph/graph.h"
@@ -31,6 +32,14 @@ struct CookOptions {
     std::filesystem::path out_dir = ".";
     bool allow_outside_out = false;              // permit absolute / escaping output paths
     bool write_outputs = true;                   // false: cook values only (hosts, tests)
+    // An output whose key (source content hash, port, format, options, path)
+    // is unchanged and whose files on disk still match what this output
+    // wrote last is not written again, and nothing cooks or loads for it.
+    // false (or checked mode): write every output.
+    bool reuse_outputs = true;
+    // With a cache_dir: after the cook, remove least recently used entries
+    // until the cache holds at most this many bytes (0 = no limit).
+    uint64_t cache_max_bytes = 0;
     ProgressSink progress;
 };
 
@@ -46,23 +55,53 @@ struct NodeReport {
     std::vector<std::string> warnings;
 };
 
+struct OutputFileReport {
+    std::filesystem::path path; // final path
+    uint64_t bytes = 0;
+    std::string hash;           // content hash (file_content_hash), hex
+};
+
 struct OutputReport {
     std::string node, port, file, format;
-    std::vector<std::filesystem::path> written;
+    std::vector<std::filesystem::path> written; // files written by this cook (none when up to date)
     std::map<std::string, double> metrics; // what the writer measured, e.g. a DDS encode's errors
+    // "written" (encoded and written), "restored" (copied from the disk
+    // cache's encoded files), "up to date" (the files on disk already held
+    // it: not touched); empty when outputs are not written.
+    std::string status;
+    std::vector<OutputFileReport> files; // every file of the output, written or not
+};
+
+// A file the cook read (an input file, a preset or forecast file a node reads).
+struct InputReport {
+    std::filesystem::path path;
+    uint64_t bytes = 0;
+    std::string hash; // file_content_hash, hex
+    std::string node; // the node that reads it
 };
 
 struct CookResult {
     std::map<std::string, NodeReport> nodes;
     std::vector<OutputReport> outputs;
+    std::vector<InputReport> inputs;
+    std::vector<std::string> warnings; // cook-level: corrupt cache entries, an unwritable cache
     double seconds = 0;
     int jobs = 1;
     bool checked = false;
+    // "ok", "failed" or "cancelled"; for a failure, the message and where:
+    // the node (empty when the graph itself failed) and its file:line:col.
+    std::string status = "ok";
+    std::string error, error_node, error_where;
 
     std::vector<std::string> with_status(const std::string& status) const;
+    // Every file the cook depends on: the graph file (when given) and the inputs, without repeats.
+    std::vector<std::filesystem::path> depends(const std::filesystem::path& graph_file) const;
     // The --report JSON document (stable keys, see docs/report.md).
     std::string to_json(const std::string& graph_file) const;
 };
+
+// One --report document for several graphs cooked in one call (see docs/report.md).
+std::string combined_report_json(const std::vector<std::pair<std::string, CookResult>>& cooks);
 
 class ValueCache; // in-memory cache, keyed by node hash
 
@@ -88,6 +127,9 @@ public:
     // Cooks the requested outputs and writes them (atomically: a failed cook
     // writes nothing). Throws atlas::Error (CancelledError on cancel).
     CookResult cook(const CookOptions& options);
+    // The result of the last cook, also when it threw: status "failed" or
+    // "cancelled", the error and where, and what had happened until then.
+    const CookResult& last_result() const { return last_; }
     // Cooks just what one node output needs and returns its value.
     Value get(const std::string& node, const std::string& port, const CookOptions& options = {});
 
@@ -101,6 +143,7 @@ private:
     std::unique_ptr<Graph> graph_;
     std::unique_ptr<ValueCache> cache_;
     std::map<std::string, Hash128> last_hashes_; // node -> hash when last needed
+    CookResult last_;
 };
 
 } // namespace atlas
