@@ -25,15 +25,21 @@ function(atlas_module name)
     # A module with headers only (or not written yet) is an interface target.
     add_library(atlas_${name} INTERFACE)
     add_library(atlas::${name} ALIAS atlas_${name})
-    target_include_directories(atlas_${name} INTERFACE "${CMAKE_CURRENT_SOURCE_DIR}/include")
+    target_include_directories(atlas_${name} INTERFACE "$<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>"
+      "$<INSTALL_INTERFACE:include>")
     target_link_libraries(atlas_${name} INTERFACE ${ARGN})
+    set_property(GLOBAL APPEND PROPERTY ATLAS_MODULE_TARGETS atlas_${name})
     return()
   endif()
   add_library(atlas_${name} STATIC ${_srcs})
   add_library(atlas::${name} ALIAS atlas_${name})
-  target_include_directories(atlas_${name} PUBLIC "${CMAKE_CURRENT_SOURCE_DIR}/include")
+  # Build tree: the source headers; installed tree: <prefix>/include (cmake/AtlasInstall.cmake).
+  target_include_directories(atlas_${name} PUBLIC "$<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>"
+    "$<INSTALL_INTERFACE:include>")
   target_link_libraries(atlas_${name} PUBLIC ${ARGN} PRIVATE atlas_warnings)
+  # PIC: the same objects also make the shared libatlas and the Python module.
   set_target_properties(atlas_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  set_property(GLOBAL APPEND PROPERTY ATLAS_MODULE_TARGETS atlas_${name})
 endfunction()
 
 # atlas_test(NAME SOURCES... LIBS ...): one GoogleTest binary registered with ctest.

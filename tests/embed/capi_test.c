@@ -1,0 +1,248 @@
+/* The C API from C: cook a small graph, read fields, and see errors, progress
+ * and cancellation arrive as status codes, messages and callbacks.
+ * Usage: capi_test QUICKSTART.yaml */
+#ifdef __cplusplus
+#error "this test must be compiled as C"
+#endif
+#include "atlas/atlas.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static int failures = 0;
+static int checks = 0;
+#define CHECK(cond)                                                                   \
+    do {                                                                              \
+        ++checks;                                                                     \
+        if (!(cond)) {                                                                \
+            ++failures;                                                               \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); \
+        }                                                                             \
+    } while (0)
+#define CHECK_OK(session, call)                                                                          \
+    do {                                                                                                 \
+        AtlasStatus st_ = (call);                                                                        \
+        ++checks;                                                                                        \
+        if (st_ != ATLAS_OK) {                                                                           \
+            ++failures;                                                                                  \
+            fprintf(stderr, "%s:%d: %s: %s: %s\n", __FILE__, __LINE__, #call, atlas_status_name(st_), \
+                    atlas_session_error(session));                                                       \
+        }                                                                                                \
+    } while (0)
+
+static const char* kGraph =
+    "atlas: 1\n"
+    "nodes:\n"
+    "  base:\n"
+    "    type: noise/value\n"
+    "    params: {resolution: [16, 8, 4], bounds_min: [0, 0, 0], bounds_max: [160, 80, 40], octaves: 2, seed: 3}\n"
+    "  coverage:\n"
+    "    type: math/remap\n"
+    "    inputs: {in: base}\n"
+    "    params: {in_min: 0.25, in_max: 0.75, out_min: 0, out_max: 1, clamp: true}\n"
+    "outputs:\n"
+    "  - {node: coverage, file: density.exr}\n";
+
+struct Progress {
+    int calls;
+    int bad_fraction;
+};
+
+static void on_progress(void* user, const char* task, double fraction, int done, int total) {
+    struct Progress* p = (struct Progress*)user;
+    /* Called from worker threads; this test cooks with one job. */
+    ++p->calls;
+    if (!(fraction >= 0.0 && fraction <= 1.0) || !task || done < 0 || total < done) ++p->bad_fraction;
+}
+
+static int cancel_always(void* user) {
+    ++*(int*)user;
+    return 1;
+}
+
+static double remap(double v, double in_min, double in_max) {
+    double t = (v - in_min) / (in_max - in_min);
+    return t < 0 ? 0 : t > 1 ? 1 : t;
+}
+
+static void test_inline_graph(void) {
+    AtlasSession* s = NULL;
+    CHECK(atlas_session_create(&s) == ATLAS_OK && s);
+    CHECK_OK(s, atlas_session_load_text(s, kGraph, "inline.yaml", NULL));
+    CHECK(strcmp(atlas_session_error(s), "") == 0);
+
+    AtlasCookOptions o;
+    atlas_cook_options_init(&o);
+    CHECK(o.struct_size == sizeof o && o.write_outputs == 0 && o.jobs == 0);
+    struct Progress progress = {0, 0};
+    o.jobs = 1;
+    o.progress = on_progress;
+    o.user = &progress;
+    CHECK_OK(s, atlas_session_cook(s, &o));
+    CHECK(progress.calls > 0);
+    CHECK(progress.bad_fraction == 0);
+    CHECK(atlas_session_node_status(s, "base") && strcmp(atlas_session_node_status(s, "base"), "cooked") == 0);
+    CHECK(atlas_session_node_status(s, "nothing") == NULL);
+    CHECK(strstr(atlas_session_report_json(s), "\"coverage\"") != NULL);
+
+    AtlasField* base = NULL;
+    AtlasField* cov = NULL;
+    CHECK_OK(s, atlas_session_get(s, "base", NULL, &o, &base));
+    CHECK_OK(s, atlas_session_get(s, "coverage", "out", &o, &cov));
+    if (!base || !cov) {
+        atlas_session_destroy(s);
+        return;
+    }
+    int res[3];
+    double lo[3], hi[3];
+    atlas_field_resolution(cov, res);
+    atlas_field_bounds(cov, lo, hi);
+    CHECK(atlas_field_dimensions(cov) == 3);
+    CHECK(res[0] == 16 && res[1] == 8 && res[2] == 4);
+    CHECK(lo[0] == 0 && lo[1] == 0 && lo[2] == 0 && hi[0] == 160 && hi[1] == 80 && hi[2] == 40);
+    CHECK(atlas_field_channels(cov) == 1);
+    CHECK(atlas_field_voxel_count(cov) == 16 * 8 * 4);
+    CHECK(strcmp(atlas_field_channel_name(base, 0), "density") == 0);
+    CHECK(atlas_field_channel_name(cov, 1) == NULL);
+    CHECK(atlas_field_channel_data(cov, -1) == NULL);
+
+    /* coverage is remap(base): check every voxel against the formula. */
+    const float* b = atlas_field_channel_data(base, 0);
+    const float* c = atlas_field_channel_data(cov, 0);
+    size_t n = atlas_field_voxel_count(cov), mismatched = 0, spread = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (fabs(c[i] - remap(b[i], 0.25, 0.75)) > 1e-6) ++mismatched;
+        if (b[i] != b[0]) ++spread;
+    }
+    CHECK(mismatched == 0);
+    CHECK(spread > 0); /* the noise is not constant */
+
+    /* An edit re-cooks only what depends on it; fields got before stay valid. */
+    CHECK_OK(s, atlas_session_set_float(s, "coverage", "in_min", 0.5));
+    CHECK_OK(s, atlas_session_cook(s, &o));
+    CHECK(strcmp(atlas_session_node_status(s, "coverage"), "cooked") == 0);
+    CHECK(strcmp(atlas_session_node_status(s, "base"), "cached") == 0);
+    AtlasField* cov2 = NULL;
+    CHECK_OK(s, atlas_session_get(s, "coverage", "out", &o, &cov2));
+    if (cov2) {
+        const float* c2 = atlas_field_channel_data(cov2, 0);
+        mismatched = 0;
+        for (size_t i = 0; i < n; ++i)
+            if (fabs(c2[i] - remap(b[i], 0.5, 0.75)) > 1e-6) ++mismatched;
+        CHECK(mismatched == 0);
+    }
+    /* An int parameter takes an integral float; the text form works as --set. */
+    CHECK_OK(s, atlas_session_set_float(s, "base", "octaves", 3.0));
+    CHECK_OK(s, atlas_session_set(s, "base", "seed", "11"));
+
+    /* Out of range: the message names the node, the parameter and the range. */
+    CHECK(atlas_session_set_int(s, "base", "octaves", 99) == ATLAS_ERROR);
+    CHECK(strstr(atlas_session_error(s), "octaves") != NULL);
+    CHECK(strstr(atlas_session_error(s), "base") != NULL);
+    CHECK(strstr(atlas_session_error(s), "16") != NULL);
+    CHECK(atlas_session_set(s, "base", "octavs", "2") == ATLAS_ERROR);
+    CHECK(strstr(atlas_session_error(s), "did you mean 'octaves'") != NULL);
+    CHECK(atlas_session_set_bool(s, "nobody", "clamp", 1) == ATLAS_ERROR);
+
+    /* Cancellation: a status, no exception; the session still works afterwards. */
+    int polls = 0;
+    AtlasCookOptions oc;
+    atlas_cook_options_init(&oc);
+    oc.jobs = 1;
+    oc.cancel = cancel_always;
+    oc.user = &polls;
+    CHECK(atlas_session_cook(s, &oc) == ATLAS_CANCELLED);
+    CHECK(polls > 0);
+    CHECK(strcmp(atlas_session_error(s), "cancelled") == 0);
+    CHECK_OK(s, atlas_session_cook(s, &o));
+
+    /* A field outlives its session. */
+    atlas_session_destroy(s);
+    CHECK(c[0] == atlas_field_channel_data(cov, 0)[0]);
+    atlas_field_release(base);
+    atlas_field_release(cov);
+    atlas_field_release(cov2);
+}
+
+static void test_errors(void) {
+    AtlasSession* s = NULL;
+    CHECK(atlas_session_create(&s) == ATLAS_OK);
+    CHECK(atlas_session_cook(s, NULL) == ATLAS_ERROR); /* no graph loaded */
+    CHECK(strstr(atlas_session_error(s), "no graph") != NULL);
+
+    /* A broken graph: an unknown parameter, at its line and column. */
+    const char* broken =
+        "atlas: 1\n"
+        "nodes:\n"
+        "  base:\n"
+        "    type: noise/value\n"
+        "    params: {octavs: 2}\n";
+    CHECK(atlas_session_load_text(s, broken, "broken.yaml", NULL) == ATLAS_PARSE_ERROR);
+    const char* file = NULL;
+    int line = 0, col = 0;
+    atlas_session_error_location(s, &file, &line, &col);
+    CHECK(file && strcmp(file, "broken.yaml") == 0);
+    CHECK(line == 5 && col > 0);
+    char prefix[64];
+    snprintf(prefix, sizeof prefix, "broken.yaml:5:%d: error:", col);
+    CHECK(strncmp(atlas_session_error(s), prefix, strlen(prefix)) == 0);
+    CHECK(strstr(atlas_session_error(s), "did you mean 'octaves'") != NULL);
+
+    /* YAML that is not YAML. */
+    CHECK(atlas_session_load_text(s, "atlas: 1\nnodes: [\n", "bad.yaml", NULL) == ATLAS_PARSE_ERROR);
+    CHECK(strncmp(atlas_session_error(s), "bad.yaml:", 9) == 0);
+
+    CHECK(atlas_session_load(s, "/nonexistent/graph.yaml") != ATLAS_OK);
+    CHECK(strstr(atlas_session_error(s), "/nonexistent/graph.yaml") != NULL);
+
+    /* NULL arguments are a status, not a crash. */
+    CHECK(atlas_session_get(s, NULL, NULL, NULL, NULL) == ATLAS_INVALID_ARGUMENT);
+    CHECK(atlas_session_load(NULL, "x") == ATLAS_INVALID_ARGUMENT);
+    atlas_session_destroy(s);
+    atlas_session_destroy(NULL);
+    atlas_field_release(NULL);
+    CHECK(atlas_field_channels(NULL) == 0);
+}
+
+static void test_quickstart(const char* path) {
+    AtlasSession* s = NULL;
+    CHECK(atlas_session_create(&s) == ATLAS_OK);
+    CHECK_OK(s, atlas_session_load(s, path));
+    AtlasCookOptions o;
+    atlas_cook_options_init(&o);
+    o.jobs = 2;
+    AtlasField* f = NULL;
+    CHECK_OK(s, atlas_session_get(s, "coverage", "out", &o, &f));
+    if (f) {
+        int res[3];
+        atlas_field_resolution(f, res);
+        CHECK(res[0] == 128 && res[1] == 128 && res[2] == 32);
+        const float* d = atlas_field_channel_data(f, 0);
+        size_t n = atlas_field_voxel_count(f), outside = 0, ones = 0, zeros = 0;
+        for (size_t i = 0; i < n; ++i) {
+            if (!(d[i] >= 0.0f && d[i] <= 1.0f)) ++outside;
+            ones += d[i] == 1.0f;
+            zeros += d[i] == 0.0f;
+        }
+        CHECK(outside == 0);
+        CHECK(zeros > 0 && zeros < n && ones < n); /* clouds and sky both present */
+        atlas_field_release(f);
+    }
+    const char* types = atlas_session_node_types_json(s);
+    CHECK(types && strstr(types, "\"noise/value\"") && strstr(types, "\"octaves\""));
+    atlas_session_destroy(s);
+}
+
+int main(int argc, char** argv) {
+    if (argc != 2) {
+        fprintf(stderr, "usage: capi_test QUICKSTART.yaml\n");
+        return 2;
+    }
+    CHECK(strlen(atlas_version()) >= 5);
+    test_inline_graph();
+    test_errors();
+    test_quickstart(argv[1]);
+    printf("%d passed, %d failed\n", checks - failures, failures);
+    return failures ? 1 : 0;
+}
