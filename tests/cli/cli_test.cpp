@@ -6,12 +6,16 @@
 #include "atlas/compress/texture.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <csignal>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -267,4 +271,197 @@ TEST(CliForeign, CompressHelpNamesEveryDecoder) {
         const std::string name = atlas::compress::decoder_name(static_cast<atlas::compress::Decoder>(i));
         EXPECT_TRUE(text.find(name + ",") != std::string::npos || text.find(name + " ") != std::string::npos) << name << " is missing from:\n" << text;
     }
+}
+
+// ------------------------------------------------- unattended cooks (issue 17)
+
+namespace {
+// Runs atlas with a file-size limit (RLIMIT_FSIZE, SIGXFSZ ignored): every
+// write past `max_file_bytes` fails with EFBIG, as on a full disk.
+CliRun run_limited(const std::string& args, long max_file_bytes) {
+    fs::path dir = fs::temp_directory_path() / ("atlas_cli_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const std::string cmd = std::string(ATLAS_BINARY_DIR) + "/bin/atlas " + args + " >" + (dir / "out").string() + " 2>" + (dir / "err").string();
+    const pid_t pid = fork();
+    if (pid == 0) {
+        signal(SIGXFSZ, SIG_IGN);
+        struct rlimit lim{rlim_t(max_file_bytes), rlim_t(max_file_bytes)};
+        setrlimit(RLIMIT_FSIZE, &lim);
+        execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    int st = 0;
+    waitpid(pid, &st, 0);
+    CliRun r;
+    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    r.out = atlas::read_file_bytes(dir / "out");
+    r.err = atlas::read_file_bytes(dir / "err");
+    return r;
+}
+
+fs::path fresh_dir(const std::string& name) {
+    fs::path d = fs::temp_directory_path() / ("atlas_cli_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+// Every regular file under `d`, relative, except the output records.
+std::vector<std::string> files_under(const fs::path& d) {
+    std::vector<std::string> v;
+    if (!fs::exists(d)) return v;
+    for (const auto& e : fs::recursive_directory_iterator(d))
+        if (e.is_regular_file() && e.path().filename() != ".atlas-outputs.json") v.push_back(fs::relative(e.path(), d).string());
+    std::sort(v.begin(), v.end());
+    return v;
+}
+
+const char* kNoiseGraph = "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params: {resolution: [64, 64, 16], seed: 3}\noutputs:\n";
+} // namespace
+
+// On a full disk (here a file-size limit) PNG, VDB, TGA slice and EXR outputs
+// fail loudly and leave nothing behind: no partial file, no staging folder.
+TEST(CliUnattended, FullDiskFailsLoudlyAndLeavesNoPartialFile) {
+    const std::vector<std::pair<std::string, std::string>> outputs = {
+        {"png", "  - {node: n, file: pic.png, options: {montage: true, bits: 16}}\n"},
+        {"vdb", "  - {node: n, file: v.vdb}\n"},
+        {"tga-slices", "  - {node: n, file: s/stack, format: tga-slices, options: {compression: none}}\n"},
+        {"exr", "  - {node: n, file: v.exr}\n"},
+    };
+    for (const auto& [fmt, line] : outputs) {
+        const fs::path d = fresh_dir("fulldisk");
+        auto g = write_graph("full_" + fmt + ".yaml", std::string(kNoiseGraph) + line);
+        // Without the limit the cook succeeds (the test can fail for the right reason).
+        CliRun ok = run("cook " + g.string() + " --out " + (d / "ok").string() + " --no-cache --quiet");
+        ASSERT_EQ(ok.status, 0) << fmt << ": " << ok.err;
+        CliRun r = run_limited("cook " + g.string() + " --out " + (d / "out").string() + " --no-cache --quiet", 12000);
+        EXPECT_EQ(r.status, 1) << fmt << ": " << r.err;
+        EXPECT_NE(r.err.find("error"), std::string::npos) << fmt << ": " << r.err;
+        EXPECT_EQ(r.out, "") << fmt; // no success line
+        EXPECT_TRUE(files_under(d / "out").empty()) << fmt << ": " << ::testing::PrintToString(files_under(d / "out"));
+        if (fs::exists(d / "out")) {
+            for (const auto& e : fs::directory_iterator(d / "out"))
+                EXPECT_EQ(e.path().filename().string().find(".atlas-staging"), std::string::npos) << fmt << ": " << e.path();
+        }
+    }
+}
+
+// A cache on a full disk costs speed, not the cook: a warning, outputs written.
+TEST(CliUnattended, FullCacheDiskDegradesToCookingWithoutTheCache) {
+    const fs::path d = fresh_dir("fullcache");
+    // The 3D field's cache entry (256 KiB) is past the limit; the small JSON output is not.
+    auto g = write_graph("fullcache.yaml", "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params: {resolution: [64, 64, 16]}\n"
+                                           "  s:\n    type: field/resample\n    inputs: {in: n}\n    params: {resolution: [4, 4, 1]}\n"
+                                           "outputs:\n  - {node: s, file: s.exr}\n");
+    CliRun r = run_limited("cook " + g.string() + " --out " + (d / "out").string() + " --cache " + (d / "cache").string(), 40000);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: disk cache: cannot store node 'n'"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(d / "out" / "s.exr"));
+}
+
+// The depfile names every output file as a target and the graph and every
+// file it reads as prerequisites, in Make syntax.
+TEST(CliUnattended, DepfileListsGraphAndInputs) {
+    const fs::path d = fresh_dir("depfile");
+    auto src = write_graph("dep_src.yaml", std::string(kNoiseGraph) + "  - {node: n, file: in.exr}\n");
+    ASSERT_EQ(run("cook " + src.string() + " --out " + d.string() + " --quiet").status, 0);
+    auto g = write_graph("dep use.yaml", "atlas: 1\nnodes:\n  i:\n    type: import/exr\n    params: {file: " + (d / "in.exr").string() +
+                                             "}\noutputs:\n  - {node: i, file: copy.exr}\n  - {node: i, file: st/copy, format: tga-slices}\n");
+    CliRun r = run("cook '" + g.string() + "' --out " + (d / "o").string() + " --depfile " + (d / "cook.d").string() + " --quiet");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string dep = atlas::read_file_bytes(d / "cook.d");
+    const std::string escaped_graph = (g.parent_path() / "dep\\ use.yaml").string();
+    EXPECT_EQ(dep.find((d / "o" / "copy.exr").string()), 0u) << dep;
+    EXPECT_NE(dep.find((d / "o" / "st" / "copy.001.tga").string()), std::string::npos) << dep;
+    EXPECT_NE(dep.find("copy.016.tga"), std::string::npos) << dep;
+    const auto colon = dep.find(':');
+    EXPECT_GT(dep.find(escaped_graph), colon) << dep;
+    EXPECT_GT(dep.find((d / "in.exr").string()), colon) << dep;
+    // A second, no-op cook gives the same depfile (outputs up to date are still its targets).
+    ASSERT_EQ(run("cook '" + g.string() + "' --out " + (d / "o").string() + " --depfile " + (d / "cook2.d").string() + " --quiet").status, 0);
+    EXPECT_EQ(atlas::read_file_bytes(d / "cook2.d"), dep);
+}
+
+// A failed cook still writes its report (status, error, node, file:line) and exits 1.
+TEST(CliUnattended, FailedCookWritesAReport) {
+    const fs::path d = fresh_dir("failreport");
+    auto g = write_graph("fail.yaml", "atlas: 1\nnodes:\n  i:\n    type: import/exr\n    params: {file: missing.exr}\noutputs:\n"
+                                      "  - {node: i, file: copy.exr}\n");
+    CliRun r = run("cook " + g.string() + " --out " + d.string() + " --report " + (d / "r.json").string() + " --quiet");
+    EXPECT_EQ(r.status, 1);
+    const auto j = nlohmann::json::parse(atlas::read_file_bytes(d / "r.json"));
+    EXPECT_EQ(j["status"], "failed");
+    EXPECT_EQ(j["error"]["node"], "i");
+    EXPECT_EQ(j["error"]["where"], g.string() + ":3:3");
+    EXPECT_NE(j["error"]["message"].get<std::string>().find("missing.exr"), std::string::npos);
+    // A graph that does not parse: the report names the place.
+    auto bad = write_graph("bad.yaml", "atlas: 1\nnodes:\n  n:\n    type: noise/valu\noutputs: []\n");
+    CliRun r2 = run("cook " + bad.string() + " --out " + d.string() + " --report " + (d / "r2.json").string() + " --quiet");
+    EXPECT_EQ(r2.status, 1);
+    const auto j2 = nlohmann::json::parse(atlas::read_file_bytes(d / "r2.json"));
+    EXPECT_EQ(j2["status"], "failed");
+    EXPECT_EQ(j2["error"]["where"], bad.string() + ":4:11");
+}
+
+// Several graphs in one call: one cache, one report; a no-op second call
+// rewrites nothing (the files' mtimes stay).
+TEST(CliUnattended, SeveralGraphsShareOneReportAndANoOpCookWritesNothing) {
+    const fs::path d = fresh_dir("multi");
+    auto g1 = write_graph("multi1.yaml", std::string(kNoiseGraph) + "  - {node: n, file: one.png, options: {slice: 2}}\n");
+    auto g2 = write_graph("multi2.yaml", std::string(kNoiseGraph) + "  - {node: n, file: two.exr}\n");
+    const std::string args = "cook " + g1.string() + " " + g2.string() + " --out " + (d / "o").string() + " --cache " + (d / "c").string() +
+                             " --report " + (d / "r.json").string();
+    CliRun r = run(args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    auto j = nlohmann::json::parse(atlas::read_file_bytes(d / "r.json"));
+    ASSERT_EQ(j["graphs"].size(), 2u);
+    EXPECT_EQ(j["status"], "ok");
+    EXPECT_EQ(j["graphs"][0]["nodes"]["n"]["status"], "cooked");
+    EXPECT_EQ(j["graphs"][1]["nodes"]["n"]["status"], "cached"); // the same node content: from the shared cache
+    const auto t1 = fs::last_write_time(d / "o" / "one.png"), t2 = fs::last_write_time(d / "o" / "two.exr");
+    CliRun again = run(args);
+    ASSERT_EQ(again.status, 0) << again.err;
+    EXPECT_NE(again.out.find("cooked 0, cached 0, skipped 2 nodes"), std::string::npos) << again.out;
+    EXPECT_NE(again.out.find("wrote 0 files"), std::string::npos) << again.out;
+    EXPECT_EQ(fs::last_write_time(d / "o" / "one.png"), t1);
+    EXPECT_EQ(fs::last_write_time(d / "o" / "two.exr"), t2);
+    j = nlohmann::json::parse(atlas::read_file_bytes(d / "r.json"));
+    EXPECT_EQ(j["graphs"][1]["outputs"][0]["status"], "up to date");
+    EXPECT_EQ(j["graphs"][1]["outputs"][0]["files"][0]["hash"].get<std::string>().size(), 32u);
+}
+
+// Two cooks running at once with one cache directory both succeed with the
+// same bytes (entries are written atomically; either one's is valid).
+TEST(CliUnattended, TwoConcurrentCooksSharingACacheStayCorrect) {
+    const fs::path d = fresh_dir("shared");
+    auto g = write_graph("shared.yaml", "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params: {resolution: [64, 64, 32]}\n"
+                                        "  r:\n    type: math/remap\n    inputs: {in: n}\n    params: {in_min: 0.3, in_max: 0.7}\n"
+                                        "outputs:\n  - {node: r, file: r.exr}\n");
+    const std::string bin = std::string(ATLAS_BINARY_DIR) + "/bin/atlas";
+    const std::string c = " --cache " + (d / "c").string() + " --quiet";
+    const std::string cmd = bin + " cook " + g.string() + " --out " + (d / "a").string() + c + " & " + bin + " cook " + g.string() + " --out " +
+                            (d / "b").string() + c + " & wait";
+    ASSERT_EQ(std::system(("sh -c '" + cmd + "' >/dev/null 2>&1").c_str()), 0);
+    ASSERT_TRUE(fs::exists(d / "a" / "r.exr"));
+    ASSERT_TRUE(fs::exists(d / "b" / "r.exr"));
+    EXPECT_EQ(atlas::read_file_bytes(d / "a" / "r.exr"), atlas::read_file_bytes(d / "b" / "r.exr"));
+    // A third cook from the shared cache gives the same bytes again.
+    ASSERT_EQ(run("cook " + g.string() + " --out " + (d / "x").string() + c).status, 0);
+    EXPECT_EQ(atlas::read_file_bytes(d / "x" / "r.exr"), atlas::read_file_bytes(d / "a" / "r.exr"));
+}
+
+TEST(CliUnattended, CachePruneKeepsTheMostRecentlyUsed) {
+    const fs::path d = fresh_dir("prune");
+    auto g = write_graph("prune.yaml", std::string(kNoiseGraph) + "  - {node: n, file: n.exr}\n");
+    ASSERT_EQ(run("cook " + g.string() + " --out " + (d / "o").string() + " --cache " + (d / "c").string() + " --quiet").status, 0);
+    uint64_t before = 0;
+    for (const auto& e : fs::directory_iterator(d / "c")) before += e.file_size();
+    ASSERT_GT(before, 0u);
+    CliRun keep = run("cache prune " + (d / "c").string() + " --max-size " + std::to_string(before));
+    EXPECT_EQ(keep.status, 0) << keep.err;
+    EXPECT_NE(keep.out.find("removed 0 entries"), std::string::npos) << keep.out;
+    CliRun all = run("cache prune " + (d / "c").string() + " --max-size 0 --quiet");
+    EXPECT_EQ(all.status, 0) << all.err;
+    EXPECT_NE(all.out.find("removed 1 entries (" + std::to_string(before) + " bytes), 0 bytes left"), std::string::npos) << all.out;
+    EXPECT_EQ(run("cache prune " + (d / "c").string()).status, 2); // --max-size is required
 }
