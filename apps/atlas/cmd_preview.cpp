@@ -9,6 +9,7 @@
 #include "atlas/graph/evaluator.h"
 #include "atlas/io/readers.h"
 #include "atlas/render/image_out.h"
+#include "atlas/render/layer.h"
 #include "atlas/render/renderer.h"
 #include "atlas/render/sweep.h"
 
@@ -19,6 +20,7 @@
 #include <iostream>
 #include <optional>
 #include <sstream>
+#include <variant>
 
 namespace atlas::cli {
 
@@ -46,30 +48,203 @@ bool is_graph(const std::string& f) {
     return ext == ".yaml" || ext == ".yml" || ext == ".atlas";
 }
 
-// The NVDF set a graph writes: the first volume/nvdf node with an output.
-// Cooked like `atlas cook` (same disk cache, so a second preview of an
-// unchanged graph cooks nothing) but without writing the graph's files.
-render::CloudScene scene_from_graph(const std::string& file, int jobs, ProgressSink progress,
-                                    const std::optional<std::filesystem::path>& cache_dir, bool quiet) {
-    Session session(builtin_nodes());
-    session.load(file);
+// What a graph writes that the preview can draw, found by cooking (values
+// only, through the cache like `atlas cook`) the graph's outputs:
+//   volume/nvdf vdb_set                    -> voxel mode
+//   a 2D field with coverage, min_height, max_height (an NDF set) -> 2.5D mode
+//   a 2D field with coverage only (a weather map)      -> 2.5D, heights 1500..4000 m
+//   a 2D field with bottom, top (ndf/profile_lut)      -> the layer's profile LUT
+//   a 2D field with apex_height, cone_ratio (ndf/cone_map) / ndf/distance_map -> envelope
+//   a 2D field with a 'cirrus' channel (ndf/cirrus)    -> a cirrus layer at 8 km
+//   otherwise the last 1-channel 2D field               -> a sky layer at 6 km (Quilez)
+struct GraphContent {
+    Field3DPtr nvdf;
+    Field2DPtr ndf, lut, cone, cirrus, sky2d;
+    Field3DPtr distance;
+    std::string ndf_node;
+    std::vector<std::string> written; // "node 'n' (type) port 'p' -> file"
+};
+
+void apply_sets(Session& s, const Args& a) {
+    for (const auto& kv : a.all("--set")) {
+        auto eq = kv.find('=');
+        auto dot = kv.find('.');
+        if (eq == std::string::npos || dot == std::string::npos || dot > eq)
+            throw UsageError{"--set expects NODE.PARAM=VALUE, got '" + kv + "'", "preview"};
+        s.set_text(kv.substr(0, dot), kv.substr(dot + 1, eq - dot - 1), kv.substr(eq + 1));
+    }
+}
+
+bool has_channels(const Field2D& f, std::initializer_list<const char*> names) {
+    for (const char* n : names)
+        if (f.find_channel(n) < 0) return false;
+    return true;
+}
+
+// A weather map (coverage [, type, precipitation]) as a layer set with the
+// FC6 presets' default heights.
+Field2DPtr weather_map_as_set(const Field2D& m) {
+    std::vector<std::string> names{"coverage", "type", "precipitation", "min_height", "max_height"};
+    Field2D f(m.resolution(), int(names.size()), m.bounds(), names);
+    const int ct = m.find_channel("type"), cp = m.find_channel("precipitation"), cc = m.find_channel("coverage");
+    for (int y = 0; y < m.height(); ++y)
+        for (int x = 0; x < m.width(); ++x) {
+            f.at(0, x, y) = m.at(cc, x, y);
+            f.at(1, x, y) = ct >= 0 ? m.at(ct, x, y) : 0.5f;
+            f.at(2, x, y) = cp >= 0 ? m.at(cp, x, y) : 0.0f;
+            f.at(3, x, y) = 1500;
+            f.at(4, x, y) = 4000;
+        }
+    return std::make_shared<const Field2D>(std::move(f));
+}
+
+GraphContent cook_graph(Session& session, const std::string& file, int jobs, ProgressSink progress,
+                        const std::optional<std::filesystem::path>& cache_dir, bool quiet) {
+    GraphContent g;
+    struct Want {
+        std::string node, port, type, file;
+        bool generic; // a PortType::Field port: 2D or 3D, known only once cooked
+    };
+    std::vector<Want> wants;
     for (const auto& out : session.graph().outputs) {
         const GraphNode* n = session.graph().find(out.node);
-        if (!n || n->type != "volume/nvdf") continue;
+        if (!n) continue;
+        const NodeType* t = session.registry().find(n->type);
+        if (!t || t->decl.outputs().empty()) continue;
+        const PortDecl* port = out.port.empty() ? &t->decl.outputs().front() : t->decl.find_output(out.port);
+        if (!port) continue;
+        g.written.push_back("node '" + out.node + "' (" + n->type + ") port '" + port->name + "' -> " + out.file);
+        const bool nvdf = n->type == "volume/nvdf" && port->name == "vdb_set";
+        const bool dist = n->type == "ndf/distance_map";
+        if (nvdf || dist || port->type == PortType::Field2D || port->type == PortType::Field)
+            wants.push_back({out.node, port->name, n->type, out.file, port->type == PortType::Field && !nvdf && !dist});
+    }
+    // Two passes: typed outputs first; generic field outputs (which may be
+    // large volumes) only when nothing drawable was found.
+    for (int pass = 0; pass < 2; ++pass) {
+        std::vector<const Want*> now;
+        for (const auto& w : wants)
+            if (w.generic == (pass == 1)) now.push_back(&w);
+        if (now.empty()) continue;
+        if (pass == 1 && (g.nvdf || g.ndf || g.cirrus || g.sky2d)) break;
         CookOptions o;
         o.write_outputs = false;
         o.jobs = jobs;
         o.cache_dir = cache_dir;
-        o.progress = std::move(progress);
-        o.outputs = {out.file};
+        o.progress = progress;
+        for (const Want* w : now) o.outputs.push_back(w->file);
         const CookResult r = session.cook(o);
         if (!quiet)
-            std::fprintf(stderr, "graph: cooked %zu, cached %zu nodes in %.2f s%s\n", r.with_status("cooked").size(),
-                         r.with_status("cached").size(), r.seconds, cache_dir ? (" (cache " + cache_dir->string() + ")").c_str() : "");
-        Value v = session.get(out.node, "vdb_set", o); // from the session's memory cache now
-        return render::scene_from_nvdf_set(std::get<Field3DPtr>(v));
+            std::fprintf(stderr, "graph: cooked %zu, cached %zu nodes in %.2f s%s\n", r.with_status("cooked").size(), r.with_status("cached").size(),
+                         r.seconds, cache_dir ? (" (cache " + cache_dir->string() + ")").c_str() : "");
+        for (const Want* wp : now) {
+            const Want& w = *wp;
+            Value v = session.get(w.node, w.port, o); // from the session's memory cache now
+            const std::string what = file + ": node '" + w.node + "' output '" + w.port + "'";
+            if (auto* f3 = std::get_if<Field3DPtr>(&v); f3 && *f3) {
+                if (w.type == "volume/nvdf" && !g.nvdf) render::check_finite(**f3, what), g.nvdf = *f3;
+                else if (w.type == "ndf/distance_map" && !g.distance) render::check_finite(**f3, what), g.distance = *f3;
+                continue;
+            }
+            auto* f2 = std::get_if<Field2DPtr>(&v);
+            if (!f2 || !*f2) continue;
+            const Field2D& f = **f2;
+            if (has_channels(f, {"coverage", "min_height", "max_height"})) {
+                render::check_finite(f, what);
+                if (!g.ndf) g.ndf = *f2, g.ndf_node = w.node;
+            } else if (has_channels(f, {"coverage"}) && !has_channels(f, {"cumulus"})) {
+                render::check_finite(f, what);
+                if (!g.ndf) g.ndf = weather_map_as_set(f), g.ndf_node = w.node;
+            } else if (has_channels(f, {"bottom", "top"})) {
+                if (!g.lut) g.lut = *f2;
+            } else if (has_channels(f, {"apex_height", "cone_ratio"})) {
+                if (!g.cone) g.cone = *f2;
+            } else if (has_channels(f, {"cirrus"})) {
+                render::check_finite(f, what);
+                if (!g.cirrus) g.cirrus = *f2;
+            } else if (f.channels() == 1) {
+                render::check_finite(f, what);
+                g.sky2d = *f2; // the last one written
+            }
+        }
     }
-    throw Error(file + ": the graph writes no volume/nvdf output to preview");
+    return g;
+}
+
+// The HZD noise set and the default profile LUT, cooked through the same
+// cache as the graph (a second preview cooks nothing).
+struct LayerInputs {
+    Field3DPtr low, high;
+    Field2DPtr curl, lut;
+};
+LayerInputs cook_layer_inputs(int jobs, const std::optional<std::filesystem::path>& cache_dir, ProgressSink progress, bool quiet) {
+    Session s(builtin_nodes());
+    s.load_text("atlas: 1\n"
+                "nodes:\n"
+                "  hzd_noise: {type: noise/hzd_set, params: {low_size: 128, high_size: 32, curl_size: 128, seed: 0}}\n"
+                "  profile_lut: {type: ndf/profile_lut, params: {resolution: [97, 128]}}\n"
+                "outputs:\n"
+                "  - {node: hzd_noise, port: low, file: low.exr}\n"
+                "  - {node: hzd_noise, port: high, file: high.exr}\n"
+                "  - {node: hzd_noise, port: curl, file: curl.exr}\n"
+                "  - {node: profile_lut, file: lut.exr}\n",
+                "<preview layer inputs>", ".");
+    CookOptions o;
+    o.write_outputs = false;
+    o.jobs = jobs;
+    o.cache_dir = cache_dir;
+    o.progress = std::move(progress);
+    const CookResult r = s.cook(o);
+    if (!quiet) std::fprintf(stderr, "noise/hzd_set + ndf/profile_lut: cooked %zu, cached %zu in %.2f s\n", r.with_status("cooked").size(),
+                             r.with_status("cached").size(), r.seconds);
+    LayerInputs in;
+    in.low = std::get<Field3DPtr>(s.get("hzd_noise", "low", o));
+    in.high = std::get<Field3DPtr>(s.get("hzd_noise", "high", o));
+    in.curl = std::get<Field2DPtr>(s.get("hzd_noise", "curl", o));
+    in.lut = std::get<Field2DPtr>(s.get("profile_lut", "out", o));
+    return in;
+}
+
+// A sky layer's opacity ramp from the texture's statistics: clear below the
+// mean, opaque two standard deviations above it.
+render::SkyLayer sky_layer_from(Field2DPtr tex, int channel, double altitude, double tile, double opacity) {
+    render::SkyLayer l;
+    l.texture = tex;
+    l.channel = channel;
+    l.altitude = altitude;
+    l.tile = tile;
+    l.opacity = opacity;
+    auto ch = tex->channel(channel);
+    double sum = 0, sq = 0;
+    for (float v : ch) sum += v, sq += double(v) * v;
+    const double n = double(ch.size()), mean = sum / n, sd = std::sqrt(std::max(0.0, sq / n - mean * mean));
+    l.value_min = mean;
+    l.value_max = mean + 2 * std::max(sd, 1e-6);
+    l.wind = {{3, 1}};
+    return l;
+}
+
+// The box around the voxels that hold cloud (SDF < 0), or the whole bounds.
+Box3d cloud_bounds(const render::CloudScene& scene) {
+    const Field3D& sdf = *scene.sdf;
+    const int c = std::max(0, sdf.find_channel("sdf"));
+    Vec3i lo{{sdf.nx(), sdf.ny(), sdf.nz()}}, hi{{-1, -1, -1}};
+    for (int z = 0; z < sdf.nz(); ++z)
+        for (int y = 0; y < sdf.ny(); ++y)
+            for (int x = 0; x < sdf.nx(); ++x)
+                if (sdf.at(c, x, y, z) < 0) {
+                    lo = {{std::min(lo[0], x), std::min(lo[1], y), std::min(lo[2], z)}};
+                    hi = {{std::max(hi[0], x), std::max(hi[1], y), std::max(hi[2], z)}};
+                }
+    const Box3d b = sdf.bounds();
+    if (hi[0] < 0) return b;
+    const Vec3d v = sdf.voxel_size();
+    Box3d r;
+    for (int a = 0; a < 3; ++a) {
+        r.min[a] = b.min[a] + lo[a] * v[a];
+        r.max[a] = b.min[a] + (hi[a] + 1) * v[a];
+    }
+    return r;
 }
 
 // Writes into `staged` (a temporary path); the caller moves it into place.
@@ -98,6 +273,46 @@ render::PointLight parse_light(const std::string& text) {
 
 } // namespace
 
+namespace {
+
+// --view ground|aerial|orbit[:AZ,EL]
+struct View {
+    std::string kind = "auto";
+    double az = 30, el = 20;
+};
+View parse_view(const Args& a) {
+    View v;
+    if (!a.has("--view")) return v;
+    std::string t = a.get("--view");
+    auto colon = t.find(':');
+    v.kind = t.substr(0, colon);
+    if (v.kind != "ground" && v.kind != "aerial" && v.kind != "orbit")
+        throw UsageError{"--view expects ground, aerial or orbit[:AZ,EL], got '" + t + "'", "preview"};
+    if (colon != std::string::npos) {
+        if (v.kind != "orbit") throw UsageError{"--view: only orbit takes angles (orbit:AZ,EL), got '" + t + "'", "preview"};
+        auto n = numbers(t.substr(colon + 1), 2, "--view orbit");
+        v.az = n[0];
+        v.el = n[1];
+    }
+    return v;
+}
+
+render::Camera voxel_camera(const render::CloudScene& scene, const View& v, double aspect) {
+    const Box3d b = cloud_bounds(scene);
+    if (v.kind == "ground") {
+        render::Camera c;
+        c.fov_deg = 60;
+        const Vec3d size = b.max - b.min;
+        c.position = {{0.5 * (b.min[0] + b.max[0]), b.min[1] - 0.4 * size[1], std::max(2.0, b.min[2] - 0.25 * size[2])}};
+        c.look_at = (b.min + b.max) * 0.5;
+        return c;
+    }
+    if (v.kind == "aerial") return render::framing_camera(b, aspect, 30, 55);
+    return render::framing_camera(b, aspect, v.az, v.el);
+}
+
+} // namespace
+
 int run_preview(const Args& a) {
     if (a.positional.empty()) throw UsageError{"expected a graph file or NVDF files", "preview"};
     if (!a.has("--out") && !a.has("--sweep")) throw UsageError{"expected -o OUT.png (or OUT.exr)", "preview"};
@@ -114,9 +329,13 @@ int run_preview(const Args& a) {
         w = static_cast<int>(numbers(s.substr(0, x), 1, "--size")[0]);
         h = static_cast<int>(numbers(s.substr(x + 1), 1, "--size")[0]);
     }
+    std::string mode = a.has("--mode") ? a.get("--mode") : "auto";
+    if (mode != "auto" && mode != "layer" && mode != "voxel") throw UsageError{"--mode expects layer or voxel, got '" + mode + "'", "preview"};
+    const View view = parse_view(a);
     const bool quiet = a.has("--quiet");
     ProgressBar bar(!quiet);
     ProgressSink sink = bar.sink();
+    const auto t_start = std::chrono::steady_clock::now();
 
     Field3DPtr noise;
     if (a.has("--noise")) noise = io::as_field3d(io::read_field_file(a.get("--noise")));
@@ -124,20 +343,90 @@ int run_preview(const Args& a) {
     std::optional<std::filesystem::path> cache_dir;
     if (a.has("--cache")) cache_dir = a.get("--cache");
     else if (const char* env = std::getenv("ATLAS_CACHE_DIR"); env && *env && !a.has("--no-cache")) cache_dir = env;
+
+    bool have_voxel = false, have_layer = false;
     render::CloudScene scene;
+    render::LayerScene layer;
     if (a.positional.size() == 1 && is_graph(a.positional[0])) {
-        scene = scene_from_graph(a.positional[0], jobs, sink, cache_dir, quiet);
+        const std::string file = a.positional[0];
+        Session session(builtin_nodes());
+        session.load(file);
+        apply_sets(session, a);
+        GraphContent g = cook_graph(session, file, jobs, sink, cache_dir, quiet);
+        const bool layerish = g.ndf || g.cirrus || g.sky2d;
+        if (!g.nvdf && !layerish) {
+            std::string list;
+            for (const auto& x : g.written) list += "\n  " + x;
+            throw Error(file + ": the graph writes nothing to preview: no volume/nvdf vdb_set (voxel mode), no NDF set or weather map (2.5D mode) and no "
+                               "2D sky layer; it writes:" + (list.empty() ? std::string(" no outputs") : list));
+        }
+        if (mode == "voxel" && !g.nvdf) throw Error(file + ": --mode voxel, but the graph writes no volume/nvdf output");
+        if (mode == "layer" && !layerish) throw Error(file + ": --mode layer, but the graph writes no NDF set, weather map or 2D sky layer");
+        have_voxel = g.nvdf && mode != "layer";
+        have_layer = layerish && mode != "voxel";
+        if (have_voxel) scene = render::scene_from_nvdf_set(g.nvdf);
+        if (have_layer) {
+            LayerInputs in = cook_layer_inputs(jobs, cache_dir, sink, quiet);
+            layer.ndf = g.ndf;
+            if (!layer.ndf) {
+                // Only 2D layers: an empty cloud layer under them.
+                Field2D empty({{2, 2}}, 3, Box2d{{{0, 0}}, {{40000, 40000}}}, {"coverage", "min_height", "max_height"});
+                for (int y = 0; y < 2; ++y)
+                    for (int x = 0; x < 2; ++x) empty.at(1, x, y) = 1500, empty.at(2, x, y) = 4000;
+                layer.ndf = std::make_shared<const Field2D>(std::move(empty));
+            }
+            layer.profile_lut = g.lut ? g.lut : in.lut;
+            layer.base_noise = in.low;
+            layer.detail_noise = in.high;
+            layer.curl = in.curl;
+            layer.envelope.cone_map = g.cone;
+            layer.envelope.distance_map = g.distance;
+            auto tile_of = [](const Field2D& f) {
+                const double sx = f.bounds().max[0] - f.bounds().min[0];
+                return sx > 100 ? sx : 20000.0; // unit-box textures: 20 km per tile
+            };
+            if (g.cirrus) layer.sky_layers.push_back(sky_layer_from(g.cirrus, g.cirrus->find_channel("cirrus"), 8000, tile_of(*g.cirrus), 0.8));
+            if (g.sky2d) layer.sky_layers.push_back(sky_layer_from(g.sky2d, 0, 6000, tile_of(*g.sky2d), 0.9));
+        }
     } else {
+        if (mode == "layer") throw UsageError{"--mode layer needs a graph that writes an NDF set", "preview"};
         std::vector<std::filesystem::path> files(a.positional.begin(), a.positional.end());
         scene = render::load_scene(files, a.has("--voxel") ? numbers(a.get("--voxel"), 1, "--voxel")[0] : 0.0);
+        have_voxel = true;
     }
-    scene.noise = noise;
-    if (a.has("--noise-tile")) scene.noise_tile = numbers(a.get("--noise-tile"), 1, "--noise-tile")[0];
-    render::validate_scene(scene);
+    if (have_voxel) {
+        scene.noise = noise;
+        if (a.has("--noise-tile")) scene.noise_tile = numbers(a.get("--noise-tile"), 1, "--noise-tile")[0];
+        render::validate_scene(scene);
+    }
+    if (have_layer) {
+        if (a.has("--time")) layer.time = numbers(a.get("--time"), 1, "--time")[0];
+        if (a.has("--earth-radius")) layer.earth_radius = numbers(a.get("--earth-radius"), 1, "--earth-radius")[0];
+        if (a.has("--wind")) {
+            auto v = numbers(a.get("--wind"), 2, "--wind");
+            layer.wind = {{v[0], v[1]}};
+        }
+        render::validate_layer_scene(layer);
+    }
 
-    const Box3d bounds = scene.modeling->bounds();
+    const Box3d bounds = have_voxel ? scene.modeling->bounds() : Box3d{{{0, 0, 0}}, {{1, 1, 1}}};
     render::RenderSettings s = render::preview_settings(bounds, w, h);
     s.threads = jobs;
+    const double aspect = double(w) / h;
+    if (have_layer) {
+        const auto kind = view.kind == "aerial" ? render::LayerView::Aerial
+                          : view.kind == "orbit" ? render::LayerView::Orbit
+                                                 : render::LayerView::Ground;
+        s.camera = render::layer_camera(layer, kind, aspect, view.az, view.el);
+        // A daylight sky gradient unless --sky says otherwise.
+        s.sky_colour = {{0.16f, 0.32f, 0.75f}};
+        s.sky_horizon = Vec3f{{0.62f, 0.72f, 0.86f}};
+        s.sun_direction = render::sun_direction(150, 25);
+    } else if (have_voxel && a.positional.size() == 1 && is_graph(a.positional[0])) {
+        s.camera = voxel_camera(scene, view, aspect);
+    } else if (have_voxel && view.kind != "auto") {
+        s.camera = voxel_camera(scene, view, aspect);
+    }
     if (a.has("--camera")) {
         auto v = numbers(a.get("--camera"), 6, "--camera");
         s.camera.position = {{v[0], v[1], v[2]}};
@@ -160,6 +449,7 @@ int run_preview(const Args& a) {
     const double exposure = a.has("--exposure") ? numbers(a.get("--exposure"), 1, "--exposure")[0] : 1.5;
 
     if (a.has("--sweep")) {
+        if (!have_voxel) throw UsageError{"--sweep measures the voxel renderer; the graph has no volume/nvdf output", "preview"};
         auto r = render::quality_sweep(scene, s, {0.25, 0.5, 1, 2, 4}, &sink);
         bar.finish();
         // stdout: the table (data); a CSV-friendly layout.
@@ -174,11 +464,34 @@ int run_preview(const Args& a) {
     const int frames = a.has("--turntable") ? static_cast<int>(numbers(a.get("--turntable"), 1, "--turntable")[0]) : 0;
     if (a.has("--turntable") && (frames < 1 || frames > 3600)) throw UsageError{"--turntable expects 1..3600 frames", "preview"};
     auto t0 = std::chrono::steady_clock::now();
-    render::RenderReport report;
+    std::string features;
+    // One frame: the layer, the voxel set, or the voxel set composited over the layer.
+    auto render_frame = [&](const render::RenderSettings& fs) {
+        std::optional<Field2D> img;
+        features.clear();
+        if (have_layer) {
+            auto r = render::render_layer(layer, fs, &sink);
+            features += " [2.5D:";
+            for (const auto& f : r.report.active_features()) features += " " + f;
+            char buf[128];
+            std::snprintf(buf, sizeof buf, "; %.2f s, %llu cheap + %llu full samples, %llu skips]", r.report.seconds,
+                          (unsigned long long)r.report.cheap_samples, (unsigned long long)r.report.full_samples,
+                          (unsigned long long)r.report.skipped_steps);
+            features += buf;
+            img = std::move(r.image);
+        }
+        if (have_voxel) {
+            auto r = render::render_clouds(scene, fs, &sink);
+            features += have_layer ? " [voxel:" : "";
+            for (const auto& f : r.report.active_features()) features += " " + f;
+            if (have_layer) features += "]";
+            img = img ? render::composite_over(r.image, *img, fs) : std::move(r.image);
+        }
+        return std::move(*img);
+    };
     if (frames == 0) {
-        auto r = render::render_clouds(scene, s, &sink);
-        report = r.report;
-        write_picture_atomic(r.image, out, exposure);
+        Field2D image = render_frame(s);
+        write_picture_atomic(image, out, exposure);
         bar.finish();
         std::cout << out.string() << "\n";
     } else {
@@ -186,13 +499,14 @@ int run_preview(const Args& a) {
         StagedOutputs staged(out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path());
         std::vector<std::filesystem::path> paths;
         for (int i = 0; i < frames; ++i) {
-            s.camera = render::framing_camera(bounds, double(w) / h, 30 + 360.0 * i / frames);
-            auto r = render::render_clouds(scene, s, &sink);
-            report = r.report;
+            if (have_layer) s.camera = render::layer_camera(layer, render::LayerView::Orbit, double(w) / h, 30 + 360.0 * i / frames, view.el);
+            else s.camera = render::framing_camera(have_voxel && is_graph(a.positional[0]) ? cloud_bounds(scene) : bounds, double(w) / h,
+                                                   30 + 360.0 * i / frames);
+            Field2D image = render_frame(s);
             char suffix[32];
             std::snprintf(suffix, sizeof suffix, "_%03d", i);
             const std::filesystem::path name = out.stem().string() + suffix + out.extension().string();
-            write_picture(r.image, staged.stage(name), exposure);
+            write_picture(image, staged.stage(name), exposure);
             paths.push_back(out.parent_path() / name);
         }
         staged.commit();
@@ -200,11 +514,12 @@ int run_preview(const Args& a) {
         for (const auto& p : paths) std::cout << p.string() << "\n";
     }
     if (!quiet) {
-        const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::string features;
-        for (const auto& f : report.active_features()) features += " " + f;
-        std::fprintf(stderr, "rendered %dx%d%s in %.2f s; features:%s\n", w, h, frames ? (" x" + std::to_string(frames)).c_str() : "", secs,
-                     features.c_str());
+        const auto now = std::chrono::steady_clock::now();
+        const double secs = std::chrono::duration<double>(now - t0).count();
+        const double total = std::chrono::duration<double>(now - t_start).count();
+        std::fprintf(stderr, "rendered %dx%d%s (%s) in %.2f s (%.2f s with cooking); features:%s\n", w, h,
+                     frames ? (" x" + std::to_string(frames)).c_str() : "",
+                     have_layer && have_voxel ? "2.5D + voxel composited" : (have_layer ? "2.5D" : "voxel"), secs, total, features.c_str());
     }
     return 0;
 }

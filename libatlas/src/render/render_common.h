@@ -42,6 +42,9 @@ inline double remap(double v, double a, double b, double c, double d) {
     return c + (d - c) * t;
 }
 
+// GPU Pro 7's Remap: (v - a) / (b - a) * (d - c) + c, not clamped.
+inline double remap_unclamped(double v, double a, double b, double c, double d) { return c + (v - a) / (b - a) * (d - c); }
+
 inline double dual_hg(const RenderSettings& s, double cos_theta) {
     return s.hg_forward_weight * hg(cos_theta, s.hg_forward) + (1 - s.hg_forward_weight) * hg(cos_theta, s.hg_back);
 }

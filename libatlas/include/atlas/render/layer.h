@@ -1,0 +1,180 @@
+// atlas/render/layer.h - the 2.5D cloudscape ray-marcher: an NDF set (2D
+// weather maps) drawn as a cloud layer in a spherical shell over a curved
+// Earth, the method of Schneider's GPU Pro 7 chapter "Real-Time Volumetric
+// Cloudscapes" (Horizon Zero Dawn) and of his GDC 2022 superstorm talk.
+//
+// Density at a point p (docs/render.md, "2.5D mode", has the formulas):
+// altitude h = |p - C| - R over an Earth of radius R centred below the map
+// centre; the set read bilinearly at p's map position; the height fraction
+// f = (h - min_height) / (max_height - min_height); the vertical profile
+// bottom(bottom_type, f) * top(top_type, f) from the profile LUT; the HZD
+// base noise (Perlin-Worley dilated by its Worley FBM) times the profile,
+// remapped by coverage, eroded by the curl-distorted detail Worley FBM
+// (wispy at the base, billowy above); wind skews the tops and scrolls the
+// noise. Lighting is the voxel renderer's (renderer.h): Beer-powder, dual-lobe
+// HG, ambient, multiple scattering, with six cone samples plus one long
+// sample toward the sun, precipitation thickening the light path; a sky
+// gradient, ground, distance haze and optional 2D layers (cirrus) above.
+//
+// Units: metres, z up; world x, y are the map's coordinates, z = 0 is the
+// ground at the map centre. Threading and determinism: fixed 16x16 tiles,
+// every pixel a function of its coordinates only: same bytes for any thread
+// count.
+#pragma once
+
+#include "atlas/core/field.h"
+#include "atlas/core/progress.h"
+#include "atlas/render/renderer.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace atlas::render {
+
+// How the NDF set continues beyond its bounds.
+enum class MapEdge {
+    Wrap,  // the map tiles (noise-made weather maps tile exactly)
+    Clamp, // edge texels extend
+    Empty, // no cloud outside the map
+};
+
+// A 2D cloud texture on a sphere `altitude` metres up (HZD's high-altitude
+// clouds, Far Cry 6's cirrus, Quilez's sky layer), drawn behind the
+// volumetric clouds. Opacity = opacity * saturate((v - value_min) /
+// (value_max - value_min)), v = channel `channel` at the hit's map position
+// (texture tiled every `tile` metres, scrolled by wind * time).
+struct SkyLayer {
+    Field2DPtr texture;
+    int channel = 0;
+    double altitude = 8000;  // metres above the ground, > 0
+    double tile = 20000;     // metres per texture period, > 0
+    double value_min = 0, value_max = 1;
+    double opacity = 1;      // [0, 1]
+    Vec2d wind{{0, 0}};      // m/s
+};
+
+// Optional data of the envelope method (Nubis³): empty-space skipping.
+//   cone_map      ndf/cone_map robust output (apex_height, cone_ratio) over
+//                 the set's bounds, for the cloud tops (max_height channel
+//                 where coverage > 0): above the apex a step of
+//                 c (z - apex) / (1 - c d_z) (|d_xy| = 1) cannot enter cloud
+//   distance_map  ndf/distance_map output: Euclidean distance (metres) to the
+//                 nearest solid voxel, over the set's bounds and [z0, z1]
+// Either may be null. Both only skip: the image equals plain marching within
+// the tolerance stated in docs/render.md.
+struct LayerEnvelope {
+    Field2DPtr cone_map;
+    Field3DPtr distance_map;
+};
+
+struct LayerScene {
+    // The NDF set: channels found by name, coverage, min_height and
+    // max_height required; type (0), top_type / bottom_type (type),
+    // precipitation (0) optional. Values must be finite.
+    Field2DPtr ndf;
+    // ndf/profile_lut: channels bottom, top, density over (type, f),
+    // end-aligned texels. Required.
+    Field2DPtr profile_lut;
+    // noise/hzd_set: low RGBA (Perlin-Worley, 3 Worley FBMs), high RGB
+    // (Worley FBMs), curl RG in [0, 1] ([-4, 4] remapped). Null low: the
+    // profile and coverage alone (smooth shapes); null high/curl: no erosion
+    // / no distortion.
+    Field3DPtr base_noise;
+    Field3DPtr detail_noise;
+    Field2DPtr curl;
+    double base_tile = 6000;     // metres per base-noise period
+    double detail_tile = 1200;   // metres per detail-noise period
+    double curl_tile = 4000;     // metres per curl period
+    double curl_amount = 120;    // metres of distortion at the cloud base (1 - f at the top)
+    double erosion = 0.2;        // HZD's detail erosion factor (final = remap(base, mod * erosion, 1, 0, 1))
+    double density_scale = 1;    // multiplies the final density, >= 0
+    double earth_radius = 6360e3; // metres, > 0
+    MapEdge edge = MapEdge::Wrap;
+    // Wind: direction and speed (m/s) of the flow; time (s) scrolls the map
+    // and the noises (detail faster); cloud_top_offset skews the tops by
+    // f * offset metres downwind.
+    Vec2d wind{{8, 0}};
+    double time = 0;
+    double cloud_top_offset = 500;
+    // Rain clouds: the light path's density is multiplied by
+    // 1 + rain_absorption * precipitation (GPU Pro 7 "Rain Clouds").
+    double rain_absorption = 2;
+    // Ground albedo (linear RGB) lit by sun and sky, shadowed by no cloud.
+    Vec3f ground_albedo{{0.05f, 0.075f, 0.1f}}; // a dark sea by default (GPU Pro 7 fig. 4.32)
+    // Aerial perspective: clouds and ground fade to the horizon colour over
+    // this distance (1 - exp(-t / haze_distance)); 0 = none.
+    double haze_distance = 90000;
+    LayerEnvelope envelope;
+    std::vector<SkyLayer> sky_layers;
+};
+
+// Throws atlas::Error naming the problem (null fields, missing channels,
+// non-finite values: "channel 'coverage' holds NaN at texel (x, y)", bad
+// numbers).
+void validate_layer_scene(const LayerScene& scene);
+
+// Throws atlas::Error "WHAT: channel 'c' holds NaN|Inf at texel (x, y)" for
+// the first non-finite value (x fastest, channels in order).
+void check_finite(const Field2D& f, const std::string& what);
+void check_finite(const Field3D& f, const std::string& what);
+
+struct LayerReport {
+    bool base_noise = false, detail_noise = false, curl = false;
+    bool cheap_search = true;     // HZD: cheap base-only samples until a cloud is near
+    bool cone_skipping = false;   // envelope cone map used
+    bool distance_skipping = false;
+    bool wind = false;            // non-zero wind or top offset
+    bool precipitation = false;   // some precipitation > 0
+    int sky_layers = 0;
+    bool sky_gradient = false;
+    uint64_t cheap_samples = 0;   // base-only density evaluations (view rays)
+    uint64_t full_samples = 0;    // full density evaluations (view rays)
+    uint64_t skipped_steps = 0;   // envelope jumps
+    double seconds = 0;
+    // "curved_earth base_noise detail_erosion curl ..." - space separated.
+    std::vector<std::string> active_features() const;
+};
+
+struct LayerResult {
+    Field2D image; // r, g, b, transmittance as RenderResult
+    LayerReport report;
+};
+
+// Renders the layer with the camera, sun, sky, size, quality (step scale),
+// extinction, phase, ambient, multiple scattering, seed and thread settings
+// of `settings` (mode, light grid, lights are voxel-only and ignored).
+// Throws atlas::Error on a bad setting or scene, and when the camera is
+// under the ground ("the camera is 12 m under the ground"); CancelledError
+// on cancel.
+LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings, const ProgressSink* progress = nullptr);
+
+// Camera presets over the layer (aspect = width / height):
+//   Ground  2 m over the ground at the map's south edge + 15 % looking north,
+//           pitched up 20 degrees, fov 60
+//   Aerial  1.5 km above the highest cloud top, south of the map centre,
+//           looking north and down 20 degrees, fov 60
+//   Orbit   looking at the map centre at mid-cloud height from the given
+//           azimuth (0 = from -y, counter-clockwise) and elevation at a
+//           distance that frames the map, fov 50
+enum class LayerView { Ground, Aerial, Orbit };
+Camera layer_camera(const LayerScene& scene, LayerView view, double aspect, double azimuth_deg = 30, double elevation_deg = 25);
+
+// Intersections of the ray o + t d (unit d, t >= 0) with the cloud shell
+// between radii r_inner and r_outer around `centre`, stopping at the ground
+// sphere of radius r_ground (<= r_inner): up to two [t0, t1] segments in
+// order. Returns the number of segments (0..2). The analytic core of the
+// curved-Earth march, public for tests and tools.
+int shell_segments(const Vec3d& o, const Vec3d& d, const Vec3d& centre, double r_ground, double r_inner, double r_outer, double seg[4]);
+
+// The first t >= 0 where the ray meets the sphere of radius r (from outside
+// or inside), or -1.
+double ray_sphere_exit_or_hit(const Vec3d& o, const Vec3d& d, const Vec3d& centre, double r);
+
+// Composites a voxel render (in front: its clouds, then its transmittance)
+// over a layer render of the same settings: front clouds + T_front * back.
+// Both images from render_clouds / render_layer with identical camera,
+// size and sky. Throws atlas::Error on mismatched sizes.
+Field2D composite_over(const Field2D& front, const Field2D& back, const RenderSettings& settings);
+
+} // namespace atlas::render

@@ -1,0 +1,803 @@
+// The 2.5D cloudscape ray-marcher (atlas/render/layer.h; formulas in
+// docs/render.md, "2.5D mode").
+#include "atlas/render/layer.h"
+
+#include "render_common.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace atlas::render {
+
+std::vector<std::string> LayerReport::active_features() const {
+    std::vector<std::string> f{"curved_earth", "vertical_profile_lut"};
+    if (base_noise) f.push_back("base_noise");
+    if (detail_noise) f.push_back("detail_erosion");
+    if (curl) f.push_back("curl_distortion");
+    if (wind) f.push_back("wind");
+    if (precipitation) f.push_back("rain_absorption");
+    if (cheap_search) f.push_back("cheap_search");
+    if (cone_skipping) f.push_back("cone_skipping");
+    if (distance_skipping) f.push_back("distance_skipping");
+    f.push_back("cone_light_samples");
+    f.push_back("beer_powder");
+    f.push_back("dual_hg");
+    f.push_back("ambient");
+    f.push_back("multiple_scattering");
+    f.push_back("haze");
+    if (sky_gradient) f.push_back("sky_gradient");
+    if (sky_layers > 0) f.push_back("sky_layers");
+    return f;
+}
+
+namespace {
+
+template <class F>
+void check_finite_impl(const F& f, const std::string& what, int nx, int ny) {
+    for (int c = 0; c < f.channels(); ++c) {
+        auto ch = f.channel(c);
+        for (size_t i = 0; i < ch.size(); ++i) {
+            if (std::isfinite(ch[i])) continue;
+            const size_t plane = size_t(nx) * size_t(ny);
+            const size_t x = i % size_t(nx), y = (i / size_t(nx)) % size_t(ny), z = i / plane;
+            std::string at = "(" + std::to_string(x) + ", " + std::to_string(y);
+            if (plane < ch.size()) at += ", " + std::to_string(z);
+            at += ")";
+            const std::string name = c < int(f.channel_names().size()) ? f.channel_names()[size_t(c)] : std::to_string(c);
+            throw Error(what + ": channel '" + name + "' holds " + (std::isnan(ch[i]) ? "NaN" : "Inf") + " at texel " + at);
+        }
+    }
+}
+
+} // namespace
+
+void check_finite(const Field2D& f, const std::string& what) { check_finite_impl(f, what, f.width(), f.height()); }
+void check_finite(const Field3D& f, const std::string& what) { check_finite_impl(f, what, f.nx(), f.ny()); }
+
+namespace {
+
+void need(bool ok, const std::string& what) {
+    if (!ok) throw Error("render (2.5D): " + what);
+}
+
+bool positive_finite(double v) { return v > 0 && std::isfinite(v); }
+
+// Bilinear lookup of a 2D field at texel coordinate (u, v) (centres at
+// i + 0.5) with wrap or clamp addressing.
+struct Bilinear {
+    int x0, x1, y0, y1;
+    float tx, ty;
+};
+
+inline void axis_wrap(double u, int n, int& i0, int& i1, float& t) {
+    u -= 0.5;
+    const double f = std::floor(u);
+    t = static_cast<float>(u - f);
+    long long i = static_cast<long long>(f) % n;
+    if (i < 0) i += n;
+    i0 = static_cast<int>(i);
+    i1 = i0 + 1 == n ? 0 : i0 + 1;
+}
+
+inline void axis_clamp(double u, int n, int& i0, int& i1, float& t) {
+    u -= 0.5;
+    if (u <= 0) { i0 = i1 = 0; t = 0; return; }
+    if (u >= n - 1) { i0 = i1 = n - 1; t = 0; return; }
+    i0 = static_cast<int>(u);
+    i1 = i0 + 1;
+    t = static_cast<float>(u - i0);
+}
+
+inline float lerp2(const float* p, int nx, const Bilinear& b) {
+    const float* r0 = p + size_t(b.y0) * size_t(nx);
+    const float* r1 = p + size_t(b.y1) * size_t(nx);
+    const float a = r0[b.x0] + (r0[b.x1] - r0[b.x0]) * b.tx;
+    const float c = r1[b.x0] + (r1[b.x1] - r1[b.x0]) * b.tx;
+    return a + (c - a) * b.ty;
+}
+
+// A tiling 3D noise with up to 4 channels, trilinear.
+struct Noise3 {
+    std::array<const float*, 4> ch{};
+    int n = 0, nx = 0, ny = 0, nz = 0;
+    double inv_tile = 0;
+    bool ok() const { return n > 0; }
+    void init(const Field3D* f, double tile) {
+        if (!f) return;
+        n = std::min(4, f->channels());
+        for (int c = 0; c < 4; ++c) ch[size_t(c)] = f->channel(std::min(c, n - 1)).data();
+        nx = f->nx();
+        ny = f->ny();
+        nz = f->nz();
+        inv_tile = 1.0 / tile;
+    }
+    void sample(double x, double y, double z, float out[4]) const {
+        int x0, x1, y0, y1, z0, z1;
+        float tx, ty, tz;
+        axis_wrap(x * inv_tile * nx, nx, x0, x1, tx);
+        axis_wrap(y * inv_tile * ny, ny, y0, y1, ty);
+        axis_wrap(z * inv_tile * nz, nz, z0, z1, tz);
+        const size_t sy = size_t(nx), sz = size_t(nx) * size_t(ny);
+        const size_t r0 = size_t(z0) * sz + size_t(y0) * sy, r1 = size_t(z0) * sz + size_t(y1) * sy;
+        const size_t r2 = size_t(z1) * sz + size_t(y0) * sy, r3 = size_t(z1) * sz + size_t(y1) * sy;
+        for (int c = 0; c < 4; ++c) {
+            const float* p = ch[size_t(c)];
+            const float a = p[r0 + size_t(x0)] + (p[r0 + size_t(x1)] - p[r0 + size_t(x0)]) * tx;
+            const float b = p[r1 + size_t(x0)] + (p[r1 + size_t(x1)] - p[r1 + size_t(x0)]) * tx;
+            const float cc = p[r2 + size_t(x0)] + (p[r2 + size_t(x1)] - p[r2 + size_t(x0)]) * tx;
+            const float d = p[r3 + size_t(x0)] + (p[r3 + size_t(x1)] - p[r3 + size_t(x0)]) * tx;
+            const float ab = a + (b - a) * ty, cd = cc + (d - cc) * ty;
+            out[c] = ab + (cd - ab) * tz;
+        }
+    }
+};
+
+int channel_of(const Field2D& f, const char* name) { return f.find_channel(name); }
+
+// The weather at one map position.
+struct Column {
+    double coverage = 0, type = 0, top_type = 0, bottom_type = 0, min_h = 0, max_h = 0, precip = 0;
+};
+
+double sample_lut(const Field2D& lut, const float* ch, double type, double f) {
+    // End-aligned texels (ndf/profile_lut): texel i at type i / (W - 1).
+    const int w = lut.width(), h = lut.height();
+    Bilinear b;
+    axis_clamp(0.5 + detail::saturate(type) * (w - 1), w, b.x0, b.x1, b.tx);
+    axis_clamp(0.5 + detail::saturate(f) * (h - 1), h, b.y0, b.y1, b.ty);
+    return lerp2(ch, w, b);
+}
+
+// Everything the march reads, prepared once per render.
+class LayerModel {
+public:
+    LayerModel(const LayerScene& s) : s_(s), ndf_(*s.ndf), lut_(*s.profile_lut) {
+        const int cc = channel_of(ndf_, "coverage"), cmin = channel_of(ndf_, "min_height"), cmax = channel_of(ndf_, "max_height");
+        const int ct = channel_of(ndf_, "type"), ctt = channel_of(ndf_, "top_type"), cbt = channel_of(ndf_, "bottom_type");
+        const int cp = channel_of(ndf_, "precipitation");
+        ch_cov_ = ndf_.channel(cc).data();
+        ch_min_ = ndf_.channel(cmin).data();
+        ch_max_ = ndf_.channel(cmax).data();
+        ch_type_ = ct >= 0 ? ndf_.channel(ct).data() : nullptr;
+        ch_top_ = ctt >= 0 ? ndf_.channel(ctt).data() : ch_type_;
+        ch_bot_ = cbt >= 0 ? ndf_.channel(cbt).data() : ch_type_;
+        ch_precip_ = cp >= 0 ? ndf_.channel(cp).data() : nullptr;
+        lut_bottom_ = lut_.channel(lut_.find_channel("bottom")).data();
+        lut_top_ = lut_.channel(lut_.find_channel("top")).data();
+        const Box2d& b = ndf_.bounds();
+        origin_ = {{b.min[0], b.min[1]}};
+        size_ = {{b.max[0] - b.min[0], b.max[1] - b.min[1]}};
+        inv_texel_ = {{ndf_.width() / size_[0], ndf_.height() / size_[1]}};
+        centre_ = {{0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), -s.earth_radius}};
+        bottom_ = std::numeric_limits<double>::infinity();
+        top_ = -bottom_;
+        auto cov = ndf_.channel(cc), mn = ndf_.channel(cmin), mx = ndf_.channel(cmax);
+        for (size_t i = 0; i < cov.size(); ++i) {
+            if (!(cov[i] > 0) || !(mx[i] > mn[i])) continue;
+            bottom_ = std::min(bottom_, double(mn[i]));
+            top_ = std::max(top_, double(mx[i]));
+            any_cloud_ = true;
+        }
+        if (!any_cloud_) bottom_ = top_ = 0;
+        if (ch_precip_) {
+            auto p = ndf_.channel(cp);
+            precipitation_ = std::any_of(p.begin(), p.end(), [](float v) { return v > 0; });
+        }
+        base_.init(s.base_noise.get(), s.base_tile);
+        if (base_.ok()) build_coverage_table(*s.base_noise);
+        detail_.init(s.detail_noise.get(), s.detail_tile);
+        if (s.curl) {
+            curl_ = s.curl.get();
+            curl_r_ = curl_->channel(0).data();
+            curl_g_ = curl_->channel(std::min(1, curl_->channels() - 1)).data();
+        }
+        const double w = std::hypot(s.wind[0], s.wind[1]);
+        wind_dir_ = w > 0 ? Vec2d{{s.wind[0] / w, s.wind[1] / w}} : Vec2d{{1, 0}};
+        map_shift_ = {{s.wind[0] * s.time, s.wind[1] * s.time}};
+        if (s.envelope.cone_map) {
+            cone_ = s.envelope.cone_map.get();
+            const int ca = cone_->find_channel("apex_height"), cr = cone_->find_channel("cone_ratio");
+            cone_apex_ = cone_->channel(ca).data();
+            cone_ratio_ = cone_->channel(cr).data();
+        }
+        if (s.envelope.distance_map) dist_ = s.envelope.distance_map.get();
+    }
+
+    const Vec3d& centre() const { return centre_; }
+    double bottom() const { return bottom_; }
+    double top() const { return top_; }
+    bool any_cloud() const { return any_cloud_; }
+    bool precipitation() const { return precipitation_; }
+    bool has_base() const { return base_.ok(); }
+    bool has_detail() const { return detail_.ok(); }
+    bool has_curl() const { return curl_ != nullptr; }
+    bool has_cone() const { return cone_ != nullptr; }
+    bool has_distance() const { return dist_ != nullptr; }
+
+    double altitude(const Vec3d& p) const { return length(p - centre_) - s_.earth_radius; }
+
+    // The weather at world (x, y); false outside an Empty-edged map.
+    bool column(double x, double y, Column& c) const {
+        double u = (x - map_shift_[0] - origin_[0]) * inv_texel_[0], v = (y - map_shift_[1] - origin_[1]) * inv_texel_[1];
+        const int nx = ndf_.width(), ny = ndf_.height();
+        Bilinear b;
+        if (s_.edge == MapEdge::Empty && (u < 0 || v < 0 || u > nx || v > ny)) return false;
+        if (s_.edge == MapEdge::Wrap) {
+            axis_wrap(u, nx, b.x0, b.x1, b.tx);
+            axis_wrap(v, ny, b.y0, b.y1, b.ty);
+        } else {
+            axis_clamp(u, nx, b.x0, b.x1, b.tx);
+            axis_clamp(v, ny, b.y0, b.y1, b.ty);
+        }
+        c.coverage = lerp2(ch_cov_, nx, b);
+        if (!(c.coverage > 0)) return false;
+        c.min_h = lerp2(ch_min_, nx, b);
+        c.max_h = lerp2(ch_max_, nx, b);
+        c.type = ch_type_ ? lerp2(ch_type_, nx, b) : 0.0;
+        c.top_type = ch_top_ ? lerp2(ch_top_, nx, b) : 0.0;
+        c.bottom_type = ch_bot_ ? lerp2(ch_bot_, nx, b) : 0.0;
+        c.precip = ch_precip_ ? detail::saturate(lerp2(ch_precip_, nx, b)) : 0.0;
+        return c.max_h > c.min_h;
+    }
+
+    // Coverage is the probability of cloud (ndf_set.h): the threshold the
+    // coverage remap uses is the (1 - coverage) quantile of the dilated base
+    // shape over the noise texture, so coverage c leaves a fraction c of a
+    // full-profile column cloudy (the noise's own range, 0.39..0.97 for the
+    // HZD Perlin-Worley, would otherwise turn coverage 0.3 into overcast).
+    void build_coverage_table(const Field3D& n) {
+        const int c = n.channels();
+        auto r = n.channel(0), g = n.channel(std::min(1, c - 1)), b = n.channel(std::min(2, c - 1)), a = n.channel(std::min(3, c - 1));
+        std::vector<float> v;
+        const size_t stride = std::max<size_t>(1, r.size() / 65536);
+        for (size_t i = 0; i < r.size(); i += stride) v.push_back(float(dilated_base(r[i], g[i], b[i], a[i])));
+        std::sort(v.begin(), v.end());
+        for (int k = 0; k <= kQuantiles; ++k) quantile_[size_t(k)] = v[std::min(v.size() - 1, size_t(double(k) / kQuantiles * double(v.size() - 1) + 0.5))];
+        equalised_ = true;
+    }
+    static double dilated_base(double r, double g, double b, double a) {
+        const double low_fbm = g * 0.625 + b * 0.25 + a * 0.125;
+        // Dilate the Perlin-Worley shape by the Worley FBM (GPU Pro 7).
+        return detail::remap_unclamped(r, -(1.0 - low_fbm), 1.0, 0.0, 1.0);
+    }
+    // The base value above which a fraction `coverage` of the texture lies.
+    double coverage_threshold(double coverage) const {
+        if (!equalised_) return 1.0 - coverage;
+        const double u = (1.0 - detail::saturate(coverage)) * kQuantiles;
+        const int i = std::min(kQuantiles - 1, int(u));
+        return quantile_[size_t(i)] + (quantile_[size_t(i + 1)] - quantile_[size_t(i)]) * (u - i);
+    }
+
+    // Density at p (altitude h). full = false: the cheap base shape only
+    // (HZD's "cheap" sample). shape_out: the base shape with coverage (the
+    // sample's profile for ambient and multiple scattering).
+    double density(const Vec3d& p, double h, bool full, Column* col_out = nullptr, double* shape_out = nullptr) const {
+        Column c;
+        if (!column(p[0], p[1], c)) return 0;
+        if (h <= c.min_h || h >= c.max_h) return 0;
+        const double f = (h - c.min_h) / (c.max_h - c.min_h);
+        const double profile =
+            sample_lut(lut_, lut_bottom_, c.bottom_type, f) * sample_lut(lut_, lut_top_, c.top_type, f);
+        if (!(profile > 0)) return 0;
+        // Wind: tops pushed downwind, the noise scrolled (detail faster, a
+        // little upward: clouds seem to grow).
+        const double skew = f * s_.cloud_top_offset;
+        const double qx = p[0] + wind_dir_[0] * skew - s_.wind[0] * s_.time;
+        const double qy = p[1] + wind_dir_[1] * skew - s_.wind[1] * s_.time;
+        const double qz = h - 0.1 * std::hypot(s_.wind[0], s_.wind[1]) * s_.time;
+        double base = 1;
+        if (base_.ok()) {
+            float n[4];
+            base_.sample(qx, qy, qz, n);
+            base = dilated_base(n[0], n[1], n[2], n[3]);
+        }
+        base *= profile;
+        // Coverage grows the shape and scales its density: HZD's
+        // remap(base, 1 - coverage, 1, 0, 1) * coverage with the equalised threshold.
+        const double thr = coverage_threshold(c.coverage);
+        double shaped = thr < 1.0 ? (base - thr) / (1.0 - thr) * c.coverage : 0.0;
+        if (!(shaped > 0)) return 0;
+        shaped = std::min(shaped, 1.0);
+        if (col_out) *col_out = c;
+        if (shape_out) *shape_out = shaped;
+        if (!full || !detail_.ok()) return shaped * s_.density_scale;
+        double dx = qx * 1.3, dy = qy * 1.3, dz = qz * 1.3; // detail moves faster than the base
+        if (curl_) {
+            // Turbulence at the cloud base: curl-distorted detail coordinates.
+            Bilinear b;
+            axis_wrap(dx / s_.curl_tile * curl_->width(), curl_->width(), b.x0, b.x1, b.tx);
+            axis_wrap(dy / s_.curl_tile * curl_->height(), curl_->height(), b.y0, b.y1, b.ty);
+            const double k = s_.curl_amount * (1.0 - f);
+            dx += (2.0 * lerp2(curl_r_, curl_->width(), b) - 1.0) * k;
+            dy += (2.0 * lerp2(curl_g_, curl_->width(), b) - 1.0) * k;
+        }
+        float n[4];
+        detail_.sample(dx, dy, dz, n);
+        const double high_fbm = n[0] * 0.625 + n[1] * 0.25 + n[2] * 0.125;
+        // Wispy (FBM) at the base to billowy (inverted) above 10 % height.
+        const double mod = high_fbm + ((1.0 - high_fbm) - high_fbm) * detail::saturate(f * 10.0);
+        const double final_density = detail::saturate(detail::remap_unclamped(shaped, mod * s_.erosion, 1.0, 0.0, 1.0));
+        return final_density * s_.density_scale;
+    }
+
+    // Envelope: a distance along the unit ray that surely holds no cloud, 0
+    // when none is known. p at altitude h.
+    double skip_distance(const Vec3d& p, const Vec3d& d, double h) const {
+        double best = 0;
+        const double u = (p[0] - map_shift_[0] - origin_[0]) / size_[0], v = (p[1] - map_shift_[1] - origin_[1]) / size_[1];
+        if (!(u >= 0 && u <= 1 && v >= 0 && v <= 1)) return 0; // the maps cover one tile
+        // Never jump past the map tile (its neighbours are other data).
+        double to_edge = std::numeric_limits<double>::infinity();
+        for (int a = 0; a < 2; ++a) {
+            const double lo = origin_[a] + map_shift_[a], hi = lo + size_[a];
+            if (d[a] > 1e-12) to_edge = std::min(to_edge, (hi - p[a]) / d[a]);
+            else if (d[a] < -1e-12) to_edge = std::min(to_edge, (lo - p[a]) / d[a]);
+        }
+        if (cone_) {
+            Bilinear b;
+            axis_clamp(u * cone_->width(), cone_->width(), b.x0, b.x1, b.tx);
+            axis_clamp(v * cone_->height(), cone_->height(), b.y0, b.y1, b.ty);
+            const double apex = lerp2(cone_apex_, cone_->width(), b), c = lerp2(cone_ratio_, cone_->width(), b);
+            if (h > apex && c > 0) {
+                const double hl = std::hypot(d[0], d[1]);
+                const double denom = hl - c * d[2];
+                const double s = denom > 1e-12 ? c * (h - apex) / denom : std::numeric_limits<double>::infinity();
+                best = std::max(best, s);
+            }
+        }
+        if (dist_) {
+            const Box3d& bb = dist_->bounds();
+            const Vec3d vs = dist_->voxel_size();
+            const double z = h;
+            if (z >= bb.min[2] && z <= bb.max[2]) {
+                // Trilinear distance minus a voxel diagonal: interpolation
+                // and voxel-centre solids are each off by less than that.
+                const double fx = u * dist_->nx() - 0.5, fy = v * dist_->ny() - 0.5, fz = (z - bb.min[2]) / vs[2] - 0.5;
+                auto cl = [](double t, int n) { return std::clamp(t, 0.0, double(n - 1)); };
+                const double cx = cl(fx, dist_->nx()), cy = cl(fy, dist_->ny()), cz = cl(fz, dist_->nz());
+                const int x0 = int(cx), y0 = int(cy), z0 = int(cz);
+                const int x1 = std::min(x0 + 1, dist_->nx() - 1), y1 = std::min(y0 + 1, dist_->ny() - 1), z1 = std::min(z0 + 1, dist_->nz() - 1);
+                const double tx = cx - x0, ty = cy - y0, tz = cz - z0;
+                auto at = [&](int x, int y, int zz) { return double(dist_->at(0, x, y, zz)); };
+                const double c00 = at(x0, y0, z0) + (at(x1, y0, z0) - at(x0, y0, z0)) * tx;
+                const double c10 = at(x0, y1, z0) + (at(x1, y1, z0) - at(x0, y1, z0)) * tx;
+                const double c01 = at(x0, y0, z1) + (at(x1, y0, z1) - at(x0, y0, z1)) * tx;
+                const double c11 = at(x0, y1, z1) + (at(x1, y1, z1) - at(x0, y1, z1)) * tx;
+                const double c0 = c00 + (c10 - c00) * ty, c1 = c01 + (c11 - c01) * ty;
+                const double dd = c0 + (c1 - c0) * tz - length(vs);
+                best = std::max(best, dd);
+            }
+        }
+        return std::min(best, to_edge);
+    }
+
+private:
+    const LayerScene& s_;
+    const Field2D& ndf_;
+    const Field2D& lut_;
+    const float *ch_cov_, *ch_min_, *ch_max_, *ch_type_, *ch_top_, *ch_bot_, *ch_precip_;
+    const float *lut_bottom_, *lut_top_;
+    Vec2d origin_, size_, inv_texel_;
+    Vec3d centre_;
+    double bottom_ = 0, top_ = 0;
+    bool any_cloud_ = false, precipitation_ = false;
+    Noise3 base_, detail_;
+    const Field2D* curl_ = nullptr;
+    const float *curl_r_ = nullptr, *curl_g_ = nullptr;
+    Vec2d wind_dir_, map_shift_;
+    const Field2D* cone_ = nullptr;
+    const float *cone_apex_ = nullptr, *cone_ratio_ = nullptr;
+    const Field3D* dist_ = nullptr;
+    static constexpr int kQuantiles = 256;
+    std::array<double, kQuantiles + 1> quantile_{};
+    bool equalised_ = false;
+};
+
+// Both roots of |o + t d - c|^2 = r^2 (unit d); false when the ray misses.
+bool sphere_roots(const Vec3d& o, const Vec3d& d, const Vec3d& c, double r, double& t0, double& t1) {
+    const Vec3d oc = o - c;
+    const double b = dot(oc, d);
+    // c_term computed as (|oc| - r)(|oc| + r): no cancellation for r ~ 6e6 m.
+    const double len = length(oc);
+    const double cterm = (len - r) * (len + r);
+    const double disc = b * b - cterm;
+    if (disc < 0) return false;
+    const double sq = std::sqrt(disc);
+    // Stable quadratic roots.
+    const double q = b > 0 ? -(b + sq) : -(b - sq);
+    double a0 = q, a1 = q != 0 ? cterm / q : 0;
+    if (a0 > a1) std::swap(a0, a1);
+    t0 = a0;
+    t1 = a1;
+    return true;
+}
+
+} // namespace
+
+double ray_sphere_exit_or_hit(const Vec3d& o, const Vec3d& d, const Vec3d& centre, double r) {
+    double t0, t1;
+    if (!sphere_roots(o, d, centre, r, t0, t1)) return -1;
+    if (t0 >= 0) return t0;
+    if (t1 >= 0) return t1;
+    return -1;
+}
+
+int shell_segments(const Vec3d& o, const Vec3d& d, const Vec3d& c, double r_ground, double r_inner, double r_outer, double seg[4]) {
+    double o0, o1;
+    if (!sphere_roots(o, d, c, r_outer, o0, o1) || o1 <= 0) return 0;
+    double start = std::max(0.0, o0), end = o1;
+    // The ground stops the ray.
+    double g0, g1;
+    // (A ray tangent to the ground, chord 0, is not blocked.)
+    if (sphere_roots(o, d, c, r_ground, g0, g1) && g0 >= 0 && g1 > g0) end = std::min(end, g0);
+    double i0, i1;
+    int n = 0;
+    auto push = [&](double a, double b) {
+        if (b > a) {
+            seg[2 * n] = a;
+            seg[2 * n + 1] = b;
+            ++n;
+        }
+    };
+    if (sphere_roots(o, d, c, r_inner, i0, i1) && i1 > start) {
+        // Inside the inner sphere between i0 and i1: not in the shell.
+        push(start, std::min(end, i0));
+        push(std::max(start, i1), end);
+    } else {
+        push(start, end);
+    }
+    return n;
+}
+
+void validate_layer_scene(const LayerScene& s) {
+    need(s.ndf != nullptr, "the NDF set is missing");
+    need(s.profile_lut != nullptr, "the vertical-profile LUT is missing");
+    for (const char* ch : {"coverage", "min_height", "max_height"})
+        need(s.ndf->find_channel(ch) >= 0, std::string("the NDF set has no '") + ch + "' channel");
+    for (const char* ch : {"bottom", "top"})
+        need(s.profile_lut->find_channel(ch) >= 0, std::string("the profile LUT has no '") + ch + "' channel (ndf/profile_lut)");
+    need(s.profile_lut->width() >= 2 && s.profile_lut->height() >= 2, "the profile LUT must be at least 2x2 texels");
+    const Box2d& b = s.ndf->bounds();
+    need(b.max[0] > b.min[0] && b.max[1] > b.min[1], "the NDF set's bounds are empty");
+    check_finite(*s.ndf, "NDF set");
+    check_finite(*s.profile_lut, "profile LUT");
+    need(!s.base_noise || s.base_noise->channels() >= 1, "base noise has no channels");
+    need(!s.detail_noise || s.detail_noise->channels() >= 1, "detail noise has no channels");
+    need(!s.curl || s.curl->channels() >= 1, "curl texture has no channels");
+    need(positive_finite(s.base_tile), "base_tile must be finite and > 0 metres");
+    need(positive_finite(s.detail_tile), "detail_tile must be finite and > 0 metres");
+    need(positive_finite(s.curl_tile), "curl_tile must be finite and > 0 metres");
+    need(std::isfinite(s.curl_amount) && s.curl_amount >= 0, "curl_amount must be finite and >= 0");
+    need(std::isfinite(s.erosion) && s.erosion >= 0 && s.erosion < 1, "erosion must be in [0, 1)");
+    need(std::isfinite(s.density_scale) && s.density_scale >= 0, "density_scale must be finite and >= 0");
+    need(positive_finite(s.earth_radius), "earth_radius must be finite and > 0 metres");
+    need(std::isfinite(s.wind[0]) && std::isfinite(s.wind[1]) && std::hypot(s.wind[0], s.wind[1]) <= 1000, "wind must be finite, at most 1000 m/s");
+    need(std::isfinite(s.time), "time must be finite");
+    need(std::isfinite(s.cloud_top_offset), "cloud_top_offset must be finite");
+    need(std::isfinite(s.rain_absorption) && s.rain_absorption >= 0, "rain_absorption must be finite and >= 0");
+    need(std::isfinite(s.haze_distance) && s.haze_distance >= 0, "haze_distance must be finite and >= 0 (0 = none)");
+    for (int c = 0; c < 3; ++c) need(std::isfinite(s.ground_albedo[c]) && s.ground_albedo[c] >= 0, "ground_albedo must be finite and >= 0");
+    if (s.envelope.cone_map) {
+        need(s.envelope.cone_map->find_channel("apex_height") >= 0 && s.envelope.cone_map->find_channel("cone_ratio") >= 0,
+             "the cone map needs channels apex_height and cone_ratio (ndf/cone_map with robust: true)");
+        check_finite(*s.envelope.cone_map, "cone map");
+    }
+    if (s.envelope.distance_map) check_finite(*s.envelope.distance_map, "distance map");
+    for (size_t i = 0; i < s.sky_layers.size(); ++i) {
+        const SkyLayer& l = s.sky_layers[i];
+        const std::string w = "sky_layers[" + std::to_string(i) + "]";
+        need(l.texture != nullptr, w + ": texture is missing");
+        need(l.channel >= 0 && l.channel < l.texture->channels(), w + ": channel out of range");
+        need(positive_finite(l.altitude), w + ": altitude must be finite and > 0 metres");
+        need(positive_finite(l.tile), w + ": tile must be finite and > 0 metres");
+        need(std::isfinite(l.value_min) && std::isfinite(l.value_max) && l.value_max > l.value_min, w + ": value_max must exceed value_min");
+        need(l.opacity >= 0 && l.opacity <= 1, w + ": opacity must be in [0, 1]");
+        need(std::isfinite(l.wind[0]) && std::isfinite(l.wind[1]), w + ": wind must be finite");
+        check_finite(*l.texture, w);
+    }
+}
+
+namespace {
+
+struct LayerIntegrator {
+    const LayerModel& m;
+    const LayerScene& sc;
+    const RenderSettings& s;
+    Vec3d sun;
+    Vec3d cam_up; // local up at the camera
+    double ambient[3];
+    double base_step, grow;
+    double light_step;
+    double r_ground, r_inner, r_outer;
+    bool use_envelope;
+    const detail::Sky& sky;
+    Vec3f haze_colour;
+    Vec3d cone_kernel[6];
+
+    // Summed density toward the sun: six samples in a widening cone, then one
+    // long sample at three cone lengths (GPU Pro 7, "Cone-Sampled Lighting").
+    double sun_depth(const Vec3d& p, bool cheap) const {
+        double acc = 0;
+        for (int i = 0; i < 6; ++i) {
+            const Vec3d q = p + sun * ((i + 0.5) * light_step) + cone_kernel[i] * (light_step * (i + 0.5) * 0.5);
+            acc += m.density(q, m.altitude(q), !cheap) * light_step;
+        }
+        const Vec3d q = p + sun * (18 * light_step);
+        acc += m.density(q, m.altitude(q), false) * 6 * light_step;
+        return acc;
+    }
+
+    // Summed density straight up to the column's top (2 cheap samples).
+    double sky_depth(const Vec3d& p, double h, const Column& c) const {
+        const double len = c.max_h - h;
+        if (!(len > 0)) return 0;
+        const Vec3d up = detail::normalized(p - m.centre());
+        double acc = 0;
+        for (int i = 0; i < 2; ++i) {
+            const Vec3d q = p + up * ((i + 0.5) * 0.5 * len);
+            acc += m.density(q, m.altitude(q), false);
+        }
+        return acc * 0.5 * len;
+    }
+
+    void trace(const Vec3d& o, const Vec3d& dir, float jitter, double rgb[3], double& trans, double& bg_weight_t, uint64_t& cheap,
+               uint64_t& full, uint64_t& skipped) const {
+        rgb[0] = rgb[1] = rgb[2] = 0;
+        trans = 1;
+        bg_weight_t = std::numeric_limits<double>::infinity();
+        double seg[4];
+        const int nseg = shell_segments(o, dir, m.centre(), r_ground, r_inner, r_outer, seg);
+        const detail::SunTerms st = detail::sun_terms(s, dot(dir, sun));
+        const double ext = s.extinction;
+        int steps = 0;
+        constexpr int kMaxSteps = 1024;
+        for (int si = 0; si < nseg && steps < kMaxSteps; ++si) {
+            double t = seg[2 * si];
+            const double t_end = seg[2 * si + 1];
+            bool first = true, searching = true;
+            int zero_run = 0;
+            while (t < t_end && steps < kMaxSteps) {
+                ++steps;
+                double dt = base_step * (1 + t / grow);
+                if (first) dt *= 0.5 + 0.5 * jitter; // jittered start
+                first = false;
+                if (searching) {
+                    // Cheap search at twice the step; step back on a hit.
+                    const Vec3d p = o + dir * t;
+                    const double h = m.altitude(p);
+                    if (use_envelope) {
+                        const double skip = m.skip_distance(p, dir, h);
+                        if (skip > 2 * dt) {
+                            t += skip;
+                            ++skipped;
+                            continue;
+                        }
+                    }
+                    const double len = std::min(2 * dt, t_end - t);
+                    const Vec3d q = o + dir * (t + 0.5 * len);
+                    ++cheap;
+                    if (m.density(q, m.altitude(q), false) > 0) {
+                        searching = false;
+                        zero_run = 0;
+                        continue; // re-march this stretch with full samples
+                    }
+                    t += len;
+                    continue;
+                }
+                dt = std::min(dt, t_end - t);
+                const double tm = t + 0.5 * dt;
+                const Vec3d p = o + dir * tm;
+                const double h = m.altitude(p);
+                Column col;
+                double shape = 0;
+                ++full;
+                const double d = m.density(p, h, true, &col, &shape);
+                if (d > 0) {
+                    zero_run = 0;
+                    const double sigma = ext * d;
+                    const double rain = 1 + sc.rain_absorption * col.precip;
+                    // Light: cheap samples once the view ray is optically deep (HZD's 0.3).
+                    const bool cheap_light = trans < 0.7;
+                    const double tau = ext * sun_depth(p, cheap_light) * rain;
+                    const double sky_tau = ext * sky_depth(p, h, col) * rain;
+                    double sun_w, sky_w;
+                    const double dp = detail::saturate(shape);
+                    detail::shade(s, st, tau, dp, detail::remap(dp, 0.0, 1.0, 0.25, 0.05), sky_tau, sun_w, sky_w);
+                    const double haze = sc.haze_distance > 0 ? 1 - std::exp(-tm / sc.haze_distance) : 0.0;
+                    const double absorbed = -std::expm1(-sigma * dt);
+                    const double w = trans * absorbed;
+                    for (int c = 0; c < 3; ++c) {
+                        const double ls = sun_w * s.sun_colour[c] + sky_w * ambient[c];
+                        rgb[c] += w * (ls + (double(haze_colour[c]) - ls) * haze);
+                    }
+                    trans *= std::exp(-sigma * dt);
+                    if (trans < s.min_transmittance) return;
+                } else if (++zero_run >= 6) {
+                    searching = true; // six empty full samples: back to the cheap search
+                }
+                t += dt;
+            }
+        }
+    }
+
+    // What lies behind the clouds along dir: sky (with 2D layers) or ground.
+    void background(const Vec3d& o, const Vec3d& dir, double out[3]) const {
+        const double tg = [&] {
+            double t0, t1;
+            if (!sphere_roots(o, dir, m.centre(), r_ground, t0, t1) || t0 < 0 || !(t1 > t0)) return -1.0;
+            return t0;
+        }();
+        if (tg >= 0) {
+            const Vec3d p = o + dir * tg;
+            const Vec3d n = detail::normalized(p - m.centre());
+            const double lit = std::max(0.0, dot(n, sun));
+            const double haze = sc.haze_distance > 0 ? 1 - std::exp(-tg / sc.haze_distance) : 0.0;
+            for (int c = 0; c < 3; ++c) {
+                const double g = sc.ground_albedo[c] * (s.sun_colour[c] * lit + ambient[c]);
+                out[c] = g + (double(haze_colour[c]) - g) * haze;
+            }
+            return;
+        }
+        const double up_t = detail::saturate(dot(dir, cam_up));
+        for (int c = 0; c < 3; ++c) out[c] = sky.at(c, up_t);
+        for (const SkyLayer& l : sc.sky_layers) {
+            const double t = ray_sphere_exit_or_hit(o, dir, m.centre(), sc.earth_radius + l.altitude);
+            if (!(t > 0)) continue;
+            const Vec3d p = o + dir * t;
+            const Field2D& tex = *l.texture;
+            Bilinear b;
+            axis_wrap((p[0] - l.wind[0] * sc.time) / l.tile * tex.width(), tex.width(), b.x0, b.x1, b.tx);
+            axis_wrap((p[1] - l.wind[1] * sc.time) / l.tile * tex.height(), tex.height(), b.y0, b.y1, b.ty);
+            const double v = lerp2(tex.channel(l.channel).data(), tex.width(), b);
+            double a = l.opacity * detail::saturate((v - l.value_min) / (l.value_max - l.value_min));
+            // Fade toward the horizon where the layer's texels alias.
+            a *= detail::saturate(dot(dir, cam_up) * 8.0);
+            if (!(a > 0)) continue;
+            const double ph = 0.55 + 0.45 * std::min(4.0, detail::hg(dot(dir, sun), 0.5));
+            for (int c = 0; c < 3; ++c) {
+                const double lc = 0.8 * s.sun_colour[c] * ph * std::max(0.1, sun[2] + 0.2) + 0.6 * ambient[c];
+                out[c] += (lc - out[c]) * a;
+            }
+        }
+    }
+};
+
+} // namespace
+
+LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings, const ProgressSink* progress) {
+    const auto t0 = std::chrono::steady_clock::now();
+    detail::check_settings(settings);
+    validate_layer_scene(scene);
+    LayerModel model(scene);
+    const double cam_alt = model.altitude(settings.camera.position);
+    if (cam_alt < 0) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "render (2.5D): the camera is %.1f m under the ground (inside the Earth of radius %.0f m); raise camera z", -cam_alt,
+                      scene.earth_radius);
+        throw Error(buf);
+    }
+    const detail::Sky sky(settings);
+    LayerReport report;
+    report.base_noise = model.has_base();
+    report.detail_noise = model.has_detail();
+    report.curl = model.has_curl() && model.has_detail();
+    report.wind = scene.wind[0] != 0 || scene.wind[1] != 0 || scene.cloud_top_offset != 0;
+    report.precipitation = model.precipitation() && scene.rain_absorption > 0;
+    report.cone_skipping = model.has_cone();
+    report.distance_skipping = model.has_distance();
+    report.sky_layers = int(scene.sky_layers.size());
+    report.sky_gradient = settings.sky_horizon.has_value();
+
+    const double thickness = std::max(1.0, model.top() - model.bottom());
+    LayerIntegrator in{model,
+                       scene,
+                       settings,
+                       detail::normalized(settings.sun_direction),
+                       detail::normalized(settings.camera.position - model.centre()),
+                       {sky.ambient[0], sky.ambient[1], sky.ambient[2]},
+                       std::clamp(thickness / 96.0, 5.0, 60.0) / settings.quality,
+                       4000.0, // the step doubles every 4 km of distance
+                       std::clamp(thickness / 40.0, 20.0, 120.0),
+                       scene.earth_radius,
+                       scene.earth_radius + model.bottom(),
+                       scene.earth_radius + model.top(),
+                       model.has_cone() || model.has_distance(),
+                       sky,
+                       settings.sky_horizon.value_or(settings.sky_colour),
+                       {}};
+    // Six fixed directions in [-1, 1]^3 spread the light cone (the talk's noise kernel).
+    for (int i = 0; i < 6; ++i)
+        for (int a = 0; a < 3; ++a) in.cone_kernel[i][a] = 2.0 * hash_to_unit(hash_coords(0x636f6e65u, i, a)) - 1.0;
+
+    const int w = settings.width, h = settings.height;
+    Field2D image({{w, h}}, 4, Box2d{{{0, 0}}, {{double(w), double(h)}}}, {"r", "g", "b", "transmittance"});
+    const detail::Pinhole cam(settings);
+    std::vector<uint64_t> cheap(size_t(w) * size_t(h), 0);
+    std::vector<uint64_t> full_v(size_t(w) * size_t(h), 0), skip_v(size_t(w) * size_t(h), 0);
+    detail::for_each_pixel(settings, progress, "render (2.5D)", [&](int x, int y, float jitter, uint64_t& samples) {
+        const Vec3d dir = cam.dir(x, y);
+        double rgb[3], trans, unused;
+        uint64_t c = 0, f = 0, k = 0;
+        if (model.any_cloud()) in.trace(settings.camera.position, dir, jitter, rgb, trans, unused, c, f, k);
+        else rgb[0] = rgb[1] = rgb[2] = 0, trans = 1;
+        double bg[3];
+        in.background(settings.camera.position, dir, bg);
+        for (int ch = 0; ch < 3; ++ch) image.at(ch, x, y) = static_cast<float>(rgb[ch] + trans * bg[ch]);
+        image.at(3, x, y) = static_cast<float>(trans);
+        const size_t i = size_t(y) * size_t(w) + size_t(x);
+        cheap[i] = c;
+        full_v[i] = f;
+        skip_v[i] = k;
+        samples += c + f;
+    });
+    for (size_t i = 0; i < cheap.size(); ++i) {
+        report.cheap_samples += cheap[i];
+        report.full_samples += full_v[i];
+        report.skipped_steps += skip_v[i];
+    }
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return {std::move(image), report};
+}
+
+Camera layer_camera(const LayerScene& scene, LayerView view, double aspect, double azimuth_deg, double elevation_deg) {
+    validate_layer_scene(scene);
+    LayerModel m(scene);
+    const Box2d& b = scene.ndf->bounds();
+    const double cx = 0.5 * (b.min[0] + b.max[0]), cy = 0.5 * (b.min[1] + b.max[1]);
+    const double sx = b.max[0] - b.min[0], sy = b.max[1] - b.min[1];
+    const double mid = 0.5 * (m.bottom() + m.top());
+    const double deg = std::numbers::pi / 180;
+    Camera c;
+    c.up = {{0, 0, 1}};
+    switch (view) {
+    case LayerView::Ground: {
+        c.fov_deg = 60;
+        c.position = {{cx, b.min[1] + 0.15 * sy, 2.0}};
+        c.look_at = c.position + Vec3d{{0, std::cos(20 * deg), std::sin(20 * deg)}};
+        break;
+    }
+    case LayerView::Aerial: {
+        c.fov_deg = 60;
+        c.position = {{cx, b.min[1] + 0.1 * sy, m.top() + 1500}};
+        c.look_at = c.position + Vec3d{{0, std::cos(20 * deg), -std::sin(20 * deg)}};
+        break;
+    }
+    case LayerView::Orbit: {
+        c.fov_deg = 50;
+        const double r = 0.5 * std::hypot(sx, sy);
+        const double dist = r / std::tan(0.5 * c.fov_deg * deg) * (aspect >= 1 ? 1.0 : 1.0 / aspect) * 0.9;
+        const double az = azimuth_deg * deg, el = elevation_deg * deg;
+        c.look_at = {{cx, cy, mid}};
+        // Azimuth 0 = from -y, counter-clockwise seen from above (framing_camera's convention).
+        c.position = c.look_at + Vec3d{{std::sin(az) * std::cos(el) * dist, -std::cos(az) * std::cos(el) * dist, std::sin(el) * dist}};
+        if (c.position[2] < 2) c.position[2] = 2;
+        break;
+    }
+    }
+    return c;
+}
+
+Field2D composite_over(const Field2D& front, const Field2D& back, const RenderSettings& settings) {
+    if (front.width() != back.width() || front.height() != back.height() || front.channels() < 4 || back.channels() < 4)
+        throw Error("render: composite_over needs two r, g, b, transmittance images of the same size");
+    if (front.width() != settings.width || front.height() != settings.height) throw Error("render: composite_over: the images do not match the settings' size");
+    const detail::Sky sky(settings);
+    const detail::Pinhole cam(settings);
+    Field2D out = back;
+    for (int y = 0; y < front.height(); ++y)
+        for (int x = 0; x < front.width(); ++x) {
+            const double t = front.at(3, x, y);
+            const double up_t = detail::saturate(cam.dir(x, y)[2]);
+            for (int c = 0; c < 3; ++c) {
+                const double clouds = double(front.at(c, x, y)) - t * sky.at(c, up_t); // the front's own clouds
+                out.at(c, x, y) = static_cast<float>(clouds + t * double(back.at(c, x, y)));
+            }
+            out.at(3, x, y) = static_cast<float>(t * double(back.at(3, x, y)));
+        }
+    return out;
+}
+
+} // namespace atlas::render
