@@ -678,3 +678,28 @@ TEST_F(Fixture, EncodedTextureIsRestoredFromTheCache) {
     EXPECT_TRUE(fs::exists(dir / "out" / "a.dds.json"));
     EXPECT_EQ(output_named(r2, "a.dds").metrics, output_named(r1, "a.dds").metrics);
 }
+
+// A change upstream that leaves an output's value as it was (here a salt that
+// changes the node's hash, not its value) cooks, but writes nothing.
+TEST_F(Fixture, RecookedButUnchangedValueIsNotRewritten) {
+    CookOptions o = options();
+    session().cook(o);
+    const fs::path gate = dir / "out" / "sub" / "gate.exr";
+    const int64_t t = mtime_ns(gate);
+    Session s = session();
+    s.set_text("gate", "salt", "7");
+    CookResult r = s.cook(o);
+    EXPECT_EQ(r.nodes.at("gate").status, "cooked");
+    EXPECT_EQ(output_named(r, "sub/gate.exr").status, "up to date");
+    EXPECT_EQ(mtime_ns(gate), t);
+    // The record now carries the new key: the next cook needs nothing.
+    Session s2 = session();
+    s2.set_text("gate", "salt", "7");
+    CookResult r2 = s2.cook(o);
+    EXPECT_EQ(r2.nodes.at("gate").status, "skipped");
+    // A changed value is written.
+    Session s3 = session();
+    s3.set_text("a", "value", "9");
+    EXPECT_EQ(output_named(s3.cook(o), "sub/gate.exr").status, "written");
+    EXPECT_NE(mtime_ns(gate), t);
+}

@@ -183,3 +183,38 @@ TEST(GraphParse, SetParamTextChecksTypeAndRange) {
         EXPECT_NE(std::string(e.what()).find("did you mean 'value'?"), std::string::npos) << e.what();
     }
 }
+
+// Two outputs naming one file, however spelled, or a file another output
+// writes beside its own, are errors before anything cooks (issue 17).
+TEST(GraphParse, OutputsThatNameTheSameFile) {
+    const std::string head = "atlas: 1\nnodes:\n  a:\n    type: test/source\noutputs:\n  - {node: a, file: v.exr}\n";
+    for (const std::string other : {"./v.exr", "x/../v.exr", "sub/../v.exr"}) {
+        auto f = parse_failure(head + "  - {node: a, file: " + other + "}\n");
+        EXPECT_EQ(f.line, 7) << other;
+        EXPECT_NE(f.message.find("names the same file as output 'v.exr' (g.yaml:6:"), std::string::npos) << f.message;
+    }
+    auto twice = parse_failure(head + "  - {node: a, file: v.exr, options: {half: true}}\n");
+    EXPECT_NE(twice.message.find("is written twice"), std::string::npos) << twice.message;
+    auto d = parse_failure("atlas: 1\nnodes:\n  a:\n    type: test/source\noutputs:\n  - {node: a, file: d/v.exr}\n  - {node: a, file: d//v.exr}\n");
+    EXPECT_NE(d.message.find("names the same file"), std::string::npos) << d.message;
+    // A slice stem beside one of its slices, either order.
+    auto s1 = parse_failure("atlas: 1\nnodes:\n  a:\n    type: test/source\noutputs:\n  - {node: a, file: s/st, format: tga-slices}\n"
+                            "  - {node: a, file: s/st.001.tga}\n");
+    EXPECT_NE(s1.message.find("collides with a file written by output 's/st'"), std::string::npos) << s1.message;
+    auto s2 = parse_failure("atlas: 1\nnodes:\n  a:\n    type: test/source\noutputs:\n  - {node: a, file: st(3).tga}\n"
+                            "  - {node: a, file: st, format: tga-slices}\n");
+    EXPECT_NE(s2.message.find("collides"), std::string::npos) << s2.message;
+    // Different files are fine.
+    auto reg = test::test_registry(std::make_shared<test::CookLog>());
+    EXPECT_NO_THROW(parse_graph("atlas: 1\nnodes:\n  a:\n    type: test/source\noutputs:\n  - {node: a, file: st, format: tga-slices}\n"
+                                "  - {node: a, file: st.exr}\n  - {node: a, file: st.x01.tga, options: {slice: 1}}\n",
+                                "g.yaml", ".", reg));
+}
+
+TEST(GraphParse, FormatThatContradictsTheExtension) {
+    auto f = parse_failure("atlas: 1\nnodes:\n  a:\n    type: test/source\noutputs:\n  - {node: a, file: v.exr, format: png}\n");
+    EXPECT_EQ(f.line, 6);
+    EXPECT_NE(f.message.find("format 'png' contradicts the file name's extension (a 'exr' file)"), std::string::npos) << f.message;
+    auto s = parse_failure("atlas: 1\nnodes:\n  a:\n    type: test/source\noutputs:\n  - {node: a, file: v.tga, format: tga-slices}\n");
+    EXPECT_NE(s.message.find("takes DIR/STEM without an extension"), std::string::npos) << s.message;
+}

@@ -273,7 +273,12 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         const GraphOutput* out = nullptr;
         std::filesystem::path root, rel;
         std::string name; // the record's name: rel, generic form
+        std::string spec; // hash of everything in the key but the source
         Hash128 key;
+        // The files on disk were written with this spec from a value that may
+        // be the same as the one cooked now (an upstream change that did not
+        // change this port): compare value hashes before writing.
+        const OutputRecord* same_spec = nullptr;
         enum { write, current, restore } action = write;
         const OutputRecord* record = nullptr;
         std::optional<disk_cache::CachedFiles> cached;
@@ -299,10 +304,11 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 throw Error(o->where.str() + ": " + e.what());
             }
             p.name = p.rel.generic_string();
-            Hasher h;
-            h.add("atlas-output").add(int64_t(kOutputFormatVersion)).add(state.at(o->node).hash).add(o->port).add(o->format).add(p.name);
-            for (const auto& [k, v] : o->options) h.add(k).add(v);
-            p.key = h.finish();
+            Hasher spec;
+            spec.add("atlas-output").add(int64_t(kOutputFormatVersion)).add(o->port).add(o->format).add(p.name);
+            for (const auto& [k, v] : o->options) spec.add(k).add(v);
+            p.spec = spec.finish().hex();
+            p.key = Hasher(spec).add(state.at(o->node).hash).finish();
             auto& rec = records[p.root];
             if (!rec) {
                 remove_stale_staging(p.root); // what killed cooks left
@@ -311,6 +317,8 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             if (reuse) {
                 if ((p.record = rec->current(p.name, p.key.hex()))) {
                     p.action = OutputPlan::current;
+                } else if (const OutputRecord* r = rec->on_disk(p.name); r && r->spec == p.spec && !r->value_hash.empty()) {
+                    p.same_spec = r;
                 } else if (opt.cache_dir && kCachedOutputFormats.count(o->format) &&
                            std::filesystem::exists(disk_cache::files_entry_path(*opt.cache_dir, p.key))) {
                     std::string why;
@@ -520,9 +528,29 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             std::vector<std::filesystem::path> staged;
         };
         std::vector<Written> written;
+        // Content hash of each value written, once per node port.
+        std::map<std::pair<std::string, std::string>, std::string> value_hashes;
+        auto value_hash = [&](const GraphOutput* o) -> const std::string& {
+            auto [it, fresh] = value_hashes.try_emplace({o->node, o->port});
+            if (fresh) {
+                Hasher h;
+                hash_value(h, values.at(o->node)->at(o->port));
+                it->second = h.finish().hex();
+            }
+            return it->second;
+        };
+        std::vector<std::pair<OutputPlan*, OutputRecord>> rekeyed;
         for (OutputPlan& p : plans) {
             const GraphOutput* o = p.out;
             OutputReport orep{o->node, o->port, o->file, o->format, {}, {}, {}, {}};
+            if (p.same_spec && p.same_spec->value_hash == value_hash(o)) {
+                // Upstream changed, this port did not: the files already hold it.
+                p.action = OutputPlan::current;
+                p.record = p.same_spec;
+                OutputRecord r = *p.same_spec;
+                r.key = p.key.hex();
+                rekeyed.emplace_back(&p, std::move(r));
+            }
             if (p.action == OutputPlan::current) {
                 orep.status = "up to date";
                 orep.metrics = p.record->metrics;
@@ -585,9 +613,12 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         // Everything written: move it into place.
         for (auto& [root, st] : staging) st->commit();
         // Record what is on disk now (renames keep the mtime).
+        for (auto& [plan, rec] : rekeyed) records.at(plan->root)->set(plan->name, std::move(rec));
         for (const auto& w : written) {
             OutputRecord rec;
             rec.key = w.plan->key.hex();
+            rec.spec = w.plan->spec;
+            if (w.plan->action == OutputPlan::write) rec.value_hash = value_hash(w.plan->out);
             const OutputReport& orep = result.outputs[w.report];
             rec.metrics = orep.metrics;
             for (const auto& f : orep.files)

@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <set>
 
@@ -139,6 +140,28 @@ void parse_inputs(const Parser& p, const YAML::Node& inputs, GraphNode& node) {
         if (b.node.empty()) p.fail(it->second, "node '" + node.name + "': input '" + port + "' names no node");
         node.inputs[port] = b;
     }
+}
+
+// "" when outputs a and b write different files; else how they collide.
+std::string output_clash(const GraphOutput& a, const GraphOutput& b) {
+    const std::string pa = std::filesystem::path(a.file).lexically_normal().generic_string();
+    const std::string pb = std::filesystem::path(b.file).lexically_normal().generic_string();
+    if (pa == pb) return a.file == b.file ? "is written twice: also by" : "names the same file as";
+    // Files a multi-file output claims beside its name.
+    auto claims = [](const GraphOutput& o, const std::string& stem, const std::string& name) {
+        auto digits_between = [&](const std::string& pre, const std::string& post) {
+            if (name.size() <= stem.size() + pre.size() + post.size() || name.rfind(stem + pre, 0) != 0) return false;
+            if (name.compare(name.size() - post.size(), post.size(), post) != 0) return false;
+            const std::string mid = name.substr(stem.size() + pre.size(), name.size() - stem.size() - pre.size() - post.size());
+            return !mid.empty() && std::all_of(mid.begin(), mid.end(), [](unsigned char c) { return std::isdigit(c); });
+        };
+        if (o.format == "tga-slices") return digits_between(".", ".tga") || digits_between("(", ").tga");
+        if (o.format == "vdb-sequence") return digits_between(".", ".vdb");
+        if (o.format == "dds") return name == stem + ".json";
+        return false;
+    };
+    if (claims(a, pa, pb) || claims(b, pb, pa)) return "collides with a file written by";
+    return "";
 }
 
 // The output's format exists, accepts what the port produces, and knows its options.
@@ -344,8 +367,26 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
         } catch (const Error& e) {
             p.fail(o, "output '" + out.file + "': " + e.what());
         }
+        // An explicit format that the file's extension contradicts (format: png on a .exr name).
+        if (o["format"]) {
+            std::string by_name;
+            try {
+                by_name = io::output_format_for_path(out.file);
+            } catch (const Error&) {
+                // no known extension: a stem (tga-slices, vdb-sequence) or a custom name
+            }
+            if (!by_name.empty() && by_name != out.format)
+                p.fail(o["format"], "output '" + out.file + "': format '" + out.format + "' contradicts the file name's extension (a '" + by_name +
+                                        "' file)" + (out.format == "tga-slices" || out.format == "vdb-sequence"
+                                                         ? "; format '" + out.format + "' takes DIR/STEM without an extension"
+                                                         : "; rename the file or drop 'format'"));
+        }
+        // Two outputs may not name the same file, however spelled (./v.exr,
+        // x/../v.exr, d//v.exr), nor a file another output writes beside its
+        // own (a slice stack's STEM.001.tga, a DDS manifest).
         for (const auto& prev : g.outputs)
-            if (prev.file == out.file) p.fail(o, "output file '" + out.file + "' is written twice");
+            if (const std::string clash = output_clash(prev, out); !clash.empty())
+                p.fail(o, "output '" + out.file + "' " + clash + " output '" + prev.file + "' (" + prev.where.str() + ")");
         g.outputs.push_back(std::move(out));
     }
 

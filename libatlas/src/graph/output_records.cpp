@@ -22,6 +22,8 @@ std::map<std::string, OutputRecord> read_records(const std::filesystem::path& fi
         for (const auto& [name, r] : j.at("outputs").items()) {
             OutputRecord rec;
             rec.key = r.at("key").get<std::string>();
+            rec.spec = r.value("spec", "");
+            rec.value_hash = r.value("value_hash", "");
             for (const auto& f : r.at("files"))
                 rec.files.push_back({f.at("path").get<std::string>(), f.at("bytes").get<uint64_t>(), f.at("mtime_ns").get<int64_t>(),
                                      f.at("hash").get<std::string>()});
@@ -46,7 +48,13 @@ OutputRecords::OutputRecords(std::filesystem::path root) : root_(std::move(root)
 
 const OutputRecord* OutputRecords::current(const std::string& name, const std::string& key) {
     auto it = records_.find(name);
-    if (it == records_.end() || it->second.key != key || it->second.files.empty()) return nullptr;
+    if (it == records_.end() || it->second.key != key) return nullptr;
+    return on_disk(name);
+}
+
+const OutputRecord* OutputRecords::on_disk(const std::string& name) {
+    auto it = records_.find(name);
+    if (it == records_.end() || it->second.files.empty()) return nullptr;
     OutputRecord& r = it->second;
     bool refreshed = false;
     for (auto& f : r.files) {
@@ -83,7 +91,7 @@ void OutputRecords::save() {
         for (const auto& f : r.files) files.push_back({{"path", f.path}, {"bytes", f.bytes}, {"mtime_ns", f.mtime_ns}, {"hash", f.hash}});
         nlohmann::json m = nlohmann::json::object();
         for (const auto& [k, v] : r.metrics) m[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-        outs[name] = {{"key", r.key}, {"files", files}, {"metrics", m}};
+        outs[name] = {{"key", r.key}, {"spec", r.spec}, {"value_hash", r.value_hash}, {"files", files}, {"metrics", m}};
     }
     const std::string text = nlohmann::json{{"atlas_outputs_version", 1}, {"outputs", outs}}.dump(1) + "\n";
     write_file_atomic(root_ / kFileName, [&](const std::filesystem::path& tmp) { write_file_checked(tmp, text.data(), text.size()); });

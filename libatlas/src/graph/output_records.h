@@ -28,6 +28,8 @@ struct OutputFileRecord {
 
 struct OutputRecord {
     std::string key;
+    std::string spec;       // hash of format, options, path (the key without the source)
+    std::string value_hash; // content hash of the value written (hash_value)
     std::vector<OutputFileRecord> files;
     std::map<std::string, double> metrics; // the writer's, reported again when not rewritten
 };
@@ -40,6 +42,9 @@ public:
     // The record of output `name` when its key is `key` and every file it
     // wrote is still on disk unchanged; null otherwise.
     const OutputRecord* current(const std::string& name, const std::string& key);
+    // The record of output `name` when every file it wrote is still on disk
+    // unchanged, whatever its key; null otherwise.
+    const OutputRecord* on_disk(const std::string& name);
     void set(const std::string& name, OutputRecord record);
     // Writes the records (merged over what is on disk now, so two cooks into
     // one directory keep each other's). Throws atlas::Error on failure.
@@ -50,6 +55,9 @@ private:
     std::filesystem::path root_;
     std::map<std::string, OutputRecord> records_, updates_;
 };
+
+// A record written with the same spec and value hash describes files that
+// already hold this output: the new key replaces the old without a write.
 
 // The mtime of a file in nanoseconds (0 when it cannot be read).
 int64_t file_mtime_ns(const std::filesystem::path& p);
