@@ -180,7 +180,12 @@ TEST(Bc4, FastEncodesFlatBlocksWithTheirLevel) {
         std::fill(src, src + 16, float(level) / 255.0f);
         uint8_t blk[8];
         const BlockResult r = fast.encode(src, blk);
-        EXPECT_EQ(r.max_error, 0.0f) << "level " << level;
+        // The reported error bounds the exact one: float(level / 255) is an ulp away from
+        // level / 255 (except 0 and 1), and the bound is widened by 2^-21 relative.
+        EXPECT_LE(r.max_error, src[0] * 1.0e-6f) << "level " << level;
+        if (level == 0 || level == 255) {
+            EXPECT_EQ(r.max_error, 0.0f);
+        }
         float v[16];
         decode_bc4_block(blk, false, Decoder::Reference, v);
         for (int t = 0; t < 16; ++t) EXPECT_EQ(v[t], src[t]);
@@ -208,7 +213,15 @@ TEST(Bc4, ConstantAndExtremeBlocksAreExact) {
         float src[16];
         std::fill(src, src + 16, v);
         uint8_t blk[8];
-        EXPECT_EQ(enc.encode(src, blk).max_error, 0.0f) << v;
+        const float e = enc.encode(src, blk).max_error;
+        if (v == 0.0f || v == 1.0f) {
+            EXPECT_EQ(e, 0.0f);
+        } else {
+            EXPECT_LE(e, v * 1.0e-6f) << v; // an exact-arithmetic bound (see FastEncodesFlatBlocksWithTheirLevel)
+        }
+        float dec[16];
+        decode_bc4_block(blk, false, Decoder::Reference, dec);
+        for (int t = 0; t < 16; ++t) EXPECT_EQ(dec[t], v);
     }
     float two[16];
     for (int t = 0; t < 16; ++t) two[t] = (t & 1) ? 1.0f : 0.0f;

@@ -41,6 +41,53 @@ uint16_t split(float v, const ScalarUnpack& u, const float* t5, const float* t6,
     return uint16_t((r << 11) | (g << 5) | b);
 }
 
+// Upper bound of code c's endpoint value under every decoder of the set, as the
+// interval palette bounds it (the per-channel largest levels, the dot product's order,
+// widened to bound the exact value).
+float endpoint_hi(uint16_t c, const ScalarUnpack& u, const detail::ScalarTables& T) {
+    return detail::widen_up((T.hi5[c >> 11] * u.weights[0] + T.hi6[(c >> 5) & 63] * u.weights[1]) + T.hi5[c & 31] * u.weights[2]);
+}
+
+// The largest-value split of v whose endpoint is <= v under every decoder: the greedy
+// split subtracts in float, so its sum can land an ulp above v (then the endpoint is
+// not one-sided and a block of such texels would be left with the 3-colour black);
+// step down until the bound holds. Code 0 decodes to exactly 0.
+uint16_t split_below(float v, const ScalarUnpack& u, const detail::ScalarTables& T) {
+    if (!(v > 0)) return 0;
+    int c = split(v, u, T.hi5, T.hi6, false);
+    while (c > 0 && endpoint_hi(uint16_t(c), u, T) > v) {
+        // Lower the last digit that is not 0 (B, then G, then R), refilling the lower ones.
+        if ((c & 31) > 0) --c;
+        else if (((c >> 5) & 63) > 0) c = (c - 32) | 31;
+        else c = (c - 2048) | 0x7FF;
+    }
+    return uint16_t(c);
+}
+
+// The split of v with the R digit fixed to r (G and B greedy on the rest, clamped to
+// the digit's range); `below`: step down until the endpoint is <= v under every
+// decoder (returns 0xFFFF when no code of that digit is).
+uint16_t split_r(float v, int r, const ScalarUnpack& u, const detail::ScalarTables& T, bool below) {
+    const float* t5 = below ? T.hi5 : T.ref5;
+    const float* t6 = below ? T.hi6 : T.ref6;
+    float rest = v - t5[r] * u.weights[0];
+    int g = 0, b = 0;
+    if (rest > 0) {
+        g = floor_level(t6, 64, u.weights[1], rest);
+        rest -= t6[g] * u.weights[1];
+        b = floor_level(t5, 32, u.weights[2], rest);
+    }
+    int c = (r << 11) | (g << 5) | b;
+    if (below) {
+        while ((c & 0x7FF) > 0 && endpoint_hi(uint16_t(c), u, T) > v) {
+            if ((c & 31) > 0) --c;
+            else c = (c - 32) | 31;
+        }
+        if (endpoint_hi(uint16_t(c), u, T) > v) return 0xFFFF;
+    }
+    return uint16_t(c);
+}
+
 // A small sorted set of endpoint codes without allocation.
 struct Codes {
     uint16_t v[64];
@@ -103,18 +150,35 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
     // One-sided under Conformant: endpoints without margin are never feasible.
     for (int k = (nm > 1 && options.one_sided_below) ? 1 : 0; k < nm; ++k) {
         const float m = margins[k];
-        lows.add(split(smin - m, u, T.hi5, T.hi6, false));
-        highs.add(split(smax - m, u, T.hi5, T.hi6, false));
+        lows.add(split_below(smin - m, u, T));
+        highs.add(split_below(smax - m, u, T));
         if (options.quality != Quality::Fast) { // Nubis: move the high endpoint down
-            highs.add(split(sorted[13] - m, u, T.hi5, T.hi6, false));
-            highs.add(split(sorted[10] - m, u, T.hi5, T.hi6, false));
+            highs.add(split_below(sorted[13] - m, u, T));
+            highs.add(split_below(sorted[10] - m, u, T));
         }
         if (options.quality == Quality::Best)
-            for (int t = 0; t < 16; ++t) highs.add(split(src[t] - m, u, T.hi5, T.hi6, false));
+            for (int t = 0; t < 16; ++t) highs.add(split_below(src[t] - m, u, T));
     }
     if (!options.one_sided_below) {
         lows.add(split(smin, u, T.ref5, T.ref6, true));
         highs.add(split(smax, u, T.ref5, T.ref6, true));
+    }
+    // Pairs sharing one R digit: the R channel is then constant over the palette, so
+    // its entries are the endpoint's R level under every decoder (the 8-bit decoders
+    // round R interpolants differently, by up to ~1/255 of the range), and G carries
+    // the block's variation (G's range covers an R step). The digits of the minimum's
+    // round-down and the one below.
+    if (options.one_sided_below && options.quality != Quality::Fast && !T.conformant) {
+        const int r_min = lows.v[0] >> 11;
+        for (int r = r_min; r >= std::max(0, r_min - 1); --r) {
+            const uint16_t lo_c = split_r(smin, r, u, T, true);
+            if (lo_c == 0xFFFF) continue;
+            lows.add(lo_c);
+            for (float x : {smax, sorted[13], sorted[10]}) {
+                const uint16_t hi_c = split_r(x, r, u, T, true);
+                if (hi_c != 0xFFFF) highs.add(hi_c);
+            }
+        }
     }
     highs.sort_unique();
     lows.sort_unique();
@@ -133,10 +197,195 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
         consider(std::max(a, b), std::min(a, b));
         consider(std::min(a, b), std::max(a, b));
     };
+    // The constant block of the round-down of the minimum: one-sided by construction
+    // (a 3-colour pair of equal codes decodes its endpoints and midpoint to the
+    // endpoint's value under every model), so a one-sided block's error never exceeds
+    // the block's spread plus one endpoint step, whatever the other candidates do.
+    consider(lows.v[0], lows.v[0]);
     for (int i = 0; i < highs.n; ++i)
         for (int j = 0; j < lows.n; ++j) both(highs.v[i], lows.v[j]);
+    // Retargeting: an entry k of the palette is a fixed blend fa*u + fb*v of the endpoint
+    // values; for every distinct texel value s and entry k, move one endpoint (the other
+    // fixed) so that entry k lands just below s, by the entry's current excess of its
+    // upper bound over its Reference value (the other decoders' rounding). One-sided
+    // optima sit entries just below texel values, which the extreme-based candidates
+    // above rarely hit (a ramp's texels take 4-7 distinct values).
+    const int rounds = options.quality == Quality::Fast ? 0 : options.quality == Quality::Normal ? 1 : 4;
+    float distinct[16];
+    int nd = 0;
+    for (int t = 0; t < 16; ++t)
+        if (nd == 0 || sorted[t] != distinct[nd - 1]) distinct[nd++] = sorted[t];
+    const int kBelow = options.quality == Quality::Best ? 2 : 1;
+    // `focused`: only the texels whose error is at least half the block's (those an entry
+    // placed just below would help most), for Normal's single round.
+    auto retarget = [&](int nrounds, bool focused) {
+        for (int round = 0; round < nrounds && have; ++round) {
+            const uint16_t k0 = b0, k1 = b1;
+            float targets[16];
+            int nt = 0;
+            if (focused) {
+                detail::Palette<1> pb;
+                detail::scalar_interval_palette(T, k0, k1, pb);
+                for (int t = 0; t < 16; ++t)
+                    if (src[t] - pb.lo[best.idx[t]][0] >= 0.5f * best.max_err && std::find(targets, targets + nt, src[t]) == targets + nt)
+                        targets[nt++] = src[t];
+            } else {
+                std::copy(distinct, distinct + nd, targets);
+                nt = nd;
+            }
+            // Both orders of the two codes: the 4-colour geometry of (max, min) and the
+            // 3-colour one of (min, max), whichever mode the incumbent is in.
+            for (int mode = 0; mode < 2; ++mode) {
+                const uint16_t c0 = mode == 1 ? std::max(k0, k1) : std::min(k0, k1), c1 = mode == 1 ? std::min(k0, k1) : std::max(k0, k1);
+                if (mode == 1 && c0 == c1) continue; // no 4-colour order of equal codes
+                detail::Palette<1> p;
+                detail::scalar_interval_palette(T, c0, c1, p);
+                const bool four = c0 > c1;
+                const float uv = p.ref[0][0], vv = p.ref[1][0];
+                const int n = four ? 4 : 3;
+                const float fa[4] = {1.0f, 0.0f, four ? 2.0f / 3.0f : 0.5f, 1.0f / 3.0f};
+                const float fb[4] = {0.0f, 1.0f, four ? 1.0f / 3.0f : 0.5f, 2.0f / 3.0f};
+                // Move endpoint `e` (0: c0, 1: c1) to code c; the code below too (the
+                // round-down of a blend can land an ulp above its target).
+                auto move = [&](int e, uint16_t c, float x = -1.0f) {
+                    if (x >= 0 && options.one_sided_below) { // also with the other endpoint's R digit
+                        const uint16_t same = split_r(x, (e == 0 ? c1 : c0) >> 11, u, T, false);
+                        if (same != c) {
+                            if (e == 0) both(same, c1);
+                            else both(c0, same);
+                        }
+                    }
+                    for (int d = 0; d < kBelow && c >= d; ++d) {
+                        const uint16_t cd = uint16_t(c - d);
+                        if (e == 0) both(cd, c1);
+                        else both(c0, cd);
+                    }
+                };
+                for (int t = 0; t < nt; ++t)
+                    for (int i = 0; i < n; ++i) {
+                        const float excess = p.hi[i][0] - p.ref[i][0], target = targets[t] - excess;
+                        // Endpoints: the round-down under every decoder (plus Conformant's tolerance).
+                        const float at_end = targets[t] - (T.conformant ? excess : 0.0f);
+                        if (i == 0) move(0, split_below(at_end, u, T));
+                        else if (i == 1) move(1, split_below(at_end, u, T));
+                        else {
+                            const float x0 = (target - fb[i] * vv) / fa[i], x1 = (target - fa[i] * uv) / fb[i];
+                            if (x0 >= 0 && x0 <= u.max_value) move(0, split(x0, u, T.ref5, T.ref6, false), x0);
+                            if (x1 >= 0 && x1 <= u.max_value) move(1, split(x1, u, T.ref5, T.ref6, false), x1);
+                        }
+                    }
+            }
+            if (k0 == b0 && k1 == b1) break;
+        }
+    };
+    // Few clusters of values (a ramp along a block axis has 4 distinct values, a slightly
+    // tilted one 4 tight pairs): the one-sided minimax fit of evenly spaced entries
+    // e + k g to the clusters in order (cluster j, values [lo_j, hi_j], on entry k_j).
+    // For a fixed g the best e is min_j (lo_j - k_j g) and the error
+    // max_j (hi_j - k_j g) - e is convex in g, so the optimum is at a crossing of two of
+    // those lines. The endpoints are then rounded down (and one code lower).
+    float fit_floor = INFINITY; // the smallest error of a fit with exact entries (not a proof: a guide)
+    if (options.one_sided_below && options.quality != Quality::Fast && nd >= 2) {
+        static constexpr int kAssign[5][4] = {{0, 1, 2, 3}, {0, 1, 3, 0}, {0, 2, 3, 0}, {0, 1, 2, 0}, {0, 3, 0, 0}};
+        for (int a = 0; a < 5; ++a) {
+            const int* k = kAssign[a];
+            const int groups = a == 0 ? 4 : a < 4 ? 3 : 2;
+            if (groups > nd || (nd <= 4 && groups != nd)) continue;
+            // Split the sorted distinct values at the groups - 1 largest gaps.
+            int cut[4] = {nd, nd, nd, nd}, ncut = 0; // cut[c]: first index of group c + 1
+            for (int c = 0; c < groups - 1; ++c) {
+                int at = -1;
+                for (int t = 1; t < nd; ++t) {
+                    bool used = false;
+                    for (int q = 0; q < ncut; ++q) used |= cut[q] == t;
+                    if (!used && (at < 0 || distinct[t] - distinct[t - 1] > distinct[at] - distinct[at - 1])) at = t;
+                }
+                cut[ncut++] = at;
+            }
+            std::sort(cut, cut + ncut);
+            float glo[4], ghi[4];
+            for (int j = 0, t0 = 0; j < groups; ++j) {
+                const int t1 = j < ncut ? cut[j] : nd;
+                glo[j] = distinct[t0];
+                ghi[j] = distinct[t1 - 1];
+                t0 = t1;
+            }
+            // Entry of the palette that cluster j's position k serves: 4-colour (top, bottom)
+            // has entries top, bottom, (2 top + bottom) / 3, (top + 2 bottom) / 3; the
+            // 3-colour (bottom, top) has bottom, top, the midpoint.
+            const bool three = a == 3;
+            auto entry_of = [&](int kk) { return three ? (kk == 0 ? 0 : kk == 1 ? 2 : 1) : (kk == 0 ? 1 : kk == 1 ? 3 : kk == 2 ? 2 : 0); };
+            // Up to three passes: the plain fit, then the fit with each cluster shifted by its
+            // entry's decoder spread in the previous pass's pair (upper bound above the Reference value
+            // must stay below the cluster; the lower bound adds to the error).
+            float up[4] = {0, 0, 0, 0}, down[4] = {0, 0, 0, 0};
+            uint16_t last[3] = {0, 0, 0};
+            for (int pass = 0; pass < 3; ++pass) {
+                auto err_at = [&](float g, float& e) {
+                    float lo_r = INFINITY, hi_r = -INFINITY;
+                    for (int j = 0; j < groups; ++j) {
+                        lo_r = std::min(lo_r, glo[j] - up[j] - float(k[j]) * g);
+                        hi_r = std::max(hi_r, ghi[j] + down[j] - float(k[j]) * g);
+                    }
+                    e = lo_r;
+                    return hi_r - lo_r;
+                };
+                float best_g = 0, best_err = INFINITY;
+                for (int i = 0; i < groups; ++i)
+                    for (int j = i + 1; j < groups; ++j)
+                        for (float x : {ghi[j] + down[j] - ghi[i] - down[i], glo[j] - up[j] - glo[i] + up[i], ghi[j] + down[j] - glo[i] + up[i],
+                                        glo[j] - up[j] - ghi[i] - down[i]}) {
+                            float e;
+                            const float g = x / float(k[j] - k[i]), err = err_at(g, e);
+                            if (g >= 0 && err < best_err) { best_err = err; best_g = g; }
+                        }
+                if (pass == 0) fit_floor = std::min(fit_floor, best_err);
+                // The fit's error is that of exact Reference entries at any real positions: a
+                // palette of this assignment does no better, so skip it when it cannot win.
+                if (have && !(best_err < best.max_err)) break;
+                float e;
+                err_at(best_g, e);
+                const float top = e + (three ? 2.0f : 3.0f) * best_g;
+                if (!(e >= 0) || !(top <= u.max_value)) break;
+                const uint16_t cv = split_below(e, u, T);
+                // The top endpoint also with the bottom's R digit (R then exact in every decoder).
+                const uint16_t tops[2] = {split(top, u, T.ref5, T.ref6, false), split_r(top, cv >> 11, u, T, false)};
+                if (pass > 0 && tops[0] == last[0] && tops[1] == last[1] && cv == last[2]) break; // converged
+                last[0] = tops[0];
+                last[1] = tops[1];
+                last[2] = cv;
+                for (int t = 0; t < 2; ++t) {
+                    const uint16_t cu = tops[t];
+                    if (t == 1 && cu == tops[0]) break;
+                    for (int du = 0; du < 2 && cu >= du; ++du)
+                        for (int dv = 0; dv < 2 && cv >= dv; ++dv) {
+                            const uint16_t x = uint16_t(cu - du), y = uint16_t(cv - dv);
+                            if (three) consider(std::min(x, y), std::max(x, y)); // the mode the fit is for
+                            else if (x != y) consider(std::max(x, y), std::min(x, y));
+                        }
+                }
+                // Spreads of the pair with the shared R digit, for the next pass.
+                const uint16_t cu = tops[1];
+                if (three ? !(cv <= cu) : !(cu > cv)) break;
+                detail::Palette<1> p;
+                detail::scalar_interval_palette(T, three ? cv : cu, three ? cu : cv, p);
+                for (int j = 0; j < groups; ++j) {
+                    const int i = entry_of(k[j]);
+                    up[j] = p.hi[i][0] - p.ref[i][0];
+                    down[j] = p.ref[i][0] - p.lo[i][0];
+                }
+            }
+        }
+    }
+    // Normal retargets only blocks well above the exact-entry fit (twice it plus one
+    // endpoint step), and not under Conformant, whose tolerance (not the entries'
+    // positions) sets the error: most blocks are done by then.
+    const bool normal_skips = options.quality == Quality::Normal &&
+                              (T.conformant || (options.one_sided_below && best.max_err <= 2.0f * fit_floor + u.endpoint_step));
+    if (!normal_skips) retarget(rounds, options.quality == Quality::Normal);
     const bool missed = !have || (options.max_error >= 0 && best.max_err > options.max_error);
     if (options.quality == Quality::Best || missed) {
+        if (missed && rounds < 4) retarget(4, false);
         // Nudge both endpoint codes by a few units (neighbouring codes are neighbouring values).
         for (int round = 0; round < 4 && have; ++round) {
             const uint16_t k0 = b0, k1 = b1;

@@ -110,7 +110,7 @@ void scalar_interval_palette(const ScalarTables& T, uint16_t c0, uint16_t c1, Pa
     _mm_storeu_ps(rv, ref);
     _mm_storeu_ps(lv, lo);
     _mm_storeu_ps(hv, hi);
-    for (int i = 0; i < 4; ++i) { p.ref[i][0] = rv[i]; p.lo[i][0] = lv[i]; p.hi[i][0] = hv[i]; }
+    for (int i = 0; i < 4; ++i) { p.ref[i][0] = rv[i]; p.lo[i][0] = widen_down(lv[i]); p.hi[i][0] = widen_up(hv[i]); }
 #else
     float ref[4], lo[4], hi[4];
     for (int i = 0; i < 4; ++i) {
@@ -134,7 +134,7 @@ void scalar_interval_palette(const ScalarTables& T, uint16_t c0, uint16_t c1, Pa
             hi[i] = std::max(hi[i], ref[i] + ti);
         }
     }
-    for (int i = 0; i < 4; ++i) { p.ref[i][0] = ref[i]; p.lo[i][0] = lo[i]; p.hi[i][0] = hi[i]; }
+    for (int i = 0; i < 4; ++i) { p.ref[i][0] = ref[i]; p.lo[i][0] = widen_down(lo[i]); p.hi[i][0] = widen_up(hi[i]); }
 #endif
 }
 

@@ -39,8 +39,18 @@ struct ScalarTables {
 // other weights get tables built into `local`.
 const ScalarTables& scalar_tables(const ScalarUnpack& u, std::unique_ptr<ScalarTables>& local);
 
-// Interval palette of (c0, c1): identical values to evaluating each decoder's
-// palette and the dot product per entry.
+// Relative widening of an interval bound: the float palette rounds 4 times (channel
+// value, product, two sums), each by at most 2^-24 relative, all terms >= 0, so the
+// exact value (and a double-precision decoder's, ~1e-16 off it) lies within 2^-21
+// relative of the float result.
+constexpr float kScalarExactMargin = 1.0f / 2097152.0f; // 2^-21
+inline float widen_up(float x) { return x + (x < 0 ? -x : x) * kScalarExactMargin; }
+inline float widen_down(float x) { return x - (x < 0 ? -x : x) * kScalarExactMargin; }
+
+// Interval palette of (c0, c1): the float values of evaluating each decoder's palette
+// and the dot product per entry (ref), with lo / hi widened by kScalarExactMargin so
+// that they bound the exact values too (promises hold for a decoder computing in
+// double). Exact zeros (the 3-colour black) stay exact.
 void scalar_interval_palette(const ScalarTables& T, uint16_t c0, uint16_t c1, Palette<1>& p);
 
 } // namespace atlas::compress::detail

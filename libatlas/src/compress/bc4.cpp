@@ -47,7 +47,20 @@ void palette_values(uint8_t b0, uint8_t b1, bool snorm, Decoder d, float v[8]) {
     }
 }
 
-void interval_palette(uint8_t b0, uint8_t b1, bool snorm, DecoderSet set, detail::Palette<1>& p) {
+// Relative widening that makes a float palette bound the exact value: a BC4 entry is
+// rounded at most twice (num / steps, then / 255 or 127), 2^-23 relative, and a decoder
+// computing in double is ~1e-16 off the exact value; 2^-21 covers both. Values that are
+// exactly 0 or +-1 in float are exact (no other entry rounds to them) and stay so.
+constexpr float kExactMargin = 1.0f / 2097152.0f;
+float widen(float x, float dir) {
+    if (x == 0.0f || x == 1.0f || x == -1.0f) return x;
+    return x + dir * std::fabs(x) * kExactMargin;
+}
+
+// `exact_bounds`: widen lo / hi to bound the exact values (the encoder's tables, so that
+// its one-sided and max-error results hold in exact arithmetic); off for the public
+// interval decode, which reports the float values the decoder models compute.
+void interval_palette(uint8_t b0, uint8_t b1, bool snorm, DecoderSet set, detail::Palette<1>& p, bool exact_bounds = false) {
     p.n = 8;
     float ref[8];
     palette_values(b0, b1, snorm, Decoder::Reference, ref);
@@ -76,6 +89,8 @@ void interval_palette(uint8_t b0, uint8_t b1, bool snorm, DecoderSet set, detail
         }
         any = true;
     }
+    if (exact_bounds)
+        for (int i = 0; i < 8; ++i) { p.lo[i][0] = widen(p.lo[i][0], -1.0f); p.hi[i][0] = widen(p.hi[i][0], 1.0f); }
 }
 
 void write_block(uint8_t b0, uint8_t b1, const uint8_t idx[16], uint8_t out[8]) {
@@ -143,7 +158,7 @@ Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
     for (int k = 0; k < 65536; ++k) {
         const uint8_t b0 = uint8_t(k >> 8), b1 = uint8_t(k & 255);
         auto& p = T.pal[size_t(k)];
-        interval_palette(b0, b1, snorm_, options_.decoders, p);
+        interval_palette(b0, b1, snorm_, options_.decoders, p, true);
         const bool eight = snorm_ ? (static_cast<int8_t>(b0) > static_cast<int8_t>(b1)) : (b0 > b1);
         const int interp = eight ? 8 : 6;
         float mn = p.lo[0][0], imx = p.hi[0][0];

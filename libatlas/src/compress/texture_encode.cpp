@@ -50,8 +50,10 @@ uint32_t quantize_unorm(float n, int levels, bool one_sided, float& decoded) {
     const float m = float(levels);
     int q = int(one_sided ? std::floor(n * m) : std::nearbyint(n * m));
     q = std::clamp(q, 0, levels);
+    // q / m <= n exactly (the double product of a float and an integer < 2^16 is
+    // exact), so a decoder computing q / m in any precision stays <= n.
     if (one_sided)
-        while (q > 0 && float(q) / m > n) --q;
+        while (q > 0 && double(q) > double(n) * double(levels)) --q;
     decoded = float(q) / m;
     return uint32_t(q);
 }
@@ -207,6 +209,14 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
             }
     }
     const float nmin = map.kind == MapKind::Snorm ? -1.0f : 0.0f;
+    // The engine's reconstruction lo + n (hi - lo) (SNORM: (n + 1) / 2), in double.
+    auto src_double = [&](float n) {
+        if (map.kind == MapKind::Float) return double(n);
+        const double u = map.kind == MapKind::Snorm ? (double(n) + 1.0) * 0.5 : double(n);
+        return double(map.lo) + u * (double(map.hi) - double(map.lo));
+    };
+    const double slope = (map.kind == MapKind::Snorm ? 0.5 : 1.0) * (double(map.hi) - double(map.lo)); // d src / d n
+    double map_slack = 0; // max |src_double(n) - v| over the stored texels (the mapping's own rounding)
 
     const bool volume = field.nz() > 1 && !o.as_array;
     const int layers = volume ? 1 : field.nz();
@@ -237,9 +247,17 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
                                     std::to_string(map.hi) + "]");
                     n = std::clamp(n, nmin, 1.0f);
                 }
-                // One-sided: the normalized source must map back to <= the source.
-                if (o.one_sided_below)
-                    while (n > nmin && map.to_src(n) > v) n = std::nextafter(n, -INFINITY);
+                // One-sided: the normalized source must map back to <= the source, as an
+                // engine computes it in double (the float mapping can round an ulp down).
+                if (o.one_sided_below && n > nmin && src_double(n) > double(v)) {
+                    // Jump to the value that maps to v, then step by ulps (near SNORM's 0
+                    // an ulp of n is far below a source ulp: stepping alone takes ~10^5 steps).
+                    float m = float(double(n) - (src_double(n) - double(v)) / slope);
+                    if (!(m < n)) m = std::nextafter(n, -INFINITY);
+                    n = std::max(m, nmin);
+                    while (n > nmin && src_double(n) > double(v)) n = std::nextafter(n, -INFINITY);
+                }
+                if (map.kind != MapKind::Float) map_slack = std::max(map_slack, std::fabs(src_double(n) - double(v)));
                 dst[i] = n;
             }
         }
@@ -274,7 +292,18 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     // value), so the guarantee for all of `decoders` is verified with one decode.
     const DecoderSet verify_decoders = is_block_compressed(dx) ? bo.decoders : kReferenceOnly;
     const double scale = map.scale();
-    bo.max_error = o.max_error ? float(*o.max_error / scale) : -1.0f;
+    // Block errors are float bounds in normalized units: the exact error of a block is at
+    // most (err (1 + 2^-22) + kNormSlack) * scale (1 + 1e-12) + map_slack (float rounding
+    // of the error itself and of uncompressed decodes, the double scaling, the mapping's
+    // rounding), so the encoders aim below E by that much and a block counts as missing
+    // E on that bound: max_error then holds for a decoder computing in double.
+    constexpr double kNormSlack = 1.0 / 8388608.0; // 2^-23, an ulp at 1
+    // Float formats store values as is: their errors are float differences (exact or
+    // within 2^-24 relative), with no mapping and no absolute slack.
+    const double norm_slack = map.kind == MapKind::Float ? 0.0 : kNormSlack;
+    auto exact_bound = [&](float err) { return (double(err) * (1.0 + 1.0 / 4194304.0) + norm_slack) * scale * (1.0 + 1e-12) + map_slack; };
+    bo.max_error = o.max_error ? float(std::max(0.0, ((*o.max_error - map_slack) / (scale * (1.0 + 1e-12)) - norm_slack) / (1.0 + 1.0 / 4194304.0)))
+                               : -1.0f;
     std::unique_ptr<Bc4Encoder> bc4;
     if (o.format == Format::Bc4 || o.format == Format::Bc4Snorm) bc4 = std::make_unique<Bc4Encoder>(o.format == Format::Bc4Snorm, bo);
     const ScalarUnpack unpack = bc1_scalar_unpack(bo.decoders);
@@ -289,7 +318,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
             if (is_block_compressed(dx)) encode_bc(L, l, o.format, bo, bc4.get(), unpack, dst, blocks, bw, bh, progress);
             else encode_plain(L, l, dx, o.one_sided_below, dst, blocks, bw, bh);
             for (size_t b = 0; b < blocks.size(); ++b) {
-                const bool over = (o.max_error && double(blocks[b].err) * scale > double(*o.max_error)) ||
+                const bool over = (o.max_error && exact_bound(blocks[b].err) > double(*o.max_error)) ||
                                   (o.one_sided_below && !blocks[b].one_sided_ok);
                 if (!over) continue;
                 BlockMiss miss;
@@ -298,7 +327,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
                 miss.z = int(b / (size_t(bw) * size_t(bh)));
                 miss.array_index = l;
                 miss.mip = m;
-                miss.best_error = float(double(blocks[b].err) * scale);
+                miss.best_error = float(exact_bound(blocks[b].err));
                 miss.one_sided_failed = o.one_sided_below && !blocks[b].one_sided_ok;
                 rep.blocks_over_bound.push_back(miss);
             }
