@@ -703,3 +703,18 @@ TEST_F(Fixture, RecookedButUnchangedValueIsNotRewritten) {
     EXPECT_EQ(output_named(s3.cook(o), "sub/gate.exr").status, "written");
     EXPECT_NE(mtime_ns(gate), t);
 }
+
+// A commit that cannot complete (a path component is a file) changes nothing:
+// the other outputs keep their old files, no staging folder remains.
+TEST_F(Fixture, FailedCommitLeavesNothingPartial) {
+    fs::create_directories(dir / "out");
+    { std::ofstream(dir / "out" / "a.exr") << "old a"; }
+    { std::ofstream(dir / "out" / "sub") << "a file where a directory should be"; }
+    Session s = session(kTwoOutputs); // writes a.exr and sub/b.png
+    EXPECT_THROW(s.cook(options()), Error);
+    EXPECT_EQ(slurp(dir / "out" / "a.exr"), "old a");
+    EXPECT_EQ(slurp(dir / "out" / "sub"), "a file where a directory should be");
+    for (const auto& e : fs::directory_iterator(dir / "out"))
+        EXPECT_EQ(e.path().filename().string().find(".atlas-staging"), std::string::npos) << e.path();
+    EXPECT_EQ(s.last_result().status, "failed");
+}

@@ -159,13 +159,53 @@ std::vector<fs::path> StagedOutputs::staged_files() const {
 fs::path StagedOutputs::final_path(const fs::path& staged) const { return root_ / staged.lexically_relative(staging_); }
 
 std::vector<fs::path> StagedOutputs::commit() {
-    std::vector<fs::path> done;
-    for (const auto& rel : staged_files()) {
-        fs::path dst = root_ / rel;
+    const std::vector<fs::path> files = staged_files();
+    // 1. Every destination directory first: a path component that is a file
+    //    fails here, before anything moved.
+    for (const auto& rel : files) {
+        const fs::path dst = root_ / rel;
         std::error_code ec;
         fs::create_directories(dst.parent_path(), ec);
+        if (ec || !fs::is_directory(dst.parent_path()))
+            throw Error("cannot move '" + rel.string() + "' into '" + root_.string() + "': cannot create directory '" +
+                        dst.parent_path().string() + "'" + (ec ? ": " + ec.message() : ": a file is in the way"));
+    }
+    // 2. Move; the files replaced are kept in the staging area until every
+    //    move succeeded, so a failure puts the old files back.
+    const fs::path old_dir = staging_ / ".atlas-replaced";
+    struct Move {
+        fs::path rel;
+        bool replaced;
+    };
+    std::vector<Move> moved;
+    auto undo = [&] {
+        for (auto it = moved.rbegin(); it != moved.rend(); ++it) {
+            std::error_code e;
+            fs::rename(root_ / it->rel, staging_ / it->rel, e);
+            if (it->replaced) fs::rename(old_dir / it->rel, root_ / it->rel, e);
+        }
+    };
+    std::vector<fs::path> done;
+    for (const auto& rel : files) {
+        const fs::path dst = root_ / rel;
+        std::error_code ec;
+        bool replaced = false;
+        if (fs::is_regular_file(fs::symlink_status(dst, ec))) {
+            fs::create_directories((old_dir / rel).parent_path(), ec);
+            fs::rename(dst, old_dir / rel, ec);
+            replaced = !ec;
+        }
+        ec.clear();
         fs::rename(staging_ / rel, dst, ec);
-        if (ec) throw Error("cannot move '" + rel.string() + "' into '" + root_.string() + "': " + ec.message());
+        if (ec) {
+            if (replaced) {
+                std::error_code e;
+                fs::rename(old_dir / rel, dst, e);
+            }
+            undo();
+            throw Error("cannot move '" + rel.string() + "' into '" + root_.string() + "': " + ec.message() + " (nothing was changed)");
+        }
+        moved.push_back({rel, replaced});
         done.push_back(dst);
     }
     committed_ = true;
