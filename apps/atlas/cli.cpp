@@ -88,6 +88,8 @@ const std::vector<Command>& commands() {
           {"--time", "S", "2.5D: seconds of wind scroll (map and noise)"},
           {"--wind", "X,Y", "2.5D: wind velocity in m/s (default 8,0)"},
           {"--earth-radius", "M", "2.5D: Earth radius in metres (default 6360000)"},
+          {"--edge", "wrap|clamp|empty", "2.5D: the map beyond its bounds (default: empty for a superstorm set, else wrap)"},
+          {"--envelope", "on|off|auto", "2.5D: skip empty space with a cone map over the cloud tops (the graph's ndf/cone_map if it writes one); auto (default) = on above the lowest cloud base"},
           {"--quiet", "", "no progress bar or summary"}},
          run_preview},
     };

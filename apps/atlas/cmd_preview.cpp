@@ -8,6 +8,7 @@
 #include "atlas/core/files.h"
 #include "atlas/graph/evaluator.h"
 #include "atlas/io/readers.h"
+#include "atlas/ndf/cone_map.h"
 #include "atlas/render/image_out.h"
 #include "atlas/render/layer.h"
 #include "atlas/render/renderer.h"
@@ -18,6 +19,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <variant>
@@ -224,6 +226,35 @@ render::SkyLayer sky_layer_from(Field2DPtr tex, int channel, double altitude, do
     return l;
 }
 
+// The envelope's cone-step map over the cloud tops (ndf::cone_map, robust
+// for bilinear lookups): heights = max_height where coverage > 0, 0 (the
+// ground) elsewhere, max-pooled to at most 128 texels a side (a pooled top is
+// >= every top it covers, so its cones stay free) and dilated by one pooled
+// texel (the set is read bilinearly).
+Field2DPtr cloud_top_cone_map(const Field2D& set) {
+    const int cc = set.find_channel("coverage"), cm = set.find_channel("max_height");
+    const int w = set.width(), h = set.height();
+    const int k = std::max(1, (std::max(w, h) + 127) / 128);
+    const int pw = (w + k - 1) / k, ph = (h + k - 1) / k;
+    Field2D pooled({{pw, ph}}, 1, set.bounds(), {"top"});
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            if (set.at(cc, x, y) > 0) pooled.at(0, x / k, y / k) = std::max(pooled.at(0, x / k, y / k), set.at(cm, x, y));
+    Field2D tops({{pw, ph}}, 1, set.bounds(), {"top"});
+    for (int y = 0; y < ph; ++y)
+        for (int x = 0; x < pw; ++x) {
+            float top = 0;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx)
+                    top = std::max(top, pooled.at(0, std::clamp(x + dx, 0, pw - 1), std::clamp(y + dy, 0, ph - 1)));
+            tops.at(0, x, y) = top;
+        }
+    ndf::ConeMapOptions o;
+    o.robust = true;
+    o.texel_size = std::min((set.bounds().max[0] - set.bounds().min[0]) / pw, (set.bounds().max[1] - set.bounds().min[1]) / ph);
+    return std::make_shared<const Field2D>(ndf::cone_map(tops, 0, o, nullptr));
+}
+
 // The box around the voxels that hold cloud (SDF < 0), or the whole bounds.
 Box3d cloud_bounds(const render::CloudScene& scene) {
     const Field3D& sdf = *scene.sdf;
@@ -406,6 +437,19 @@ int run_preview(const Args& a) {
             auto v = numbers(a.get("--wind"), 2, "--wind");
             layer.wind = {{v[0], v[1]}};
         }
+        // A storm is one feature: no copies of it beyond the map. Weather maps tile.
+        const int cs = layer.ndf->find_channel("superstorm_coverage");
+        bool storm = false;
+        if (cs >= 0)
+            for (float v : layer.ndf->channel(cs)) storm = storm || v > 0;
+        layer.edge = storm ? render::MapEdge::Empty : render::MapEdge::Wrap;
+        if (a.has("--edge")) {
+            const std::string e = a.get("--edge");
+            if (e == "wrap") layer.edge = render::MapEdge::Wrap;
+            else if (e == "clamp") layer.edge = render::MapEdge::Clamp;
+            else if (e == "empty") layer.edge = render::MapEdge::Empty;
+            else throw UsageError{"--edge expects wrap, clamp or empty, got '" + e + "'", "preview"};
+        }
         render::validate_layer_scene(layer);
     }
 
@@ -422,15 +466,34 @@ int run_preview(const Args& a) {
         s.sky_colour = {{0.16f, 0.32f, 0.75f}};
         s.sky_horizon = Vec3f{{0.62f, 0.72f, 0.86f}};
         s.sun_direction = render::sun_direction(150, 25);
-    } else if (have_voxel && a.positional.size() == 1 && is_graph(a.positional[0])) {
-        s.camera = voxel_camera(scene, view, aspect);
-    } else if (have_voxel && view.kind != "auto") {
+    } else if (have_voxel && (view.kind != "auto" || (a.positional.size() == 1 && is_graph(a.positional[0])))) {
         s.camera = voxel_camera(scene, view, aspect);
     }
     if (a.has("--camera")) {
         auto v = numbers(a.get("--camera"), 6, "--camera");
         s.camera.position = {{v[0], v[1], v[2]}};
         s.camera.look_at = {{v[3], v[4], v[5]}};
+    }
+    if (have_layer) {
+        // Envelope skipping pays off looking down on the layer (a ground view
+        // starts under the clouds, where the cone map over the tops cannot
+        // help): auto = on when the camera is above the lowest cloud base.
+        std::string env = a.has("--envelope") ? a.get("--envelope") : "auto";
+        if (env != "on" && env != "off" && env != "auto") throw UsageError{"--envelope expects on, off or auto, got '" + env + "'", "preview"};
+        if (env == "auto") {
+            const int cmin = layer.ndf->find_channel("min_height");
+            float lowest = std::numeric_limits<float>::infinity();
+            for (float v : layer.ndf->channel(cmin)) lowest = std::min(lowest, v);
+            env = s.camera.position[2] > lowest ? "on" : "off";
+        }
+        if (env == "off") layer.envelope = {};
+        if (env == "on" && !layer.envelope.cone_map && layer.ndf->width() > 2) {
+            const auto t = std::chrono::steady_clock::now();
+            layer.envelope.cone_map = cloud_top_cone_map(*layer.ndf);
+            if (!quiet)
+                std::fprintf(stderr, "envelope: cone map over the cloud tops (%dx%d) in %.2f s\n", layer.ndf->width(), layer.ndf->height(),
+                             std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count());
+        }
     }
     if (a.has("--fov")) s.camera.fov_deg = numbers(a.get("--fov"), 1, "--fov")[0];
     if (a.has("--sun")) {

@@ -99,19 +99,24 @@ inline float lerp2(const float* p, int nx, const Bilinear& b) {
     return a + (c - a) * b.ty;
 }
 
-// A tiling 3D noise with up to 4 channels, trilinear.
+// A tiling 3D noise with up to 4 channels, trilinear, stored interleaved
+// (one 16-byte texel per voxel: 8 loads per lookup instead of 32).
 struct Noise3 {
-    std::array<const float*, 4> ch{};
+    std::vector<std::array<float, 4>> texels;
     int n = 0, nx = 0, ny = 0, nz = 0;
     double inv_tile = 0;
     bool ok() const { return n > 0; }
     void init(const Field3D* f, double tile) {
         if (!f) return;
         n = std::min(4, f->channels());
-        for (int c = 0; c < 4; ++c) ch[size_t(c)] = f->channel(std::min(c, n - 1)).data();
         nx = f->nx();
         ny = f->ny();
         nz = f->nz();
+        texels.resize(size_t(nx) * size_t(ny) * size_t(nz));
+        for (int c = 0; c < 4; ++c) {
+            auto ch = f->channel(std::min(c, n - 1));
+            for (size_t i = 0; i < texels.size(); ++i) texels[i][size_t(c)] = ch[i];
+        }
         inv_tile = 1.0 / tile;
     }
     void sample(double x, double y, double z, float out[4]) const {
@@ -121,14 +126,22 @@ struct Noise3 {
         axis_wrap(y * inv_tile * ny, ny, y0, y1, ty);
         axis_wrap(z * inv_tile * nz, nz, z0, z1, tz);
         const size_t sy = size_t(nx), sz = size_t(nx) * size_t(ny);
+        const std::array<float, 4>* t = texels.data();
         const size_t r0 = size_t(z0) * sz + size_t(y0) * sy, r1 = size_t(z0) * sz + size_t(y1) * sy;
         const size_t r2 = size_t(z1) * sz + size_t(y0) * sy, r3 = size_t(z1) * sz + size_t(y1) * sy;
-        for (int c = 0; c < 4; ++c) {
-            const float* p = ch[size_t(c)];
-            const float a = p[r0 + size_t(x0)] + (p[r0 + size_t(x1)] - p[r0 + size_t(x0)]) * tx;
-            const float b = p[r1 + size_t(x0)] + (p[r1 + size_t(x1)] - p[r1 + size_t(x0)]) * tx;
-            const float cc = p[r2 + size_t(x0)] + (p[r2 + size_t(x1)] - p[r2 + size_t(x0)]) * tx;
-            const float d = p[r3 + size_t(x0)] + (p[r3 + size_t(x1)] - p[r3 + size_t(x0)]) * tx;
+        const auto& a0 = t[r0 + size_t(x0)];
+        const auto& a1 = t[r0 + size_t(x1)];
+        const auto& b0 = t[r1 + size_t(x0)];
+        const auto& b1 = t[r1 + size_t(x1)];
+        const auto& c0 = t[r2 + size_t(x0)];
+        const auto& c1 = t[r2 + size_t(x1)];
+        const auto& d0 = t[r3 + size_t(x0)];
+        const auto& d1 = t[r3 + size_t(x1)];
+        for (size_t c = 0; c < 4; ++c) {
+            const float a = a0[c] + (a1[c] - a0[c]) * tx;
+            const float b = b0[c] + (b1[c] - b0[c]) * tx;
+            const float cc = c0[c] + (c1[c] - c0[c]) * tx;
+            const float d = d0[c] + (d1[c] - d0[c]) * tx;
             const float ab = a + (b - a) * ty, cd = cc + (d - cc) * ty;
             out[c] = ab + (cd - ab) * tz;
         }
@@ -257,6 +270,7 @@ public:
         std::sort(v.begin(), v.end());
         for (int k = 0; k <= kQuantiles; ++k) quantile_[size_t(k)] = v[std::min(v.size() - 1, size_t(double(k) / kQuantiles * double(v.size() - 1) + 0.5))];
         equalised_ = true;
+        base_max_ = quantile_[kQuantiles];
     }
     static double dilated_base(double r, double g, double b, double a) {
         const double low_fbm = g * 0.625 + b * 0.25 + a * 0.125;
@@ -288,6 +302,10 @@ public:
         const double qx = p[0] + wind_dir_[0] * skew - s_.wind[0] * s_.time;
         const double qy = p[1] + wind_dir_[1] * skew - s_.wind[1] * s_.time;
         const double qz = h - 0.1 * std::hypot(s_.wind[0], s_.wind[1]) * s_.time;
+        const double thr = coverage_threshold(c.coverage);
+        // The base is at most the texture's largest value: skip the lookup
+        // where even that stays under the coverage threshold.
+        if (profile * base_max_ <= thr) return 0;
         double base = 1;
         if (base_.ok()) {
             float n[4];
@@ -297,7 +315,6 @@ public:
         base *= profile;
         // Coverage grows the shape and scales its density: HZD's
         // remap(base, 1 - coverage, 1, 0, 1) * coverage with the equalised threshold.
-        const double thr = coverage_threshold(c.coverage);
         double shaped = thr < 1.0 ? (base - thr) / (1.0 - thr) * c.coverage : 0.0;
         if (!(shaped > 0)) return 0;
         shaped = std::min(shaped, 1.0);
@@ -394,6 +411,7 @@ private:
     static constexpr int kQuantiles = 256;
     std::array<double, kQuantiles + 1> quantile_{};
     bool equalised_ = false;
+    double base_max_ = 1; // largest dilated base value (1 without noise)
 };
 
 // Both roots of |o + t d - c|^2 = r^2 (unit d); false when the ray misses.
@@ -600,7 +618,7 @@ struct LayerIntegrator {
                     const double sigma = ext * d;
                     const double rain = 1 + sc.rain_absorption * col.precip;
                     // Light: cheap samples once the view ray is optically deep (HZD's 0.3).
-                    const bool cheap_light = trans < 0.7;
+                    const bool cheap_light = trans < 0.7 || tm > 15000; // far samples are hazed and small on screen
                     const double tau = ext * sun_depth(p, cheap_light) * rain;
                     const double sky_tau = ext * sky_depth(p, h, col) * rain;
                     double sun_w, sky_w;
@@ -699,7 +717,7 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
                        detail::normalized(settings.camera.position - model.centre()),
                        {sky.ambient[0], sky.ambient[1], sky.ambient[2]},
                        std::clamp(thickness / 96.0, 5.0, 60.0) / settings.quality,
-                       4000.0, // the step doubles every 4 km of distance
+                       2500.0, // the step doubles every 2.5 km of distance
                        std::clamp(thickness / 40.0, 20.0, 120.0),
                        scene.earth_radius,
                        scene.earth_radius + model.bottom(),

@@ -1,0 +1,146 @@
+// `atlas preview` picking its mode from what a graph writes: an NDF set ->
+// 2.5D, an NVDF set -> voxel, both -> one composited picture; --mode
+// overrides; a graph that writes neither, a camera under the ground and
+// --set reach the user as clear messages; --jobs never changes the bytes.
+#include "atlas/core/files.h"
+#include "atlas/io/readers.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+    int status = -1;
+    std::string out, err;
+};
+
+fs::path work_dir() {
+    fs::path d = fs::temp_directory_path() / ("atlas_layer_cli_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+}
+
+// Runs atlas with a cache shared by the tests of this file (the HZD noise
+// cooks once).
+CliRun run_atlas(const std::string& args) {
+    const fs::path dir = work_dir();
+    const std::string cmd = "cd " + dir.string() + " && ATLAS_CACHE_DIR= " + std::string(ATLAS_BINARY_DIR) + "/bin/atlas " + args +
+                            " --cache " + (dir / "cache").string() + " 2>err.txt";
+    CliRun r;
+    FILE* p = popen(cmd.c_str(), "r");
+    std::array<char, 4096> buf;
+    size_t n;
+    while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
+    const int st = pclose(p);
+    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    r.err = atlas::read_file_bytes(dir / "err.txt");
+    return r;
+}
+
+const char* kLayerGraph = R"(atlas: 1
+nodes:
+  coverage_noise:
+    type: ndf/noise
+    params: {resolution: [32, 32], bounds_max: [20000, 20000], period: [3, 3], octaves: 3, seed: 5}
+  set:
+    type: ndf/set
+    inputs: {coverage: coverage_noise}
+    params: {type: 0.6, min_height: 1500, max_height: 3500}
+outputs:
+  - {node: set, file: set.exr}
+)";
+
+const char* kVoxelNodes = R"(
+  base:
+    type: noise/value
+    params: {resolution: [16, 16, 8], bounds_min: [9000, 4000, 1600], bounds_max: [10600, 5600, 2400], period: [2, 2, 1], octaves: 2, seed: 3}
+  coverage:
+    type: math/remap
+    inputs: {in: base}
+    params: {in_min: 0.4, in_max: 0.56, out_min: 0, out_max: 1, clamp: true}
+  distance:
+    type: volume/sdf
+    inputs: {in: coverage}
+    params: {iso: 0.5}
+  nvdf:
+    type: volume/nvdf
+    inputs: {sdf: distance}
+    params: {depth: 32}
+)";
+
+void write(const std::string& name, const std::string& text) { std::ofstream(work_dir() / name) << text; }
+
+} // namespace
+
+TEST(LayerCli, NdfSetGraphRendersInLayerModeSameBytesForAnyJobs) {
+    write("layer.yaml", kLayerGraph);
+    const CliRun a = run_atlas("preview layer.yaml --size 64x36 --jobs 1 -o a.png");
+    ASSERT_EQ(a.status, 0) << a.err;
+    EXPECT_NE(a.err.find("(2.5D)"), std::string::npos) << a.err;
+    EXPECT_NE(a.err.find("curved_earth"), std::string::npos) << a.err;
+    const CliRun b = run_atlas("preview layer.yaml --size 64x36 --jobs 2 -o b.png");
+    ASSERT_EQ(b.status, 0) << b.err;
+    EXPECT_EQ(atlas::read_file_bytes(work_dir() / "a.png"), atlas::read_file_bytes(work_dir() / "b.png"));
+    // The graph's own outputs are not written.
+    EXPECT_FALSE(fs::exists(work_dir() / "set.exr"));
+    // --set reaches the graph: a different seed, a different picture.
+    const CliRun c = run_atlas("preview layer.yaml --size 64x36 --set coverage_noise.seed=9 -o c.png");
+    ASSERT_EQ(c.status, 0) << c.err;
+    EXPECT_NE(atlas::read_file_bytes(work_dir() / "a.png"), atlas::read_file_bytes(work_dir() / "c.png"));
+    for (const char* v : {"aerial", "orbit:120,30"}) {
+        const CliRun d = run_atlas(std::string("preview layer.yaml --size 32x18 --view ") + v + " -o d.png");
+        EXPECT_EQ(d.status, 0) << v << ": " << d.err;
+    }
+}
+
+TEST(LayerCli, BothSetsComposeOneImageAndModeOverrides) {
+    std::string g = kLayerGraph;
+    g.insert(g.find("outputs:"), std::string(kVoxelNodes).substr(1));
+    g += "  - {node: nvdf, port: vdb_set, file: nvdf.vdb}\n";
+    write("both.yaml", g);
+    const CliRun both = run_atlas("preview both.yaml --size 48x27 -o both.png");
+    ASSERT_EQ(both.status, 0) << both.err;
+    EXPECT_NE(both.err.find("2.5D + voxel composited"), std::string::npos) << both.err;
+    const CliRun layer = run_atlas("preview both.yaml --size 48x27 --mode layer -o layer.png");
+    ASSERT_EQ(layer.status, 0) << layer.err;
+    EXPECT_NE(layer.err.find("(2.5D)"), std::string::npos) << layer.err;
+    const CliRun voxel = run_atlas("preview both.yaml --size 48x27 --mode voxel -o voxel.png");
+    ASSERT_EQ(voxel.status, 0) << voxel.err;
+    EXPECT_NE(voxel.err.find("(voxel)"), std::string::npos) << voxel.err;
+    const CliRun bad = run_atlas("preview layer.yaml --size 48x27 --mode voxel -o x.png");
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE(bad.err.find("no volume/nvdf"), std::string::npos) << bad.err;
+}
+
+TEST(LayerCli, GraphWithNothingToPreviewListsWhatItWrites) {
+    write("mesh_only.yaml", R"(atlas: 1
+nodes:
+  lut:
+    type: ndf/profile_lut
+    params: {resolution: [8, 8]}
+outputs:
+  - {node: lut, file: lut.exr}
+)");
+    const CliRun r = run_atlas("preview mesh_only.yaml -o x.png");
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("writes nothing to preview"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("node 'lut' (ndf/profile_lut) port 'out' -> lut.exr"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(work_dir() / "x.png"));
+}
+
+TEST(LayerCli, CameraUnderTheGroundIsAClearMessage) {
+    write("layer.yaml", kLayerGraph);
+    const CliRun r = run_atlas("preview layer.yaml --size 32x18 --camera 10000,10000,-50,10000,20000,0 -o x.png");
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("under the ground"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(work_dir() / "x.png"));
+}
