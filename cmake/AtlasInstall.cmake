@@ -19,6 +19,10 @@ include(CMakePackageConfigHelpers)
 get_property(_atlas_modules GLOBAL PROPERTY ATLAS_MODULE_TARGETS)
 set(_atlas_static_libs ${_atlas_modules} atlas_nodes)
 
+# Position-independent like the modules: the shared libatlas and the Python
+# module are made of these objects too.
+set_target_properties(atlas_nodes PROPERTIES POSITION_INDEPENDENT_CODE ON)
+
 # Installed headers live in <prefix>/include; atlas_nodes' own directory is
 # only for the node files themselves.
 set_property(TARGET atlas_nodes PROPERTY INTERFACE_INCLUDE_DIRECTORIES

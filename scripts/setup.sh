@@ -14,6 +14,8 @@ PACKAGES=(
   # Independent readers for the engine-import test (tests/engine_import/): OpenImageIO's
   # and OpenVDB's own Python bindings for the system Python 3.11, and pytest.
   python3-openimageio python3-openvdb python3-numpy python3-pytest
+  # The atlas Python module (python/) for the same system Python, and its headers.
+  pybind11-dev python3-dev
 )
 
 missing=()

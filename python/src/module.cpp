@@ -1,0 +1,396 @@
+// The atlas Python module (_atlas, wrapped by python/atlas/__init__.py):
+// Session, errors as exceptions, declarations as plain data.
+#include "bindings.h"
+
+#include "atlas/graph/node_docs.h"
+
+#include <cmath>
+
+namespace atlas::python {
+
+namespace {
+
+// Exception classes (created once per interpreter; the module holds them).
+PyObject* g_error = nullptr;
+PyObject* g_parse_error = nullptr;
+PyObject* g_cancelled = nullptr;
+PyObject* g_memory = nullptr;
+
+void raise_with(PyObject* type, const std::string& message, const SourceLocation* where, const std::string* detail) {
+    py::object exc = py::reinterpret_borrow<py::object>(type)(message);
+    if (where) {
+        exc.attr("file") = where->file;
+        exc.attr("line") = where->line;
+        exc.attr("column") = where->column;
+        exc.attr("where") = where->str();
+    }
+    if (detail) exc.attr("detail") = *detail;
+    PyErr_SetObject(type, exc.ptr());
+}
+
+void translate(std::exception_ptr p) {
+    try {
+        if (p) std::rethrow_exception(p);
+    } catch (const ParseError& e) {
+        raise_with(g_parse_error, e.what(), &e.where(), &e.detail());
+    } catch (const CancelledError& e) {
+        raise_with(g_cancelled, e.what(), nullptr, nullptr);
+    } catch (const MemoryBudgetError& e) {
+        raise_with(g_memory, e.what(), nullptr, nullptr);
+    } catch (const Error& e) {
+        raise_with(g_error, e.what(), nullptr, nullptr);
+    }
+}
+
+const ParamDecl* find_decl(const Session& s, const std::string& node, const std::string& param) {
+    const GraphNode* n = s.graph().find(node);
+    const NodeType* t = n ? s.registry().find(n->type) : nullptr;
+    return t ? t->decl.find_param(param) : nullptr;
+}
+
+// Callbacks: Python callables run with the GIL taken; a Python exception in
+// one becomes an atlas::Error (the cook fails with its message).
+ProgressSink make_sink(const py::object& progress, const py::object& cancel) {
+    ProgressSink sink;
+    if (!progress.is_none()) {
+        SharedPyObject fn(progress);
+        sink.on_progress = [fn](const ProgressEvent& e) {
+            py::gil_scoped_acquire gil;
+            try {
+                fn.get()(e.fraction, e.task, e.done, e.total);
+            } catch (py::error_already_set& err) {
+                throw Error("progress callback raised " + python_error_message(err));
+            }
+        };
+    }
+    if (!cancel.is_none()) {
+        SharedPyObject fn(cancel);
+        sink.is_cancelled = [fn]() {
+            py::gil_scoped_acquire gil;
+            try {
+                return bool(py::bool_(fn.get()()));
+            } catch (py::error_already_set& err) {
+                throw Error("cancel callback raised " + python_error_message(err));
+            }
+        };
+    }
+    return sink;
+}
+
+CookOptions make_options(const py::object& outputs, int jobs, bool write_outputs, const py::object& out_dir,
+                         const py::object& cache_dir, bool checked, const py::object& memory_budget,
+                         const py::object& progress, const py::object& cancel) {
+    CookOptions o;
+    if (!outputs.is_none()) o.outputs = outputs.cast<std::vector<std::string>>();
+    o.jobs = jobs;
+    o.write_outputs = write_outputs;
+    if (!out_dir.is_none()) o.out_dir = py::str(out_dir).cast<std::string>();
+    if (!cache_dir.is_none()) o.cache_dir = std::filesystem::path(py::str(cache_dir).cast<std::string>());
+    o.checked = checked;
+    if (!memory_budget.is_none()) o.memory_budget = memory_budget.cast<uint64_t>();
+    o.progress = make_sink(progress, cancel);
+    return o;
+}
+
+py::dict result_to_python(const CookResult& r) {
+    py::dict nodes;
+    for (const auto& [name, n] : r.nodes) {
+        py::dict d;
+        d["type"] = n.type;
+        d["status"] = n.status;
+        d["reason"] = n.reason;
+        d["hash"] = n.hash;
+        d["seconds"] = n.seconds;
+        d["bytes"] = n.bytes;
+        d["metrics"] = n.metrics;
+        d["warnings"] = n.warnings;
+        nodes[py::str(name)] = d;
+    }
+    py::list outputs;
+    for (const auto& o : r.outputs) {
+        py::dict d;
+        d["node"] = o.node;
+        d["port"] = o.port;
+        d["file"] = o.file;
+        d["format"] = o.format;
+        py::list written;
+        for (const auto& p : o.written) written.append(p.string());
+        d["written"] = written;
+        d["metrics"] = o.metrics;
+        outputs.append(d);
+    }
+    py::dict d;
+    d["nodes"] = nodes;
+    d["outputs"] = outputs;
+    d["seconds"] = r.seconds;
+    d["jobs"] = r.jobs;
+    d["checked"] = r.checked;
+    return d;
+}
+
+py::list graph_nodes(const Session& s) {
+    py::list out;
+    const Graph& g = s.graph();
+    for (const GraphNode& n : g.nodes) {
+        const NodeType* t = s.registry().find(n.type);
+        py::dict d;
+        d["name"] = n.name;
+        d["type"] = n.type;
+        d["where"] = n.where.str();
+        py::dict params, explicit_params;
+        if (t) {
+            auto resolved = resolved_params(n, *t);
+            for (const ParamDecl& p : t->decl.params()) params[py::str(p.name)] = param_to_python(resolved.at(p.name), p.type);
+            for (const auto& [name, setting] : n.params) {
+                const ParamDecl* p = t->decl.find_param(name);
+                explicit_params[py::str(name)] = param_to_python(setting.value, p ? p->type : ParamType::String);
+            }
+        }
+        d["params"] = params;
+        d["explicit"] = explicit_params;
+        py::dict inputs;
+        for (const auto& [port, b] : n.inputs) inputs[py::str(port)] = py::make_tuple(b.node, b.port);
+        d["inputs"] = inputs;
+        out.append(d);
+    }
+    return out;
+}
+
+py::list graph_outputs(const Session& s) {
+    py::list out;
+    for (const GraphOutput& o : s.graph().outputs) {
+        py::dict d;
+        d["node"] = o.node;
+        d["port"] = o.port;
+        d["file"] = o.file;
+        d["format"] = o.format;
+        d["options"] = o.options;
+        d["where"] = o.where.str();
+        out.append(d);
+    }
+    return out;
+}
+
+} // namespace
+
+std::string python_error_message(py::error_already_set& e) {
+    std::string msg = py::str(e.value()).cast<std::string>();
+    if (!PyErr_GivenExceptionMatches(e.type().ptr(), g_error))
+        msg = py::str(e.type().attr("__name__")).cast<std::string>() + ": " + msg;
+    // The innermost Python frame: where a TD's node code failed.
+    py::object tb = e.trace() ? py::reinterpret_borrow<py::object>(e.trace()) : py::none();
+    py::object last = py::none();
+    while (!tb.is_none()) {
+        last = tb;
+        tb = tb.attr("tb_next");
+    }
+    if (!last.is_none()) {
+        py::object code = last.attr("tb_frame").attr("f_code");
+        msg += " (at " + py::str(code.attr("co_filename")).cast<std::string>() + ":" +
+               py::str(last.attr("tb_lineno")).cast<std::string>() + " in " + py::str(code.attr("co_name")).cast<std::string>() + ")";
+    }
+    return msg;
+}
+
+py::object param_to_python(const ParamValue& v, ParamType type) {
+    if (auto* b = std::get_if<bool>(&v)) return py::bool_(*b);
+    if (auto* i = std::get_if<int64_t>(&v)) return py::int_(*i);
+    if (auto* d = std::get_if<double>(&v)) return py::float_(*d);
+    if (auto* s = std::get_if<std::string>(&v)) return py::str(*s);
+    const auto& vec = std::get<std::vector<double>>(v);
+    py::list l;
+    const bool ints = type == ParamType::Int2 || type == ParamType::Int3;
+    for (double x : vec) {
+        if (ints) l.append(py::int_(int64_t(x)));
+        else l.append(py::float_(x));
+    }
+    return l;
+}
+
+ParamValue param_from_python(const py::handle& o, ParamType type, const std::string& what) {
+    auto bad = [&](const char* expected) {
+        return py::type_error(what + ": expected " + expected + ", got " + py::str(py::type::handle_of(o).attr("__name__")).cast<std::string>() +
+                              " " + py::repr(o).cast<std::string>());
+    };
+    switch (type) {
+    case ParamType::Bool:
+        if (!py::isinstance<py::bool_>(o)) throw bad("a bool");
+        return o.cast<bool>();
+    case ParamType::Int:
+        if (py::isinstance<py::bool_>(o)) throw bad("an int");
+        if (py::isinstance<py::int_>(o)) return o.cast<int64_t>();
+        if (py::isinstance<py::float_>(o)) {
+            double d = o.cast<double>();
+            if (std::isfinite(d) && std::floor(d) == d && std::fabs(d) < 9.0e15) return int64_t(d);
+        }
+        throw bad("an int");
+    case ParamType::Float:
+        if (py::isinstance<py::bool_>(o) || !(py::isinstance<py::int_>(o) || py::isinstance<py::float_>(o)))
+            throw bad("a number");
+        return o.cast<double>();
+    case ParamType::String:
+    case ParamType::Enum:
+    case ParamType::Path:
+        if (py::hasattr(o, "__fspath__")) return py::str(o.attr("__fspath__")()).cast<std::string>();
+        if (!py::isinstance<py::str>(o)) throw bad("a str");
+        return o.cast<std::string>();
+    default: {
+        if (py::isinstance<py::str>(o) || !py::isinstance<py::sequence>(o)) throw bad("a sequence of numbers");
+        std::vector<double> v;
+        for (auto item : o) {
+            if (py::isinstance<py::bool_>(item) || !(py::isinstance<py::int_>(item) || py::isinstance<py::float_>(item)))
+                throw bad("a sequence of numbers");
+            v.push_back(item.cast<double>());
+        }
+        return v;
+    }
+    }
+}
+
+py::dict declaration_to_python(const NodeType& t) {
+    auto ports = [](const std::deque<PortDecl>& list) {
+        py::list l;
+        for (const PortDecl& p : list) {
+            py::dict d;
+            d["name"] = p.name;
+            d["type"] = std::string(port_type_name(p.type));
+            d["doc"] = p.doc;
+            d["optional"] = p.optional;
+            l.append(d);
+        }
+        return l;
+    };
+    py::list params;
+    for (const ParamDecl& p : t.decl.params()) {
+        py::dict d;
+        d["name"] = p.name;
+        d["type"] = std::string(param_type_name(p.type));
+        d["default"] = param_to_python(p.default_value, p.type);
+        d["min"] = p.min ? py::object(py::float_(*p.min)) : py::object(py::none());
+        d["max"] = p.max ? py::object(py::float_(*p.max)) : py::object(py::none());
+        d["unit"] = p.unit;
+        d["doc"] = p.doc;
+        d["choices"] = p.choices;
+        params.append(d);
+    }
+    py::dict d;
+    d["name"] = t.name;
+    d["version"] = t.version;
+    d["doc"] = t.decl.doc();
+    d["inputs"] = ports(t.decl.inputs());
+    d["outputs"] = ports(t.decl.outputs());
+    d["params"] = params;
+    return d;
+}
+
+} // namespace atlas::python
+
+using namespace atlas;
+using namespace atlas::python;
+
+PYBIND11_MODULE(_atlas, m) {
+    m.doc() = "Atlas: node graphs cooked into volumetric cloud data (bindings over libatlas).";
+    m.attr("__version__") = ATLAS_VERSION_STRING;
+
+    g_error = PyErr_NewExceptionWithDoc("atlas.Error", "Any Atlas failure; str(e) is the full message (file:line:col, node, parameter).",
+                                        PyExc_RuntimeError, nullptr);
+    g_parse_error = PyErr_NewExceptionWithDoc("atlas.ParseError",
+                                              "A graph file or text that cannot be used: .file, .line, .column, .where ('file:line:col'), .detail.",
+                                              g_error, nullptr);
+    g_cancelled = PyErr_NewExceptionWithDoc("atlas.CancelledError", "The cancel callback asked to stop.", g_error, nullptr);
+    g_memory = PyErr_NewExceptionWithDoc("atlas.MemoryBudgetError", "An allocation past the memory budget was refused.", g_error, nullptr);
+    // The module keeps references for the interpreter's lifetime.
+    m.attr("Error") = py::handle(g_error);
+    m.attr("ParseError") = py::handle(g_parse_error);
+    m.attr("CancelledError") = py::handle(g_cancelled);
+    m.attr("MemoryBudgetError") = py::handle(g_memory);
+    py::register_exception_translator(translate);
+
+    bind_fields(m);
+    bind_python_nodes(m);
+
+    py::class_<Session>(m, "Session", R"doc(
+A loaded graph and its in-memory cache (atlas::Session). Edit parameters and
+re-cook: only what changed cooks again. Not thread-safe: one call at a time
+per Session (cook releases the GIL, so other Python threads run meanwhile).)doc")
+        .def(py::init([](const py::object& registry) {
+                 if (registry.is_none()) return std::make_unique<Session>(builtin_nodes());
+                 return std::make_unique<Session>(registry.cast<const NodeRegistry&>());
+             }),
+             py::arg("registry") = py::none(), "A session over `registry` (an atlas.NodeRegistry; default: the built-in node types).")
+        .def("load", [](Session& s, const py::object& path) { s.load(py::str(path).cast<std::string>()); }, py::arg("path"),
+             "Loads (parses and validates) a graph file; raises atlas.ParseError with file:line:col.")
+        .def("load_text", [](Session& s, const std::string& text, const std::string& name, const py::object& base_dir) {
+                 s.load_text(text, name, base_dir.is_none() ? std::filesystem::current_path() : std::filesystem::path(py::str(base_dir).cast<std::string>()));
+             }, py::arg("text"), py::arg("name") = "<text>", py::arg("base_dir") = py::none(),
+             "Loads a graph from YAML text; `name` is used in messages, relative paths resolve against base_dir (default: the current directory).")
+        .def("set", [](Session& s, const std::string& node, const std::string& param, const py::object& value) {
+                 const ParamDecl* d = find_decl(s, node, param);
+                 if (!d) {
+                     // Let the library name what is wrong (unknown node or parameter, with a hint).
+                     s.set_text(node, param, py::str(value).cast<std::string>());
+                     return;
+                 }
+                 s.set(node, param, param_from_python(value, d->type, node + "." + param));
+             }, py::arg("node"), py::arg("param"), py::arg("value"),
+             "Overrides NODE.PARAM with a Python value, validated against the declaration (type, range, choices).")
+        .def("set_text", &Session::set_text, py::arg("node"), py::arg("param"), py::arg("text"),
+             "Overrides NODE.PARAM from text as the CLI's --set spells it ('0.5', '[1, 2, 3]', 'name').")
+        .def("cook", [](Session& s, const py::object& outputs, int jobs, bool write_outputs, const py::object& out_dir,
+                        const py::object& cache_dir, bool checked, const py::object& memory_budget, const py::object& progress,
+                        const py::object& cancel) {
+                 CookOptions o = make_options(outputs, jobs, write_outputs, out_dir, cache_dir, checked, memory_budget, progress, cancel);
+                 CookResult r;
+                 {
+                     py::gil_scoped_release nogil;
+                     r = s.cook(o);
+                 }
+                 return result_to_python(r);
+             },
+             py::arg("outputs") = py::none(), py::arg("jobs") = 0, py::arg("write_outputs") = false, py::arg("out_dir") = py::none(),
+             py::arg("cache_dir") = py::none(), py::arg("checked") = false, py::arg("memory_budget") = py::none(),
+             py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+             R"doc(Cooks the graph's outputs (or those named) and returns the report as a dict:
+{"nodes": {name: {"status": "cooked"|"cached"|"skipped", "type", "reason", "hash", "seconds", "bytes", "metrics", "warnings"}}, "outputs": [...], ...}.
+write_outputs=True also writes the output files into out_dir (atomically). The GIL is released while
+cooking; progress(fraction, task, done, total) and cancel() -> bool are called from worker threads
+with the GIL taken. Raises atlas.CancelledError when cancel() returns true.)doc")
+        .def("get", [](Session& s, const std::string& node, const py::object& port, int jobs, const py::object& cache_dir,
+                       const py::object& memory_budget, const py::object& progress, const py::object& cancel) {
+                 std::string port_name = port.is_none() ? "" : port.cast<std::string>();
+                 if (port_name.empty()) {
+                     const GraphNode* n = s.graph().find(node);
+                     const NodeType* t = n ? s.registry().find(n->type) : nullptr;
+                     if (t && !t->decl.outputs().empty()) port_name = t->decl.outputs().front().name;
+                 }
+                 CookOptions o = make_options(py::none(), jobs, false, py::none(), cache_dir, false, memory_budget, progress, cancel);
+                 Value v;
+                 {
+                     py::gil_scoped_release nogil;
+                     v = s.get(node, port_name, o);
+                 }
+                 return value_to_python(v);
+             },
+             py::arg("node"), py::arg("port") = py::none(), py::arg("jobs") = 0, py::arg("cache_dir") = py::none(),
+             py::arg("memory_budget") = py::none(), py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+             "Cooks what one node output needs (port default: the node's first output) and returns it: an atlas.Field2D or "
+             "Field3D (channels as read-only NumPy views), or for a mesh / points a dict of read-only arrays.")
+        .def("nodes", &graph_nodes, "The graph's nodes in file order: [{name, type, where, params (resolved), explicit, inputs}].")
+        .def("outputs", &graph_outputs, "The graph's outputs: [{node, port, file, format, options, where}].")
+        .def("node_types", [](const Session& s) {
+                 py::list l;
+                 for (const NodeType* t : s.registry().all()) l.append(declaration_to_python(*t));
+                 return l;
+             }, "Every node type's declaration as plain data (see atlas.node_types()).")
+        .def("declaration", [](const Session& s, const std::string& type) {
+                 const NodeType* t = s.registry().find(type);
+                 if (!t) throw Error("unknown node type '" + type + "'" + name_hint(type, s.registry().names()));
+                 return declaration_to_python(*t);
+             }, py::arg("type"), "One node type's declaration as plain data.")
+        .def("node_hashes", [](const Session& s) {
+                 std::map<std::string, std::string> out;
+                 for (const auto& [name, h] : s.node_hashes()) out[name] = h.hex();
+                 return out;
+             }, "Each node's content hash (hex).")
+        .def_property_readonly("file", [](const Session& s) { return s.graph().file.string(); }, "The graph file ('' when loaded from text).");
+}
