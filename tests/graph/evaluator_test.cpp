@@ -718,3 +718,22 @@ TEST_F(Fixture, FailedCommitLeavesNothingPartial) {
         EXPECT_EQ(e.path().filename().string().find(".atlas-staging"), std::string::npos) << e.path();
     EXPECT_EQ(s.last_result().status, "failed");
 }
+
+// The cache's checksum depends only on the bytes (not on how they are fed)
+// and sees every single-bit change.
+TEST(ContentHasher, SplitIndependentAndBitSensitive) {
+    std::string bytes(1000, '\0');
+    for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i * 7 + 3);
+    const Hash128 whole = ContentHasher().add(bytes.data(), bytes.size()).finish();
+    for (size_t cut : {0, 1, 31, 32, 33, 500, 999, 1000}) {
+        ContentHasher h;
+        h.add(bytes.data(), cut).add(bytes.data() + cut, bytes.size() - cut);
+        EXPECT_EQ(h.finish(), whole) << cut;
+    }
+    for (size_t bit = 0; bit < bytes.size() * 8; bit += 37) {
+        std::string b = bytes;
+        b[bit / 8] ^= char(1 << (bit % 8));
+        EXPECT_NE(ContentHasher().add(b.data(), b.size()).finish(), whole) << bit;
+    }
+    EXPECT_NE(ContentHasher().add(bytes.data(), 999).finish(), ContentHasher().add((bytes.substr(0, 999) + '\0').data(), 1000).finish());
+}

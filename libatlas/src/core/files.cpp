@@ -107,20 +107,66 @@ void write_file_checked(const fs::path& path, const void* data, size_t size) {
     if (::close(fd) != 0) throw Error(path.string() + ": write failed when closing the file: " + std::strerror(errno));
 }
 
+namespace {
+constexpr uint64_t kP1 = 0x9E3779B185EBCA87ull, kP2 = 0xC2B2AE3D27D4EB4Full, kP3 = 0x165667B19E3779F9ull;
+constexpr uint64_t rotl(uint64_t x, int r) { return (x << r) | (x >> (64 - r)); }
+constexpr uint64_t round64(uint64_t acc, uint64_t w) { return rotl(acc + w * kP2, 31) * kP1; }
+} // namespace
+
+void ContentHasher::block(const unsigned char* p) {
+    for (int k = 0; k < 4; ++k) {
+        uint64_t w;
+        std::memcpy(&w, p + 8 * k, 8);
+        lane_[k] = round64(lane_[k], w);
+    }
+}
+
+ContentHasher& ContentHasher::add(const void* data, size_t size) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    total_ += size;
+    if (buffered_) {
+        const size_t take = std::min(size, 32 - buffered_);
+        std::memcpy(buf_ + buffered_, p, take);
+        buffered_ += take, p += take, size -= take;
+        if (buffered_ < 32) return *this;
+        block(buf_);
+        buffered_ = 0;
+    }
+    for (; size >= 32; p += 32, size -= 32) block(p);
+    std::memcpy(buf_, p, size);
+    buffered_ = size;
+    return *this;
+}
+
+Hash128 ContentHasher::finish() const {
+    uint64_t l[4] = {lane_[0], lane_[1], lane_[2], lane_[3]};
+    // The tail, zero-padded, as one more block (the length below tells tails apart).
+    if (buffered_) {
+        unsigned char tail[32] = {};
+        std::memcpy(tail, buf_, buffered_);
+        for (int k = 0; k < 4; ++k) {
+            uint64_t w;
+            std::memcpy(&w, tail + 8 * k, 8);
+            l[k] = round64(l[k], w);
+        }
+    }
+    uint64_t a = rotl(l[0], 1) + rotl(l[1], 7) + rotl(l[2], 12) + rotl(l[3], 18);
+    for (uint64_t v : l) a = (a ^ round64(0, v)) * kP1 + kP3;
+    const uint64_t hi = mix64(a ^ total_);
+    const uint64_t lo = mix64(hi ^ l[0] ^ rotl(l[2], 29) ^ (total_ * kP3));
+    return {hi, mix64(lo ^ l[1] ^ rotl(l[3], 17))};
+}
+
 Hash128 file_content_hash(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path.string() + ": cannot open file for reading");
-    Hasher h;
+    ContentHasher h;
     std::vector<char> buf(1 << 20);
-    uint64_t total = 0;
     while (in) {
         in.read(buf.data(), std::streamsize(buf.size()));
-        const auto n = size_t(in.gcount());
-        if (n) h.add_bytes(buf.data(), n);
-        total += n;
+        if (const auto n = size_t(in.gcount())) h.add(buf.data(), n);
     }
     if (in.bad()) throw Error(path.string() + ": read error");
-    h.add(total);
     return h.finish();
 }
 
@@ -273,8 +319,7 @@ void hash_file(Hasher& h, const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path.string() + ": cannot open input file (does it exist?)");
     h.add(path.filename().string());
-    // The same chunking as file_content_hash, so the recorded hash equals it.
-    Hasher content;
+    ContentHasher content; // equals file_content_hash of the same bytes
     std::vector<char> buf(1 << 20);
     uint64_t total = 0;
     while (in) {
@@ -282,13 +327,12 @@ void hash_file(Hasher& h, const fs::path& path) {
         const auto n = size_t(in.gcount());
         if (n) {
             h.add_bytes(buf.data(), n);
-            content.add_bytes(buf.data(), n);
+            content.add(buf.data(), n);
         }
         total += n;
     }
     if (in.bad()) throw Error(path.string() + ": read error");
     h.add(total);
-    content.add(total);
     if (t_file_reads) t_file_reads->push_back({path, total, content.finish()});
 }
 } // namespace atlas

@@ -532,11 +532,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         std::map<std::pair<std::string, std::string>, std::string> value_hashes;
         auto value_hash = [&](const GraphOutput* o) -> const std::string& {
             auto [it, fresh] = value_hashes.try_emplace({o->node, o->port});
-            if (fresh) {
-                Hasher h;
-                hash_value(h, values.at(o->node)->at(o->port));
-                it->second = h.finish().hex();
-            }
+            if (fresh) it->second = disk_cache::content_hash(values.at(o->node)->at(o->port)).hex();
             return it->second;
         };
         std::vector<std::pair<OutputPlan*, OutputRecord>> rekeyed;

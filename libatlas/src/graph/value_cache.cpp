@@ -38,16 +38,16 @@ constexpr size_t kMagicSize = sizeof(kMagic) - 1;
 // Both sides stream: a cached NVDF set is hundreds of MB, and a whole-file
 // string in between would double the memory and the page faults.
 struct Writer {
-    std::ostream& out;
-    Hasher sum{};
+    std::ostream* out; // null: checksum only (content_hash)
+    ContentHasher sum{};
     void bytes(const void* p, size_t n) {
-        sum.add_bytes(p, n);
-        out.write(static_cast<const char*>(p), std::streamsize(n));
+        sum.add(p, n);
+        if (out) out->write(static_cast<const char*>(p), std::streamsize(n));
     }
     void checksum() {
         const Hash128 h = sum.finish();
-        out.write(reinterpret_cast<const char*>(&h.hi), 8);
-        out.write(reinterpret_cast<const char*>(&h.lo), 8);
+        out->write(reinterpret_cast<const char*>(&h.hi), 8);
+        out->write(reinterpret_cast<const char*>(&h.lo), 8);
     }
     void u64(uint64_t v) { bytes(&v, 8); }
     void f64(double v) { bytes(&v, 8); }
@@ -60,12 +60,12 @@ struct Reader {
     uint64_t size; // bytes in the entry: every length is checked against what is left
     uint64_t pos = 0;
     bool ok = true;
-    Hasher sum{};
+    ContentHasher sum{};
     bool take(void* dst, size_t n) {
         if (!ok || size - pos < n) return ok = false;
         in.read(static_cast<char*>(dst), std::streamsize(n));
         if (uint64_t(in.gcount()) != n) return ok = false;
-        sum.add_bytes(dst, n); // the same calls, in the same order, as Writer::bytes
+        sum.add(dst, n);
         pos += n;
         return true;
     }
@@ -117,12 +117,21 @@ bool read_storage(Reader& r, detail::FieldStorage& f, int channels) {
     return true;
 }
 
+void write_value(Writer& w, const Value& v);
+
 void serialize_to(std::ostream& out, const NodeOutputs& outputs) {
-    Writer w{out};
+    Writer w{&out};
     w.bytes(kMagic, kMagicSize);
     w.u64(outputs.size());
     for (const auto& [port, v] : outputs) {
         w.str(port);
+        write_value(w, v);
+    }
+    w.checksum();
+}
+
+void write_value(Writer& w, const Value& v) {
+    {
         w.u64(v.index());
         if (auto f = std::get_if<Field2DPtr>(&v)) {
             w.u64(uint64_t((*f)->width())); w.u64(uint64_t((*f)->height()));
@@ -141,7 +150,6 @@ void serialize_to(std::ostream& out, const NodeOutputs& outputs) {
             for (const auto& [name, vals] : (*p)->attributes) { w.str(name); w.raw(vals.data(), vals.size() * sizeof(float)); }
         }
     }
-    w.checksum();
 }
 
 std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std::string* why_not) {
@@ -208,6 +216,12 @@ std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std
 }
 } // namespace
 
+Hash128 content_hash(const Value& v) {
+    Writer w{nullptr};
+    write_value(w, v);
+    return w.sum.finish();
+}
+
 std::string serialize(const NodeOutputs& outputs) {
     std::ostringstream out;
     serialize_to(out, outputs);
@@ -267,7 +281,7 @@ void store_files(const std::filesystem::path& dir, const Hash128& key,
                  const std::vector<std::pair<std::string, std::filesystem::path>>& files, const std::map<std::string, double>& metrics) {
     write_file_atomic(files_entry_path(dir, key), [&](const std::filesystem::path& tmp) {
         std::ofstream f(tmp, std::ios::binary);
-        Writer w{f};
+        Writer w{&f};
         w.bytes(kFilesMagic, kFilesMagicSize);
         w.u64(metrics.size());
         for (const auto& [k, v] : metrics) { w.str(k); w.f64(v); }

@@ -57,6 +57,9 @@ void store_files(const std::filesystem::path& dir, const Hash128& key,
 std::optional<CachedFiles> load_files(const std::filesystem::path& dir, const Hash128& key, std::string* why_not = nullptr);
 
 
+// ContentHasher of a value's serialised form (shape, bounds, channel names
+// and data): equal values give equal hashes, fast enough for every output.
+Hash128 content_hash(const Value& v);
 // Serialisation (exposed for tests).
 std::string serialize(const NodeOutputs& outputs);
 std::optional<NodeOutputs> deserialize(const std::string& bytes, std::string* why_not = nullptr);
