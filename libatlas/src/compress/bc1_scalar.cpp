@@ -186,7 +186,14 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
     detail::Selection best;
     uint16_t b0 = 0, b1 = 0;
     bool have = false;
+    // Pairs already evaluated (the candidate generators repeat many): a small ring.
+    uint32_t seen[32];
+    int nseen = 0;
     auto consider = [&](uint16_t c0, uint16_t c1) {
+        const uint32_t key = (uint32_t(c0) << 16) | c1;
+        for (int i = 0; i < std::min(nseen, 32); ++i)
+            if (seen[i] == key) return;
+        seen[nseen++ % 32] = key;
         detail::Palette<1> p;
         detail::scalar_interval_palette(T, c0, c1, p);
         detail::Selection s = detail::select_indices(p, src, options.one_sided_below, have ? best.max_err : INFINITY);
@@ -247,18 +254,21 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
                 const float fb[4] = {0.0f, 1.0f, four ? 1.0f / 3.0f : 0.5f, 2.0f / 3.0f};
                 // Move endpoint `e` (0: c0, 1: c1) to code c; the code below too (the
                 // round-down of a blend can land an ulp above its target).
+                // Only this mode's order: the other mode has its own geometry pass.
+                auto pair = [&](uint16_t a, uint16_t b) {
+                    if (four ? a > b : a <= b) consider(a, b);
+                };
                 auto move = [&](int e, uint16_t c, float x = -1.0f) {
-                    if (x >= 0 && options.one_sided_below) { // also with the other endpoint's R digit
-                        const uint16_t same = split_r(x, (e == 0 ? c1 : c0) >> 11, u, T, false);
-                        if (same != c) {
-                            if (e == 0) both(same, c1);
-                            else both(c0, same);
-                        }
+                    const int other_r = (e == 0 ? c1 : c0) >> 11;
+                    if (x >= 0 && options.one_sided_below && (c >> 11) != other_r) { // also with the other endpoint's R digit
+                        const uint16_t same = split_r(x, other_r, u, T, false);
+                        if (e == 0) pair(same, c1);
+                        else pair(c0, same);
                     }
                     for (int d = 0; d < kBelow && c >= d; ++d) {
                         const uint16_t cd = uint16_t(c - d);
-                        if (e == 0) both(cd, c1);
-                        else both(c0, cd);
+                        if (e == 0) pair(cd, c1);
+                        else pair(c0, cd);
                     }
                 };
                 for (int t = 0; t < nt; ++t)
@@ -377,11 +387,12 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
             }
         }
     }
-    // Normal retargets only blocks well above the exact-entry fit (twice it plus one
-    // endpoint step), and not under Conformant, whose tolerance (not the entries'
-    // positions) sets the error: most blocks are done by then.
+    // Normal retargets only blocks well above the exact-entry fit (twice it plus the
+    // endpoint slack: the decoders' disagreement on an endpoint and one step), and not
+    // under Conformant, whose tolerance (not the entries' positions) sets the error: most
+    // blocks are done by then.
     const bool normal_skips = options.quality == Quality::Normal &&
-                              (T.conformant || (options.one_sided_below && best.max_err <= 2.0f * fit_floor + u.endpoint_step));
+                              (T.conformant || (options.one_sided_below && best.max_err <= 2.0f * fit_floor + T.endpoint_slack));
     if (!normal_skips) retarget(rounds, options.quality == Quality::Normal);
     const bool missed = !have || (options.max_error >= 0 && best.max_err > options.max_error);
     if (options.quality == Quality::Best || missed) {

@@ -37,6 +37,22 @@ std::unique_ptr<ScalarTables> build(const ScalarUnpack& u) {
         for (int i = 0; i < 64; ++i) T->hi6[i] = std::max(T->hi6[i], level_value(i, 6, Decoder(di)));
     }
     T->conformant = (set & decoder_bit(Decoder::Conformant)) != 0;
+    {
+        float s5 = 0, s6 = 0;
+        for (int i = 0; i < 32; ++i) {
+            float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
+            for (int di = 0; di < kDecoderCount; ++di)
+                if (set & (DecoderSet(1) << di)) { lo = std::min(lo, level_value(i, 5, Decoder(di))); hi = std::max(hi, level_value(i, 5, Decoder(di))); }
+            s5 = std::max(s5, hi - lo);
+        }
+        for (int i = 0; i < 64; ++i) {
+            float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
+            for (int di = 0; di < kDecoderCount; ++di)
+                if (set & (DecoderSet(1) << di)) { lo = std::min(lo, level_value(i, 6, Decoder(di))); hi = std::max(hi, level_value(i, 6, Decoder(di))); }
+            s6 = std::max(s6, hi - lo);
+        }
+        T->endpoint_slack = s5 * u.weights[0] + s6 * u.weights[1] + s5 * u.weights[2] + u.endpoint_step;
+    }
     // Reference tables are always built (tie break); Conformant uses them too.
     const int conf = int(Decoder::Conformant);
     for (int di = 0; di < kDecoderCount; ++di) T->in_set[di] = di != conf && (set & (DecoderSet(1) << di));

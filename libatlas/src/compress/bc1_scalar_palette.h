@@ -32,6 +32,10 @@ struct ScalarTables {
     float b[kDecoderCount][2][32][32][4];
     // Conformant tolerance of a channel pair times its weight.
     float tr[32][32], tg[64][64], tb[32][32];
+    // The decoders' largest disagreement on an endpoint value (sum over the channels of
+    // the widest level spread times the weight) plus the largest endpoint step: how far
+    // one endpoint can be from a value it stands for from below.
+    float endpoint_slack = 0;
 };
 
 // Tables for an unpack (weights and decoder set). Those of bc1_scalar_unpack(set)

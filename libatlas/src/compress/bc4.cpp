@@ -47,18 +47,50 @@ void palette_values(uint8_t b0, uint8_t b1, bool snorm, Decoder d, float v[8]) {
     }
 }
 
-// Relative widening that makes a float palette bound the exact value: a BC4 entry is
-// rounded at most twice (num / steps, then / 255 or 127), 2^-23 relative, and a decoder
-// computing in double is ~1e-16 off the exact value; 2^-21 covers both. Values that are
-// exactly 0 or +-1 in float are exact (no other entry rounds to them) and stay so.
-constexpr float kExactMargin = 1.0f / 2097152.0f;
-float widen(float x, float dir) {
-    if (x == 0.0f || x == 1.0f || x == -1.0f) return x;
-    return x + dir * std::fabs(x) * kExactMargin;
+// The exact palette of a pair under one model, in double (num / (steps * scale) has a
+// relative error of ~1e-16 there), for bounds that hold in exact arithmetic.
+void palette_exact(uint8_t b0, uint8_t b1, bool snorm, Decoder d, double v[8]) {
+    const int e0 = level(b0, snorm), e1 = level(b1, snorm);
+    const double scale = snorm ? 127.0 : 255.0;
+    const bool eight = snorm ? (static_cast<int8_t>(b0) > static_cast<int8_t>(b1)) : (b0 > b1);
+    const bool integer = (d == Decoder::Tool8 || d == Decoder::Tool8Round);
+    const bool round = d == Decoder::Tool8Round;
+    v[0] = e0 / scale;
+    v[1] = e1 / scale;
+    const int steps = eight ? 7 : 5;
+    const int count = eight ? 6 : 4;
+    for (int k = 0; k < count; ++k) {
+        const int num = (steps - 1 - k) * e0 + (k + 1) * e1;
+        const int rounded = round ? (num >= 0 ? (num + steps / 2) / steps : (num - steps / 2) / steps) : num / steps;
+        v[2 + k] = integer ? rounded / scale : num / (double(steps) * scale);
+    }
+    if (!eight) {
+        v[6] = snorm ? -1.0 : 0.0;
+        v[7] = 1.0;
+    }
 }
 
-// `exact_bounds`: widen lo / hi to bound the exact values (the encoder's tables, so that
-// its one-sided and max-error results hold in exact arithmetic); off for the public
+// The smallest float >= x (1 + 1e-15) and the largest <= x (1 - 1e-15) (for x >= 0;
+// mirrored below 0): bounds of the exact value and of any double computation of it.
+// Values a float holds exactly (0, +-1: the palettes' denominators are odd, so no
+// other value is dyadic) are computed exactly in double too and stay as they are.
+float float_up(double x) {
+    if (double(float(x)) == x) return float(x);
+    const double t = x + std::fabs(x) * 1e-15;
+    float f = float(t);
+    if (double(f) < t) f = std::nextafter(f, INFINITY);
+    return f;
+}
+float float_down(double x) {
+    if (double(float(x)) == x) return float(x);
+    const double t = x - std::fabs(x) * 1e-15;
+    float f = float(t);
+    if (double(f) > t) f = std::nextafter(f, -INFINITY);
+    return f;
+}
+
+// `exact_bounds`: lo / hi bound the exact values (the encoder's tables, so that its
+// one-sided and max-error results hold in exact arithmetic); off for the public
 // interval decode, which reports the float values the decoder models compute.
 void interval_palette(uint8_t b0, uint8_t b1, bool snorm, DecoderSet set, detail::Palette<1>& p, bool exact_bounds = false) {
     p.n = 8;
@@ -90,7 +122,18 @@ void interval_palette(uint8_t b0, uint8_t b1, bool snorm, DecoderSet set, detail
         any = true;
     }
     if (exact_bounds)
-        for (int i = 0; i < 8; ++i) { p.lo[i][0] = widen(p.lo[i][0], -1.0f); p.hi[i][0] = widen(p.hi[i][0], 1.0f); }
+        for (int di = 0; di < kDecoderCount; ++di) {
+            if (!(set & (DecoderSet(1) << di))) continue;
+            const Decoder d = static_cast<Decoder>(di);
+            double x[8];
+            palette_exact(b0, b1, snorm, d == Decoder::Conformant ? Decoder::Reference : d, x);
+            const bool eight = snorm ? (static_cast<int8_t>(b0) > static_cast<int8_t>(b1)) : (b0 > b1);
+            for (int i = 0; i < 8; ++i) {
+                const double t = (d == Decoder::Conformant && i >= 2 && i < (eight ? 8 : 6)) ? 1.0 / 255.0 : 0.0;
+                p.lo[i][0] = std::min(p.lo[i][0], float_down(x[i] - t));
+                p.hi[i][0] = std::max(p.hi[i][0], float_up(x[i] + t));
+            }
+        }
 }
 
 void write_block(uint8_t b0, uint8_t b1, const uint8_t idx[16], uint8_t out[8]) {
@@ -329,8 +372,11 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     // Floor / ceil of the extremes (Best and blocks missing the bound start the
     // exhaustive search from this incumbent: the result is the same, found sooner).
     const int hstep = options_.quality == Quality::Fast ? std::max(1, qhi1 - qhi0) : 1;
-    for (int h = qhi0; h <= qhi1; h += hstep)
-        for (int l = qlo0; l <= qlo1; ++l) {
+    for (int h = os && qhi0 > lo_lim ? qhi0 - hstep : qhi0; h <= qhi1; h += hstep)
+        // One-sided: also the level below the floor. The bounds are exact (widened), so a
+        // minimum that sits on a level's float value can be an ulp below the level itself,
+        // and without a lower endpoint such a texel would be left with the constant 0.
+        for (int l = os ? clampi(qlo0 - 1) : qlo0; l <= qlo1; ++l) {
             int a = clampi(h), b = clampi(l);
             if (a > b) consider(a, b);  // 8 interpolated values
             // Fast skips the 6-value mode, except for flat blocks (a == b) where the
