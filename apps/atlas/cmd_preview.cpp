@@ -463,9 +463,13 @@ int run_preview(const Args& a) {
                                                  : render::LayerView::Ground;
         s.camera = render::layer_camera(layer, kind, aspect, view.az, view.el);
         // A daylight sky gradient unless --sky says otherwise.
-        s.sky_colour = {{0.16f, 0.32f, 0.75f}};
-        s.sky_horizon = Vec3f{{0.62f, 0.72f, 0.86f}};
-        s.sun_direction = render::sun_direction(150, 25);
+        s.sky_colour = {{0.07f, 0.17f, 0.50f}};
+        s.sky_horizon = Vec3f{{0.45f, 0.55f, 0.70f}};
+        s.sun_direction = render::sun_direction(230, 20);
+        // Kilometre-sized clouds are optically thick: a brighter sun over the
+        // same sky keeps their lit sides brighter than the sky, as in photographs.
+        s.sun_colour = {{2.6f, 2.45f, 2.25f}};
+        s.multiple_scattering = 0.8;
     } else if (have_voxel && (view.kind != "auto" || (a.positional.size() == 1 && is_graph(a.positional[0])))) {
         s.camera = voxel_camera(scene, view, aspect);
     }

@@ -527,7 +527,7 @@ struct LayerIntegrator {
     Vec3d sun;
     Vec3d cam_up; // local up at the camera
     double ambient[3];
-    double base_step, grow;
+    double base_step, grow, max_step;
     double light_step;
     double r_ground, r_inner, r_outer;
     bool use_envelope;
@@ -579,7 +579,7 @@ struct LayerIntegrator {
             int zero_run = 0;
             while (t < t_end && steps < kMaxSteps) {
                 ++steps;
-                double dt = base_step * (1 + t / grow);
+                double dt = std::min(max_step, base_step * (1 + t / grow));
                 if (first) dt *= 0.5 + 0.5 * jitter; // jittered start
                 first = false;
                 if (searching) {
@@ -718,6 +718,7 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
                        {sky.ambient[0], sky.ambient[1], sky.ambient[2]},
                        std::clamp(thickness / 96.0, 5.0, 60.0) / settings.quality,
                        2500.0, // the step doubles every 2.5 km of distance
+                       400.0 / settings.quality, // at most 400 m (the search strides twice that)
                        std::clamp(thickness / 40.0, 20.0, 120.0),
                        scene.earth_radius,
                        scene.earth_radius + model.bottom(),
@@ -784,11 +785,31 @@ Camera layer_camera(const LayerScene& scene, LayerView view, double aspect, doub
         break;
     }
     case LayerView::Orbit: {
+        // Frame the cloud mass, not the map: the centroid and spread of
+        // coverage x thickness^2 (tall storms dominate a fair-weather field).
+        const Field2D& f = *scene.ndf;
+        const int cc = f.find_channel("coverage"), cmn = f.find_channel("min_height"), cmx = f.find_channel("max_height");
+        double sw = 0, sx1 = 0, sy1 = 0, sx2 = 0, sy2 = 0;
+        for (int y = 0; y < f.height(); ++y)
+            for (int x = 0; x < f.width(); ++x) {
+                const double t = std::max(0.0, double(f.at(cmx, x, y)) - f.at(cmn, x, y));
+                const double wgt = std::max(0.0, double(f.at(cc, x, y))) * t * t;
+                const Vec2d p = f.texel_center(x, y);
+                sw += wgt, sx1 += wgt * p[0], sy1 += wgt * p[1], sx2 += wgt * p[0] * p[0], sy2 += wgt * p[1] * p[1];
+            }
+        double mx = cx, my = cy, r = 0.5 * std::hypot(sx, sy);
+        if (sw > 0) {
+            mx = sx1 / sw, my = sy1 / sw;
+            const double var = std::max(0.0, sx2 / sw - mx * mx) + std::max(0.0, sy2 / sw - my * my);
+            r = std::clamp(std::sqrt(var), 2000.0, r);
+        }
         c.fov_deg = 50;
-        const double r = 0.5 * std::hypot(sx, sy);
-        const double dist = r / std::tan(0.5 * c.fov_deg * deg) * (aspect >= 1 ? 1.0 : 1.0 / aspect) * 0.9;
+        const double half = 0.5 * c.fov_deg * deg;
+        const double half_min = std::min(half, std::atan(std::tan(half) * aspect));
+        const double radius = std::hypot(r, 0.5 * (m.top() - m.bottom()));
+        const double dist = radius / std::sin(half_min);
         const double az = azimuth_deg * deg, el = elevation_deg * deg;
-        c.look_at = {{cx, cy, mid}};
+        c.look_at = {{mx, my, mid}};
         // Azimuth 0 = from -y, counter-clockwise seen from above (framing_camera's convention).
         c.position = c.look_at + Vec3d{{std::sin(az) * std::cos(el) * dist, -std::cos(az) * std::cos(el) * dist, std::sin(el) * dist}};
         if (c.position[2] < 2) c.position[2] = 2;

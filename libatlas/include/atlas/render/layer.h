@@ -154,9 +154,10 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
 //           pitched up 20 degrees, fov 60
 //   Aerial  1.5 km above the highest cloud top, south of the map centre,
 //           looking north and down 20 degrees, fov 60
-//   Orbit   looking at the map centre at mid-cloud height from the given
-//           azimuth (0 = from -y, counter-clockwise) and elevation at a
-//           distance that frames the map, fov 50
+//   Orbit   looking at the cloud mass (centroid of coverage x thickness^2
+//           at mid-cloud height) from the given azimuth (0 = from -y,
+//           counter-clockwise) and elevation, at a distance that frames
+//           one standard deviation of that mass (at least 2 km), fov 50
 enum class LayerView { Ground, Aerial, Orbit };
 Camera layer_camera(const LayerScene& scene, LayerView view, double aspect, double azimuth_deg = 30, double elevation_deg = 25);
 
