@@ -68,7 +68,7 @@ void declare(NodeDeclaration& d) {
     d.param_int("pressure_max_iterations", 200).range(1, 10000).describe("CG iteration cap per projection");
     d.param_bool("multigrid", true).describe("multigrid-preconditioned CG (false: Jacobi-preconditioned)");
     d.param_float("condensation_rate", 0).range(0, 1e9).with_unit("1/s").describe("0: instantaneous saturation adjustment");
-    d.param_float("vorticity_confinement", 0).range(0, 0.5).describe(
+    d.param_float("vorticity_confinement", 0).range(0, 0.2).describe(
         "dimensionless epsilon of vorticity confinement, f = eps dx |omega| (N x omega) (billowy detail; 0.1..0.2 typical)");
     d.param_float("viscosity", 0).range(0, 1e4).with_unit("m^2/s").describe("explicit kinematic viscosity");
     d.param_float("diffusivity", 0).range(0, 1e4).with_unit("m^2/s").describe("explicit diffusivity of theta', qv, qc");

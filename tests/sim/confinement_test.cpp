@@ -171,7 +171,7 @@ TEST(SimConfinement, NoForceInSolidBodyRotationOrAtRest) {
 // past the eps = 0 run. Now confinement adds detail, not energy.
 TEST(SimConfinement, BubbleUpdraftStaysNearTheUnconfinedRun) {
     for (int n : {16, 32}) {
-        double w0 = bubble_max_w(n, 0.0, 400), w1 = bubble_max_w(n, 0.15, 400);
+        double w0 = bubble_max_w(n, 0.0, 400), w1 = bubble_max_w(n, 0.1, 400);
         EXPECT_GT(w0, 2.0) << n;
         EXPECT_LT(w1, 1.5 * w0) << n;
         EXPECT_GE(w1, w0 * 0.9) << n;
@@ -180,17 +180,17 @@ TEST(SimConfinement, BubbleUpdraftStaysNearTheUnconfinedRun) {
 
 // Same physical bubble at 94 m and 47 m cells: similar max w with confinement.
 TEST(SimConfinement, BubbleUpdraftSimilarAtTwoResolutions) {
-    double coarse = bubble_max_w(16, 0.15, 400), fine = bubble_max_w(32, 0.15, 400);
+    double coarse = bubble_max_w(16, 0.1, 400), fine = bubble_max_w(32, 0.1, 400);
     EXPECT_LT(std::fabs(fine - coarse) / fine, 0.25) << coarse << " vs " << fine;
 }
 
-// The largest allowed eps (0.5) stays finite and bounded; beyond it the
+// The largest allowed eps (0.2) stays finite and bounded; beyond it the
 // confinement outgrows the advection's dissipation and is refused.
 TEST(SimConfinement, LargestEpsStaysBoundedAndLargerIsRefused) {
-    double w0 = bubble_max_w(32, 0.0, 400), w2 = bubble_max_w(32, 0.5, 400);
+    double w0 = bubble_max_w(32, 0.0, 400), w2 = bubble_max_w(32, 0.2, 400);
     EXPECT_TRUE(std::isfinite(w2));
     EXPECT_LT(w2, 4 * w0);
     SimOptions o;
-    o.vorticity_confinement = 0.51;
+    o.vorticity_confinement = 0.21;
     EXPECT_THROW(o.validate(4), atlas::Error);
 }

@@ -128,11 +128,19 @@ float cubic_limited_at(const Lattice& l, const float* q, const double p[3]) {
     return std::clamp(float(v), lo, hi);
 }
 
-// True when p lies within one cell of a domain edge along an axis with more than one cell.
-bool near_edge(const GridSpec& g, const double p[3]) {
+// True when p lies within one cell of an open face (along an axis with more
+// than one cell). There inflow values are read from the clamped edge, which the
+// backward trace cannot invert, so the correction would be wrong. At closed
+// (free-slip) faces the flow runs along the wall, both traces stay inside and
+// the correction keeps its second order (falling back to semi-Lagrangian in a
+// one-cell band made the whole Taylor-Green run first order in the max norm).
+bool near_open_edge(const GridSpec& g, const double p[3]) {
     const int n[3] = {g.nx, g.ny, g.nz};
-    for (int a = 0; a < 3; ++a)
-        if (n[a] > 1 && (p[a] < 1.0 || p[a] > n[a] - 1.0)) return true;
+    for (int a = 0; a < 3; ++a) {
+        if (n[a] <= 1) continue;
+        if (g.face(2 * a) == Boundary::Open && p[a] < 1.0) return true;
+        if (g.face(2 * a + 1) == Boundary::Open && p[a] > n[a] - 1.0) return true;
+    }
     return false;
 }
 
@@ -260,7 +268,7 @@ void advect_many(const MacVelocity& vel, const Lattice& l, std::span<const std::
             double src[3];
             pos(fwd_pos, id, p, src);
             const float fv = fwd_val[id];
-            if (near_edge(vel.spec, src)) {
+            if (near_open_edge(vel.spec, src)) {
                 out[id] = fv; // keep semi-Lagrangian
                 return;
             }

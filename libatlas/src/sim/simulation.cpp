@@ -35,6 +35,13 @@ void check_range(double v, double lo, double hi, const char* what) {
     }
 }
 
+void check_nonnegative(const std::vector<float>& a, const char* what) {
+    for (size_t n = 0; n < a.size(); ++n)
+        if (a[n] < 0)
+            throw Error(std::string("sim step: ") + what + " = " + std::to_string(a[n]) + " kg/kg at cell " + std::to_string(n) +
+                        "; mixing ratios written into the state must be >= 0 (not clamped: that would add water)");
+}
+
 void check_finite(const std::vector<float>& a, const std::string& what) {
     for (size_t n = 0; n < a.size(); ++n)
         if (!std::isfinite(a[n])) throw Error("sim: " + what + " holds NaN/Inf at cell " + std::to_string(n));
@@ -178,9 +185,10 @@ ReferenceProfile make_reference(const Sounding& s, int nz, double dx) {
 
 void SimOptions::validate(int nz) const {
     check_range(cfl, 0.1, 5, "options.cfl");
+    check_range(step_error_tolerance, 0, 1, "options.step_error_tolerance (cells)");
     check_range(max_substeps, 1, 10000, "options.max_substeps");
     check_range(condensation_rate, 0, 1e9, "options.condensation_rate (1/s)");
-    check_range(vorticity_confinement, 0, 0.5, "options.vorticity_confinement (dimensionless)");
+    check_range(vorticity_confinement, 0, 0.2, "options.vorticity_confinement (dimensionless)");
     check_range(viscosity, 0, 1e4, "options.viscosity (m^2/s)");
     check_range(diffusivity, 0, 1e4, "options.diffusivity (m^2/s)");
     if (!wind.empty() && wind.size() != size_t(nz)) throw Error("sim: options.wind needs nz entries (one per cell row)");
@@ -191,7 +199,9 @@ void SimOptions::validate(int nz) const {
 
 uint64_t simulation_bytes(const GridSpec& spec, const SimOptions& options) {
     return simulation_bytes(spec) + (options.rain ? uint64_t(spec.cells()) * kSimRainBytesPerCell : 0) +
-           (options.advection_reflection ? uint64_t(spec.cells()) * kSimReflectionBytesPerCell : 0);
+           (options.advection_reflection ? uint64_t(spec.cells()) * kSimReflectionBytesPerCell
+            : options.time_scheme == TimeScheme::Trapezoidal ? uint64_t(spec.cells()) * kSimTrapezoidalBytesPerCell
+                                                             : 0);
 }
 
 std::string StepReport::to_json() const {
@@ -204,12 +214,14 @@ std::string StepReport::to_json() const {
                   "\"min_theta_perturbation\":%.9g,\"max_qc\":%.9g,\"seconds_advect\":%.6f,\"seconds_sources\":%.6f,"
                   "\"seconds_thermo\":%.6f,\"seconds_forces\":%.6f,\"seconds_project\":%.6f,\"water_mass\":%.9g,"
                   "\"rain_fallout\":%.9g,\"autoconverted\":%.9g,\"accreted\":%.9g,\"rain_evaporated\":%.9g,"
-                  "\"max_qr\":%.9g,\"sedimentation_substeps\":%d,\"seconds_rain\":%.6f}",
+                  "\"max_qr\":%.9g,\"sedimentation_substeps\":%d,\"seconds_rain\":%.6f,\"step_error\":%.9g,"
+                  "\"accuracy_dt\":%.9g,\"dt_limit\":\"%s\",\"vapour_sink_deficit\":%.9g,\"water_redistributed\":%.9g}",
                   dt, substeps, substep_dt, pressure_iterations, max_pressure_iterations,
                   pressure_converged ? "true" : "false", divergence.l2, divergence.max, total_water, water_drift,
                   theta_l_drift, condensed, max_w, max_speed, max_theta_perturbation, min_theta_perturbation, max_qc,
                   seconds_advect, seconds_sources, seconds_thermo, seconds_forces, seconds_project, water_mass,
-                  rain_fallout, autoconverted, accreted, rain_evaporated, max_qr, sedimentation_substeps, seconds_rain);
+                  rain_fallout, autoconverted, accreted, rain_evaporated, max_qr, sedimentation_substeps, seconds_rain,
+                  step_error, accuracy_dt, dt_limit, vapour_sink_deficit, water_redistributed);
     return buf;
 }
 
@@ -233,6 +245,7 @@ Simulation::Simulation(const GridSpec& spec, const Sounding& sounding, const Sim
     qc_.assign(n, 0.f);
     if (opt_.rain) qr_.assign(n, 0.f);
     if (opt_.advection_reflection) vel_third_ = MacVelocity(spec);
+    else if (opt_.time_scheme == TimeScheme::Trapezoidal) vel_prev_ = MacVelocity(spec), grad_ = MacVelocity(spec);
     tmp_.resize(n);
     heat_src_.assign(n, 0.f);
     vap_src_.assign(n, 0.f);
@@ -283,7 +296,7 @@ void Simulation::set_sources(const Field3D& heat, const Field3D& vap, const std:
 void Simulation::add_ground_patch(const GroundPatch& g) {
     check_range(g.radius, 1e-3, 1e9, "ground_patch.radius (m)");
     check_range(g.depth, 1e-3, 1e9, "ground_patch.depth (m)");
-    check_range(g.heat_rate, 0, 10, "ground_patch.heat_rate (K/s)");
+    check_range(g.heat_rate, -10, 10, "ground_patch.heat_rate (K/s)");
     check_range(g.vapour_rate, 0, 1e-3, "ground_patch.vapour_rate (kg/kg/s)");
     check_range(g.noise_scale, 1e-3, 1e9, "ground_patch.noise_scale (m)");
     check_range(g.noise_amount, 0, 1, "ground_patch.noise_amount");
@@ -318,7 +331,7 @@ double Simulation::max_buoyancy() const {
     return m;
 }
 
-void Simulation::buoyancy(double dt) {
+void Simulation::buoyancy_into(MacVelocity& v, double dt) {
     const int nx = spec_.nx, ny = spec_.ny, nz = spec_.nz;
     std::vector<float>& b = tmp_;
     for_slices(nz, [&](int k) {
@@ -334,7 +347,7 @@ void Simulation::buoyancy(double dt) {
             for (int i = 0; i < nx; ++i) {
                 double bb = k == 0 ? b[vel_.ic(i, j, 0)] : k == nz ? b[vel_.ic(i, j, nz - 1)]
                                                                    : 0.5 * (b[vel_.ic(i, j, k - 1)] + b[vel_.ic(i, j, k)]);
-                vel_.w[vel_.iw(i, j, k)] += float(dt * bb);
+                v.w[v.iw(i, j, k)] += float(dt * bb);
             }
     });
 }
@@ -342,12 +355,13 @@ void Simulation::buoyancy(double dt) {
 void Simulation::confinement(double dt) { add_confinement(vel_, opt_.vorticity_confinement, dt); }
 
 namespace {
-// q += dt * coef * lap(q - ref) on lattice l, zero-gradient edges.
-void diffuse_lattice(const Lattice& l, std::vector<float>& q, double coef_dt_h2, const std::vector<double>* ref_by_k) {
-    std::vector<float> src = q;
+// out += coef_dt_h2 * lap(in - ref) on lattice l, zero-gradient edges (the
+// mirror image across a free-slip wall / no-flux face). out may not alias in.
+void lap_accumulate(const Lattice& l, const std::vector<float>& in, std::vector<float>& out, double coef_dt_h2,
+                    const std::vector<double>* ref_by_k) {
     auto at = [&](int i, int j, int k) {
         i = std::clamp(i, 0, l.n[0] - 1), j = std::clamp(j, 0, l.n[1] - 1), k = std::clamp(k, 0, l.n[2] - 1);
-        double v = src[(size_t(k) * l.n[1] + j) * l.n[0] + i];
+        double v = in[(size_t(k) * l.n[1] + j) * l.n[0] + i];
         return ref_by_k ? v - (*ref_by_k)[size_t(k)] : v;
     };
     for_slices(l.n[2], [&](int k) {
@@ -356,9 +370,47 @@ void diffuse_lattice(const Lattice& l, std::vector<float>& q, double coef_dt_h2,
                 double c = at(i, j, k);
                 double lap = at(i - 1, j, k) + at(i + 1, j, k) + at(i, j - 1, k) + at(i, j + 1, k) + at(i, j, k - 1) +
                              at(i, j, k + 1) - 6 * c;
-                q[(size_t(k) * l.n[1] + j) * l.n[0] + i] += float(coef_dt_h2 * lap);
+                out[(size_t(k) * l.n[1] + j) * l.n[0] + i] += float(coef_dt_h2 * lap);
             }
     });
+}
+
+// q += dt * coef * lap(q - ref) (forward Euler).
+void diffuse_lattice(const Lattice& l, std::vector<float>& q, double coef_dt_h2, const std::vector<double>* ref_by_k) {
+    const std::vector<float> src = q;
+    lap_accumulate(l, src, q, coef_dt_h2, ref_by_k);
+}
+
+// The arrival half of the trapezoidal rule for explicit diffusion, a two-stage
+// (Heun) evaluation: s = q + c lap q; q += c lap s, c = dt/2 * coef / dx^2.
+void diffuse_heun(const Lattice& l, std::vector<float>& q, double coef_dt_h2, const std::vector<double>* ref_by_k,
+                  std::vector<float>& scratch) {
+    scratch = q;
+    lap_accumulate(l, q, scratch, coef_dt_h2, ref_by_k);
+    lap_accumulate(l, scratch, q, coef_dt_h2, ref_by_k);
+}
+
+// Sets negative values to 0 and takes the same amount from the positive cells
+// of the same z-slice in proportion to their values, so each slice's sum is
+// kept (to float rounding). A slice without enough positive water keeps its
+// negatives clamped (counted all the same). Returns the amount moved.
+double redistribute_negatives(std::vector<float>& q, int nz, size_t plane) {
+    if (q.empty()) return 0;
+    std::vector<double> moved(size_t(nz), 0.0);
+    for_slices(nz, [&](int k) {
+        double neg = 0, pos = 0;
+        for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
+            if (q[c] < 0) neg -= q[c];
+            else pos += q[c];
+        }
+        if (neg == 0) return;
+        const double scale = pos > neg ? (pos - neg) / pos : 0.0;
+        for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) q[c] = q[c] < 0 ? 0.f : float(q[c] * scale);
+        moved[size_t(k)] = neg;
+    });
+    double t = 0;
+    for (double m : moved) t += m;
+    return t;
 }
 } // namespace
 
@@ -375,12 +427,230 @@ void Simulation::diffuse(double dt) {
         diffuse_lattice(l, theta_, opt_.diffusivity * dt / h2, &ref_.theta);
         diffuse_lattice(l, qv_, opt_.diffusivity * dt / h2, &ref_.qv);
         diffuse_lattice(l, qc_, opt_.diffusivity * dt / h2, nullptr);
-        for (float& x : qc_) x = std::max(x, 0.f);
-        for (float& x : qv_) x = std::max(x, 0.f);
     }
 }
 
+void Simulation::add_sources(double dt, StepReport& rep) {
+    const size_t plane = size_t(spec_.nx) * spec_.ny;
+    std::vector<double> deficit(size_t(spec_.nz), 0.0);
+    for_slices(spec_.nz, [&](int k) {
+        double d = 0;
+        for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
+            theta_[c] += float(dt * heat_src_[c]);
+            const float v = qv_[c] + float(dt * vap_src_[c]);
+            if (v < 0) d -= v; // a sink takes only the vapour that is there
+            qv_[c] = std::max(v, 0.f);
+        }
+        deficit[size_t(k)] = d;
+    });
+    for (double d : deficit) rep.vapour_sink_deficit += d;
+}
+
+void Simulation::thermodynamics(double dt, StepReport& rep) {
+    const int nz = spec_.nz;
+    const size_t plane = size_t(spec_.nx) * spec_.ny;
+    auto t0 = Clock::now();
+    if (opt_.moist) {
+        const double relax = opt_.condensation_rate > 0 ? 1 - std::exp(-opt_.condensation_rate * dt) : 1.0;
+        const size_t nzs = size_t(nz);
+        std::vector<double> before(nzs), after(nzs), drift(nzs), cond(nzs);
+        for_slices(nz, [&](int k) {
+            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)], lk = kLv / (kCp * pi);
+            double wb = 0, wa = 0, dr = 0, cd = 0;
+            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
+                wb += double(qv_[c]) + qc_[c];
+                double thl0 = theta_[c] - lk * qc_[c];
+                AdjustResult r = opt_.reversible_theta_e ? saturation_adjust_theta_e(theta_[c], qv_[c], qc_[c], p, relax)
+                                                         : saturation_adjust(theta_[c], qv_[c], qc_[c], p, relax);
+                float dq = float(r.condensed);
+                dq = std::clamp(dq, -qc_[c], qv_[c]);
+                qv_[c] -= dq;
+                qc_[c] += dq;
+                theta_[c] = float(r.theta);
+                cd += dq;
+                wa += double(qv_[c]) + qc_[c];
+                dr = std::max(dr, std::fabs(theta_[c] - lk * qc_[c] - thl0));
+            }
+            before[size_t(k)] = wb, after[size_t(k)] = wa, drift[size_t(k)] = dr, cond[size_t(k)] = cd;
+        });
+        double wb = 0, wa = 0;
+        for (int k = 0; k < nz; ++k) {
+            wb += before[size_t(k)], wa += after[size_t(k)];
+            rep.theta_l_drift = std::max(rep.theta_l_drift, drift[size_t(k)]);
+            rep.condensed += cond[size_t(k)];
+        }
+        rep.water_drift = std::max(rep.water_drift, wb > 0 ? std::fabs(wa - wb) / wb : 0.0);
+    }
+    rep.seconds_thermo += seconds_since(t0);
+    // Kessler warm rain: conversions, evaporation, fallout.
+    if (!qr_.empty()) {
+        t0 = Clock::now();
+        KesslerReport kr = kessler_conversions(spec_, theta_, qv_, qc_, qr_, ref_.pressure, ref_.exner, ref_.rho, dt, opt_.kessler);
+        rep.autoconverted += kr.autoconverted;
+        rep.accreted += kr.accreted;
+        rep.rain_evaporated += kr.evaporated;
+        if (opt_.kessler.sedimentation) {
+            KesslerReport sr = rain_sedimentation(spec_, qr_, ref_.rho, dt, opt_.kessler);
+            rep.rain_fallout += sr.fallout;
+            rep.sedimentation_substeps += sr.sedimentation_substeps;
+        }
+        rep.seconds_rain += seconds_since(t0);
+    }
+}
+
+namespace {
+template <class F>
+void for_components(MacVelocity& a, F&& f) {
+    f(a.u, 0);
+    f(a.v, 1);
+    f(a.w, 2);
+}
+Lattice component_lattice(const GridSpec& g, int c) { return c == 0 ? u_lattice(g) : c == 1 ? v_lattice(g) : w_lattice(g); }
+bool component_moves(const GridSpec& g, int c) { return (c == 0 ? g.nx : c == 1 ? g.ny : g.nz) > 1; }
+} // namespace
+
+void Simulation::substep_trapezoidal(double dt, StepReport& rep) {
+    const int nz = spec_.nz;
+    const size_t plane = size_t(spec_.nx) * spec_.ny;
+    const double h2 = spec_.dx * spec_.dx;
+    auto t0 = Clock::now();
+    // 0. Departure-point half of the forces, from the state at t^n. Velocity:
+    //    S = u^n - (dt / dt_prev) g + dt/2 b^n + dt/2 nu lap u^n, with g the last
+    //    projection's removed part (dt_prev/2 grad p^n). Trace velocity (into
+    //    vel_prev_): u^n + (dt / (2 dt_prev)) (u^n - u^{n-1}).
+    const bool history = history_dt_ > 0;
+    const double r = history ? dt / history_dt_ : 0.0;
+    if (!history) {
+        vel_prev_ = vel_;
+        grad_ = vel_;
+    } else {
+        for_components(grad_, [&](std::vector<float>& g, int c) {
+            const std::vector<float>& u = c == 0 ? vel_.u : c == 1 ? vel_.v : vel_.w;
+            std::vector<float>& up = c == 0 ? vel_prev_.u : c == 1 ? vel_prev_.v : vel_prev_.w;
+            for (size_t n = 0; n < g.size(); ++n) {
+                g[n] = float(u[n] - r * g[n]);
+                up[n] = float(u[n] + 0.5 * r * (double(u[n]) - up[n]));
+            }
+        });
+    }
+    buoyancy_into(grad_, 0.5 * dt);
+    if (opt_.viscosity > 0)
+        for_components(grad_, [&](std::vector<float>& g, int c) {
+            if (component_moves(spec_, c))
+                lap_accumulate(component_lattice(spec_, c), c == 0 ? vel_.u : c == 1 ? vel_.v : vel_.w, g,
+                               0.5 * dt * opt_.viscosity / h2, nullptr);
+        });
+    grad_.enforce_walls();
+    add_sources(0.5 * dt, rep);
+    if (opt_.diffusivity > 0) {
+        const Lattice l = cell_lattice(spec_);
+        const double c = 0.5 * dt * opt_.diffusivity / h2;
+        diffuse_lattice(l, theta_, c, &ref_.theta);
+        diffuse_lattice(l, qv_, c, &ref_.qv);
+        diffuse_lattice(l, qc_, c, nullptr);
+        rep.water_redistributed += redistribute_negatives(qv_, nz, plane) + redistribute_negatives(qc_, nz, plane);
+    }
+    rep.seconds_forces += seconds_since(t0);
+    // 1. Advection along the time-centred trajectory.
+    t0 = Clock::now();
+    const Lattice cl = cell_lattice(spec_);
+    if (opt_.reversible_theta_e && opt_.moist) {
+        for_slices(nz, [&](int k) {
+            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
+            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
+                theta_[c] = float(equivalent_potential_temperature(theta_[c] * pi, p, qv_[c], double(qv_[c]) + qc_[c]));
+        });
+    }
+    {
+        std::vector<float>&a = scalar_tmp_[0], &b = scalar_tmp_[1], &c = scalar_tmp_[2];
+        a.resize(theta_.size());
+        b.resize(theta_.size());
+        c.resize(qr_.size());
+        std::span<const float> in[4] = {theta_, qv_, qc_, qr_};
+        std::span<float> out[4] = {tmp_, a, b, c};
+        advect_many(vel_prev_, cl, std::span(in, qr_.empty() ? 3 : 4), std::span(out, qr_.empty() ? 3 : 4), dt,
+                    opt_.scheme, *scratch_);
+        theta_.swap(tmp_);
+        qv_.swap(a);
+        qc_.swap(b);
+        qr_.swap(c);
+    }
+    if (opt_.reversible_theta_e && opt_.moist) {
+        for_slices(nz, [&](int k) {
+            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
+            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
+                theta_[c] = float(temperature_from_theta_e(theta_[c], p, qv_[c], double(qv_[c]) + qc_[c]) / pi);
+        });
+    }
+    for_components(grad_, [&](std::vector<float>& g, int c) {
+        if (!component_moves(spec_, c)) return;
+        std::span<const float> qs[1] = {g};
+        std::span<float> os[1] = {c == 0 ? vel_tmp_.u : c == 1 ? vel_tmp_.v : vel_tmp_.w};
+        advect_many(vel_prev_, component_lattice(spec_, c), qs, os, dt, opt_.scheme, *scratch_);
+    });
+    vel_tmp_.enforce_walls();
+    std::swap(vel_prev_, vel_); // vel_prev_ = u^n, vel_ = trace velocity
+    std::swap(vel_, vel_tmp_);  // vel_ = advected, vel_tmp_ = trace velocity
+    rep.seconds_advect += seconds_since(t0);
+    // 2. Arrival half of the sources and of the scalar diffusion, thermodynamics.
+    t0 = Clock::now();
+    add_sources(0.5 * dt, rep);
+    rep.seconds_sources += seconds_since(t0);
+    if (opt_.diffusivity > 0) {
+        t0 = Clock::now();
+        const double c = 0.5 * dt * opt_.diffusivity / h2;
+        diffuse_heun(cl, theta_, c, &ref_.theta, scalar_tmp_[0]);
+        diffuse_heun(cl, qv_, c, &ref_.qv, scalar_tmp_[0]);
+        diffuse_heun(cl, qc_, c, nullptr, scalar_tmp_[0]);
+        rep.water_redistributed += redistribute_negatives(qv_, nz, plane) + redistribute_negatives(qc_, nz, plane);
+        rep.seconds_forces += seconds_since(t0);
+    }
+    thermodynamics(dt, rep);
+    // 3. Arrival half of buoyancy and viscosity; confinement (O(dx), first order).
+    t0 = Clock::now();
+    buoyancy(0.5 * dt);
+    if (opt_.viscosity > 0) {
+        std::vector<float> s;
+        for_components(vel_, [&](std::vector<float>& q, int c) {
+            if (component_moves(spec_, c)) diffuse_heun(component_lattice(spec_, c), q, 0.5 * dt * opt_.viscosity / h2, nullptr, s);
+        });
+        vel_.enforce_walls();
+    }
+    if (opt_.vorticity_confinement > 0) confinement(dt);
+    rep.seconds_forces += seconds_since(t0);
+    // 4. Projection; its removed part g = u* - u^{n+1} = dt/2 grad p^{n+1} is kept.
+    t0 = Clock::now();
+    grad_ = vel_;
+    ProjectionReport pr = solver_.project(vel_, opt_.projection);
+    for_components(grad_, [&](std::vector<float>& g, int c) {
+        const std::vector<float>& u = c == 0 ? vel_.u : c == 1 ? vel_.v : vel_.w;
+        for (size_t n = 0; n < g.size(); ++n) g[n] -= u[n];
+    });
+    rep.pressure_iterations += pr.iterations;
+    rep.max_pressure_iterations = std::max(rep.max_pressure_iterations, pr.iterations);
+    rep.pressure_converged = rep.pressure_converged && pr.converged;
+    rep.divergence = pr.after;
+    rep.seconds_project += seconds_since(t0);
+    // 5. Embedded error estimate: the trace velocity against the time-centred
+    //    mean of the velocities now known, as a displacement in cells.
+    double err = 0;
+    for_components(vel_tmp_, [&](std::vector<float>& t, int c) {
+        const std::vector<float>& a = c == 0 ? vel_prev_.u : c == 1 ? vel_prev_.v : vel_prev_.w;
+        const std::vector<float>& b = c == 0 ? vel_.u : c == 1 ? vel_.v : vel_.w;
+        for (size_t n = 0; n < t.size(); ++n) err = std::max(err, std::fabs(double(t[n]) - 0.5 * (double(a[n]) + b[n])));
+    });
+    err *= dt / spec_.dx;
+    rep.step_error = std::max(rep.step_error, err);
+    last_error_ = err;
+    last_dt_ = dt;
+    history_dt_ = dt;
+}
+
 void Simulation::substep(double dt, StepReport& rep) {
+    if (!opt_.advection_reflection && opt_.time_scheme == TimeScheme::Trapezoidal) {
+        substep_trapezoidal(dt, rep);
+        return;
+    }
     const int nx = spec_.nx, ny = spec_.ny, nz = spec_.nz;
     const size_t plane = size_t(nx) * ny;
     auto t0 = Clock::now();
@@ -457,66 +727,18 @@ void Simulation::substep(double dt, StepReport& rep) {
     rep.seconds_advect += seconds_since(t0);
     // 2. Sources.
     t0 = Clock::now();
-    for_slices(nz, [&](int k) {
-        for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
-            theta_[c] += float(dt * heat_src_[c]);
-            qv_[c] = std::max(0.f, qv_[c] + float(dt * vap_src_[c]));
-        }
-    });
+    add_sources(dt, rep);
     rep.seconds_sources += seconds_since(t0);
-    // 3. Saturation adjustment (water and theta_l accounted per slice, summed in order).
-    t0 = Clock::now();
-    if (opt_.moist) {
-        const double relax = opt_.condensation_rate > 0 ? 1 - std::exp(-opt_.condensation_rate * dt) : 1.0;
-        const size_t nzs = size_t(nz);
-        std::vector<double> before(nzs), after(nzs), drift(nzs), cond(nzs);
-        for_slices(nz, [&](int k) {
-            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)], lk = kLv / (kCp * pi);
-            double wb = 0, wa = 0, dr = 0, cd = 0;
-            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
-                wb += double(qv_[c]) + qc_[c];
-                double thl0 = theta_[c] - lk * qc_[c];
-                AdjustResult r = opt_.reversible_theta_e ? saturation_adjust_theta_e(theta_[c], qv_[c], qc_[c], p, relax)
-                                                         : saturation_adjust(theta_[c], qv_[c], qc_[c], p, relax);
-                float dq = float(r.condensed);
-                dq = std::clamp(dq, -qc_[c], qv_[c]);
-                qv_[c] -= dq;
-                qc_[c] += dq;
-                theta_[c] = float(r.theta);
-                cd += dq;
-                wa += double(qv_[c]) + qc_[c];
-                dr = std::max(dr, std::fabs(theta_[c] - lk * qc_[c] - thl0));
-            }
-            before[size_t(k)] = wb, after[size_t(k)] = wa, drift[size_t(k)] = dr, cond[size_t(k)] = cd;
-        });
-        double wb = 0, wa = 0;
-        for (int k = 0; k < nz; ++k) {
-            wb += before[size_t(k)], wa += after[size_t(k)];
-            rep.theta_l_drift = std::max(rep.theta_l_drift, drift[size_t(k)]);
-            rep.condensed += cond[size_t(k)];
-        }
-        rep.water_drift = std::max(rep.water_drift, wb > 0 ? std::fabs(wa - wb) / wb : 0.0);
-    }
-    rep.seconds_thermo += seconds_since(t0);
-    // 3b. Kessler warm rain: conversions, evaporation, fallout.
-    if (!qr_.empty()) {
-        t0 = Clock::now();
-        KesslerReport kr = kessler_conversions(spec_, theta_, qv_, qc_, qr_, ref_.pressure, ref_.exner, ref_.rho, dt, opt_.kessler);
-        rep.autoconverted += kr.autoconverted;
-        rep.accreted += kr.accreted;
-        rep.rain_evaporated += kr.evaporated;
-        if (opt_.kessler.sedimentation) {
-            KesslerReport sr = rain_sedimentation(spec_, qr_, ref_.rho, dt, opt_.kessler);
-            rep.rain_fallout += sr.fallout;
-            rep.sedimentation_substeps += sr.sedimentation_substeps;
-        }
-        rep.seconds_rain += seconds_since(t0);
-    }
+    // 3. Saturation adjustment, Kessler rain.
+    thermodynamics(dt, rep);
     // 4. Forces.
     t0 = Clock::now();
     buoyancy(reflect ? 0.5 * dt : dt);
     if (opt_.vorticity_confinement > 0) confinement(dt);
-    if (opt_.viscosity > 0 || opt_.diffusivity > 0) diffuse(dt);
+    if (opt_.viscosity > 0 || opt_.diffusivity > 0) {
+        diffuse(dt);
+        rep.water_redistributed += redistribute_negatives(qv_, nz, plane) + redistribute_negatives(qc_, nz, plane);
+    }
     rep.seconds_forces += seconds_since(t0);
     // 5. Projection.
     t0 = Clock::now();
@@ -534,17 +756,35 @@ StepReport Simulation::step(double dt) {
     check_finite(qv_, "qv");
     check_finite(qc_, "qc");
     check_finite(qr_, "qr");
+    check_nonnegative(qv_, "qv");
+    check_nonnegative(qc_, "qc");
+    check_nonnegative(qr_, "qr");
     if (!std::isfinite(vel_.max_abs())) throw Error("sim step: velocity holds NaN/Inf");
     StepReport rep;
     const double h = spec_.dx;
+    const bool controlled = !opt_.advection_reflection && opt_.time_scheme == TimeScheme::Trapezoidal &&
+                            opt_.step_error_tolerance > 0;
+    const char* why = "step";
     auto limit = [&]() {
         double lim = 1e30;
+        why = "step";
+        auto take = [&](double l, const char* w) {
+            if (l < lim) lim = l, why = w;
+        };
         double vmax = vel_.max_abs();
-        if (vmax > 0) lim = std::min(lim, opt_.cfl * h / vmax);
+        if (vmax > 0) take(opt_.cfl * h / vmax, "cfl");
         double b = max_buoyancy();
-        if (b > 0) lim = std::min(lim, opt_.cfl * std::sqrt(h / b)); // distance from rest under b stays < cfl cells
+        if (b > 0) take(opt_.cfl * std::sqrt(h / b), "buoyancy"); // distance from rest under b stays < cfl cells
         double nu = std::max(opt_.viscosity, opt_.diffusivity);
-        if (nu > 0) lim = std::min(lim, h * h / (8 * nu));
+        if (nu > 0) take(h * h / (8 * nu), "diffusion");
+        rep.accuracy_dt = 0;
+        if (controlled && history_dt_ > 0 && last_dt_ > 0) {
+            // err ~ dt^3: the substep that would make it 0.9^3 of the tolerance, grown at most 2x.
+            const double acc = last_error_ > 0 ? std::min(2 * last_dt_, 0.9 * last_dt_ * std::cbrt(opt_.step_error_tolerance / last_error_))
+                                               : 2 * last_dt_;
+            rep.accuracy_dt = acc;
+            take(acc, "accuracy");
+        }
         return lim;
     };
     double remaining = dt;
@@ -553,9 +793,9 @@ StepReport Simulation::step(double dt) {
     if (need > opt_.max_substeps) {
         char buf[300];
         std::snprintf(buf, sizeof buf,
-                      "sim step: dt = %g s needs %.0f substeps at CFL %g (max_substeps = %d); lower dt or raise "
-                      "options.max_substeps",
-                      dt, need, opt_.cfl, opt_.max_substeps);
+                      "sim step: dt = %g s needs %.0f substeps at CFL %g (limited by %s; max_substeps = %d); lower dt "
+                      "or raise options.max_substeps",
+                      dt, need, opt_.cfl, why, opt_.max_substeps);
         throw Error(buf);
     }
     while (remaining > 1e-12 * dt) {
@@ -565,6 +805,7 @@ StepReport Simulation::step(double dt) {
         double lim = limit();
         int n = int(std::ceil(remaining / lim - 1e-9));
         double sdt = n <= 1 ? remaining : remaining / n;
+        if (n > 1 || rep.substeps == 0) rep.dt_limit = n > 1 ? why : "step"; // what split the step
         substep(sdt, rep);
         rep.substep_dt = sdt;
         remaining -= sdt;

@@ -77,21 +77,43 @@ struct GroundPatch {
     double center_x = 0, center_y = 0; // m, in grid coordinates (min corner = 0)
     double radius = 500;               // m, > 0
     double depth = 200;                // m above ground that is heated, > 0
-    double heat_rate = 0.01;           // K/s at the centre, [0, 10]
+    double heat_rate = 0.01;           // K/s at the centre, [-10, 10] (< 0: a cooling patch)
     double vapour_rate = 0.0;          // kg/kg/s at the centre, [0, 1e-3]
     double noise_scale = 200;          // m, feature size of the modulation, > 0
     double noise_amount = 0.5;         // 0 = smooth patch, 1 = fully noise-modulated
     uint32_t seed = 1;
 };
 
+// How the operators of one substep are combined in time.
+//   Split: advect with u^n (frozen), then sources, buoyancy, diffusion and the
+//     projection at the arrival point: first order in dt (the pressure, the
+//     forces and the trajectory are all off-centred by dt/2).
+//   Trapezoidal: second order in dt. Forces are split half at the departure
+//     point and half at the arrival point (semi-Lagrangian trapezoidal rule:
+//     q^{n+1} = A[q + dt/2 F]^n + dt/2 F^{n+1}); the pressure half of it is the
+//     previous projection's removed gradient (dt/2 grad p^n, rescaled to the new
+//     dt) taken off before advecting; back-traces use the time-centred velocity
+//     u^n + (dt / (2 dt_prev)) (u^n - u^{n-1}); explicit diffusion at the
+//     arrival point is a two-stage (Heun) evaluation. One projection per
+//     substep, like Split; costs kSimTrapezoidalBytesPerCell and ~10 % time.
+//     The first substep after construction or after velocity() was taken
+//     mutably has no history and is first order (a start-up step).
+enum class TimeScheme { Split, Trapezoidal };
+
 struct SimOptions {
     bool anelastic = true;                // false: Boussinesq (rho0 = const)
     bool moist = true;                    // false: dry (qv, qc stay passive)
     AdvectionScheme scheme = AdvectionScheme::MacCormack;
+    TimeScheme time_scheme = TimeScheme::Trapezoidal; // ignored when advection_reflection is on
     double cfl = 1.0;                     // max cells travelled per substep, [0.1, 5]
+    // Accuracy-based step control (Trapezoidal only; 0 = off): the embedded
+    // estimate of the back-trace error, max |u_trace - (u^n + u^{n+1}) / 2| dt / dx
+    // (cells; O(dt^3)), is kept below this by limiting the next substep to
+    // 0.9 dt (tol / err)^(1/3). [0, 1] cells.
+    double step_error_tolerance = 0.0;
     int max_substeps = 64;                // [1, 10000]
     double condensation_rate = 0;         // 1/s; 0 = instantaneous equilibrium, else relax 1 - exp(-rate dt)
-    double vorticity_confinement = 0;     // epsilon, dimensionless, [0, 0.5] (confinement.h; at 0.15 a test bubble's max w is 1.1-1.2x the eps = 0 run)
+    double vorticity_confinement = 0;     // epsilon, dimensionless, [0, 0.2] (confinement.h; at 0.1 a test bubble's max w is 1.14-1.18x the eps = 0 run)
     double viscosity = 0;                 // nu, m^2/s, [0, 1e4] (explicit; limits dt to dx^2/(8 nu))
     double diffusivity = 0;               // kappa for theta', qv, qc, m^2/s, [0, 1e4]
     std::vector<double> wind;             // optional ambient u(z) per cell row (nz entries), m/s, relaxed to at open x faces
@@ -116,6 +138,9 @@ struct SimOptions {
     void validate(int nz) const;
 };
 
+// Extra bytes per cell with TimeScheme::Trapezoidal (without advection_reflection):
+// the previous velocity u^{n-1} and the projection's removed gradient (two MAC velocities).
+constexpr uint64_t kSimTrapezoidalBytesPerCell = 24;
 // Extra bytes per cell when options.rain is on: qr and its advection output.
 constexpr uint64_t kSimRainBytesPerCell = 8;
 // Extra bytes per cell with options.advection_reflection: a third MAC velocity.
@@ -138,6 +163,18 @@ struct StepReport {
     double autoconverted = 0, accreted = 0, rain_evaporated = 0; // kg/kg summed over cells, this step
     double max_qr = 0;               // kg/kg
     int sedimentation_substeps = 0;  // summed over substeps
+    // Embedded time-step error estimate (Trapezoidal): worst over the substeps of
+    // max |u_trace - (u^n + u^{n+1}) / 2| dt / dx, cells; 0 with Split.
+    double step_error = 0;
+    double accuracy_dt = 0;          // s, the accuracy limit on the next substep (0 = none)
+    const char* dt_limit = "";       // what split the step into substeps: "step" (none), "cfl", "buoyancy", "diffusion", "accuracy"
+    // Vapour sinks (negative source rates) asked for more vapour than a cell
+    // held; only what was there was taken. kg/kg summed over cells, this step.
+    double vapour_sink_deficit = 0;
+    // Negative qv / qc / qr made by the explicit diffusion, set to 0 and taken
+    // back from the positive cells of the same z-slice in proportion (so the
+    // slice's water is conserved). kg/kg summed over cells, this step.
+    double water_redistributed = 0;
     double water_drift = 0;          // relative change of total water by the saturation adjustment (should be ~1e-7)
     double theta_l_drift = 0;        // max |delta theta_l| across the adjustment, K
     double condensed = 0;            // net condensation in the step, kg/kg summed over cells
@@ -163,8 +200,14 @@ public:
     double time() const { return time_; }
 
     // Mutable state (for set-up and art direction between steps). Cell arrays
-    // have spec().cells() entries, x fastest.
-    MacVelocity& velocity() { return vel_; }
+    // have spec().cells() entries, x fastest. Negative qv, qc or qr in the
+    // state is refused by step() (atlas::Error naming the field and cell).
+    // Taking the velocity mutably drops the Trapezoidal history (the next
+    // substep is a first-order start-up step).
+    MacVelocity& velocity() {
+        history_dt_ = 0;
+        return vel_;
+    }
     std::vector<float>& theta() { return theta_; } // full potential temperature, K
     std::vector<float>& qv() { return qv_; }
     std::vector<float>& qc() { return qc_; }
@@ -197,7 +240,11 @@ public:
 
 private:
     void substep(double dt, StepReport& rep);
-    void buoyancy(double dt);
+    void substep_trapezoidal(double dt, StepReport& rep);
+    void buoyancy(double dt) { buoyancy_into(vel_, dt); }
+    void buoyancy_into(MacVelocity& v, double dt);
+    void add_sources(double dt, StepReport& rep);
+    void thermodynamics(double dt, StepReport& rep);
     void confinement(double dt);
     void diffuse(double dt);
     double max_buoyancy() const;
@@ -208,6 +255,9 @@ private:
     std::vector<double> thetav0_;
     PressureSolver solver_;
     MacVelocity vel_, vel_tmp_, vel_third_;
+    MacVelocity vel_prev_, grad_; // Trapezoidal: u^{n-1}; the last projection's removed part (dt/2 grad p)
+    double history_dt_ = 0;       // dt of the substep that made vel_prev_ / grad_ (0 = no history)
+    double last_error_ = 0, last_dt_ = 0; // step control: the last substep's error estimate and dt
     std::vector<float> theta_, qv_, qc_, qr_, tmp_;
     std::vector<float> scalar_tmp_[3];                 // advection outputs, swapped with the state
     std::unique_ptr<AdvectionScratch> scratch_;        // back-traces kept between steps

@@ -1,0 +1,246 @@
+// Convergence study of the cloud solver (docs/solver.md "Convergence order"):
+// problems with a known answer, solved at doubling resolutions at a fixed CFL
+// number, the error in the L2 (RMS) and max norms and the observed order
+// p = log2(E(2h) / E(h)) between successive resolutions, printed as Markdown.
+// Not a timing benchmark: each case runs once (Iterations(1)).
+//
+//  Rotation:    a smooth Gaussian blob (sigma = L/12, centred L/4 off the axis)
+//               advected by a prescribed solid-body rotation for one full turn
+//               in a closed 2D slab; exact answer: the initial blob. Only the
+//               advection scheme (advect()) is exercised.
+//  TaylorGreen: u = U sin(kx) cos(kz), w = -U cos(kx) sin(kz), k = pi/L, in a
+//               closed free-slip L x L slab through the whole Simulation (dry,
+//               Boussinesq, neutral, no buoyancy): advection, projection, time
+//               splitting and the explicit viscosity. Exact answer: the initial
+//               field times exp(-2 nu k^2 t) (steady when nu = 0).
+//  Thermal:     a dry 2 K cos^2 warm bubble (radius L/5) in a neutral 300 K
+//               slab, anelastic, 2 km x 2 km, 120 s; answer: the finest run
+//               (theta' at cell centres box-averaged onto each coarser grid).
+//
+// Run:   build-sim/bench/sim_convergence_bench --benchmark_filter=Convergence
+//        (ConvergenceRotation, ConvergenceTaylorGreen, ConvergenceThermal;
+//         Smoke for CI, < 1 s)
+#include "atlas/sim/simulation.h"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+using namespace atlas::sim;
+
+namespace {
+
+struct Norms {
+    double l2 = 0, max = 0;
+};
+
+void add(Norms& e, double d, double& sum2, size_t& count) {
+    sum2 += d * d;
+    ++count;
+    e.max = std::max(e.max, std::fabs(d));
+}
+
+const char* scheme_name(AdvectionScheme s) {
+    return s == AdvectionScheme::SemiLagrangian ? "semi-Lagrangian" : s == AdvectionScheme::MacCormack ? "MacCormack (limited)" : "limited cubic";
+}
+
+const char* time_name(TimeScheme t) { return t == TimeScheme::Split ? "split (1st order)" : "trapezoidal (2nd order)"; }
+
+void print_rows(const std::string& label, const std::vector<int>& ns, const std::vector<Norms>& e) {
+    for (size_t r = 0; r < ns.size(); ++r) {
+        std::printf("| %s | %d | %.3e | %.3e |", label.c_str(), ns[r], e[r].l2, e[r].max);
+        if (r == 0) std::printf(" | |\n");
+        else std::printf(" %.2f | %.2f |\n", std::log2(e[r - 1].l2 / e[r].l2), std::log2(e[r - 1].max / e[r].max));
+    }
+    std::fflush(stdout);
+}
+
+void print_header(const char* title) {
+    std::printf("\n%s\n\n| scheme | n | L2 error | max error | L2 order | max order |\n|---|---|---|---|---|---|\n", title);
+}
+
+// ---- Rotation -------------------------------------------------------------
+
+Norms rotation(int n, AdvectionScheme scheme, double cfl) {
+    const double L = 1000, omega = 2 * M_PI / 1000; // one turn in 1000 s
+    GridSpec s;
+    s.nx = n, s.ny = 1, s.nz = n, s.dx = L / n;
+    MacVelocity vel(s);
+    const double c = L / 2;
+    for (int k = 0; k < n; ++k)
+        for (int i = 0; i <= n; ++i) vel.u[vel.iu(i, 0, k)] = float(-omega * ((k + 0.5) * s.dx - c));
+    for (int k = 0; k <= n; ++k)
+        for (int i = 0; i < n; ++i) vel.w[vel.iw(i, 0, k)] = float(omega * ((i + 0.5) * s.dx - c));
+    vel.enforce_walls();
+    const Lattice l = cell_lattice(s);
+    std::vector<float> q(l.size()), out(l.size()), q0(l.size());
+    const double sigma = L / 12, bx = c + L / 4, bz = c;
+    for (int k = 0; k < n; ++k)
+        for (int i = 0; i < n; ++i) {
+            const double x = (i + 0.5) * s.dx - bx, z = (k + 0.5) * s.dx - bz;
+            q0[size_t(k) * n + i] = float(std::exp(-(x * x + z * z) / (sigma * sigma)));
+        }
+    q = q0;
+    // Speed at the blob's outer edge (r = L/2): cfl cells per step there.
+    const double vmax = omega * L / 2;
+    const int steps = int(std::ceil(1000 / (cfl * s.dx / vmax)));
+    const double dt = 1000.0 / steps;
+    for (int st = 0; st < steps; ++st) {
+        advect(vel, l, q, out, dt, scheme);
+        q.swap(out);
+    }
+    Norms e;
+    double sum2 = 0;
+    size_t cnt = 0;
+    for (size_t m = 0; m < q.size(); ++m) add(e, double(q[m]) - q0[m], sum2, cnt);
+    e.l2 = std::sqrt(sum2 / double(cnt));
+    return e;
+}
+
+void rotation_study(benchmark::State& state, std::vector<int> ns, double cfl) {
+    for (auto _ : state) {
+        char title[160];
+        std::snprintf(title, sizeof title, "Rotation: Gaussian blob, one turn, CFL %.2g at r = L/2 (advect() only)", cfl);
+        print_header(title);
+        for (AdvectionScheme sc : {AdvectionScheme::SemiLagrangian, AdvectionScheme::MacCormack, AdvectionScheme::CubicLimited}) {
+            std::vector<Norms> e;
+            for (int n : ns) e.push_back(rotation(n, sc, cfl));
+            print_rows(scheme_name(sc), ns, e);
+        }
+    }
+}
+
+// ---- Taylor-Green -----------------------------------------------------------
+
+Norms taylor_green(int n, AdvectionScheme scheme, TimeScheme ts, double cfl, double nu, double T) {
+    const double L = 1000, U = 10, k = M_PI / L;
+    GridSpec s;
+    s.nx = n, s.ny = 1, s.nz = n, s.dx = L / n;
+    Sounding snd; // neutral 300 K, dry: no buoyancy
+    SimOptions o;
+    o.anelastic = false;
+    o.moist = false;
+    o.scheme = scheme;
+    o.time_scheme = ts;
+    o.cfl = cfl;
+    o.viscosity = nu;
+    o.max_substeps = 10000;
+    o.step_error_tolerance = 0; // CFL-limited only: the order at a fixed CFL
+    o.projection.tolerance = 1e-10;
+    o.projection.max_iterations = 1000;
+    Simulation sim(s, snd, o);
+    MacVelocity& v = sim.velocity();
+    auto uex = [&](double x, double z, double a) { return a * U * std::sin(k * x) * std::cos(k * z); };
+    for (int kk = 0; kk < n; ++kk)
+        for (int i = 0; i <= n; ++i) v.u[v.iu(i, 0, kk)] = float(uex(i * s.dx, (kk + 0.5) * s.dx, 1));
+    for (int kk = 0; kk <= n; ++kk)
+        for (int i = 0; i < n; ++i) v.w[v.iw(i, 0, kk)] = float(-uex((kk)*s.dx, (i + 0.5) * s.dx, 1)); // -U cos(kx) sin(kz) by symmetry
+    v.enforce_walls();
+    sim.step(T);
+    const double a = std::exp(-2 * nu * k * k * T);
+    Norms e;
+    double sum2 = 0;
+    size_t cnt = 0;
+    for (int kk = 0; kk < n; ++kk)
+        for (int i = 0; i <= n; ++i) add(e, v.u[v.iu(i, 0, kk)] - uex(i * s.dx, (kk + 0.5) * s.dx, a), sum2, cnt);
+    for (int kk = 0; kk <= n; ++kk)
+        for (int i = 0; i < n; ++i) add(e, v.w[v.iw(i, 0, kk)] + uex(kk * s.dx, (i + 0.5) * s.dx, a), sum2, cnt);
+    e.l2 = std::sqrt(sum2 / double(cnt));
+    return e;
+}
+
+void taylor_green_study(benchmark::State& state, std::vector<int> ns, double cfl, double nu, double T) {
+    for (auto _ : state) {
+        char title[200];
+        std::snprintf(title, sizeof title,
+                      "Taylor-Green vortex: U = 10 m/s, L = 1 km, nu = %g m^2/s, t = %g s, CFL %.2g (velocity error, m/s)", nu, T, cfl);
+        print_header(title);
+        for (TimeScheme ts : {TimeScheme::Split, TimeScheme::Trapezoidal})
+            for (AdvectionScheme sc : {AdvectionScheme::SemiLagrangian, AdvectionScheme::MacCormack, AdvectionScheme::CubicLimited}) {
+                std::vector<Norms> e;
+                for (int n : ns) e.push_back(taylor_green(n, sc, ts, cfl, nu, T));
+                print_rows(std::string(scheme_name(sc)) + ", " + time_name(ts), ns, e);
+            }
+    }
+}
+
+// ---- Thermal (self-convergence) -----------------------------------------------
+
+std::vector<float> thermal(int n, AdvectionScheme scheme, TimeScheme ts, double cfl) {
+    const double L = 2000;
+    GridSpec s;
+    s.nx = n, s.ny = 1, s.nz = n, s.dx = L / n;
+    Sounding snd;
+    SimOptions o;
+    o.moist = false;
+    o.scheme = scheme;
+    o.time_scheme = ts;
+    o.cfl = cfl;
+    o.max_substeps = 10000;
+    o.step_error_tolerance = 0;
+    o.projection.tolerance = 1e-10;
+    o.projection.max_iterations = 1000;
+    Simulation sim(s, snd, o);
+    std::vector<float> d(s.cells(), 0.f);
+    for (int k = 0; k < n; ++k)
+        for (int i = 0; i < n; ++i) {
+            const double x = (i + 0.5) * s.dx - L / 2, z = (k + 0.5) * s.dx - L / 4;
+            const double r = std::sqrt(x * x + z * z) / (L / 5);
+            if (r < 1) d[size_t(k) * n + i] = float(2 * std::pow(std::cos(0.5 * M_PI * r), 2));
+        }
+    sim.add_theta(d);
+    sim.step(120);
+    const atlas::Field3D tp = sim.theta_perturbation();
+    return std::vector<float>(tp.channel(0).begin(), tp.channel(0).end());
+}
+
+Norms against(const std::vector<float>& coarse, int nc, const std::vector<float>& fine, int nf) {
+    const int f = nf / nc;
+    Norms e;
+    double sum2 = 0;
+    size_t cnt = 0;
+    for (int k = 0; k < nc; ++k)
+        for (int i = 0; i < nc; ++i) {
+            double m = 0;
+            for (int b = 0; b < f; ++b)
+                for (int a = 0; a < f; ++a) m += fine[size_t(k * f + b) * nf + size_t(i * f + a)];
+            add(e, coarse[size_t(k) * nc + i] - m / (f * f), sum2, cnt);
+        }
+    e.l2 = std::sqrt(sum2 / double(cnt));
+    return e;
+}
+
+void thermal_study(benchmark::State& state, std::vector<int> ns, int nref, double cfl) {
+    for (auto _ : state) {
+        char title[200];
+        std::snprintf(title, sizeof title,
+                      "Dry thermal (2 K cos^2, 2 km slab, anelastic, 120 s), theta' (K) against the %d^2 run, CFL %.2g", nref, cfl);
+        print_header(title);
+        for (TimeScheme ts : {TimeScheme::Split, TimeScheme::Trapezoidal})
+            for (AdvectionScheme sc : {AdvectionScheme::MacCormack}) {
+                const std::vector<float> ref = thermal(nref, sc, ts, cfl);
+                std::vector<Norms> e;
+                for (int n : ns) e.push_back(against(thermal(n, sc, ts, cfl), n, ref, nref));
+                print_rows(std::string(scheme_name(sc)) + ", " + time_name(ts), ns, e);
+            }
+    }
+}
+
+} // namespace
+
+BENCHMARK_CAPTURE(rotation_study, Smoke, std::vector<int>{16, 32}, 1.0)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(taylor_green_study, Smoke, std::vector<int>{8, 16}, 1.0, 10.0, 20.0)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(rotation_study, ConvergenceRotation, std::vector<int>{32, 64, 128, 256}, 1.0)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(taylor_green_study, ConvergenceTaylorGreen, std::vector<int>{16, 32, 64, 128}, 1.0, 0.0, 100.0)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(taylor_green_study, ConvergenceTaylorGreenViscous, std::vector<int>{16, 32, 64, 128}, 1.0, 10.0, 100.0)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(thermal_study, ConvergenceThermal, std::vector<int>{32, 64, 128}, 256, 1.0)->Iterations(1)->Unit(benchmark::kSecond);
+
+BENCHMARK_MAIN();
