@@ -36,8 +36,15 @@ ScalarUnpack bc1_scalar_unpack(DecoderSet decoders);
 // Decodes the 16 scalars of a block under one decoder model.
 void decode_bc1_scalar_block(const uint8_t block[8], Decoder d, const ScalarUnpack& unpack, float out[16]);
 
-// Encodes 16 scalars in [0,1] (max error, then squared error; one-sided when
-// asked, always feasible through the 3-colour mode's exact black = 0).
+// Encodes 16 scalars in [0,1] (max error, then squared error; one-sided when asked).
+// One-sided is always feasible, and never by leaving a texel on the 3-colour mode's
+// exact black: the candidates include the constant block of the minimum's round-down
+// (an endpoint <= the minimum under every decoder, checked with the palette's own
+// bounds), so a block's error is at most its spread plus one endpoint's slack. Normal
+// adds a minimax fit of evenly spaced entries to the block's value clusters and
+// retargets entries just below texel values (docs/compression.md, "bc1-scalar").
+// Reported errors and the one-sided check bound the exact values (2^-21 relative), so
+// they hold for a decoder computing in double. Pure and thread-safe.
 // options.decoders must equal unpack.decoders (the weights belong to that set).
 BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& unpack, const BlockOptions& options,
                                     uint8_t out[8]);

@@ -23,7 +23,9 @@ void decode_bc4_interval(const uint8_t block[8], bool snorm, DecoderSet set, flo
 // Encodes BC4 blocks. Construction precomputes the palettes of all 65,536 endpoint
 // pairs for the decoder set (about 12 MB with the search-pruning tables); encode() is const and thread-safe.
 // Objective: minimise the block's max error under the decoder set (subject to
-// decoded <= source when one-sided), then the squared Reference error.
+// decoded <= source when one-sided), then the squared Reference error. The encoder's
+// palette bounds are the exact palette values rounded outward (a decoder computing in
+// double stays inside them); decode_bc4_interval reports the float values.
 // Quality::Best (and any block missing options.max_error) searches all pairs and is
 // therefore optimal for that objective.
 class Bc4Encoder {

@@ -32,7 +32,9 @@ struct BlockOptions {
 // What one encoded block achieved under the decoder set of its options.
 struct BlockResult {
     // max over texels, channels and decoders of |decoded - source| (for the
-    // Conformant model, the worst value inside its tolerance interval).
+    // Conformant model, the worst value inside its tolerance interval). BC4 and
+    // bc1-scalar bound the exact decoded values (a decoder computing in double stays
+    // within it, and one-sided holds for it), not only the float ones.
     float max_error = 0;
     // sum over texels and channels of the squared Reference-decoder error.
     double sum_sq = 0;
