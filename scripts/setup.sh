@@ -11,6 +11,8 @@ PACKAGES=(
   libtet1.5-dev libtbb-dev libyaml-cpp-dev zlib1g-dev libblosc-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev
   libsquish-dev libcgal-demo
+  # libFuzzer targets (tests/fuzz/): clang 14 and its fuzzer runtime.
+  clang libclang-rt-14-dev libfuzzer-14-dev
   # Independent readers for the engine-import test (tests/engine_import/): OpenImageIO's
   # and OpenVDB's own Python bindings for the system Python 3.11, and pytest.
   python3-openimageio python3-openvdb python3-numpy python3-pytest

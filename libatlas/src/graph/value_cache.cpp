@@ -169,7 +169,11 @@ std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std
             std::string port = r.str();
             uint64_t kind = r.u64();
             if (kind == 1) {
-                Vec2i res{{int(r.u64()), int(r.u64())}};
+                // Dimensions are checked as read: each in 1..2^30, and the data they
+                // imply no larger than the entry (no absurd allocation from a damaged header).
+                const uint64_t w = r.u64(), h = r.u64();
+                if (!r.ok || w == 0 || h == 0 || w > (1u << 30) || h > (1u << 30) || w * h > size) return fail("corrupt field");
+                Vec2i res{{int(w), int(h)}};
                 Box2d b;
                 for (int k = 0; k < 2; ++k) { b.min[k] = r.f64(); b.max[k] = r.f64(); }
                 uint64_t ch = r.u64();
@@ -178,7 +182,11 @@ std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std
                 if (!read_storage(r, *f, int(ch))) return fail("truncated field");
                 out[port] = Field2DPtr(f);
             } else if (kind == 2) {
-                Vec3i res{{int(r.u64()), int(r.u64()), int(r.u64())}};
+                const uint64_t nx = r.u64(), ny = r.u64(), nz = r.u64();
+                if (!r.ok || nx == 0 || ny == 0 || nz == 0 || nx > (1u << 30) || ny > (1u << 30) || nz > (1u << 30) || nx * ny > size ||
+                    nz > size / (nx * ny))
+                    return fail("corrupt field");
+                Vec3i res{{int(nx), int(ny), int(nz)}};
                 Box3d b;
                 for (int k = 0; k < 3; ++k) { b.min[k] = r.f64(); b.max[k] = r.f64(); }
                 uint64_t ch = r.u64();
@@ -206,7 +214,7 @@ std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std
                 return fail("unknown value kind");
             }
         }
-    } catch (const Error&) {
+    } catch (const std::exception&) { // atlas::Error from a field's checks, or a refused allocation
         return fail("corrupt value");
     }
     if (!r.ok) return fail("truncated");

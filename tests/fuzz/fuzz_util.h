@@ -1,0 +1,24 @@
+// Shared by the fuzz targets: the input as a file, for readers that take paths.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+namespace atlas::fuzz {
+
+// One file per process, rewritten for each input (in the temp directory).
+inline std::filesystem::path input_file(const uint8_t* data, size_t size, const char* ext) {
+    static const std::filesystem::path path =
+        std::filesystem::temp_directory_path() / ("atlas_fuzz_" + std::to_string(::getpid()) + ext);
+    FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) std::abort();
+    if (size && std::fwrite(data, 1, size, f) != size) std::abort();
+    std::fclose(f);
+    return path;
+}
+
+} // namespace atlas::fuzz
