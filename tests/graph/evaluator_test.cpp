@@ -4,6 +4,7 @@
 #include "atlas/graph/disk_cache.h"
 #include "atlas/graph/evaluator.h"
 #include "../support/test_nodes.h"
+#include "../../libatlas/src/graph/value_cache.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -736,4 +737,29 @@ TEST(ContentHasher, SplitIndependentAndBitSensitive) {
         EXPECT_NE(ContentHasher().add(b.data(), b.size()).finish(), whole) << bit;
     }
     EXPECT_NE(ContentHasher().add(bytes.data(), 999).finish(), ContentHasher().add((bytes.substr(0, 999) + '\0').data(), 1000).finish());
+}
+
+// A damaged header claiming absurd dimensions is a miss, not an exception or
+// an allocation of what it claims. (The input cache_entry_fuzz found, which
+// threw std::length_error, is tests/fuzz/corpus/cache_entry_fuzz/
+// regress_huge_resolution; the fuzz smoke run replays it.)
+TEST(DiskCache, AbsurdDimensionsAreAMiss) {
+    auto u64 = [](std::string& s, uint64_t v) { s.append(reinterpret_cast<const char*>(&v), 8); };
+    for (uint64_t dim : {uint64_t(0), uint64_t(1) << 31, ~uint64_t(0), uint64_t(1) << 20, (uint64_t(1) << 55) | 4}) {
+        std::string b = std::string("ATLASCACHE\x02", 11);
+        u64(b, 1);
+        u64(b, 3);
+        b += "out";
+        u64(b, 2); // a Field3D
+        for (int k = 0; k < 3; ++k) u64(b, dim);
+        for (int k = 0; k < 3; ++k) {
+            const double lo = 0, hi = 1;
+            b.append(reinterpret_cast<const char*>(&lo), 8).append(reinterpret_cast<const char*>(&hi), 8);
+        }
+        u64(b, 1); // one channel
+        b += std::string(200, '\0');
+        std::string why;
+        EXPECT_FALSE(disk_cache::deserialize(b, &why).has_value()) << dim;
+        EXPECT_FALSE(why.empty());
+    }
 }
