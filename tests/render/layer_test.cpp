@@ -3,6 +3,7 @@
 #include "atlas/core/error.h"
 #include "atlas/ndf/cone_map.h"
 #include "atlas/ndf/ndf_set.h"
+#include "atlas/ndf/superstorm.h"
 #include "atlas/ndf/vertical_profile.h"
 #include "atlas/noise/recipes.h"
 #include "atlas/render/layer.h"
@@ -290,4 +291,62 @@ TEST(LayerRender, ConeMapSkippingMatchesPlainMarching) {
     for (int y = 0; y < 27; ++y)
         for (int x = 0; x < 48; ++x)
             if (ref.image.at(3, x, y) < 0.9f) { EXPECT_LT(fast.image.at(3, x, y), 0.999f) << x << "," << y; }
+}
+
+TEST(LayerAnvil, AnvilMapIsTheStencilsFalloffAndChainsByMax) {
+    Field2D set = ndf::make_ndf_set({{32, 32}}, Box2d{{{0, 0}}, {{32000, 32000}}}, 1500, 4000, nullptr);
+    ndf::SuperstormStencil a;
+    a.center = {{16000, 16000}};
+    a.radius = 8000;
+    a.core = 0.25;
+    a.blend = 0.5;
+    a.anvil = 0.8;
+    const Field2D first = ndf::superstorm_anvil(set, a, nullptr, nullptr);
+    ndf::SuperstormStencil b = a;
+    b.center = {{6000, 6000}};
+    b.radius = 4000;
+    b.blend = 1;
+    b.anvil = 0.3;
+    const Field2D both = ndf::superstorm_anvil(set, b, &first, nullptr);
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) {
+            const double ra = length(set.texel_center(x, y) - a.center), rb = length(set.texel_center(x, y) - b.center);
+            const double ga = ra < a.radius ? 1 - ndf::smoothstep(a.core * a.radius, a.radius, ra) : 0.0;
+            const double gb = rb < b.radius ? 1 - ndf::smoothstep(b.core * b.radius, b.radius, rb) : 0.0;
+            EXPECT_NEAR(first.at(0, x, y), a.anvil * a.blend * ga, 1e-6);
+            EXPECT_NEAR(both.at(0, x, y), std::max(a.anvil * a.blend * ga, b.anvil * b.blend * gb), 1e-6);
+            if (rb >= b.radius) {
+                EXPECT_EQ(both.at(0, x, y), first.at(0, x, y)); // beyond the radius: the previous value exactly
+            }
+        }
+    Field2D small({{4, 4}}, 1, set.bounds());
+    EXPECT_THROW(ndf::superstorm_anvil(set, a, &small, nullptr), Error);
+    a.anvil = 1.5;
+    EXPECT_THROW(ndf::superstorm_anvil(set, a, nullptr, nullptr), Error);
+}
+
+TEST(LayerAnvil, AnvilBiasSpreadsTheTopsSeenFromAbove) {
+    // Looking straight down on a layer of cumulonimbus at coverage 0.4: the
+    // anvil bias raises the coverage in the top of every column, so the tops
+    // hide more of the ground (lower mean transmittance), and only there.
+    LayerScene s = scene_with(0.4, true, 1.0);
+    RenderSettings st = small_settings(48, 27);
+    st.camera.position = {{10000, 10000, 9000}};
+    st.camera.look_at = {{10000, 10000, 0}};
+    st.camera.up = {{0, 1, 0}};
+    const LayerResult plain = render_layer(s, st, nullptr);
+    Field2D bias({{4, 4}}, 1, s.ndf->bounds(), {"anvil_bias"});
+    for (float& v : bias.channel(0)) v = 1.0f;
+    s.anvil = std::make_shared<const Field2D>(std::move(bias));
+    const LayerResult spread = render_layer(s, st, nullptr);
+    double tp = 0, ta = 0;
+    for (int y = 0; y < 27; ++y)
+        for (int x = 0; x < 48; ++x) tp += plain.image.at(3, x, y), ta += spread.image.at(3, x, y);
+    EXPECT_LT(ta, tp * 0.97);
+    const auto f = spread.report.active_features();
+    EXPECT_NE(std::find(f.begin(), f.end(), "anvil"), f.end());
+    // An all-zero anvil map is no anvil: same bytes.
+    Field2D zero({{4, 4}}, 1, s.ndf->bounds(), {"anvil_bias"});
+    s.anvil = std::make_shared<const Field2D>(std::move(zero));
+    EXPECT_TRUE(same_bytes(render_layer(s, st, nullptr).image, plain.image));
 }

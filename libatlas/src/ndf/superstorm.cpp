@@ -25,6 +25,7 @@ void validate(const SuperstormStencil& s) {
     in_unit(s.blend, "blend");
     in_unit(s.storm_type, "storm_type");
     in_unit(s.bottom_type, "bottom_type");
+    in_unit(s.anvil, "anvil");
     if (!std::isfinite(s.min_height) || !std::isfinite(s.max_height)) throw Error("superstorm: 'min_height' and 'max_height' must be finite");
     if (s.min_height > s.max_height) throw Error("superstorm: 'min_height' must not be above 'max_height'");
     if (!(s.distortion >= 0 && s.distortion < 1)) throw Error("superstorm: 'distortion' must be in [0, 1)");
@@ -68,6 +69,27 @@ Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const M
             const double wh = s.blend * (1.0 - smoothstep(s.core * s.radius, s.radius, rd));
             mix(MinHeight, s.min_height, wh);
             mix(MaxHeight, s.max_height, wh);
+        }
+    });
+    return out;
+}
+
+Field2D superstorm_anvil(const Field2D& set, const SuperstormStencil& s, const Field2D* previous, const MemoryBudget* budget) {
+    check_ndf_set(set);
+    validate(s);
+    if (previous && (previous->resolution() != set.resolution() || previous->channels() < 1))
+        throw Error("superstorm: the previous anvil map must have the set's resolution (" + std::to_string(set.width()) + "x" +
+                    std::to_string(set.height()) + ") and one channel");
+    Field2D out(set.resolution(), 1, set.bounds(), {"anvil_bias"}, budget);
+    if (previous) std::copy(previous->channel(0).begin(), previous->channel(0).end(), out.channel(0).begin());
+    if (s.blend == 0 || s.anvil == 0) return out;
+    tbb::parallel_for(0, set.height(), [&](int y) {
+        for (int x = 0; x < set.width(); ++x) {
+            const double r = length(set.texel_center(x, y) - s.center);
+            if (!(r < s.radius)) continue;
+            const double w = s.anvil * s.blend * (1.0 - smoothstep(s.core * s.radius, s.radius, r));
+            float& v = out.channel(0)[set.index(x, y)];
+            v = float(std::max(double(v), w));
         }
     });
     return out;

@@ -19,6 +19,7 @@ std::vector<std::string> LayerReport::active_features() const {
     if (curl) f.push_back("curl_distortion");
     if (wind) f.push_back("wind");
     if (precipitation) f.push_back("rain_absorption");
+    if (anvil) f.push_back("anvil");
     if (cheap_search) f.push_back("cheap_search");
     if (cone_skipping) f.push_back("cone_skipping");
     if (distance_skipping) f.push_back("distance_skipping");
@@ -217,7 +218,20 @@ public:
             cone_ratio_ = cone_->channel(cr).data();
         }
         if (s.envelope.distance_map) dist_ = s.envelope.distance_map.get();
+        if (s.anvil) {
+            const Field2D& a = *s.anvil;
+            const int c = std::max(0, a.find_channel("anvil_bias"));
+            auto ch = a.channel(c);
+            if (std::any_of(ch.begin(), ch.end(), [](float v) { return v > 0; })) {
+                anvil_ = &a;
+                anvil_ch_ = ch.data();
+                const Box2d& ab = a.bounds();
+                anvil_origin_ = {{ab.min[0], ab.min[1]}};
+                anvil_inv_ = {{a.width() / (ab.max[0] - ab.min[0]), a.height() / (ab.max[1] - ab.min[1])}};
+            }
+        }
     }
+    bool has_anvil() const { return anvil_ != nullptr; }
 
     const Vec3d& centre() const { return centre_; }
     double bottom() const { return bottom_; }
@@ -293,6 +307,14 @@ public:
         if (!column(p[0], p[1], c)) return 0;
         if (h <= c.min_h || h >= c.max_h) return 0;
         const double f = (h - c.min_h) / (c.max_h - c.min_h);
+        if (anvil_ && f > 0.7) {
+            // HZD's anvil bias: the top of the column spreads.
+            Bilinear b;
+            axis_clamp((p[0] - map_shift_[0] - anvil_origin_[0]) * anvil_inv_[0], anvil_->width(), b.x0, b.x1, b.tx);
+            axis_clamp((p[1] - map_shift_[1] - anvil_origin_[1]) * anvil_inv_[1], anvil_->height(), b.y0, b.y1, b.ty);
+            const double bias = detail::saturate(lerp2(anvil_ch_, anvil_->width(), b));
+            c.coverage = std::pow(c.coverage, detail::remap(f, 0.7, 0.8, 1.0, 1.0 - 0.5 * bias));
+        }
         const double profile =
             sample_lut(lut_, lut_bottom_, c.bottom_type, f) * sample_lut(lut_, lut_top_, c.top_type, f);
         if (!(profile > 0)) return 0;
@@ -412,6 +434,9 @@ private:
     std::array<double, kQuantiles + 1> quantile_{};
     bool equalised_ = false;
     double base_max_ = 1; // largest dilated base value (1 without noise)
+    const Field2D* anvil_ = nullptr;
+    const float* anvil_ch_ = nullptr;
+    Vec2d anvil_origin_{{0, 0}}, anvil_inv_{{1, 1}};
 };
 
 // Both roots of |o + t d - c|^2 = r^2 (unit d); false when the ray misses.
@@ -504,6 +529,11 @@ void validate_layer_scene(const LayerScene& s) {
         check_finite(*s.envelope.cone_map, "cone map");
     }
     if (s.envelope.distance_map) check_finite(*s.envelope.distance_map, "distance map");
+    if (s.anvil) {
+        const Box2d& ab = s.anvil->bounds();
+        need(ab.max[0] > ab.min[0] && ab.max[1] > ab.min[1], "the anvil map's bounds are empty");
+        check_finite(*s.anvil, "anvil map");
+    }
     for (size_t i = 0; i < s.sky_layers.size(); ++i) {
         const SkyLayer& l = s.sky_layers[i];
         const std::string w = "sky_layers[" + std::to_string(i) + "]";
@@ -704,6 +734,7 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
     report.curl = model.has_curl() && model.has_detail();
     report.wind = scene.wind[0] != 0 || scene.wind[1] != 0 || scene.cloud_top_offset != 0;
     report.precipitation = model.precipitation() && scene.rain_absorption > 0;
+    report.anvil = model.has_anvil();
     report.cone_skipping = model.has_cone();
     report.distance_skipping = model.has_distance();
     report.sky_layers = int(scene.sky_layers.size());

@@ -37,6 +37,9 @@ struct SuperstormStencil {
     double distortion = 0.3;  // [0,1): radial wobble of the height gradients
     double noise_scale = 4;   // noise lattice cells across the radius
     uint32_t seed = 0;
+    // Anvil: how far the storm's top spreads out ([0,1]); written to the
+    // separate anvil map (superstorm_anvil), not to the 8-channel set.
+    double anvil = 0;
 };
 
 // Throws atlas::Error naming the parameter: radius <= 0, min_height >
@@ -46,6 +49,15 @@ void validate(const SuperstormStencil& s);
 bool stencil_touches(const SuperstormStencil& s, const Box2d& bounds);
 // The stencil applied to an NDF set (see the formulas above).
 Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const MemoryBudget* budget);
+
+// The anvil map of a stencil: one channel "anvil_bias" over the set's grid,
+// max(previous, anvil * blend * g(r)) (previous: `previous`'s value, or 0
+// when null; it must match the set's resolution). A renderer spreads the
+// cloud top with it, as Horizon Zero Dawn's anvil bias does: in the upper
+// part of a column the coverage becomes coverage^e, e = remap(f, 0.7, 0.8,
+// 1, lerp(1, 0.5, anvil_bias)) (f the height fraction; atlas/render/layer.h).
+// Beyond the radius the previous value is kept exactly.
+Field2D superstorm_anvil(const Field2D& set, const SuperstormStencil& s, const Field2D* previous, const MemoryBudget* budget);
 
 // One vortex ring: an annulus [inner, outer] metres around the centre.
 struct VortexRing {

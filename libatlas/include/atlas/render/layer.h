@@ -107,6 +107,11 @@ struct LayerScene {
     double haze_distance = 90000;
     LayerEnvelope envelope;
     std::vector<SkyLayer> sky_layers;
+    // Optional anvil map (ndf/superstorm's `anvil` output): channel
+    // "anvil_bias" (else 0) in [0, 1] over its own bounds (read bilinearly,
+    // clamped, with the map's wind scroll). HZD's anvil: in the top of a column
+    // coverage becomes coverage^e, e = remap(f, 0.7, 0.8, 1, lerp(1, 0.5, bias)).
+    Field2DPtr anvil;
 };
 
 // Throws atlas::Error naming the problem (null fields, missing channels,
@@ -126,6 +131,7 @@ struct LayerReport {
     bool distance_skipping = false;
     bool wind = false;            // non-zero wind or top offset
     bool precipitation = false;   // some precipitation > 0
+    bool anvil = false;           // an anvil map with some bias > 0
     int sky_layers = 0;
     bool sky_gradient = false;
     uint64_t cheap_samples = 0;   // base-only density evaluations (view rays)

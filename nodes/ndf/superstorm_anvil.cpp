@@ -1,0 +1,43 @@
+// ndf/superstorm_anvil: the anvil-spread map of a superstorm stencil.
+#include "atlas/ndf/superstorm.h"
+#include "ndf/ndf_params.h"
+
+namespace {
+using namespace atlas;
+using namespace atlas::ndf_nodes;
+
+void declare(NodeDeclaration& d) {
+    d.doc("Anvil-spread map of an HFW superstorm stencil (the NDF set has no anvil channel): channel anvil_bias = "
+          "max(anvil_in, anvil x blend x g(r)) on the set's grid, g(r) = 1 - smoothstep(core x radius, radius, r) as in "
+          "ndf/superstorm (give both the same center, radius, core and blend). The 2.5D preview spreads the storm's top with it "
+          "(HZD's anvil bias: coverage^e in the top of a column, e = remap(f, 0.7, 0.8, 1, lerp(1, 0.5, bias))). "
+          "Chain several through `anvil_in`.");
+    d.input("in", PortType::Field2D, "NDF set (its grid and bounds)");
+    d.input("anvil_in", PortType::Field2D, "optional anvil map of the previous stencil (same grid)").optional = true;
+    d.output("out", PortType::Field2D, "anvil map: channel anvil_bias in [0, 1]");
+    d.param_float2("center", {{30000, 30000}}).with_unit("m").describe("stencil centre");
+    d.param_float("radius", 8000).with_unit("m").describe("stencil radius (> 0)");
+    d.param_float("core", 0.3).range(0, 0.999).describe("fraction of the radius at full strength");
+    d.param_float("blend", 1.0).range(0, 1).describe("strength of the stencil");
+    d.param_float("anvil", 1.0).range(0, 1).describe("anvil spread at the centre");
+}
+
+void cook(CookContext& ctx) {
+    ndf::SuperstormStencil s;
+    s.center = ctx.get_float2("center");
+    s.radius = ctx.get_float("radius");
+    s.core = ctx.get_float("core");
+    s.blend = ctx.get_float("blend");
+    s.anvil = ctx.get_float("anvil");
+    if (!(s.radius > 0)) ctx.fail("'radius' must be > 0");
+    auto in = ctx.input_field2d("in");
+    if (!ndf::stencil_touches(s, in->bounds())) ctx.warn("the stencil lies entirely outside the map: it changes nothing");
+    Field2DPtr previous = ctx.has_input("anvil_in") ? ctx.input_field2d("anvil_in") : nullptr;
+    ctx.check_memory(in->byte_size() / 8, "the anvil map");
+    ctx.set_output("out", out2d(ndf::superstorm_anvil(*in, s, previous.get(), &ctx.budget())));
+}
+} // namespace
+
+ATLAS_REGISTER_NODE(registry) {
+    registry.add({.name = "ndf/superstorm_anvil", .version = 1, .declare = declare, .cook = cook});
+}
