@@ -312,7 +312,8 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
                 }
                 cut[ncut++] = at;
             }
-            std::sort(cut, cut + ncut);
+            for (int i = 1; i < ncut; ++i) // at most 3 cuts (std::sort here trips GCC 12's -Warray-bounds under ASan)
+                for (int j = i; j > 0 && cut[j - 1] > cut[j]; --j) std::swap(cut[j - 1], cut[j]);
             float glo[4], ghi[4];
             for (int j = 0, t0 = 0; j < groups; ++j) {
                 const int t1 = j < ncut ? cut[j] : nd;
