@@ -1,0 +1,513 @@
+"""Atlas for Blender: open an Atlas node graph, edit its parameters, cook it and see the result.
+
+The panel (View3D > Sidebar > Atlas) opens a graph file, lists every node's parameters from the
+node declarations (with ranges and units; hover the (i) button for the doc), cooks in a background
+thread with Blender's progress indicator (Cancel stops it), re-cooks incrementally when a parameter
+changes, and shows VDB outputs (the NVDF set) as Volume objects in world units (metres) with a
+volume material that approximates the Nubis look, and 2D outputs (NDFs) as images.
+
+It needs the `atlas` Python module (python/ in the Atlas build): set its directory in the add-on's
+preferences, or ATLAS_PYTHONPATH, or put it on Blender's sys.path. Debian's Blender 3.4 runs the
+system Python 3.11 that the module is built for.
+"""
+
+bl_info = {
+    "name": "Atlas clouds",
+    "author": "Atlas",
+    "version": (0, 1, 0),
+    "blender": (3, 4, 0),
+    "location": "View3D > Sidebar > Atlas",
+    "description": "Cook Atlas node graphs (volumetric cloud data) and load their VDBs and NDFs",
+    "category": "Import-Export",
+}
+
+import os
+import sys
+import tempfile
+import threading
+
+import bpy
+from bpy.props import BoolProperty, CollectionProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty, StringProperty
+
+# ---------------------------------------------------------------- the atlas module
+
+
+def _atlas_module():
+    """Imports atlas, adding the configured directory to sys.path first."""
+    candidates = []
+    try:
+        prefs = bpy.context.preferences.addons[__name__].preferences
+        if prefs.atlas_python_path:
+            candidates.append(bpy.path.abspath(prefs.atlas_python_path))
+    except (KeyError, AttributeError):
+        pass
+    if os.environ.get("ATLAS_PYTHONPATH"):
+        candidates.append(os.environ["ATLAS_PYTHONPATH"])
+    for c in candidates:
+        if c and c not in sys.path:
+            sys.path.insert(0, c)
+    import atlas  # noqa: F401 (raises ImportError with Python's message when not found)
+
+    return atlas
+
+
+# ---------------------------------------------------------------- per-scene state
+# Blender properties cannot hold Python objects: the Session and the running cook live here,
+# keyed by scene name. Only the main thread touches bpy; the cook thread touches only the job.
+
+
+class CookJob:
+    def __init__(self, session, out_dir):
+        self.session = session
+        self.out_dir = out_dir
+        self.cancel = threading.Event()
+        self.fraction = 0.0
+        self.task = ""
+        self.report = None
+        self.error = None
+        self.thread = None
+
+    def run(self, jobs):
+        def progress(fraction, task, done, total):
+            self.fraction, self.task = fraction, task
+
+        try:
+            self.report = self.session.cook(jobs=jobs, write_outputs=True, out_dir=self.out_dir, progress=progress,
+                                            cancel=self.cancel.is_set)
+        except Exception as e:  # atlas.Error and its subclasses; shown in the panel
+            self.error = e
+
+    def done(self):
+        return self.thread is None or not self.thread.is_alive()
+
+
+_state = {}  # scene name -> {"session": atlas.Session, "job": CookJob | None, "again": bool}
+
+
+def _scene_state(scene):
+    return _state.setdefault(scene.name, {"session": None, "job": None, "again": False})
+
+
+# ---------------------------------------------------------------- properties
+
+_VECTOR_TYPES = {"float2": 2, "float3": 3, "int2": 2, "int3": 3}
+
+
+def _on_param_changed(self, context):
+    if getattr(_on_param_changed, "loading", False):
+        return
+    scene = context.scene
+    props = scene.atlas
+    st = _scene_state(scene)
+    if st["session"] is None:
+        return
+    try:
+        st["session"].set(self.node, self.name, self.value())
+        props.error = ""
+    except Exception as e:
+        props.error = str(e)
+        return
+    if props.auto_cook:
+        start_cook(scene, background=not bpy.app.background)
+
+
+class AtlasParam(bpy.types.PropertyGroup):
+    node: StringProperty()
+    name: StringProperty()
+    ptype: StringProperty()
+    unit: StringProperty()
+    doc: StringProperty()
+    range_text: StringProperty()
+    choices: StringProperty()  # comma-separated, for enums (edited as text, validated by Atlas)
+    f: FloatProperty(update=_on_param_changed, precision=4)
+    i: IntProperty(update=_on_param_changed)
+    b: BoolProperty(update=_on_param_changed)
+    s: StringProperty(update=_on_param_changed)
+    v: FloatVectorProperty(size=3, update=_on_param_changed)
+
+    def value(self):
+        t = self.ptype
+        if t == "float":
+            return self.f
+        if t == "int":
+            return self.i
+        if t == "bool":
+            return self.b
+        if t in _VECTOR_TYPES:
+            vals = list(self.v)[: _VECTOR_TYPES[t]]
+            return [int(round(x)) for x in vals] if t.startswith("int") else vals
+        return self.s
+
+    def assign(self, value):
+        t = self.ptype
+        if t == "float":
+            self.f = float(value)
+        elif t == "int":
+            self.i = max(-2**31, min(2**31 - 1, int(value)))
+        elif t == "bool":
+            self.b = bool(value)
+        elif t in _VECTOR_TYPES:
+            vals = list(value) + [0.0] * (3 - len(value))
+            self.v = [float(x) for x in vals[:3]]
+        else:
+            self.s = str(value)
+
+
+class AtlasSceneProps(bpy.types.PropertyGroup):
+    graph_path: StringProperty(name="Graph", subtype="FILE_PATH", description="An Atlas graph file (.yaml)")
+    out_dir: StringProperty(name="Output", subtype="DIR_PATH",
+                            description="Where cooked outputs are written (empty: a temporary directory)")
+    jobs: IntProperty(name="Threads", default=0, min=0, description="Cook threads (0: all); results do not depend on it")
+    auto_cook: BoolProperty(name="Re-cook on change", default=True,
+                            description="Re-cook (incrementally) whenever a parameter changes")
+    show_all: BoolProperty(name="All parameters", default=False,
+                           description="Show every declared parameter, not only those the graph sets")
+    params: CollectionProperty(type=AtlasParam)
+    error: StringProperty()
+    status: StringProperty()
+    last_cooked: StringProperty()  # names of the nodes the last cook cooked, space-separated
+
+
+class AtlasPreferences(bpy.types.AddonPreferences):
+    bl_idname = __name__
+    atlas_python_path: StringProperty(name="atlas Python module", subtype="DIR_PATH",
+                                      description="The directory that contains the atlas package (e.g. build/python)")
+
+    def draw(self, context):
+        self.layout.prop(self, "atlas_python_path")
+
+
+# ---------------------------------------------------------------- graph -> properties
+
+
+def open_graph(scene, path):
+    """Loads a graph into the scene's session and lists its parameters. Raises atlas.Error."""
+    atlas = _atlas_module()
+    props = scene.atlas
+    st = _scene_state(scene)
+    if st["job"] is not None and not st["job"].done():
+        st["job"].cancel.set()
+        st["job"].thread.join()
+    session = st["session"] or atlas.Session()
+    session.load(bpy.path.abspath(path))
+    st["session"] = session
+    props.graph_path = path
+    props.error = ""
+    fill_params(scene)
+
+
+def fill_params(scene):
+    props = scene.atlas
+    session = _scene_state(scene)["session"]
+    decls = {d["name"]: d for d in session.node_types()}
+    props.params.clear()
+    _on_param_changed.loading = True
+    try:
+        for node in session.nodes():
+            decl = decls[node["type"]]
+            for p in decl["params"]:
+                item = props.params.add()
+                item.node, item.name, item.ptype = node["name"], p["name"], p["type"]
+                item.unit, item.doc = p["unit"], p["doc"]
+                lo, hi = p["min"], p["max"]
+                item.range_text = "" if lo is None and hi is None else f"[{'' if lo is None else f'{lo:g}'}, {'' if hi is None else f'{hi:g}'}]"
+                item.choices = ",".join(p["choices"])
+                item.assign(node["params"][p["name"]])
+                item["explicit"] = p["name"] in node["explicit"]
+    finally:
+        _on_param_changed.loading = False
+
+
+# ---------------------------------------------------------------- cooking
+
+
+def _out_dir(scene):
+    props = scene.atlas
+    if props.out_dir:
+        return bpy.path.abspath(props.out_dir)
+    st = _scene_state(scene)
+    if "tmp" not in st:
+        st["tmp"] = tempfile.mkdtemp(prefix="atlas_blender_")
+    return st["tmp"]
+
+
+def start_cook(scene, background=True):
+    """Cooks the scene's graph. In the background: a thread, polled by a timer that loads the
+    results on the main thread; a cook already running is cancelled and cooked again."""
+    st = _scene_state(scene)
+    if st["session"] is None:
+        raise RuntimeError("open a graph first")
+    job = st["job"]
+    if job is not None and not job.done():
+        job.cancel.set()
+        st["again"] = True
+        return
+    job = CookJob(st["session"], _out_dir(scene))
+    st["job"] = job
+    props = scene.atlas
+    props.status = "cooking"
+    if not background:
+        job.run(props.jobs)
+        _finish(scene, job)
+        return
+    job.thread = threading.Thread(target=job.run, args=(props.jobs,), daemon=True)
+    wm = bpy.context.window_manager
+    wm.progress_begin(0, 1)
+    job.thread.start()
+    scene_name = scene.name
+
+    def poll():
+        sc = bpy.data.scenes.get(scene_name)
+        if sc is None:
+            return None
+        if not job.done():
+            wm.progress_update(job.fraction)
+            sc.atlas.status = f"cooking {job.fraction:.0%} {job.task}"
+            _redraw()
+            return 0.1
+        wm.progress_end()
+        _finish(sc, job)
+        if _scene_state(sc)["again"]:
+            _scene_state(sc)["again"] = False
+            start_cook(sc, background=True)
+        return None
+
+    bpy.app.timers.register(poll, first_interval=0.1)
+
+
+def _redraw():
+    for window in getattr(bpy.context.window_manager, "windows", []):
+        for area in window.screen.areas:
+            if area.type == "VIEW_3D":
+                area.tag_redraw()
+
+
+def _finish(scene, job):
+    props = scene.atlas
+    if job.error is not None:
+        cancelled = type(job.error).__name__ == "CancelledError"
+        props.status = "cancelled" if cancelled else "failed"
+        props.error = "" if cancelled else str(job.error)
+        return
+    report = job.report
+    cooked = sorted(n for n, r in report["nodes"].items() if r["status"] == "cooked")
+    props.last_cooked = " ".join(cooked)
+    props.status = f"cooked {len(cooked)} node(s) in {report['seconds']:.2f} s"
+    props.error = ""
+    load_outputs(scene, job.out_dir)
+
+
+# ---------------------------------------------------------------- results into the scene
+
+
+def load_outputs(scene, out_dir):
+    """VDB outputs become Volume objects (one per file, grids as in the file, world units);
+    2D image outputs become images. Returns the Volume objects."""
+    session = _scene_state(scene)["session"]
+    decls = {d["name"]: d for d in session.node_types()}
+    node_types = {n["name"]: n["type"] for n in session.nodes()}
+    volumes = []
+    for out in session.outputs():
+        path = os.path.join(out_dir, out["file"])
+        if not os.path.exists(path):
+            continue
+        stem = "atlas_" + os.path.splitext(os.path.basename(out["file"]))[0]
+        if out["format"] == "vdb":
+            volumes.append(_load_volume(scene, stem, path))
+        elif out["format"] in ("exr", "png", "tga"):
+            ports = decls[node_types[out["node"]]]["outputs"]
+            port = next((p for p in ports if p["name"] == out["port"]), ports[0])
+            if port["type"] == "field2d":
+                img = bpy.data.images.get(stem) or bpy.data.images.load(path, check_existing=False)
+                img.name = stem
+                img.filepath = path
+                img.reload()
+    return volumes
+
+
+def _load_volume(scene, name, path):
+    vol = bpy.data.volumes.get(name) or bpy.data.volumes.new(name)
+    vol.grids.unload()
+    vol.filepath = path
+    if not vol.grids.load():
+        raise RuntimeError(f"{path}: {vol.grids.error_message}")
+    obj = bpy.data.objects.get(name)
+    if obj is None:
+        obj = bpy.data.objects.new(name, vol)
+        scene.collection.objects.link(obj)
+    if not vol.materials:
+        vol.materials.append(nubis_material(vol))
+    return obj
+
+
+def nubis_material(vol):
+    """A volume material in the spirit of the Nubis look: density from the dimensional profile
+    scaled by the density-scale grid, bright forward-scattering white."""
+    names = {g.name for g in vol.grids}
+    mat = bpy.data.materials.get("Atlas Nubis") or bpy.data.materials.new("Atlas Nubis")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    vol_node = nt.nodes.new("ShaderNodeVolumePrincipled")
+    vol_node.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    vol_node.inputs["Anisotropy"].default_value = 0.6
+    vol_node.inputs["Density Attribute"].default_value = ""
+    profile = "dimensional_profile" if "dimensional_profile" in names else sorted(names)[0] if names else "density"
+    a = nt.nodes.new("ShaderNodeAttribute")
+    a.attribute_name = profile
+    density = a.outputs["Fac"]
+    if "density_scale" in names:
+        b = nt.nodes.new("ShaderNodeAttribute")
+        b.attribute_name = "density_scale"
+        mul = nt.nodes.new("ShaderNodeMath")
+        mul.operation = "MULTIPLY"
+        nt.links.new(a.outputs["Fac"], mul.inputs[0])
+        nt.links.new(b.outputs["Fac"], mul.inputs[1])
+        density = mul.outputs[0]
+    # Metres are large: clouds are thin per metre.
+    scale = nt.nodes.new("ShaderNodeMath")
+    scale.operation = "MULTIPLY"
+    scale.inputs[1].default_value = 0.02
+    nt.links.new(density, scale.inputs[0])
+    nt.links.new(scale.outputs[0], vol_node.inputs["Density"])
+    nt.links.new(vol_node.outputs["Volume"], out.inputs["Volume"])
+    return mat
+
+
+# ---------------------------------------------------------------- operators and panel
+
+
+class ATLAS_OT_open_graph(bpy.types.Operator):
+    bl_idname = "atlas.open_graph"
+    bl_label = "Open Graph"
+    bl_description = "Load an Atlas graph file and list its parameters"
+    filepath: StringProperty(subtype="FILE_PATH")
+    filter_glob: StringProperty(default="*.yaml;*.yml", options={"HIDDEN"})
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        try:
+            open_graph(context.scene, self.filepath or context.scene.atlas.graph_path)
+        except Exception as e:
+            context.scene.atlas.error = str(e)
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
+class ATLAS_OT_cook(bpy.types.Operator):
+    bl_idname = "atlas.cook"
+    bl_label = "Cook"
+    bl_description = "Cook the graph (only what changed) and load its outputs"
+    background: BoolProperty(default=True, description="Cook in a background thread")
+
+    def execute(self, context):
+        try:
+            start_cook(context.scene, background=self.background and not bpy.app.background)
+        except Exception as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        if context.scene.atlas.error:
+            self.report({"ERROR"}, context.scene.atlas.error)
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
+class ATLAS_OT_cancel(bpy.types.Operator):
+    bl_idname = "atlas.cancel"
+    bl_label = "Cancel"
+    bl_description = "Stop the running cook (nothing is written)"
+
+    def execute(self, context):
+        job = _scene_state(context.scene)["job"]
+        if job is not None:
+            job.cancel.set()
+        return {"FINISHED"}
+
+
+class ATLAS_OT_param_info(bpy.types.Operator):
+    bl_idname = "atlas.param_info"
+    bl_label = ""
+    node: StringProperty()
+    param: StringProperty()
+
+    @classmethod
+    def description(cls, context, properties):
+        for p in context.scene.atlas.params:
+            if p.node == properties.node and p.name == properties.param:
+                extra = " ".join(x for x in (p.range_text, p.unit) if x)
+                choices = f" One of: {p.choices}." if p.choices else ""
+                return f"{p.node}.{p.name} ({p.ptype}{', ' + extra if extra else ''}): {p.doc}{choices}"
+        return ""
+
+    def execute(self, context):
+        return {"FINISHED"}
+
+
+class ATLAS_PT_panel(bpy.types.Panel):
+    bl_label = "Atlas"
+    bl_idname = "ATLAS_PT_panel"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Atlas"
+
+    def draw(self, context):
+        props = context.scene.atlas
+        layout = self.layout
+        row = layout.row(align=True)
+        row.prop(props, "graph_path", text="")
+        row.operator("atlas.open_graph", text="", icon="FILE_FOLDER")
+        layout.prop(props, "out_dir")
+        row = layout.row(align=True)
+        row.operator("atlas.cook", icon="PLAY")
+        job = _scene_state(context.scene)["job"]
+        if job is not None and not job.done():
+            row.operator("atlas.cancel", icon="CANCEL")
+        row = layout.row()
+        row.prop(props, "auto_cook")
+        row.prop(props, "jobs")
+        if props.status:
+            layout.label(text=props.status, icon="INFO")
+        if props.error:
+            box = layout.box()
+            for line in props.error.splitlines()[:6]:
+                box.label(text=line, icon="ERROR")
+        layout.prop(props, "show_all")
+        node = None
+        box = None
+        for p in props.params:
+            if not props.show_all and not p.get("explicit", False):
+                continue
+            if p.node != node:
+                node = p.node
+                box = layout.box()
+                box.label(text=node, icon="NODE")
+            row = box.row(align=True)
+            label = p.name + (f" ({p.unit})" if p.unit else "")
+            field = {"float": "f", "int": "i", "bool": "b"}.get(p.ptype, "v" if p.ptype in _VECTOR_TYPES else "s")
+            row.prop(p, field, text=label)
+            info = row.operator("atlas.param_info", text="", icon="QUESTION")
+            info.node, info.param = p.node, p.name
+
+
+_classes = (AtlasParam, AtlasSceneProps, AtlasPreferences, ATLAS_OT_open_graph, ATLAS_OT_cook, ATLAS_OT_cancel,
+            ATLAS_OT_param_info, ATLAS_PT_panel)
+
+
+def register():
+    for c in _classes:
+        bpy.utils.register_class(c)
+    bpy.types.Scene.atlas = PointerProperty(type=AtlasSceneProps)
+
+
+def unregister():
+    for job in [s["job"] for s in _state.values() if s["job"] is not None]:
+        job.cancel.set()
+    del bpy.types.Scene.atlas
+    for c in reversed(_classes):
+        bpy.utils.unregister_class(c)
+    _state.clear()

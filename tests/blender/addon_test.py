@@ -1,0 +1,185 @@
+"""The Blender add-on, headless: blender -b --factory-startup --python-exit-code 1 --python addon_test.py -- \
+    --addon DIR --atlas-python DIR --atlas-bin ATLAS --graph quickstart.yaml --work DIR
+
+Installs and enables the add-on from a zip, opens the quickstart, cooks, checks the Volume object's
+grids and transform against the field's world box, compares voxel values with the CLI's VDB (read
+with OpenVDB's own Python module), changes a parameter and checks that only the dependent nodes
+re-cooked, feeds a broken graph and an out-of-range parameter, and renders a small Cycles picture.
+"""
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import traceback
+import zipfile
+
+import bpy
+
+args = argparse.ArgumentParser()
+for a in ("--addon", "--atlas-python", "--atlas-bin", "--graph", "--work"):
+    args.add_argument(a, required=True)
+args = args.parse_args(sys.argv[sys.argv.index("--") + 1:])
+
+passed, failed = 0, 0
+
+
+def check(cond, what):
+    global passed, failed
+    if cond:
+        passed += 1
+    else:
+        failed += 1
+        print(f"CHECK failed: {what}", file=sys.stderr)
+
+
+def step(fn):
+    global failed
+    try:
+        fn()
+    except Exception:
+        failed += 1
+        print(f"step {fn.__name__} raised:", file=sys.stderr)
+        traceback.print_exc()
+
+
+shutil.rmtree(args.work, ignore_errors=True)
+os.makedirs(args.work)
+out_dir = os.path.join(args.work, "out")
+scene = bpy.context.scene
+
+
+def install_and_enable():
+    zip_path = os.path.join(args.work, "atlas_blender.zip")
+    with zipfile.ZipFile(zip_path, "w") as z:
+        for root, _, files in os.walk(args.addon):
+            for f in files:
+                if f.endswith(".py"):
+                    full = os.path.join(root, f)
+                    z.write(full, os.path.join("atlas_blender", os.path.relpath(full, args.addon)))
+    bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
+    bpy.ops.preferences.addon_enable(module="atlas_blender")
+    prefs = bpy.context.preferences.addons["atlas_blender"].preferences
+    prefs.atlas_python_path = args.atlas_python
+    check(hasattr(scene, "atlas"), "the add-on registered its scene properties")
+
+
+def open_and_cook():
+    props = scene.atlas
+    props.out_dir = out_dir
+    props.auto_cook = False
+    props.jobs = 2
+    check(bpy.ops.atlas.open_graph(filepath=args.graph) == {"FINISHED"}, "open_graph finished")
+    check(props.error == "", f"no error after opening: {props.error}")
+    names = {(p.node, p.name) for p in props.params}
+    check(("coverage", "in_min") in names and ("base", "octaves") in names, "parameters listed from declarations")
+    octaves = next(p for p in props.params if (p.node, p.name) == ("base", "octaves"))
+    check(octaves.ptype == "int" and octaves.i == 4 and octaves.range_text == "[1, 16]" and octaves.doc,
+          f"octaves: {octaves.ptype} {octaves.i} {octaves.range_text!r}")
+    tip = bpy.ops.atlas.param_info.get_rna_type()  # the operator exists; its tooltip is the doc
+    check(tip is not None, "param_info operator registered")
+    check(bpy.ops.atlas.cook(background=False) == {"FINISHED"}, f"cook finished: {props.error}")
+    check(set(props.last_cooked.split()) == {"base", "coverage", "distance", "nvdf"}, f"first cook: {props.last_cooked}")
+
+
+def volume_object():
+    obj = bpy.data.objects.get("atlas_nvdf")
+    check(obj is not None and obj.type == "VOLUME", "a Volume object for nvdf.vdb")
+    if obj is None:
+        return
+    grids = {g.name: g for g in obj.data.grids}
+    check(set(grids) == {"dimensional_profile", "detail_type", "density_scale", "sdf"}, f"grids: {sorted(grids)}")
+    m = grids["sdf"].matrix_object
+    # The field is 128x128x32 over [0, 4096] x [0, 4096] x [0, 512] m, cell-centred.
+    check([round(m[i][i], 4) for i in range(3)] == [32.0, 32.0, 16.0], f"voxel size {m}")
+    check([round(m[i][3], 4) for i in range(3)] == [16.0, 16.0, 8.0], f"first voxel centre {m}")
+    ev = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    lo = [min(v[i] for v in ev.bound_box) for i in range(3)]
+    hi = [max(v[i] for v in ev.bound_box) for i in range(3)]
+    check(all(0 <= lo[i] < hi[i] <= (4096, 4096, 512)[i] for i in range(3)), f"bounds in metres {lo} {hi}")
+    check(obj.data.materials and obj.data.materials[0].name == "Atlas Nubis", "volume material")
+
+
+def same_voxels_as_the_cli():
+    cli_out = os.path.join(args.work, "cli")
+    r = subprocess.run([args.atlas_bin, "cook", args.graph, "--out", cli_out, "--output", "nvdf.vdb", "--quiet"],
+                       capture_output=True, text=True)
+    check(r.returncode == 0, f"CLI cook: {r.stderr}")
+    import pyopenvdb as vdb
+
+    ours = {g.name: g for g in vdb.readAllGridMetadata(os.path.join(out_dir, "nvdf.vdb"))}
+    check(set(ours) == {"dimensional_profile", "detail_type", "density_scale", "sdf"}, "add-on VDB grids")
+    for name in sorted(ours):
+        a = vdb.read(os.path.join(out_dir, "nvdf.vdb"), name).getConstAccessor()
+        b = vdb.read(os.path.join(cli_out, "nvdf.vdb"), name).getConstAccessor()
+        coords = [(x, y, z) for x in (0, 17, 64, 127) for y in (3, 50, 101) for z in (0, 9, 31)]
+        diff = [c for c in coords if a.getValue(c) != b.getValue(c)]
+        check(not diff, f"{name}: voxels differ from the CLI's at {diff[:3]}")
+
+
+def incremental_recook():
+    props = scene.atlas
+    props.auto_cook = True  # headless: the re-cook runs synchronously in the update
+    in_min = next(p for p in props.params if (p.node, p.name) == ("coverage", "in_min"))
+    in_min.f = 0.5
+    check(props.error == "", f"no error after the edit: {props.error}")
+    check(set(props.last_cooked.split()) == {"coverage", "distance", "nvdf"}, f"re-cooked: {props.last_cooked}")
+
+
+def bad_input():
+    props = scene.atlas
+    octaves = next(p for p in props.params if (p.node, p.name) == ("base", "octaves"))
+    props.auto_cook = False
+    octaves.i = 99
+    check("base" in props.error and "octaves" in props.error and "16" in props.error,
+          f"out-of-range message: {props.error!r}")
+    broken = os.path.join(args.work, "broken.yaml")
+    with open(broken, "w") as f:
+        f.write("atlas: 1\nnodes:\n  base:\n    type: noise/value\n    params: {octavs: 2}\noutputs: []\n")
+    try:  # an operator that reports an error raises it in background mode
+        result, reported = bpy.ops.atlas.open_graph(filepath=broken), ""
+    except RuntimeError as e:
+        result, reported = {"CANCELLED"}, str(e)
+    check(result == {"CANCELLED"} and props.error in reported, f"a broken graph is refused: {reported!r}")
+    cli = subprocess.run([args.atlas_bin, "validate", broken], capture_output=True, text=True)
+    check(cli.returncode != 0 and props.error and props.error in cli.stderr,
+          f"same message as the CLI: {props.error!r} vs {cli.stderr!r}")
+    check(props.error.startswith(broken + ":5:"), f"file:line:col: {props.error!r}")
+    # The previous graph stays loaded and cookable.
+    octaves.i = 4
+    check(bpy.ops.atlas.cook(background=False) == {"FINISHED"}, f"cook after errors: {props.error}")
+
+
+def render_small_picture():
+    obj = bpy.data.objects["atlas_nvdf"]
+    cam_data = bpy.data.cameras.new("cam")
+    cam = bpy.data.objects.new("cam", cam_data)
+    scene.collection.objects.link(cam)
+    cam.location = (2048, -3500, 1500)
+    cam.rotation_euler = (1.2, 0, 0)
+    cam_data.clip_end = 20000
+    scene.camera = cam
+    sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
+    scene.collection.objects.link(sun)
+    sun.rotation_euler = (0.6, 0.2, 0.3)
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = 4
+    scene.cycles.use_denoising = False  # Debian builds Cycles without OpenImageDenoise
+    scene.cycles.volume_step_rate = 4.0
+    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 64, 36, 100
+    scene.render.filepath = os.path.join(args.work, "render.png")
+    bpy.ops.render.render(write_still=True)
+    img = bpy.data.images.load(scene.render.filepath)
+    px = list(img.pixels)
+    lum = [sum(px[i:i + 3]) / 3 for i in range(0, len(px), 4)]
+    check(max(lum) - min(lum) > 0.02, f"the render shows something (luminance {min(lum):.3f}..{max(lum):.3f})")
+    check(obj.visible_get(), "volume visible")
+
+
+for s in (install_and_enable, open_and_cook, volume_object, same_voxels_as_the_cli, incremental_recook, bad_input,
+          render_small_picture):
+    step(s)
+
+print(f"{passed} passed, {failed} failed")
+sys.exit(1 if failed else 0)
