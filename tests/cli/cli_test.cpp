@@ -465,3 +465,17 @@ TEST(CliUnattended, CachePruneKeepsTheMostRecentlyUsed) {
     EXPECT_NE(all.out.find("removed 1 entries (" + std::to_string(before) + " bytes), 0 bytes left"), std::string::npos) << all.out;
     EXPECT_EQ(run("cache prune " + (d / "c").string()).status, 2); // --max-size is required
 }
+
+// `--out .` (or no --out) with output paths whose directories do not exist
+// yet writes them, instead of refusing them as leaving the directory.
+TEST(CliUnattended, OutDotWritesIntoNewDirectories) {
+    const fs::path d = fresh_dir("outdot");
+    auto g = write_graph("outdot.yaml", std::string(kNoiseGraph) + "  - {node: n, file: new/sub/n.exr}\n");
+    const std::string bin = std::string(ATLAS_BINARY_DIR) + "/bin/atlas";
+    const std::string cook = bin + " cook " + g.string() + " --quiet --no-cache";
+    EXPECT_EQ(std::system(("cd " + d.string() + " && " + cook + " --out . >/dev/null").c_str()), 0);
+    EXPECT_TRUE(fs::exists(d / "new" / "sub" / "n.exr"));
+    fs::remove_all(d / "new");
+    EXPECT_EQ(std::system(("cd " + d.string() + " && " + cook + " >/dev/null").c_str()), 0);
+    EXPECT_TRUE(fs::exists(d / "new" / "sub" / "n.exr"));
+}

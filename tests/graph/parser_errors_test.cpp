@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 using namespace atlas;
 
 namespace {
@@ -217,4 +219,15 @@ TEST(GraphParse, FormatThatContradictsTheExtension) {
     EXPECT_NE(f.message.find("format 'png' contradicts the file name's extension (a 'exr' file)"), std::string::npos) << f.message;
     auto s = parse_failure("atlas: 1\nnodes:\n  a:\n    type: test/source\noutputs:\n  - {node: a, file: v.tga, format: tga-slices}\n");
     EXPECT_NE(s.message.find("takes DIR/STEM without an extension"), std::string::npos) << s.message;
+}
+
+// A huge unknown type name is rejected at once and not echoed in full.
+TEST(GraphParse, HugeUnknownTypeIsCutInTheMessage) {
+    const std::string huge(2'000'000, 'x');
+    const auto t0 = std::chrono::steady_clock::now();
+    auto f = parse_failure("atlas: 1\nnodes:\n  a:\n    type: " + huge + "\noutputs: []\n");
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+    EXPECT_NE(f.message.find("unknown node type 'xxxxxxxx"), std::string::npos) << f.message.substr(0, 200);
+    EXPECT_NE(f.message.find("(2000000 bytes)"), std::string::npos) << f.message.substr(0, 200);
+    EXPECT_LT(f.message.size(), 1000u);
 }

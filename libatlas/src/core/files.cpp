@@ -268,10 +268,13 @@ fs::path resolve_output_path(const fs::path& out_dir, const std::string& relativ
     }
     fs::path joined = (out_dir / rel).lexically_normal();
     if (allow_outside) return joined;
-    fs::path base = fs::weakly_canonical(out_dir);
+    // Absolute first: weakly_canonical of a relative path whose first
+    // component does not exist yet ("nvdf/x.exr" under --out .) stays
+    // relative and would look like it left the directory.
+    fs::path base = fs::weakly_canonical(fs::absolute(out_dir));
     // weakly_canonical follows symlinks in the existing prefix, so a link
     // inside --out that points elsewhere is caught here too.
-    fs::path resolved = fs::weakly_canonical(joined);
+    fs::path resolved = fs::weakly_canonical(fs::absolute(joined));
     auto mismatch = std::mismatch(base.begin(), base.end(), resolved.begin(), resolved.end());
     if (mismatch.first != base.end())
         throw Error("output path '" + relative + "' leaves the output directory '" + out_dir.string() +

@@ -142,6 +142,13 @@ void parse_inputs(const Parser& p, const YAML::Node& inputs, GraphNode& node) {
     }
 }
 
+// A name as an error echoes it: at most 80 characters (a 10 MB string is
+// not repeated back in full).
+std::string excerpt(const std::string& s) {
+    if (s.size() <= 80) return s;
+    return s.substr(0, 60) + "... (" + std::to_string(s.size()) + " bytes)";
+}
+
 // "" when outputs a and b write different files; else how they collide.
 std::string output_clash(const GraphOutput& a, const GraphOutput& b) {
     const std::string pa = std::filesystem::path(a.file).lexically_normal().generic_string();
@@ -204,13 +211,19 @@ std::string closest_match(const std::string& word, const std::vector<std::string
         }
         return prev[b.size()];
     };
+    // The distance is at least the length difference: a candidate that far
+    // off is not measured (a 10 MB word costs nothing, not a minute).
+    auto far = [](const std::string& a, const std::string& b, size_t limit) {
+        return (a.size() > b.size() ? a.size() - b.size() : b.size() - a.size()) >= limit;
+    };
     std::string best;
     size_t best_d = std::max<size_t>(2, word.size() / 3) + 1;
+    if (word.size() > 256) return best; // no name is that long
     for (const auto& c : candidates) {
-        size_t d = distance(word, c);
+        size_t d = far(word, c, best_d) ? best_d : distance(word, c);
         // Also accept a candidate whose last path component matches ("perlin" -> "noise/perlin").
         auto slash = c.rfind('/');
-        if (slash != std::string::npos) d = std::min(d, distance(word, c.substr(slash + 1)) + 1);
+        if (slash != std::string::npos && !far(word, c.substr(slash + 1), best_d)) d = std::min(d, distance(word, c.substr(slash + 1)) + 1);
         if (d < best_d) { best_d = d; best = c; }
     }
     return best;
@@ -282,7 +295,7 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
         const NodeType* type = registry.find(n.type);
         if (!type) {
             std::string hint = closest_match(n.type, type_names);
-            p.fail(body["type"], "node '" + n.name + "': unknown node type '" + n.type + "'" +
+            p.fail(body["type"], "node '" + n.name + "': unknown node type '" + excerpt(n.type) + "'" +
                                      (hint.empty() ? " (run 'atlas nodes' for the list)" : " (did you mean '" + hint + "'?)"));
         }
         if (const YAML::Node params = body["params"]) {
