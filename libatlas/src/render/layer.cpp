@@ -156,13 +156,18 @@ struct Column {
     double coverage = 0, type = 0, top_type = 0, bottom_type = 0, min_h = 0, max_h = 0, precip = 0;
 };
 
-double sample_lut(const Field2D& lut, const float* ch, double type, double f) {
-    // End-aligned texels (ndf/profile_lut): texel i at type i / (W - 1).
+// bottom(bottom_type, f) * top(top_type, f) from the LUT's two channels,
+// end-aligned texels (ndf/profile_lut): texel i at type i / (W - 1); the
+// height axis is shared by both lookups.
+inline double profile_split(const Field2D& lut, const float* bottom, const float* top, double bottom_type, double top_type, double f) {
     const int w = lut.width(), h = lut.height();
     Bilinear b;
-    axis_clamp(0.5 + detail::saturate(type) * (w - 1), w, b.x0, b.x1, b.tx);
     axis_clamp(0.5 + detail::saturate(f) * (h - 1), h, b.y0, b.y1, b.ty);
-    return lerp2(ch, w, b);
+    axis_clamp(0.5 + detail::saturate(bottom_type) * (w - 1), w, b.x0, b.x1, b.tx);
+    const double lo = lerp2(bottom, w, b);
+    if (!(lo > 0)) return 0;
+    axis_clamp(0.5 + detail::saturate(top_type) * (w - 1), w, b.x0, b.x1, b.tx);
+    return lo * lerp2(top, w, b);
 }
 
 // Everything the march reads, prepared once per render.
@@ -179,6 +184,11 @@ public:
         ch_top_ = ctt >= 0 ? ndf_.channel(ctt).data() : ch_type_;
         ch_bot_ = cbt >= 0 ? ndf_.channel(cbt).data() : ch_type_;
         ch_precip_ = cp >= 0 ? ndf_.channel(cp).data() : nullptr;
+        // Interleaved copy: coverage, min, max, type, top type, bottom type, precipitation.
+        texels_.resize(size_t(ndf_.width()) * size_t(ndf_.height()));
+        for (size_t i = 0; i < texels_.size(); ++i)
+            texels_[i] = {ch_cov_[i], ch_min_[i], ch_max_[i], ch_type_ ? ch_type_[i] : 0.0f, ch_top_ ? ch_top_[i] : 0.0f,
+                          ch_bot_ ? ch_bot_[i] : 0.0f, ch_precip_ ? ch_precip_[i] : 0.0f, 0.0f};
         lut_bottom_ = lut_.channel(lut_.find_channel("bottom")).data();
         lut_top_ = lut_.channel(lut_.find_channel("top")).data();
         const Box2d& b = ndf_.bounds();
@@ -259,14 +269,24 @@ public:
             axis_clamp(u, nx, b.x0, b.x1, b.tx);
             axis_clamp(v, ny, b.y0, b.y1, b.ty);
         }
-        c.coverage = lerp2(ch_cov_, nx, b);
+        // One 32-byte texel per corner (channels interleaved at construction).
+        const std::array<float, 8>* t = texels_.data();
+        const auto& a0 = t[size_t(b.y0) * size_t(nx) + size_t(b.x0)];
+        const auto& a1 = t[size_t(b.y0) * size_t(nx) + size_t(b.x1)];
+        const auto& b0 = t[size_t(b.y1) * size_t(nx) + size_t(b.x0)];
+        const auto& b1 = t[size_t(b.y1) * size_t(nx) + size_t(b.x1)];
+        auto at = [&](size_t k) {
+            const float lo = a0[k] + (a1[k] - a0[k]) * b.tx, hi = b0[k] + (b1[k] - b0[k]) * b.tx;
+            return double(lo + (hi - lo) * b.ty);
+        };
+        c.coverage = at(0);
         if (!(c.coverage > 0)) return false;
-        c.min_h = lerp2(ch_min_, nx, b);
-        c.max_h = lerp2(ch_max_, nx, b);
-        c.type = ch_type_ ? lerp2(ch_type_, nx, b) : 0.0;
-        c.top_type = ch_top_ ? lerp2(ch_top_, nx, b) : 0.0;
-        c.bottom_type = ch_bot_ ? lerp2(ch_bot_, nx, b) : 0.0;
-        c.precip = ch_precip_ ? detail::saturate(lerp2(ch_precip_, nx, b)) : 0.0;
+        c.min_h = at(1);
+        c.max_h = at(2);
+        c.type = at(3);
+        c.top_type = at(4);
+        c.bottom_type = at(5);
+        c.precip = detail::saturate(at(6));
         return c.max_h > c.min_h;
     }
 
@@ -315,8 +335,7 @@ public:
             const double bias = detail::saturate(lerp2(anvil_ch_, anvil_->width(), b));
             c.coverage = std::pow(c.coverage, detail::remap(f, 0.7, 0.8, 1.0, 1.0 - 0.5 * bias));
         }
-        const double profile =
-            sample_lut(lut_, lut_bottom_, c.bottom_type, f) * sample_lut(lut_, lut_top_, c.top_type, f);
+        const double profile = profile_split(lut_, lut_bottom_, lut_top_, c.bottom_type, c.top_type, f);
         if (!(profile > 0)) return 0;
         // Wind: tops pushed downwind, the noise scrolled (detail faster, a
         // little upward: clouds seem to grow).
@@ -419,6 +438,7 @@ private:
     const Field2D& lut_;
     const float *ch_cov_, *ch_min_, *ch_max_, *ch_type_, *ch_top_, *ch_bot_, *ch_precip_;
     const float *lut_bottom_, *lut_top_;
+    std::vector<std::array<float, 8>> texels_;
     Vec2d origin_, size_, inv_texel_;
     Vec3d centre_;
     double bottom_ = 0, top_ = 0;
@@ -609,7 +629,9 @@ struct LayerIntegrator {
             int zero_run = 0;
             while (t < t_end && steps < kMaxSteps) {
                 ++steps;
-                double dt = std::min(max_step, base_step * (1 + t / grow));
+                // Capped at max_step near the camera; beyond 20 km the cap grows
+                // with distance (2 %), where haze and size hide the step noise.
+                double dt = std::min(std::max(max_step, 0.02 * t / s.quality), base_step * (1 + t / grow));
                 if (first) dt *= 0.5 + 0.5 * jitter; // jittered start
                 first = false;
                 if (searching) {
