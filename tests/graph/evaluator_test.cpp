@@ -13,6 +13,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -761,5 +762,33 @@ TEST(DiskCache, AbsurdDimensionsAreAMiss) {
         std::string why;
         EXPECT_FALSE(disk_cache::deserialize(b, &why).has_value()) << dim;
         EXPECT_FALSE(why.empty());
+    }
+}
+
+// Errors raised while cooking carry the node's place in the graph file.
+TEST_F(Fixture, CookErrorsCarryTheNodesFileLine) {
+    Session s = session();
+    log->fail = true;
+    try {
+        s.cook(options());
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("test.yaml:14:3: node 'gate' (test/fail): ", 0), 0u) << e.what();
+    }
+}
+
+// An input that is not a regular file (a device, a FIFO) would never end:
+// refused at once, naming the file.
+TEST_F(Fixture, NonRegularInputFilesAreRefused) {
+    const fs::path fifo = dir / "pipe.exr";
+    ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+    for (const std::string& f : {std::string("/dev/zero"), fifo.string()}) {
+        const std::string g = "atlas: 1\nnodes:\n  i:\n    type: import/exr\n    params: {file: " + f + "}\noutputs:\n  - {node: i, file: c.exr}\n";
+        try {
+            session(g).cook(options());
+            FAIL() << f;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(f + ": not a regular file"), std::string::npos) << e.what();
+        }
     }
 }

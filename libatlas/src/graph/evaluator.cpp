@@ -26,24 +26,28 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Prefixes an error with the node it came from (unless it already names it).
-[[noreturn]] void rethrow_for_node(const std::string& name, const std::string& type, std::exception_ptr ep) {
+// Prefixes an error with the node it came from (unless it already names it)
+// and the node's place in the graph file (file:line:col), keeping its type.
+[[noreturn]] void rethrow_for_node(const std::string& name, const std::string& type, const std::string& where, std::exception_ptr ep) {
+    auto located = [&](const std::string& msg, bool named) {
+        std::string m = named ? msg : "node '" + name + "' (" + type + "): " + msg;
+        if (!where.empty() && m.rfind(where, 0) != 0) m = where + ": " + m;
+        return m;
+    };
     try {
         std::rethrow_exception(ep);
     } catch (const CancelledError&) {
         throw;
     } catch (const MemoryBudgetError& e) {
-        std::string msg = e.what();
-        if (msg.rfind("node '", 0) == 0) throw;
-        throw MemoryBudgetError("node '" + name + "' (" + type + "): " + msg);
+        const std::string msg = e.what();
+        throw MemoryBudgetError(located(msg, msg.rfind("node '", 0) == 0));
     } catch (const Error& e) {
-        std::string msg = e.what();
-        if (msg.rfind("node '" + name + "'", 0) == 0) throw;
-        throw Error("node '" + name + "' (" + type + "): " + msg);
+        const std::string msg = e.what();
+        throw Error(located(msg, msg.rfind("node '" + name + "'", 0) == 0));
     } catch (const std::bad_alloc&) {
-        throw MemoryBudgetError("node '" + name + "' (" + type + "): out of memory");
+        throw MemoryBudgetError(located("out of memory", false));
     } catch (const std::exception& e) {
-        throw Error("node '" + name + "' (" + type + "): " + e.what());
+        throw Error(located(e.what(), false));
     }
 }
 
@@ -130,7 +134,7 @@ Hash128 node_hash(const Graph& g, const NodeRegistry& reg, const GraphNode& n, c
         try {
             type.hash_extra(np, h);
         } catch (...) {
-            rethrow_for_node(n.name, n.type, std::current_exception());
+            rethrow_for_node(n.name, n.type, n.where.str(), std::current_exception());
         }
     }
     for (const auto& in : type.decl.inputs()) {
@@ -447,7 +451,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             if (errors[i]) {
                 result.error_node = level[i]->name;
                 result.error_where = level[i]->where.str();
-                rethrow_for_node(level[i]->name, level[i]->type, errors[i]);
+                rethrow_for_node(level[i]->name, level[i]->type, level[i]->where.str(), errors[i]);
             }
         for (size_t i = 0; i < level.size(); ++i) {
             const GraphNode& n = *level[i];
