@@ -1,6 +1,6 @@
 """Atlas for Blender: open an Atlas node graph, edit its parameters, cook it and see the result.
 
-The panel (View3D > Sidebar > Atlas) opens a graph file, lists every node's parameters from the
+The panel (View3D > Sidebar > Atlas, and Properties > Scene) opens a graph file, lists every node's parameters from the
 node declarations (with ranges and units; hover the (i) button for the doc), cooks in a background
 thread with Blender's progress indicator (Cancel stops it), re-cooks incrementally when a parameter
 changes, and shows VDB outputs (the NVDF set) as Volume objects in world units (metres) with a
@@ -27,7 +27,8 @@ import tempfile
 import threading
 
 import bpy
-from bpy.props import BoolProperty, CollectionProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty, StringProperty
+from bpy.props import (BoolProperty, CollectionProperty, FloatProperty, FloatVectorProperty, IntProperty,
+                       IntVectorProperty, PointerProperty, StringProperty)
 
 # ---------------------------------------------------------------- the atlas module
 
@@ -124,6 +125,7 @@ class AtlasParam(bpy.types.PropertyGroup):
     b: BoolProperty(update=_on_param_changed)
     s: StringProperty(update=_on_param_changed)
     v: FloatVectorProperty(size=3, update=_on_param_changed)
+    iv: IntVectorProperty(size=3, update=_on_param_changed)
 
     def value(self):
         t = self.ptype
@@ -134,8 +136,7 @@ class AtlasParam(bpy.types.PropertyGroup):
         if t == "bool":
             return self.b
         if t in _VECTOR_TYPES:
-            vals = list(self.v)[: _VECTOR_TYPES[t]]
-            return [int(round(x)) for x in vals] if t.startswith("int") else vals
+            return list(self.iv if t.startswith("int") else self.v)[: _VECTOR_TYPES[t]]
         return self.s
 
     def assign(self, value):
@@ -147,8 +148,11 @@ class AtlasParam(bpy.types.PropertyGroup):
         elif t == "bool":
             self.b = bool(value)
         elif t in _VECTOR_TYPES:
-            vals = list(value) + [0.0] * (3 - len(value))
-            self.v = [float(x) for x in vals[:3]]
+            vals = (list(value) + [0] * 3)[:3]
+            if t.startswith("int"):
+                self.iv = [int(x) for x in vals]
+            else:
+                self.v = [float(x) for x in vals]
         else:
             self.s = str(value)
 
@@ -331,6 +335,10 @@ def _load_volume(scene, name, path):
     vol.filepath = path
     if not vol.grids.load():
         raise RuntimeError(f"{path}: {vol.grids.error_message}")
+    # The viewport draws the active grid: the cloud's shape, not the SDF's whole box.
+    names = [g.name for g in vol.grids]
+    if "dimensional_profile" in names:
+        vol.grids.active_index = names.index("dimensional_profile")
     obj = bpy.data.objects.get(name)
     if obj is None:
         obj = bpy.data.objects.new(name, vol)
@@ -488,14 +496,26 @@ class ATLAS_PT_panel(bpy.types.Panel):
                 box.label(text=node, icon="NODE")
             row = box.row(align=True)
             label = p.name + (f" ({p.unit})" if p.unit else "")
-            field = {"float": "f", "int": "i", "bool": "b"}.get(p.ptype, "v" if p.ptype in _VECTOR_TYPES else "s")
+            vector = "iv" if p.ptype.startswith("int") else "v"
+            field = {"float": "f", "int": "i", "bool": "b"}.get(p.ptype, vector if p.ptype in _VECTOR_TYPES else "s")
             row.prop(p, field, text=label)
             info = row.operator("atlas.param_info", text="", icon="QUESTION")
             info.node, info.param = p.node, p.name
 
 
+class ATLAS_PT_scene_panel(bpy.types.Panel):
+    """The same panel in Properties > Scene."""
+    bl_label = "Atlas"
+    bl_idname = "ATLAS_PT_scene_panel"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "scene"
+    bl_order = -100
+    draw = ATLAS_PT_panel.draw
+
+
 _classes = (AtlasParam, AtlasSceneProps, AtlasPreferences, ATLAS_OT_open_graph, ATLAS_OT_cook, ATLAS_OT_cancel,
-            ATLAS_OT_param_info, ATLAS_PT_panel)
+            ATLAS_OT_param_info, ATLAS_PT_panel, ATLAS_PT_scene_panel)
 
 
 def register():
