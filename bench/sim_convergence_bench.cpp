@@ -18,13 +18,17 @@
 //               (theta' at cell centres box-averaged onto each coarser grid).
 //
 // Run:   build-sim/bench/sim_convergence_bench --benchmark_filter=Convergence
-//        (ConvergenceRotation, ConvergenceTaylorGreen, ConvergenceThermal;
+//        (ConvergenceRotation, ConvergenceTaylorGreen[Viscous], ConvergenceThermal;
 //         Smoke for CI, < 1 s)
+//        build-sim/bench/sim_convergence_bench --benchmark_filter=DensityCurrent_200
+//        (Straka et al. 1993 density current: peak w against CFL and the step
+//         tolerance, both time schemes; DensityCurrent_100 at the published 100 m)
 #include "atlas/sim/simulation.h"
 
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -230,6 +234,79 @@ void thermal_study(benchmark::State& state, std::vector<int> ns, int nref, doubl
     }
 }
 
+
+// ---- Density current (Straka et al. 1993): peak w against the CFL number ----
+
+struct CurrentResult {
+    double min_w = 0, max_w = 0, min_theta = 0, front = 0, seconds = 0, worst_error = 0;
+    int substeps = 0;
+};
+
+// Half domain x in [0, 25.6 km] (x = 0 is the symmetry plane, a free-slip
+// wall), z in [0, 6.4 km], neutral 300 K, T' = -7.5 (cos(pi l) + 1) K for
+// l = |((x - 0) / 4 km, (z - 3 km) / 2 km)| <= 1 (theta' = T' / Pi0), nu = kappa
+// = 75 m^2/s, 900 s. Peaks over the run sampled every 60 s.
+CurrentResult density_current(double dx, TimeScheme ts, double cfl, double tol) {
+    const int nx = int(std::lround(25600 / dx)), nz = int(std::lround(6400 / dx));
+    GridSpec s;
+    s.nx = nx, s.ny = 1, s.nz = nz, s.dx = dx;
+    Sounding snd;
+    SimOptions o;
+    o.moist = false;
+    o.time_scheme = ts;
+    o.cfl = cfl;
+    o.step_error_tolerance = tol;
+    o.viscosity = o.diffusivity = 75;
+    o.max_substeps = 10000;
+    Simulation sim(s, snd, o);
+    std::vector<float> d(s.cells(), 0.f);
+    for (int k = 0; k < nz; ++k)
+        for (int i = 0; i < nx; ++i) {
+            const double x = (i + 0.5) * dx / 4000, z = ((k + 0.5) * dx - 3000) / 2000, l = std::sqrt(x * x + z * z);
+            if (l <= 1) d[size_t(k) * nx + i] = float(-7.5 * (std::cos(M_PI * l) + 1) / sim.reference().exner[size_t(k)]);
+        }
+    sim.add_theta(d);
+    CurrentResult r;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int st = 0; st < 15; ++st) {
+        const StepReport rep = sim.step(60);
+        r.substeps += rep.substeps;
+        r.worst_error = std::max(r.worst_error, rep.step_error);
+        for (float w : sim.velocity().w) r.min_w = std::min(r.min_w, double(w)), r.max_w = std::max(r.max_w, double(w));
+        r.min_theta = rep.min_theta_perturbation; // at the end (900 s)
+    }
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // Front: the largest x of a surface cell with theta' < -1 K.
+    const atlas::Field3D tp = sim.theta_perturbation();
+    for (int i = 0; i < nx; ++i)
+        if (tp.channel(0)[size_t(i)] < -1) r.front = (i + 0.5) * dx;
+    return r;
+}
+
+void density_current_study(benchmark::State& state, double dx) {
+    for (auto _ : state) {
+        std::printf("\nDensity current (Straka 1993), dx = %g m, 900 s: peaks over the run (every 60 s)\n\n"
+                    "| time scheme | CFL | step tolerance (cells) | substeps | worst step error (cells) | min w (m/s) | max w (m/s) | min theta' at 900 s (K) | front (m) | wall s |\n"
+                    "|---|---|---|---|---|---|---|---|---|---|\n",
+                    dx);
+        struct Row {
+            TimeScheme ts;
+            double cfl, tol;
+        };
+        const Row rows[] = {{TimeScheme::Split, 2, 0},       {TimeScheme::Split, 1, 0},       {TimeScheme::Split, 0.5, 0},
+                            {TimeScheme::Split, 0.25, 0},    {TimeScheme::Trapezoidal, 2, 0}, {TimeScheme::Trapezoidal, 1, 0},
+                            {TimeScheme::Trapezoidal, 0.5, 0}, {TimeScheme::Trapezoidal, 0.25, 0},
+                            {TimeScheme::Trapezoidal, 2, 0.02}, {TimeScheme::Trapezoidal, 2, 0.005},
+                            {TimeScheme::Trapezoidal, 0.1, 0}};
+        for (const Row& row : rows) {
+            const CurrentResult r = density_current(dx, row.ts, row.cfl, row.tol);
+            std::printf("| %s | %.2g | %g | %d | %.3g | %.2f | %.2f | %.2f | %.0f | %.1f |\n", time_name(row.ts), row.cfl, row.tol, r.substeps,
+                        r.worst_error, r.min_w, r.max_w, r.min_theta, r.front, r.seconds);
+            std::fflush(stdout);
+        }
+    }
+}
+
 } // namespace
 
 BENCHMARK_CAPTURE(rotation_study, Smoke, std::vector<int>{16, 32}, 1.0)->Iterations(1)->Unit(benchmark::kSecond);
@@ -242,5 +319,8 @@ BENCHMARK_CAPTURE(taylor_green_study, ConvergenceTaylorGreenViscous, std::vector
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(thermal_study, ConvergenceThermal, std::vector<int>{32, 64, 128}, 256, 1.0)->Iterations(1)->Unit(benchmark::kSecond);
+
+BENCHMARK_CAPTURE(density_current_study, DensityCurrent_200, 200.0)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(density_current_study, DensityCurrent_100, 100.0)->Iterations(1)->Unit(benchmark::kSecond);
 
 BENCHMARK_MAIN();

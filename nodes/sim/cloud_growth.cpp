@@ -26,9 +26,19 @@ void declare(NodeDeclaration& d) {
           "velocity at cell centres, and 'sequence': every sequence_every-th frame's chosen grids as channels "
           "'NNNN:GRID' for the 'vdb-sequence' format. Each step's divergence (L2, max), pressure iterations, water "
           "and theta_l drift across the saturation adjustment and seconds per stage go into the cook report as "
-          "'step_NNNN.*' metrics, with totals and maxima, and the cloud base and top (m above the floor, qc > 1e-5; -1: no cloud). Memory (simulation_bytes: 216 B per cell, +8 with rain, +12 with advection_reflection, plus outputs) is checked before allocating.");
+          "'step_NNNN.*' metrics, with totals and maxima, and the cloud base and top (m above the floor, qc > 1e-5; -1: no cloud). Initial state: optional inputs initial_theta (theta' or T'), initial_vapour (qv'), initial_velocity, an ellipsoidal cos^2 bubble. Time stepping: second-order trapezoidal (default) with an accuracy step control (step_error_tolerance; step_NNNN.step_error in the report) or the first-order split. Memory (simulation_bytes: 216 B per cell, +24 with the trapezoidal time scheme, +8 with rain, +12 with advection_reflection instead, plus outputs) is checked before allocating.");
     d.input("sounding", PortType::Field2D, "sim/sounding record (default: the sim/sounding defaults)").optional = true;
-    d.input("emitter", PortType::Field3D, "heat (K/s) and vapour (kg/kg/s) rates, e.g. sim/emitter; channels 'heat' and 'vapour' or 0 and 1").optional = true;
+    d.input("emitter", PortType::Field3D, "heat (K/s, < 0 cools) and vapour (kg/kg/s) rates, e.g. sim/emitter; channels 'heat' and 'vapour' or 0 and 1").optional = true;
+    d.input("initial_theta", PortType::Field3D,
+            "initial perturbation added to the sounding: potential temperature theta' in K (channel 0), or absolute "
+            "temperature T' in K when initial_is_temperature (converted theta' = T' / Pi0(z)); sampled at cell centres like "
+            "the emitter, zero outside it").optional = true;
+    d.input("initial_vapour", PortType::Field3D,
+            "initial water-vapour perturbation qv' in kg/kg (channel 0) added to the sounding's qv; a negative total is an "
+            "error naming the node").optional = true;
+    d.input("initial_velocity", PortType::Field3D,
+            "initial velocity u, v, w in m/s at cell centres (channels 'vel.x', 'vel.y', 'vel.z' or 0, 1, 2), averaged onto "
+            "the faces; closed faces get 0 and the first projection removes any divergence").optional = true;
     d.output("out", PortType::Field3D, "cloud water mixing ratio after the last step, channel 'density', kg/kg");
     d.output("temperature", PortType::Field3D, "absolute temperature after the last step, channel 'temperature', K");
     d.output("vapour", PortType::Field3D, "water-vapour mixing ratio after the last step, channel 'vapor', kg/kg");
@@ -43,6 +53,12 @@ void declare(NodeDeclaration& d) {
     d.param_float("duration", 300).range(1e-6, 1e7).with_unit("s").describe("simulated time");
     d.param_float("frame_dt", 10).range(1e-6, 1e5).with_unit("s").describe("time per step (one report row, one potential sequence frame)");
     d.param_float("cfl", 1).range(0.1, 5).with_unit("cells").describe("max cells travelled per substep");
+    d.param_enum("time_scheme", {"trapezoidal", "split"}, "trapezoidal")
+        .describe("trapezoidal: second-order (forces half at the departure, half at the arrival point, time-centred "
+                  "trajectories; 24 B more per cell); split: the first-order advect-then-project split");
+    d.param_float("step_error_tolerance", 0).range(0, 1).with_unit("cells")
+        .describe("accuracy step control (trapezoidal): substeps are shortened so the embedded back-trace error estimate "
+                  "stays below this (0 = CFL limits only); reported per step as step_error");
     d.param_int("max_substeps", 64).range(1, 10000).describe("substep budget per step (more is an error naming the node)");
     d.param_enum("scheme", {"maccormack", "semi_lagrangian", "cubic_limited"}, "maccormack")
         .describe("advection scheme: maccormack (limited), semi_lagrangian (trilinear, most diffusive), cubic_limited "
@@ -77,14 +93,21 @@ void declare(NodeDeclaration& d) {
     d.param_float("patch_radius", 0).range(0, 1e9).with_unit("m").describe("built-in ground patch radius (0 = none)");
     d.param_float2("patch_center", {{0, 0}}).with_unit("m").describe("world x, y of the patch centre");
     d.param_float("patch_depth", 200).range(1e-3, 1e9).with_unit("m").describe("heated depth above the floor");
-    d.param_float("patch_heat_rate", 0.01).range(0, 10).with_unit("K/s").describe("heat source at the patch centre");
+    d.param_float("patch_heat_rate", 0.01).range(-10, 10).with_unit("K/s").describe("heat source at the patch centre (< 0: a cooling patch)");
     d.param_float("patch_vapour_rate", 0).range(0, 1e-3).with_unit("kg/kg/s").describe("vapour source at the patch centre");
     d.param_float("patch_noise_scale", 200).range(1e-3, 1e9).with_unit("m").describe("feature size of the patch's noise");
     d.param_float("patch_noise_amount", 0.5).range(0, 1).describe("0 = smooth patch, 1 = fully noise-modulated");
     d.param_int("seed", 1).range(0, 4294967295.0).describe("seed of the patch noise");
     d.param_float("bubble_theta", 0).range(-20, 20).with_unit("K").describe("initial cos^2 warm bubble amplitude (0 = none)");
     d.param_float3("bubble_center", {{0, 0, 500}}).with_unit("m").describe("world centre of the bubble");
-    d.param_float("bubble_radius", 500).range(1e-3, 1e9).with_unit("m").describe("bubble radius");
+    d.param_float("bubble_radius", 500).range(1e-3, 1e9).with_unit("m").describe("bubble radius (a sphere unless bubble_radii is set)");
+    d.param_float3("bubble_radii", {{0, 0, 0}}).with_unit("m")
+        .describe("ellipsoid semi-axes along x, y, z (all > 0 to use; else the sphere of bubble_radius); the profile is "
+                  "amp (1 + cos(pi l)) / 2 = amp cos^2(pi l / 2) for l = |(x - c) / r| < 1");
+    d.param_bool("bubble_is_temperature", false)
+        .describe("bubble_theta is an absolute-temperature perturbation T' (K), converted to theta' = T' / Pi0(z) per level "
+                  "(e.g. Straka's -15 K density current); false: a potential-temperature perturbation theta'");
+    d.param_bool("initial_is_temperature", false).describe("input 'initial_theta' holds T' (K) instead of theta'");
     d.param_int("sequence_every", 0).range(0, 100000).describe("keep every K-th step as a sequence frame (0: only the last)");
     d.param_string("sequence_grids", "density").describe("comma-separated grids per frame: density, temperature, vapor, vel");
 }
@@ -123,6 +146,8 @@ sim::SimOptions options_from(const CookContext& ctx, int nz, double dx) {
     o.kessler.evaporation = ctx.get_bool("rain_evaporation");
     o.kessler.sedimentation = ctx.get_bool("rain_sedimentation");
     o.cfl = ctx.get_float("cfl");
+    o.time_scheme = ctx.get_string("time_scheme") == "split" ? sim::TimeScheme::Split : sim::TimeScheme::Trapezoidal;
+    o.step_error_tolerance = ctx.get_float("step_error_tolerance");
     o.max_substeps = int(ctx.get_int("max_substeps"));
     o.condensation_rate = ctx.get_float("condensation_rate");
     o.vorticity_confinement = ctx.get_float("vorticity_confinement");
@@ -137,30 +162,23 @@ sim::SimOptions options_from(const CookContext& ctx, int nz, double dx) {
     return o;
 }
 
-// The emitter field sampled at the grid's cell centres (world positions);
-// cells outside the emitter's bounds get no source.
-void apply_emitter(CookContext& ctx, sim::Simulation& sim, const Vec3d& origin) {
-    const Field3DPtr e = ctx.input_field3d("emitter");
-    int hc = e->find_channel("heat"), vc = e->find_channel("vapour");
-    if (hc < 0) hc = 0;
-    if (vc < 0) vc = e->channels() > 1 ? 1 : -1;
-    for (int c : {hc, vc}) {
-        if (c < 0) continue;
-        for (float v : e->channel(c))
-            if (!std::isfinite(v)) ctx.fail("input 'emitter' channel '" + e->channel_name(c) + "' holds NaN/Inf; source rates must be finite");
-    }
-    const sim::GridSpec& s = sim.spec();
-    std::vector<float> heat(s.cells(), 0.f), vap(s.cells(), 0.f);
-    const Box3d& b = e->bounds();
-    // Same cell size and an integral offset: copy cells (exact), else sample trilinearly.
+// Channel `c` of `e` sampled at the grid's cell centres (world positions):
+// copied cell by cell when the cells line up, else trilinear; 0 outside it.
+// NaN/Inf is an error naming the input and channel.
+std::vector<float> on_grid(const CookContext& ctx, const Field3D& e, int c, const sim::GridSpec& s, const Vec3d& origin,
+                           const std::string& port) {
+    for (float v : e.channel(c))
+        if (!std::isfinite(v)) ctx.fail("input '" + port + "' channel '" + e.channel_name(c) + "' holds NaN/Inf; values must be finite");
+    std::vector<float> out(s.cells(), 0.f);
+    const Box3d& b = e.bounds();
     bool aligned = true;
     std::array<long, 3> off{};
     for (int a = 0; a < 3; ++a) {
-        const double vs = e->voxel_size()[a], o = (b.min[a] - origin[a]) / s.dx;
+        const double vs = e.voxel_size()[a], o = (b.min[a] - origin[a]) / s.dx;
         off[size_t(a)] = std::lround(o);
         aligned = aligned && std::fabs(vs - s.dx) <= 1e-9 * s.dx && std::fabs(o - double(off[size_t(a)])) <= 1e-6;
     }
-    const Vec3i er = e->resolution();
+    const Vec3i er = e.resolution();
     size_t n = 0;
     for (int k = 0; k < s.nz; ++k)
         for (int j = 0; j < s.ny; ++j)
@@ -168,21 +186,80 @@ void apply_emitter(CookContext& ctx, sim::Simulation& sim, const Vec3d& origin) 
                 if (aligned) {
                     const long x = i - off[0], y = j - off[1], z = k - off[2];
                     if (x < 0 || y < 0 || z < 0 || x >= er[0] || y >= er[1] || z >= er[2]) continue;
-                    heat[n] = e->at(hc, int(x), int(y), int(z));
-                    if (vc >= 0) vap[n] = e->at(vc, int(x), int(y), int(z));
+                    out[n] = e.at(c, int(x), int(y), int(z));
                     continue;
                 }
                 const Vec3d p{{origin[0] + (i + 0.5) * s.dx, origin[1] + (j + 0.5) * s.dx, origin[2] + (k + 0.5) * s.dx}};
                 bool inside = true;
                 for (int a = 0; a < 3; ++a) inside = inside && p[a] >= b.min[a] && p[a] <= b.max[a];
-                if (!inside) continue;
-                heat[n] = e->sample_world(hc, p, WrapMode::Clamp);
-                if (vc >= 0) vap[n] = e->sample_world(vc, p, WrapMode::Clamp);
+                if (inside) out[n] = e.sample_world(c, p, WrapMode::Clamp);
             }
+    return out;
+}
+
+void apply_emitter(CookContext& ctx, sim::Simulation& sim, const Vec3d& origin) {
+    const Field3DPtr e = ctx.input_field3d("emitter");
+    int hc = e->find_channel("heat"), vc = e->find_channel("vapour");
+    if (hc < 0) hc = 0;
+    if (vc < 0) vc = e->channels() > 1 ? 1 : -1;
+    const sim::GridSpec& s = sim.spec();
+    std::vector<float> heat = on_grid(ctx, *e, hc, s, origin, "emitter");
+    std::vector<float> vap = vc >= 0 ? on_grid(ctx, *e, vc, s, origin, "emitter") : std::vector<float>(s.cells(), 0.f);
     sim.set_sources(std::move(heat), std::move(vap), "node '" + ctx.node_name() + "' input 'emitter'");
 }
 
-std::vector<float> bubble(const sim::GridSpec& s, const Vec3d& origin, double amp, const Vec3d& c, double r) {
+// theta' per cell from T' per cell: theta' = T' / Pi0(z).
+void to_theta(std::vector<float>& d, const sim::Simulation& sim) {
+    const size_t plane = size_t(sim.spec().nx) * size_t(sim.spec().ny);
+    for (size_t c = 0; c < d.size(); ++c) d[c] = float(d[c] / sim.reference().exner[c / plane]);
+}
+
+// Initial-state inputs: theta' (or T'), qv', velocity at cell centres.
+void apply_initial_state(CookContext& ctx, sim::Simulation& sim, const Vec3d& origin) {
+    const sim::GridSpec& s = sim.spec();
+    if (ctx.has_input("initial_theta")) {
+        std::vector<float> d = on_grid(ctx, *ctx.input_field3d("initial_theta"), 0, s, origin, "initial_theta");
+        if (ctx.get_bool("initial_is_temperature")) to_theta(d, sim);
+        sim.add_theta(d);
+    }
+    if (ctx.has_input("initial_vapour")) {
+        const std::vector<float> d = on_grid(ctx, *ctx.input_field3d("initial_vapour"), 0, s, origin, "initial_vapour");
+        std::vector<float>& qv = sim.qv();
+        for (size_t c = 0; c < d.size(); ++c) {
+            qv[c] += d[c];
+            if (qv[c] < 0)
+                ctx.fail("input 'initial_vapour' makes qv = " + std::to_string(qv[c]) + " kg/kg < 0 at cell " + std::to_string(c) +
+                         " (qv' is added to the sounding's vapour; water is not clamped)");
+        }
+    }
+    if (ctx.has_input("initial_velocity")) {
+        const Field3DPtr f = ctx.input_field3d("initial_velocity");
+        if (f->channels() < 3) ctx.fail("input 'initial_velocity' needs 3 channels (u, v, w), got " + std::to_string(f->channels()));
+        const char* names[3] = {"vel.x", "vel.y", "vel.z"};
+        std::vector<float> c[3];
+        for (int a = 0; a < 3; ++a) {
+            const int ch = f->find_channel(names[a]);
+            c[a] = on_grid(ctx, *f, ch >= 0 ? ch : a, s, origin, "initial_velocity");
+        }
+        sim::MacVelocity& v = sim.velocity();
+        auto cell = [&](int a, int i, int j, int k) {
+            i = std::clamp(i, 0, s.nx - 1), j = std::clamp(j, 0, s.ny - 1), k = std::clamp(k, 0, s.nz - 1);
+            return double(c[a][v.ic(i, j, k)]);
+        };
+        for (int k = 0; k < s.nz; ++k)
+            for (int j = 0; j < s.ny; ++j)
+                for (int i = 0; i <= s.nx; ++i) v.u[v.iu(i, j, k)] = float(0.5 * (cell(0, i - 1, j, k) + cell(0, i, j, k)));
+        for (int k = 0; k < s.nz; ++k)
+            for (int j = 0; j <= s.ny; ++j)
+                for (int i = 0; i < s.nx; ++i) v.v[v.iv(i, j, k)] = float(0.5 * (cell(1, i, j - 1, k) + cell(1, i, j, k)));
+        for (int k = 0; k <= s.nz; ++k)
+            for (int j = 0; j < s.ny; ++j)
+                for (int i = 0; i < s.nx; ++i) v.w[v.iw(i, j, k)] = float(0.5 * (cell(2, i, j, k - 1) + cell(2, i, j, k)));
+        v.enforce_walls();
+    }
+}
+
+std::vector<float> bubble(const sim::GridSpec& s, const Vec3d& origin, double amp, const Vec3d& c, const Vec3d& r) {
     std::vector<float> d(s.cells(), 0.f);
     size_t n = 0;
     for (int k = 0; k < s.nz; ++k)
@@ -190,7 +267,8 @@ std::vector<float> bubble(const sim::GridSpec& s, const Vec3d& origin, double am
             for (int i = 0; i < s.nx; ++i, ++n) {
                 const double x = origin[0] + (i + 0.5) * s.dx - c[0], y = origin[1] + (j + 0.5) * s.dx - c[1],
                              z = origin[2] + (k + 0.5) * s.dx - c[2];
-                const double l = std::sqrt(x * x + (s.ny > 1 ? y * y : 0.0) + z * z) / r;
+                const double ex = x / r[0], ey = y / r[1], ez = z / r[2];
+                const double l = std::sqrt(ex * ex + (s.ny > 1 ? ey * ey : 0.0) + ez * ez);
                 if (l < 1) d[n] = float(amp * std::pow(std::cos(0.5 * M_PI * l), 2));
             }
     return d;
@@ -235,6 +313,11 @@ void record_step(CookContext& ctx, int step, const sim::StepReport& r, const sim
     ctx.metric(step_key(step, "pressure_iterations"), r.pressure_iterations);
     ctx.metric(step_key(step, "div_l2"), r.divergence.l2);
     ctx.metric(step_key(step, "div_max"), r.divergence.max);
+    ctx.metric(step_key(step, "step_error"), r.step_error);
+    ctx.metric(step_key(step, "accuracy_dt"), r.accuracy_dt);
+    ctx.metric(step_key(step, "accuracy_limited"), std::string(r.dt_limit) == "accuracy" ? 1.0 : 0.0);
+    ctx.metric(step_key(step, "vapour_sink_deficit"), r.vapour_sink_deficit);
+    ctx.metric(step_key(step, "water_redistributed"), r.water_redistributed);
     ctx.metric(step_key(step, "water_drift"), r.water_drift);
     ctx.metric(step_key(step, "theta_l_drift"), r.theta_l_drift);
     ctx.metric(step_key(step, "max_w"), r.max_w);
@@ -314,8 +397,15 @@ void cook(CookContext& ctx) {
         g.seed = uint32_t(ctx.get_int("seed"));
         sim.add_ground_patch(g);
     }
-    if (const double a = ctx.get_float("bubble_theta"); a != 0)
-        sim.add_theta(bubble(spec, origin, a, ctx.get_float3("bubble_center"), ctx.get_float("bubble_radius")));
+    if (const double a = ctx.get_float("bubble_theta"); a != 0) {
+        const Vec3d radii = ctx.get_float3("bubble_radii");
+        const double r0 = ctx.get_float("bubble_radius");
+        const bool ellipsoid = radii[0] > 0 && radii[1] > 0 && radii[2] > 0;
+        std::vector<float> d = bubble(spec, origin, a, ctx.get_float3("bubble_center"), ellipsoid ? radii : Vec3d{{r0, r0, r0}});
+        if (ctx.get_bool("bubble_is_temperature")) to_theta(d, sim);
+        sim.add_theta(d);
+    }
+    apply_initial_state(ctx, sim, origin);
 
     std::vector<std::string> seq_names;
     for (int f = 1; f <= frames; ++f) {
@@ -347,7 +437,8 @@ void cook(CookContext& ctx) {
     };
 
     double div_l2 = 0, div_max = 0, water = 0, theta_l = 0, max_w = 0, max_qc = 0, max_qr = 0, fallout = 0;
-    double s_adv = 0, s_src = 0, s_thermo = 0, s_forces = 0, s_proj = 0;
+    double s_adv = 0, s_src = 0, s_thermo = 0, s_forces = 0, s_proj = 0, step_error = 0, sink_deficit = 0, redistributed = 0;
+    int accuracy_limited = 0;
     int substeps = 0, iterations = 0, unconverged = 0;
     for (int step = 1; step <= steps; ++step) {
         ctx.progress(double(step - 1) / steps);
@@ -361,6 +452,10 @@ void cook(CookContext& ctx) {
         max_qc = std::max(max_qc, r.max_qc);
         max_qr = std::max(max_qr, r.max_qr);
         fallout += r.rain_fallout;
+        step_error = std::max(step_error, r.step_error);
+        sink_deficit += r.vapour_sink_deficit;
+        redistributed += r.water_redistributed;
+        if (std::string(r.dt_limit) == "accuracy") ++accuracy_limited;
         s_adv += r.seconds_advect;
         s_src += r.seconds_sources;
         s_thermo += r.seconds_thermo;
@@ -381,6 +476,10 @@ void cook(CookContext& ctx) {
     ctx.metric("pressure_iterations", iterations);
     ctx.metric("div_l2_max", div_l2);
     ctx.metric("div_max_max", div_max);
+    ctx.metric("step_error_max", step_error);
+    ctx.metric("accuracy_limited_steps", accuracy_limited);
+    ctx.metric("vapour_sink_deficit", sink_deficit);
+    ctx.metric("water_redistributed", redistributed);
     ctx.metric("water_drift_max", water);
     ctx.metric("theta_l_drift_max", theta_l);
     ctx.metric("max_w", max_w);
@@ -409,5 +508,5 @@ void cook(CookContext& ctx) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "sim/cloud_growth", .version = 2, .declare = declare, .cook = cook});
+    registry.add({.name = "sim/cloud_growth", .version = 3, .declare = declare, .cook = cook});
 }

@@ -41,7 +41,7 @@ void declare(NodeDeclaration& d) {
     d.param_float("radius", 500).range(1e-3, 1e9).with_unit("m").describe("ground_patch: disc radius");
     d.param_float("depth", 200).range(1e-3, 1e9).with_unit("m").describe("ground_patch: heated layer depth above the floor");
     d.param_int("channel", 0).range(0, 255).describe("mask: channel of the input used as the shape");
-    d.param_float("heat_rate", 0.02).range(0, 10).with_unit("K/s").describe("potential-temperature source where the shape is 1");
+    d.param_float("heat_rate", 0.02).range(-10, 10).with_unit("K/s").describe("potential-temperature source where the shape is 1 (< 0: a cooling emitter, e.g. evaporative or radiative cooling)");
     d.param_float("vapour_rate", 1e-6).range(0, 1e-3).with_unit("kg/kg/s").describe("water-vapour source where the shape is 1");
     d.param_float("noise_scale", 200).range(1e-3, 1e9).with_unit("m").describe("feature size of the modulation noise");
     d.param_float("noise_amount", 0.5).range(0, 1).describe("0 = smooth, 1 = fully noise-modulated");
@@ -101,5 +101,5 @@ void cook(CookContext& ctx) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "sim/emitter", .version = 1, .declare = declare, .cook = cook});
+    registry.add({.name = "sim/emitter", .version = 2, .declare = declare, .cook = cook});
 }

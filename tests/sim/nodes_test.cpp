@@ -511,3 +511,91 @@ TEST(SimNodes, CumulusGraphCooksOnASmallGrid) {
     EXPECT_GT(m.at("max_w"), 0.0); // the heated patch and bubble set the air rising
     fs::remove_all(dir);
 }
+
+// Published-case set-up from a graph: a 2D (one-cell-thick) slab, an
+// ellipsoidal cos^2 bubble given as a temperature perturbation T' (converted
+// to theta' = T' / Pi0), an initial_theta input (theta', an aligned sub-box),
+// an initial_velocity input, explicit nu and kappa; against the same set-up
+// written out by hand with the library.
+TEST(SimNodes, InitialStateInputsAndEllipsoidalTemperatureBubbleMatchTheLibrary) {
+    const char* graph = R"(atlas: 1
+nodes:
+  air:
+    type: sim/sounding
+    params: {theta_lapse: 0.002, inversion_height: 500, inversion_jump: 3, surface_rh: 1, rh_lapse: 0, rh_above: 0.5}
+  warm:
+    type: field/constant
+    params: {resolution: [8, 1, 4], bounds_min: [0, 0, 0], bounds_max: [800, 100, 400], value: 0.5}
+  wind:
+    type: field/constant
+    params: {resolution: [32, 1, 16], bounds_min: [0, 0, 0], bounds_max: [3200, 100, 1600], channels: 3, value: 2}
+  cloud:
+    type: sim/cloud_growth
+    inputs: {sounding: air.out, initial_theta: warm, initial_velocity: wind}
+    params: {resolution: [32, 1, 16], dx: 100, duration: 20, frame_dt: 10, moist: false, viscosity: 20, diffusivity: 20,
+             bubble_theta: -5, bubble_is_temperature: true, bubble_center: [1600, 50, 800], bubble_radii: [800, 1, 400]}
+outputs:
+  - {node: cloud, port: temperature, file: t.vdb}
+)";
+    Session s(builtin_nodes());
+    s.load_text(graph, "initial.yaml", fs::temp_directory_path());
+    const auto temp = as<Field3D>(s.get("cloud", "temperature", values_only()));
+    const auto vel = as<Field3D>(s.get("cloud", "velocity", values_only()));
+
+    sim::GridSpec spec;
+    spec.nx = 32, spec.ny = 1, spec.nz = 16, spec.dx = 100;
+    sim::SimOptions o;
+    o.moist = false;
+    o.viscosity = o.diffusivity = 20;
+    sim::Simulation sim(spec, graph_sounding(), o);
+    std::vector<float> bubble(spec.cells(), 0.f), warm(spec.cells(), 0.f);
+    for (int k = 0; k < 16; ++k)
+        for (int i = 0; i < 32; ++i) {
+            const double l = std::hypot(((i + 0.5) * 100 - 1600) / 800, ((k + 0.5) * 100 - 800) / 400);
+            const float tp = l < 1 ? float(-5 * std::pow(std::cos(0.5 * M_PI * l), 2)) : 0.f; // T'
+            bubble[size_t(k) * 32 + i] = float(tp / sim.reference().exner[size_t(k)]);
+            if (i < 8 && k < 4) warm[size_t(k) * 32 + i] = 0.5f;
+        }
+    sim.add_theta(bubble);
+    sim.add_theta(warm);
+    sim::MacVelocity& v = sim.velocity();
+    std::fill(v.u.begin(), v.u.end(), 2.f); // cell-centre means of a constant 2 m/s
+    std::fill(v.w.begin(), v.w.end(), 2.f);
+    v.enforce_walls(); // closed box: 0 on the walls; v is 0 in the single-cell y direction
+    sim.step(10);
+    sim.step(10);
+    expect_same(*temp, sim.temperature(), "temperature");
+    expect_same(*vel, sim.velocity_field(), "velocity");
+    // The cold bubble is there: T' reached about -5 K at its centre initially.
+    double min_tp = 0;
+    for (float t : sim.theta_perturbation().channel(0)) min_tp = std::min(min_tp, double(t));
+    EXPECT_LT(min_tp, -4.0);
+}
+
+TEST(SimNodes, NegativeInitialVapourIsRefusedAndCoolingEmittersAreAllowed) {
+    Session s(builtin_nodes());
+    s.load_text(R"(atlas: 1
+nodes:
+  dry:
+    type: field/constant
+    params: {resolution: [8, 1, 8], bounds_min: [0, 0, 0], bounds_max: [800, 100, 800], value: -1}
+  cool:
+    type: sim/emitter
+    params: {resolution: [8, 1, 8], bounds_max: [800, 100, 800], center: [400, 50], radius: 300, depth: 300,
+             heat_rate: -0.05, vapour_rate: 0, noise_amount: 0}
+  cloud:
+    type: sim/cloud_growth
+    inputs: {initial_vapour: dry}
+    params: {resolution: [8, 1, 8], dx: 100, duration: 10, frame_dt: 10}
+outputs:
+  - {node: cloud, port: out, file: c.vdb}
+)",
+                "vapour.yaml", fs::temp_directory_path());
+    const std::string e = error_of(s, "cloud", "out");
+    EXPECT_NE(e.find("node 'cloud'"), std::string::npos) << e;
+    EXPECT_NE(e.find("initial_vapour"), std::string::npos) << e;
+    const auto cool = as<Field3D>(s.get("cool", "out", values_only()));
+    float lo = 0;
+    for (float h : cool->channel(0)) lo = std::min(lo, h);
+    EXPECT_LT(lo, -0.01f);
+}

@@ -778,7 +778,12 @@ StepReport Simulation::step(double dt) {
         double nu = std::max(opt_.viscosity, opt_.diffusivity);
         if (nu > 0) take(h * h / (8 * nu), "diffusion");
         rep.accuracy_dt = 0;
-        if (controlled && history_dt_ > 0 && last_dt_ > 0) {
+        if (controlled && !(history_dt_ > 0) && b > 0) {
+            // Start-up substep (no history, so no estimate yet): from rest the
+            // estimate is |du| dt / (2 dx) ~ b dt^2 / (2 dx); keep it within the tolerance.
+            rep.accuracy_dt = std::sqrt(2 * opt_.step_error_tolerance * h / b);
+            take(rep.accuracy_dt, "accuracy");
+        } else if (controlled && history_dt_ > 0 && last_dt_ > 0) {
             // err ~ dt^3: the substep that would make it 0.9^3 of the tolerance, grown at most 2x.
             const double acc = last_error_ > 0 ? std::min(2 * last_dt_, 0.9 * last_dt_ * std::cbrt(opt_.step_error_tolerance / last_error_))
                                                : 2 * last_dt_;
