@@ -1,9 +1,11 @@
 /* The C API from C: cook a small graph, read fields, and see errors, progress
  * and cancellation arrive as status codes, messages and callbacks.
- * Usage: capi_test QUICKSTART.yaml */
+ * Usage: capi_test QUICKSTART.yaml [ATLAS_CLI SCRATCH_DIR]
+ * With the CLI, a broken graph and an out-of-range --set must give the CLI's messages. */
 #ifdef __cplusplus
 #error "this test must be compiled as C"
 #endif
+#define _POSIX_C_SOURCE 200809L /* popen */
 #include "atlas/atlas.h"
 
 #include <math.h>
@@ -234,15 +236,61 @@ static void test_quickstart(const char* path) {
     atlas_session_destroy(s);
 }
 
+/* Runs the CLI and returns its combined output (static buffer). */
+static const char* run_cli(const char* command) {
+    static char out[8192];
+    size_t n = 0;
+    out[0] = 0;
+    FILE* p = popen(command, "r");
+    if (!p) return out;
+    while (n + 1 < sizeof out && fgets(out + n, (int)(sizeof out - n), p)) n += strlen(out + n);
+    pclose(p);
+    return out;
+}
+
+static void test_same_messages_as_the_cli(const char* cli, const char* dir) {
+    char broken[1024], good[1024], cmd[4096];
+    snprintf(broken, sizeof broken, "%s/capi_broken.yaml", dir);
+    snprintf(good, sizeof good, "%s/capi_good.yaml", dir);
+    FILE* f = fopen(broken, "w");
+    CHECK(f != NULL);
+    if (!f) return;
+    fputs("atlas: 1\nnodes:\n  base:\n    type: noise/value\n    params: {octavs: 2}\noutputs: []\n", f);
+    fclose(f);
+    f = fopen(good, "w");
+    CHECK(f != NULL);
+    if (!f) return;
+    fputs("atlas: 1\nnodes:\n  base:\n    type: noise/value\n    params: {octaves: 2}\n"
+          "outputs:\n  - {node: base, file: base.exr}\n", f);
+    fclose(f);
+
+    AtlasSession* s = NULL;
+    CHECK(atlas_session_create(&s) == ATLAS_OK);
+    CHECK(atlas_session_load(s, broken) == ATLAS_PARSE_ERROR);
+    snprintf(cmd, sizeof cmd, "'%s' validate '%s' 2>&1", cli, broken);
+    const char* out = run_cli(cmd);
+    CHECK(strlen(atlas_session_error(s)) > 20 && strstr(out, atlas_session_error(s)) != NULL);
+    if (!strstr(out, atlas_session_error(s))) fprintf(stderr, "C API: %s\nCLI:   %s\n", atlas_session_error(s), out);
+
+    CHECK_OK(s, atlas_session_load(s, good));
+    CHECK(atlas_session_set(s, "base", "octaves", "99") == ATLAS_ERROR);
+    snprintf(cmd, sizeof cmd, "'%s' cook '%s' --out '%s/capi_out' --set base.octaves=99 2>&1", cli, good, dir);
+    out = run_cli(cmd);
+    CHECK(strlen(atlas_session_error(s)) > 20 && strstr(out, atlas_session_error(s)) != NULL);
+    if (!strstr(out, atlas_session_error(s))) fprintf(stderr, "C API: %s\nCLI:   %s\n", atlas_session_error(s), out);
+    atlas_session_destroy(s);
+}
+
 int main(int argc, char** argv) {
-    if (argc != 2) {
-        fprintf(stderr, "usage: capi_test QUICKSTART.yaml\n");
+    if (argc != 2 && argc != 4) {
+        fprintf(stderr, "usage: capi_test QUICKSTART.yaml [ATLAS_CLI SCRATCH_DIR]\n");
         return 2;
     }
     CHECK(strlen(atlas_version()) >= 5);
     test_inline_graph();
     test_errors();
     test_quickstart(argv[1]);
+    if (argc == 4) test_same_messages_as_the_cli(argv[2], argv[3]);
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;
 }
