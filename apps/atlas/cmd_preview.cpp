@@ -509,6 +509,10 @@ int run_preview(const Args& a) {
         auto v = numbers(a.get("--sun"), 2, "--sun");
         s.sun_direction = render::sun_direction(v[0], v[1]);
     }
+    if (a.has("--sun-colour")) {
+        auto v = numbers(a.get("--sun-colour"), 3, "--sun-colour");
+        s.sun_colour = {{float(v[0]), float(v[1]), float(v[2])}};
+    }
     if (a.has("--quality")) s.quality = numbers(a.get("--quality"), 1, "--quality")[0];
     if (a.has("--extinction")) s.extinction = numbers(a.get("--extinction"), 1, "--extinction")[0];
     if (a.has("--reference")) s.mode = render::RenderMode::Reference;
@@ -532,9 +536,48 @@ int run_preview(const Args& a) {
         return 0;
     }
 
+    // Lightning over the layer: flashes placed by the set's storm (or rain) channel.
+    int flash0 = a.has("--flash") ? static_cast<int>(numbers(a.get("--flash"), 1, "--flash")[0]) : 0;
+    if (a.has("--lightning")) {
+        if (!have_layer) throw UsageError{"--lightning places flashes over a 2.5D layer; this preview has no NDF set", "preview"};
+        const std::string t = a.get("--lightning");
+        const size_t n = std::count(t.begin(), t.end(), ',') + 1;
+        if (n > 3) throw UsageError{"--lightning expects COUNT[,INTENSITY[,RADIUS]], got '" + t + "'", "preview"};
+        auto v = numbers(t, n, "--lightning");
+        const Field2D& set = *layer.ndf;
+        int ch = -1;
+        for (const char* name : {"superstorm_coverage", "precipitation", "coverage"}) {
+            const int c = set.find_channel(name);
+            if (c < 0) continue;
+            auto d = set.channel(c);
+            if (std::any_of(d.begin(), d.end(), [](float x) { return x > 0; })) {
+                ch = c;
+                break;
+            }
+        }
+        if (ch < 0) throw Error("--lightning: the NDF set has no storm, rain or coverage to place flashes in");
+        // Heights: 20-60 % up the columns that can flash (in-cloud flashes).
+        const int cmn = set.find_channel("min_height"), cmx = set.find_channel("max_height");
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (int y = 0; y < set.height(); ++y)
+            for (int x = 0; x < set.width(); ++x)
+                if (set.at(ch, x, y) > 0) lo = std::min(lo, double(set.at(cmn, x, y))), hi = std::max(hi, double(set.at(cmx, x, y)));
+        render::LightField f;
+        f.probability = render::layer_flash_probability(set, ch, lo + 0.2 * (hi - lo), lo + 0.6 * (hi - lo) + 1e-3);
+        f.count = static_cast<int>(v[0]);
+        f.intensity = n > 1 ? v[1] : 5e6;
+        f.radius = n > 2 ? v[2] : 4000;
+        f.flash = flash0;
+        s.light_fields.push_back(f);
+    }
     const std::filesystem::path out = a.get("--out");
-    const int frames = a.has("--turntable") ? static_cast<int>(numbers(a.get("--turntable"), 1, "--turntable")[0]) : 0;
-    if (a.has("--turntable") && (frames < 1 || frames > 3600)) throw UsageError{"--turntable expects 1..3600 frames", "preview"};
+    if (a.has("--turntable") && a.has("--frames")) throw UsageError{"--turntable and --frames contradict each other", "preview"};
+    const bool sequence = a.has("--frames");
+    const char* frames_opt = sequence ? "--frames" : "--turntable";
+    const int frames = a.has(frames_opt) ? static_cast<int>(numbers(a.get(frames_opt), 1, frames_opt)[0]) : 0;
+    if (a.has(frames_opt) && (frames < 1 || frames > 3600)) throw UsageError{std::string(frames_opt) + " expects 1..3600 frames", "preview"};
+    const double time_step = a.has("--time-step") ? numbers(a.get("--time-step"), 1, "--time-step")[0] : 60.0;
+    const double time0 = layer.time;
     auto t0 = std::chrono::steady_clock::now();
     std::string features;
     // One frame: the layer, the voxel set, or the voxel set composited over the layer.
@@ -571,9 +614,16 @@ int run_preview(const Args& a) {
         StagedOutputs staged(out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path());
         std::vector<std::filesystem::path> paths;
         for (int i = 0; i < frames; ++i) {
-            if (have_layer) s.camera = render::layer_camera(layer, render::LayerView::Orbit, double(w) / h, 30 + 360.0 * i / frames, view.el);
-            else s.camera = render::framing_camera(have_voxel && is_graph(a.positional[0]) ? cloud_bounds(scene) : bounds, double(w) / h,
-                                                   30 + 360.0 * i / frames);
+            if (sequence) {
+                // A time sequence: the wind scroll advances, each frame a new flash.
+                layer.time = time0 + i * time_step;
+                for (auto& f : s.light_fields) f.flash = flash0 + i;
+            } else if (have_layer) {
+                s.camera = render::layer_camera(layer, render::LayerView::Orbit, double(w) / h, 30 + 360.0 * i / frames, view.el);
+            } else {
+                s.camera = render::framing_camera(have_voxel && is_graph(a.positional[0]) ? cloud_bounds(scene) : bounds, double(w) / h,
+                                                  30 + 360.0 * i / frames);
+            }
             Field2D image = render_frame(s);
             char suffix[32];
             std::snprintf(suffix, sizeof suffix, "_%03d", i);

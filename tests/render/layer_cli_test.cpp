@@ -144,3 +144,13 @@ TEST(LayerCli, CameraUnderTheGroundIsAClearMessage) {
     EXPECT_NE(r.err.find("under the ground"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(work_dir() / "x.png"));
 }
+
+TEST(LayerCli, TimeSequenceWritesNumberedFramesThatMove) {
+    write("layer.yaml", kLayerGraph);
+    const CliRun r = run_atlas("preview layer.yaml --size 32x18 --frames 3 --time-step 900 --lightning 2 -o seq.png");
+    ASSERT_EQ(r.status, 0) << r.err;
+    for (const char* f : {"seq_000.png", "seq_001.png", "seq_002.png"}) EXPECT_TRUE(fs::exists(work_dir() / f)) << f;
+    EXPECT_NE(atlas::read_file_bytes(work_dir() / "seq_000.png"), atlas::read_file_bytes(work_dir() / "seq_001.png"));
+    const CliRun bad = run_atlas("preview layer.yaml --size 32x18 --frames 2 --turntable 2 -o x.png");
+    EXPECT_NE(bad.status, 0);
+}

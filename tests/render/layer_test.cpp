@@ -350,3 +350,43 @@ TEST(LayerAnvil, AnvilBiasSpreadsTheTopsSeenFromAbove) {
     s.anvil = std::make_shared<const Field2D>(std::move(zero));
     EXPECT_TRUE(same_bytes(render_layer(s, st, nullptr).image, plain.image));
 }
+
+TEST(LayerLights, FlashesBrightenTheLayerNeverItsTransmittance) {
+    LayerScene s = scene_with(0.8);
+    RenderSettings st = small_settings(48, 27);
+    st.camera = layer_camera(s, LayerView::Ground, 48.0 / 27);
+    st.sun_colour = {{0.05f, 0.05f, 0.05f}};
+    const LayerResult dark = render_layer(s, st, nullptr);
+    // Flashes placed by a 2D probability map (a disc in the map's centre).
+    Field2D prob({{16, 16}}, 1, s.ndf->bounds(), {"p"});
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) prob.at(0, x, y) = std::hypot(x - 7.5, y - 7.5) < 5 ? 1.0f : 0.0f;
+    LightField f;
+    f.probability = layer_flash_probability(prob, 0, 2000, 3000);
+    f.count = 4;
+    f.intensity = 5e7;
+    f.radius = 8000;
+    st.light_fields.push_back(f);
+    const LayerResult lit = render_layer(s, st, nullptr);
+    EXPECT_EQ(lit.report.point_lights, 4);
+    bool brighter = false;
+    for (int y = 0; y < 27; ++y)
+        for (int x = 0; x < 48; ++x) {
+            EXPECT_EQ(lit.image.at(3, x, y), dark.image.at(3, x, y)); // lights never change transmittance
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_GE(lit.image.at(c, x, y), dark.image.at(c, x, y));
+                EXPECT_TRUE(std::isfinite(lit.image.at(c, x, y)));
+            }
+            brighter = brighter || lit.image.at(1, x, y) > dark.image.at(1, x, y) * 1.5f;
+        }
+    EXPECT_TRUE(brighter);
+    // Every flash lies over the disc, inside the height range.
+    for (const PointLight& l : flash_lights(f)) {
+        EXPECT_GE(l.position[2], 2000);
+        EXPECT_LE(l.position[2], 3000);
+        const double tx = l.position[0] / 1250.0 - 0.5, ty = l.position[1] / 1250.0 - 0.5; // texel coordinates
+        EXPECT_LT(std::hypot(std::round(tx) - 7.5, std::round(ty) - 7.5), 5.8);
+    }
+    EXPECT_THROW(layer_flash_probability(prob, 1, 0, 1), Error);
+    EXPECT_THROW(layer_flash_probability(prob, 0, 5, 5), Error);
+}

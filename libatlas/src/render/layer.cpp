@@ -31,6 +31,7 @@ std::vector<std::string> LayerReport::active_features() const {
     f.push_back("haze");
     if (sky_gradient) f.push_back("sky_gradient");
     if (sky_layers > 0) f.push_back("sky_layers");
+    if (point_lights > 0) f.push_back("point_lights");
     return f;
 }
 
@@ -584,6 +585,19 @@ struct LayerIntegrator {
     const detail::Sky& sky;
     Vec3f haze_colour;
     Vec3d cone_kernel[6];
+    const std::vector<PointLight>& lights; // point lights and flashes (lights.h)
+    double light_core2;
+
+    // Summed density toward a point light `len` metres away: light_samples cheap samples.
+    double light_depth(const Vec3d& p, const Vec3d& d, double len) const {
+        const int n = s.light_samples;
+        double acc = 0;
+        for (int i = 0; i < n; ++i) {
+            const Vec3d q = p + d * ((i + 0.5) * len / n);
+            acc += m.density(q, m.altitude(q), false);
+        }
+        return acc * len / n;
+    }
 
     // Summed density toward the sun: six samples in a widening cone, then one
     // long sample at three cone lengths (GPU Pro 7, "Cone-Sampled Lighting").
@@ -679,8 +693,12 @@ struct LayerIntegrator {
                     const double haze = sc.haze_distance > 0 ? 1 - std::exp(-tm / sc.haze_distance) : 0.0;
                     const double absorbed = -std::expm1(-sigma * dt);
                     const double w = trans * absorbed;
+                    double glow[3] = {0, 0, 0};
+                    if (!lights.empty())
+                        detail::point_light_radiance(s, lights, light_core2, p, dir,
+                                                     [&](const Vec3d& q, const Vec3d& d2, double len) { return light_depth(q, d2, len); }, glow);
                     for (int c = 0; c < 3; ++c) {
-                        const double ls = sun_w * s.sun_colour[c] + sky_w * ambient[c];
+                        const double ls = sun_w * s.sun_colour[c] + sky_w * ambient[c] + glow[c];
                         rgb[c] += w * (ls + (double(haze_colour[c]) - ls) * haze);
                     }
                     trans *= std::exp(-sigma * dt);
@@ -763,6 +781,13 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
     report.sky_gradient = settings.sky_horizon.has_value();
 
     const double thickness = std::max(1.0, model.top() - model.bottom());
+    // Lights: the given ones, then each light field's flash in order.
+    std::vector<PointLight> lights = settings.lights;
+    for (const LightField& f : settings.light_fields) {
+        auto flash = flash_lights(f);
+        lights.insert(lights.end(), flash.begin(), flash.end());
+    }
+    report.point_lights = int(lights.size());
     LayerIntegrator in{model,
                        scene,
                        settings,
@@ -779,7 +804,9 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
                        model.has_cone() || model.has_distance(),
                        sky,
                        settings.sky_horizon.value_or(settings.sky_colour),
-                       {}};
+                       {},
+                       lights,
+                       25.0}; // a 5 m core keeps the inverse square finite at the light
     // Six fixed directions in [-1, 1]^3 spread the light cone (the talk's noise kernel).
     for (int i = 0; i < 6; ++i)
         for (int a = 0; a < 3; ++a) in.cone_kernel[i][a] = 2.0 * hash_to_unit(hash_coords(0x636f6e65u, i, a)) - 1.0;
@@ -870,6 +897,17 @@ Camera layer_camera(const LayerScene& scene, LayerView view, double aspect, doub
     }
     }
     return c;
+}
+
+Field3DPtr layer_flash_probability(const Field2D& map, int channel, double z_min, double z_max) {
+    if (channel < 0 || channel >= map.channels()) throw Error("render (2.5D): flash probability channel " + std::to_string(channel) + " out of range");
+    if (!(std::isfinite(z_min) && std::isfinite(z_max) && z_max > z_min)) throw Error("render (2.5D): flash heights need z_max > z_min, finite");
+    const Box2d& b = map.bounds();
+    auto f = std::make_shared<Field3D>(Vec3i{{map.width(), map.height(), 1}}, 1, Box3d{{{b.min[0], b.min[1], z_min}}, {{b.max[0], b.max[1], z_max}}},
+                                       std::vector<std::string>{"probability"});
+    auto src = map.channel(channel);
+    std::copy(src.begin(), src.end(), f->channel(0).begin());
+    return f;
 }
 
 Field2D composite_over(const Field2D& front, const Field2D& back, const RenderSettings& settings) {

@@ -77,6 +77,34 @@ inline void shade(const RenderSettings& s, const SunTerms& st, double tau, doubl
     sky_w = s.ambient_strength * amb;
 }
 
+// In-scattered radiance weight per channel at p from every point light
+// (lights.h: inverse square with a core, the radius window, Beer toward the
+// light from depth(p, dir, r) = summed density x metres, dual-lobe HG; at
+// the light itself isotropic).
+template <class DepthFn>
+void point_light_radiance(const RenderSettings& s, const std::vector<PointLight>& lights, double core2, const Vec3d& p, const Vec3d& view,
+                          DepthFn&& depth, double out[3]) {
+    out[0] = out[1] = out[2] = 0;
+    for (const PointLight& l : lights) {
+        const Vec3d to = l.position - p;
+        const double r2 = dot(to, to), r = std::sqrt(r2);
+        double window = 1;
+        if (l.radius > 0) {
+            if (r >= l.radius) continue;
+            const double q = r2 / (l.radius * l.radius);
+            window = (1 - q * q) * (1 - q * q);
+        }
+        const double energy = l.intensity * window / (r2 + core2);
+        if (!(energy > 0)) continue;
+        // At the light itself the direction is undefined: isotropic there.
+        const Vec3d dir = r > 0 ? to / r : view;
+        const double cos_theta = r > 0 ? dot(view, dir) : 0.0;
+        const double beer = r > 0 ? std::exp(-s.extinction * depth(p, dir, r)) : 1.0;
+        const double w = energy * beer * dual_hg(s, cos_theta);
+        for (int c = 0; c < 3; ++c) out[c] += w * l.colour[c];
+    }
+}
+
 // The sky: zenith and horizon colour; the same colour twice is the uniform
 // sky (h + (z - h) * t == h exactly, so the uniform look keeps its bytes).
 struct Sky {

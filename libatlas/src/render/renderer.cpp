@@ -151,25 +151,8 @@ struct Integrator {
     // In-scattered radiance weight per channel from every point light at p
     // (inverse square, window, Beer toward the light, dual-lobe HG).
     void point_light_radiance(const Vec3d& p, const Vec3d& view, double out[3]) const {
-        out[0] = out[1] = out[2] = 0;
-        for (const PointLight& l : lights) {
-            const Vec3d to = l.position - p;
-            const double r2 = dot(to, to), r = std::sqrt(r2);
-            double window = 1;
-            if (l.radius > 0) {
-                if (r >= l.radius) continue;
-                const double q = r2 / (l.radius * l.radius);
-                window = (1 - q * q) * (1 - q * q);
-            }
-            const double energy = l.intensity * window / (r2 + light_core2);
-            if (!(energy > 0)) continue;
-            // At the light itself the direction is undefined: isotropic there.
-            const Vec3d dir = r > 0 ? to / r : view;
-            const double cos_theta = r > 0 ? dot(view, dir) : 0.0;
-            const double beer = r > 0 ? std::exp(-s.extinction * light_depth(p, dir, r)) : 1.0;
-            const double w = energy * beer * phase(cos_theta);
-            for (int c = 0; c < 3; ++c) out[c] += w * l.colour[c];
-        }
+        detail::point_light_radiance(s, lights, light_core2, p, view, [&](const Vec3d& q, const Vec3d& d, double len) { return light_depth(q, d, len); },
+                                     out);
     }
 
     // Returns radiance (clouds only) and transmittance along one ray.

@@ -133,6 +133,7 @@ struct LayerReport {
     bool precipitation = false;   // some precipitation > 0
     bool anvil = false;           // an anvil map with some bias > 0
     int sky_layers = 0;
+    int point_lights = 0;         // lights integrated (given + flashes)
     bool sky_gradient = false;
     uint64_t cheap_samples = 0;   // base-only density evaluations (view rays)
     uint64_t full_samples = 0;    // full density evaluations (view rays)
@@ -148,8 +149,11 @@ struct LayerResult {
 };
 
 // Renders the layer with the camera, sun, sky, size, quality (step scale),
-// extinction, phase, ambient, multiple scattering, seed and thread settings
-// of `settings` (mode, light grid, lights are voxel-only and ignored).
+// extinction, phase, ambient, multiple scattering, seed, thread, light and
+// light-field settings of `settings` (mode and light grid are voxel-only).
+// Point lights and flashes (lights.h) light the layer as they light voxels:
+// inverse square (5 m core), radius window, Beer from light_samples cheap
+// density samples toward the light, dual-lobe HG.
 // Throws atlas::Error on a bad setting or scene, and when the camera is
 // under the ground ("the camera is 12 m under the ground"); CancelledError
 // on cancel.
@@ -166,6 +170,13 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
 //           one standard deviation of that mass (at least 2 km), fov 50
 enum class LayerView { Ground, Aerial, Orbit };
 Camera layer_camera(const LayerScene& scene, LayerView view, double aspect, double azimuth_deg = 30, double elevation_deg = 25);
+
+// Lightning over the layer: a flash-probability field (LightField::probability)
+// from a 2D map's channel (e.g. the set's superstorm_coverage): one z layer
+// spanning [z_min, z_max] metres over the map's bounds, so a flash lands above
+// a texel drawn by probability at a uniform height in that range. Throws on a
+// bad channel or z_max <= z_min.
+Field3DPtr layer_flash_probability(const Field2D& map, int channel, double z_min, double z_max);
 
 // Intersections of the ray o + t d (unit d, t >= 0) with the cloud shell
 // between radii r_inner and r_outer around `centre`, stopping at the ground
