@@ -188,3 +188,23 @@ TEST(SimAccuracy, StepControlBoundsTheEmbeddedErrorEstimate) {
     std::printf("step control: worst error %.4f cells in %d substeps uncontrolled, %.4f in %d with tolerance 0.005\n", free_err,
                 free_sub, ctl_err, ctl_sub);
 }
+
+// The documented cell-size range and the check agree: dx up to 1e5 m is a
+// valid grid, a Simulation refuses a top cell centre above the modelled
+// atmosphere (Exner 0.05: z = 0.95 c_p theta / g = 29.18 km for neutral 300 K,
+// analytic since Exner is linear in z there) and names that height.
+TEST(SimAccuracy, CellSizeRangeMatchesTheModelledAtmosphere) {
+    GridSpec big = column(4, 2, 1e5);
+    EXPECT_NO_THROW(big.validate());
+    SimOptions o;
+    o.moist = false;
+    const double ztop = 0.95 * 1004.5 * 300 / 9.81;
+    EXPECT_NO_THROW(Simulation(column(4, 2, ztop / 1.5 * 0.999), Sounding{}, o));
+    try {
+        Simulation sim(column(4, 2, ztop / 1.5 * 1.001), Sounding{}, o);
+        FAIL() << "a top cell above the model top was accepted";
+    } catch (const atlas::Error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("at z = " + std::to_string(long(std::lround(ztop))) + " m"), std::string::npos) << m; // the analytic top
+    }
+}

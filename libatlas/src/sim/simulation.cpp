@@ -154,10 +154,21 @@ ReferenceProfile make_reference(const Sounding& s, int nz, double dx) {
         double h = (zc - z) / sub;
         for (int m = 0; m < sub; ++m) {
             double th = saturated ? theta_below : s.theta_at(z + (m + 0.5) * h);
-            pi -= kGravity / (kCp * th) * h;
+            const double next = pi - kGravity / (kCp * th) * h;
+            if (!(next > 0.05)) {
+                // Where Exner reaches 0.05 (linear within the sub-step): the model top.
+                const double ztop = z + m * h + h * (pi - 0.05) / (pi - next);
+                char buf[400];
+                std::snprintf(buf, sizeof buf,
+                              "sim: the cell centre at z = %g m (row %d of nz = %d, dx = %g m) lies above the modelled "
+                              "atmosphere, which ends where the Exner function falls to 0.05, at z = %.0f m for this "
+                              "sounding; keep (nz - 1/2) dx below it (lower nz or dx)",
+                              zc, k, nz, dx, ztop);
+                throw Error(buf);
+            }
+            pi = next;
         }
         z = zc;
-        if (!(pi > 0.05)) throw Error("sim: the domain top reaches above the modelled atmosphere (Exner < 0.05); lower nz * dx");
         double p = kP00 * std::pow(pi, kCp / kRd);
         double th, qv, qc = 0;
         if (saturated) {

@@ -31,7 +31,11 @@ constexpr BoundarySet all_open() { return {Boundary::Open, Boundary::Open, Bound
 
 // Size and spacing of a simulation grid.
 //   nx, ny, nz: cells, each in [1, 4096], at least 2 along two axes.
-//   dx: cell edge in metres, in [1e-3, 1e5].
+//   dx: cell edge in metres, in [1e-3, 1e5] (what the grid, the advection and
+//       the pressure solver accept). A Simulation also needs its top cell centre,
+//       (nz - 1/2) dx, inside the modelled atmosphere (Exner > 0.05: about 29 km
+//       for a neutral 300 K sounding, so dx <= 19.5 km at nz = 2 and 58 km for an
+//       x-y slab with nz = 1); make_reference refuses it naming that height.
 // A direction with a single cell is always treated as closed (a 2D slab).
 struct GridSpec {
     int nx = 0, ny = 0, nz = 0;
