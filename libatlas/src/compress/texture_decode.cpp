@@ -291,11 +291,13 @@ CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* mani
                         // The decoded slab is in DDS row order (top-down); the source is y-up.
                         const float s = sc >= 0 ? source.channel(sc)[first + detail::dds_row_flip(i, L.w, L.h)]
                                                 : map.to_src(c == 3 ? 1.0f : 0.0f); // missing: stored constants
-                        const double lo = map.to_src(L.lo[size_t(c)][i]), hi = map.to_src(L.hi[size_t(c)][i]);
+                        // In double, as an engine may reconstruct: the float mapping can round
+                        // an ulp below and hide a texel just above its source.
+                        const double lo = map.to_src_exact(L.lo[size_t(c)][i]), hi = map.to_src_exact(L.hi[size_t(c)][i]);
                         st.max_error[size_t(c)] = std::max(st.max_error[size_t(c)], std::max(hi - s, s - lo));
                         st.max_over = std::max(st.max_over, hi - s);
                         if (hi > s) ++st.one_sided_violations;
-                        const double mid = map.to_src(0.5f * (L.lo[size_t(c)][i] + L.hi[size_t(c)][i]));
+                        const double mid = map.to_src_exact(0.5 * (double(L.lo[size_t(c)][i]) + double(L.hi[size_t(c)][i])));
                         under += s - mid;
                         sq[size_t(c)] += (mid - s) * (mid - s);
                         ++count;

@@ -209,12 +209,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
             }
     }
     const float nmin = map.kind == MapKind::Snorm ? -1.0f : 0.0f;
-    // The engine's reconstruction lo + n (hi - lo) (SNORM: (n + 1) / 2), in double.
-    auto src_double = [&](float n) {
-        if (map.kind == MapKind::Float) return double(n);
-        const double u = map.kind == MapKind::Snorm ? (double(n) + 1.0) * 0.5 : double(n);
-        return double(map.lo) + u * (double(map.hi) - double(map.lo));
-    };
+    auto src_double = [&](float n) { return map.to_src_exact(n); };
     const double slope = (map.kind == MapKind::Snorm ? 0.5 : 1.0) * (double(map.hi) - double(map.lo)); // d src / d n
     double map_slack = 0; // max |src_double(n) - v| over the stored texels (the mapping's own rounding)
 
@@ -400,7 +395,7 @@ CompressReport compress_to_dds(const Field3D& field, const fs::path& path, const
         msg << "compress: " << enc.report.blocks_over_bound.size() << " block(s) cannot meet the bound";
         if (o.max_error) msg << " max_error " << *o.max_error;
         if (o.one_sided_below) msg << (o.max_error ? " with" : "") << " one-sided below";
-        msg << " for format '" << format_name(o.format) << "'; first:";
+        msg << " for format '" << format_name(o.format) << "'; first (DDS texel x, row from the top, slice):";
         for (size_t i = 0; i < std::min<size_t>(5, enc.report.blocks_over_bound.size()); ++i) {
             const BlockMiss& b = enc.report.blocks_over_bound[i];
             msg << " [mip " << b.mip << " layer " << b.array_index << " block at (" << b.x << ", " << b.y << ", " << b.z

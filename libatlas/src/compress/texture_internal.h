@@ -24,6 +24,13 @@ struct Mapping {
         const float u = kind == MapKind::Snorm ? (n + 1.0f) * 0.5f : n;
         return lo + u * (hi - lo);
     }
+    // The engine's reconstruction lo + n (hi - lo) (SNORM: (n + 1) / 2) in double: what
+    // the guarantees are stated against (a decoder computing in double).
+    double to_src_exact(double n) const {
+        if (kind == MapKind::Float) return n;
+        const double u = kind == MapKind::Snorm ? (n + 1.0) * 0.5 : n;
+        return double(lo) + u * (double(hi) - double(lo));
+    }
 };
 
 MapKind map_kind(DxgiFormat f);
