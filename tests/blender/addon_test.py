@@ -150,6 +150,49 @@ def bad_input():
     check(bpy.ops.atlas.cook(background=False) == {"FINISHED"}, f"cook after errors: {props.error}")
 
 
+def background_thread_and_cancel():
+    import threading
+
+    import atlas_blender
+
+    st = atlas_blender._scene_state(scene)
+    st["session"].set("coverage", "in_min", 0.4)
+    job = atlas_blender.CookJob(st["session"], out_dir)
+    # Cancel as soon as the cook has reported progress (the panel's Cancel sets the same flag).
+    job.cancel.is_set = lambda: job.task != ""
+    job.thread = threading.Thread(target=job.run, args=(1,))
+    job.thread.start()
+    job.thread.join(60)
+    check(job.done() and type(job.error).__name__ == "CancelledError", f"cancelled in the thread: {job.error!r}")
+    atlas_blender._finish(scene, job)
+    check(scene.atlas.status == "cancelled" and scene.atlas.error == "", f"status {scene.atlas.status!r}")
+    # A cook on the thread that is not cancelled loads its result.
+    st["session"].set("coverage", "in_min", 0.42)
+    job = atlas_blender.CookJob(st["session"], out_dir)
+    job.thread = threading.Thread(target=job.run, args=(2,))
+    job.thread.start()
+    job.thread.join(60)
+    check(job.error is None and job.fraction > 0, f"thread cook: {job.error!r}")
+    atlas_blender._finish(scene, job)
+    check(scene.atlas.last_cooked == "coverage distance nvdf", f"thread re-cook: {scene.atlas.last_cooked!r}")
+
+
+def ndf_as_image():
+    graph = os.path.join(args.work, "map.yaml")
+    with open(graph, "w") as f:
+        f.write("atlas: 1\nnodes:\n  coverage_map:\n    type: ndf/constant\n"
+                "    params: {resolution: [6, 4], bounds_max: [600, 400], value: 0.25}\n"
+                "outputs:\n  - {node: coverage_map, file: map.exr}\n")
+    check(bpy.ops.atlas.open_graph(filepath=graph) == {"FINISHED"}, f"open map graph: {scene.atlas.error}")
+    check(bpy.ops.atlas.cook(background=False) == {"FINISHED"}, f"cook map: {scene.atlas.error}")
+    img = bpy.data.images.get("atlas_map")
+    check(img is not None and tuple(img.size) == (6, 4), f"the NDF as an image: {img and tuple(img.size)}")
+    if img is not None:
+        px = list(img.pixels)
+        check(px[:4] == [0.25, 0.25, 0.25, 1.0] and img.is_float, f"texel {px[:4]}")
+    check(bpy.ops.atlas.open_graph(filepath=args.graph) == {"FINISHED"}, "back to the quickstart")
+
+
 def render_small_picture():
     obj = bpy.data.objects["atlas_nvdf"]
     cam_data = bpy.data.cameras.new("cam")
@@ -178,7 +221,7 @@ def render_small_picture():
 
 
 for s in (install_and_enable, open_and_cook, volume_object, same_voxels_as_the_cli, incremental_recook, bad_input,
-          render_small_picture):
+          background_thread_and_cancel, ndf_as_image, render_small_picture):
     step(s)
 
 print(f"{passed} passed, {failed} failed")

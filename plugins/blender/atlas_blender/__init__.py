@@ -4,7 +4,7 @@ The panel (View3D > Sidebar > Atlas, and Properties > Scene) opens a graph file,
 node declarations (with ranges and units; hover the (i) button for the doc), cooks in a background
 thread with Blender's progress indicator (Cancel stops it), re-cooks incrementally when a parameter
 changes, and shows VDB outputs (the NVDF set) as Volume objects in world units (metres) with a
-volume material that approximates the Nubis look, and 2D outputs (NDFs) as images.
+volume material that approximates the Nubis look, and 2D outputs (NDFs) as float images.
 
 It needs the `atlas` Python module (python/ in the Atlas build): set its directory in the add-on's
 preferences, or ATLAS_PYTHONPATH, or put it on Blender's sys.path. Debian's Blender 3.4 runs the
@@ -318,15 +318,36 @@ def load_outputs(scene, out_dir):
         stem = "atlas_" + os.path.splitext(os.path.basename(out["file"]))[0]
         if out["format"] == "vdb":
             volumes.append(_load_volume(scene, stem, path))
-        elif out["format"] in ("exr", "png", "tga"):
+        else:
             ports = decls[node_types[out["node"]]]["outputs"]
-            port = next((p for p in ports if p["name"] == out["port"]), ports[0])
+            port = next((p for p in ports if p["name"] == (out["port"] or ports[0]["name"])), ports[0])
             if port["type"] == "field2d":
-                img = bpy.data.images.get(stem) or bpy.data.images.load(path, check_existing=False)
-                img.name = stem
-                img.filepath = path
-                img.reload()
+                _field_image(stem, session.get(out["node"], port["name"]))
     return volumes
+
+
+def _field_image(name, field):
+    """A 2D field (an NDF) as a float image with its exact values: channels 0..3 as R, G, B, A (one
+    channel as grey), row 0 at the bottom as in the field (y up). Made from the cooked value, not
+    the file, so that every output format (and EXR channel names Blender does not read) looks the same."""
+    import numpy as np
+
+    nx, ny = field.resolution
+    img = bpy.data.images.get(name)
+    if img is None or tuple(img.size) != (nx, ny):
+        if img is not None:
+            bpy.data.images.remove(img)
+        img = bpy.data.images.new(name, nx, ny, alpha=True, float_buffer=True)
+    rgba = np.ones((ny, nx, 4), np.float32)
+    if field.channels == 1:
+        rgba[..., :3] = field[0][..., None]
+    else:
+        for c in range(min(4, field.channels)):
+            rgba[..., c] = field[c]
+    img.pixels.foreach_set(rgba.ravel())
+    img.update()
+    img["atlas_channels"] = ",".join(field.channel_names)
+    return img
 
 
 def _load_volume(scene, name, path):
