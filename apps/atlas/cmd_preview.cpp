@@ -57,12 +57,13 @@ bool is_graph(const std::string& f) {
 //   a 2D field with coverage only (a weather map)      -> 2.5D, heights 1500..4000 m
 //   a 2D field with bottom, top (ndf/profile_lut)      -> the layer's profile LUT
 //   a 2D field with anvil_bias (ndf/superstorm anvil)  -> the storm's anvil spread
+//   ndf/vortex_rings' table (inner, outer, speed, ...)  -> the storm turns with --time
 //   a 2D field with apex_height, cone_ratio (ndf/cone_map) / ndf/distance_map -> envelope
 //   a 2D field with a 'cirrus' channel (ndf/cirrus)    -> a cirrus layer at 8 km
 //   otherwise the last 1-channel 2D field               -> a sky layer at 6 km (Quilez)
 struct GraphContent {
     Field3DPtr nvdf;
-    Field2DPtr ndf, lut, cone, cirrus, sky2d, anvil;
+    Field2DPtr ndf, lut, cone, cirrus, sky2d, anvil, vortex;
     Field3DPtr distance;
     std::string ndf_node;
     std::vector<std::string> written; // "node 'n' (type) port 'p' -> file"
@@ -158,6 +159,9 @@ GraphContent cook_graph(Session& session, const std::string& file, int jobs, Pro
             } else if (has_channels(f, {"coverage"}) && !has_channels(f, {"cumulus"})) {
                 render::check_finite(f, what);
                 if (!g.ndf) g.ndf = weather_map_as_set(f), g.ndf_node = w.node;
+            } else if (has_channels(f, {"inner", "outer", "speed", "overlap_end"})) {
+                render::check_finite(f, what);
+                if (!g.vortex) g.vortex = *f2;
             } else if (has_channels(f, {"anvil_bias"})) {
                 render::check_finite(f, what);
                 g.anvil = *f2; // the last one written: the end of a stencil chain
@@ -416,6 +420,7 @@ int run_preview(const Args& a) {
             layer.curl = in.curl;
             layer.envelope.cone_map = g.cone;
             layer.anvil = g.anvil;
+            layer.vortex_table = g.vortex;
             layer.envelope.distance_map = g.distance;
             auto tile_of = [](const Field2D& f) {
                 const double sx = f.bounds().max[0] - f.bounds().min[0];

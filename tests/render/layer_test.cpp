@@ -390,3 +390,41 @@ TEST(LayerLights, FlashesBrightenTheLayerNeverItsTransmittance) {
     EXPECT_THROW(layer_flash_probability(prob, 1, 0, 1), Error);
     EXPECT_THROW(layer_flash_probability(prob, 0, 5, 5), Error);
 }
+
+TEST(LayerVortex, RingsTurnTheStormAndAFullTurnIsTheStart) {
+    // One ring over the whole map turning at w rad/s, no wind: at time t the
+    // layer is the t = 0 layer turned by w t about the centre, so w t = 2 pi
+    // gives the t = 0 picture (to float rounding of the rotation) and pi does not.
+    LayerScene s = scene_with(0.0);
+    Field2D set = *s.ndf;
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) set.at(ndf::Coverage, x, y) = x < 8 ? 0.9f : 0.1f; // not rotation-symmetric
+    s.ndf = std::make_shared<const Field2D>(std::move(set));
+    s.wind = {{0, 0}};
+    s.cloud_top_offset = 0;
+    Field2D table({{1, 1}}, 5, Box2d{{{0, 0}}, {{20000, 20000}}}, {"inner", "outer", "speed", "skew", "overlap_end"});
+    table.at(0, 0, 0) = 0;
+    table.at(1, 0, 0) = 5e5; // every visible point (the map wraps)
+    table.at(2, 0, 0) = 0.01f;
+    table.at(4, 0, 0) = 6e5;
+    RenderSettings st = small_settings(40, 24);
+    st.camera.position = {{10000, -4000, 9000}};
+    st.camera.look_at = {{10000, 10000, 2000}};
+    const LayerResult start = render_layer(s, st, nullptr);
+    s.vortex_table = std::make_shared<const Field2D>(std::move(table));
+    EXPECT_TRUE(same_bytes(render_layer(s, st, nullptr).image, start.image)) << "time 0: no turn";
+    s.time = 2 * std::numbers::pi / 0.01f;
+    const LayerResult full = render_layer(s, st, nullptr);
+    s.time = std::numbers::pi / 0.01f;
+    const LayerResult half = render_layer(s, st, nullptr);
+    double d_full = 0, d_half = 0;
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 40; ++x) {
+            d_full = std::max(d_full, std::fabs(double(full.image.at(3, x, y)) - start.image.at(3, x, y)));
+            d_half = std::max(d_half, std::fabs(double(half.image.at(3, x, y)) - start.image.at(3, x, y)));
+        }
+    EXPECT_LT(d_full, 0.02);
+    EXPECT_GT(d_half, 0.2);
+    const auto f = full.report.active_features();
+    EXPECT_NE(std::find(f.begin(), f.end(), "vortex_rings"), f.end());
+}

@@ -20,6 +20,7 @@ std::vector<std::string> LayerReport::active_features() const {
     if (wind) f.push_back("wind");
     if (precipitation) f.push_back("rain_absorption");
     if (anvil) f.push_back("anvil");
+    if (vortex) f.push_back("vortex_rings");
     if (cheap_search) f.push_back("cheap_search");
     if (cone_skipping) f.push_back("cone_skipping");
     if (distance_skipping) f.push_back("distance_skipping");
@@ -229,6 +230,14 @@ public:
             cone_ratio_ = cone_->channel(cr).data();
         }
         if (s.envelope.distance_map) dist_ = s.envelope.distance_map.get();
+        if (s.vortex_table && s.time != 0) {
+            const Field2D& t = *s.vortex_table;
+            const int ci = t.find_channel("inner"), co = t.find_channel("outer"), cs = t.find_channel("speed"), ce = t.find_channel("overlap_end");
+            for (int i = 0; i < t.width(); ++i)
+                rings_.push_back({t.at(ci, i, 0), t.at(co, i, 0), t.at(cs, i, 0), t.at(ce, i, 0)});
+            const Box2d& tb = t.bounds();
+            vortex_centre_ = {{0.5 * (tb.min[0] + tb.max[0]), 0.5 * (tb.min[1] + tb.max[1])}};
+        }
         if (s.anvil) {
             const Field2D& a = *s.anvil;
             const int c = std::max(0, a.find_channel("anvil_bias"));
@@ -243,6 +252,36 @@ public:
         }
     }
     bool has_anvil() const { return anvil_ != nullptr; }
+    bool has_vortex() const { return !rings_.empty(); }
+
+    // Vortex rings: the angle (radians) the map turns by at radius r.
+    double vortex_angle(double r) const {
+        const size_t n = rings_.size();
+        for (size_t i = 0; i < n; ++i) {
+            const Ring& g = rings_[i];
+            if (r < g.inner) break;
+            const double a = g.speed * s_.time;
+            if (r < g.outer) {
+                // Inside ring i: the previous ring's overlap band reaches in.
+                if (i > 0 && r < rings_[i - 1].overlap_end) {
+                    const Ring& pr = rings_[i - 1];
+                    const double w = (r - pr.outer) / std::max(1e-9, pr.overlap_end - pr.outer);
+                    return pr.speed * s_.time + (a - pr.speed * s_.time) * w;
+                }
+                return a;
+            }
+            if (i + 1 == n && r < g.overlap_end) return a * (1 - (r - g.outer) / std::max(1e-9, g.overlap_end - g.outer));
+        }
+        return 0;
+    }
+    // p with its x, y turned about the vortex centre by -angle(r).
+    Vec3d unrotate(const Vec3d& p) const {
+        const double dx = p[0] - vortex_centre_[0], dy = p[1] - vortex_centre_[1];
+        const double a = -vortex_angle(std::hypot(dx, dy));
+        if (a == 0) return p;
+        const double c = std::cos(a), sn = std::sin(a);
+        return {{vortex_centre_[0] + c * dx - sn * dy, vortex_centre_[1] + sn * dx + c * dy, p[2]}};
+    }
 
     const Vec3d& centre() const { return centre_; }
     double bottom() const { return bottom_; }
@@ -323,7 +362,8 @@ public:
     // Density at p (altitude h). full = false: the cheap base shape only
     // (HZD's "cheap" sample). shape_out: the base shape with coverage (the
     // sample's profile for ambient and multiple scattering).
-    double density(const Vec3d& p, double h, bool full, Column* col_out = nullptr, double* shape_out = nullptr) const {
+    double density(const Vec3d& p_in, double h, bool full, Column* col_out = nullptr, double* shape_out = nullptr) const {
+        const Vec3d p = rings_.empty() ? p_in : unrotate(p_in);
         Column c;
         if (!column(p[0], p[1], c)) return 0;
         if (h <= c.min_h || h >= c.max_h) return 0;
@@ -455,6 +495,11 @@ private:
     std::array<double, kQuantiles + 1> quantile_{};
     bool equalised_ = false;
     double base_max_ = 1; // largest dilated base value (1 without noise)
+    struct Ring {
+        double inner, outer, speed, overlap_end;
+    };
+    std::vector<Ring> rings_;
+    Vec2d vortex_centre_{{0, 0}};
     const Field2D* anvil_ = nullptr;
     const float* anvil_ch_ = nullptr;
     Vec2d anvil_origin_{{0, 0}}, anvil_inv_{{1, 1}};
@@ -550,6 +595,13 @@ void validate_layer_scene(const LayerScene& s) {
         check_finite(*s.envelope.cone_map, "cone map");
     }
     if (s.envelope.distance_map) check_finite(*s.envelope.distance_map, "distance map");
+    if (s.vortex_table) {
+        const Field2D& t = *s.vortex_table;
+        for (const char* ch : {"inner", "outer", "speed", "overlap_end"})
+            need(t.find_channel(ch) >= 0, std::string("the vortex table has no '") + ch + "' channel (ndf/vortex_rings port table)");
+        need(t.height() == 1, "the vortex table must be N x 1 texels");
+        check_finite(t, "vortex table");
+    }
     if (s.anvil) {
         const Box2d& ab = s.anvil->bounds();
         need(ab.max[0] > ab.min[0] && ab.max[1] > ab.min[1], "the anvil map's bounds are empty");
@@ -775,8 +827,9 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
     report.wind = scene.wind[0] != 0 || scene.wind[1] != 0 || scene.cloud_top_offset != 0;
     report.precipitation = model.precipitation() && scene.rain_absorption > 0;
     report.anvil = model.has_anvil();
-    report.cone_skipping = model.has_cone();
-    report.distance_skipping = model.has_distance();
+    report.vortex = model.has_vortex();
+    report.cone_skipping = model.has_cone() && !model.has_vortex();
+    report.distance_skipping = model.has_distance() && !model.has_vortex();
     report.sky_layers = int(scene.sky_layers.size());
     report.sky_gradient = settings.sky_horizon.has_value();
 
@@ -801,7 +854,8 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
                        scene.earth_radius,
                        scene.earth_radius + model.bottom(),
                        scene.earth_radius + model.top(),
-                       model.has_cone() || model.has_distance(),
+                       // The envelope describes the unturned map: no skipping while rings turn it.
+                       (model.has_cone() || model.has_distance()) && !model.has_vortex(),
                        sky,
                        settings.sky_horizon.value_or(settings.sky_colour),
                        {},

@@ -112,6 +112,13 @@ struct LayerScene {
     // clamped, with the map's wind scroll). HZD's anvil: in the top of a column
     // coverage becomes coverage^e, e = remap(f, 0.7, 0.8, 1, lerp(1, 0.5, bias)).
     Field2DPtr anvil;
+    // Optional vortex rings (ndf/vortex_rings' `table`: N x 1 texels with
+    // channels inner, outer (m), speed (rad/s), overlap_end (m); bounds =
+    // centre +- radius). At `time` the map and the noise are read rotated by
+    // -speed_i * time about the centre inside ring i; in ring i's overlap band
+    // [outer_i, overlap_end_i] the angle blends linearly to ring i+1's (past
+    // the last ring, to 0), so the storm turns, faster inside.
+    Field2DPtr vortex_table;
 };
 
 // Throws atlas::Error naming the problem (null fields, missing channels,
@@ -132,6 +139,7 @@ struct LayerReport {
     bool wind = false;            // non-zero wind or top offset
     bool precipitation = false;   // some precipitation > 0
     bool anvil = false;           // an anvil map with some bias > 0
+    bool vortex = false;          // vortex rings turn the storm (table given and time != 0)
     int sky_layers = 0;
     int point_lights = 0;         // lights integrated (given + flashes)
     bool sky_gradient = false;
