@@ -82,11 +82,23 @@ class CookJob:
         return self.thread is None or not self.thread.is_alive()
 
 
-_state = {}  # scene name -> {"session": atlas.Session, "job": CookJob | None, "again": bool}
+# scene name -> {"session": atlas.Session, "job": CookJob | None, "again": bool, "pending": [(node, param, value)]}
+_state = {}
 
 
 def _scene_state(scene):
-    return _state.setdefault(scene.name, {"session": None, "job": None, "again": False})
+    return _state.setdefault(scene.name, {"session": None, "job": None, "again": False, "pending": []})
+
+
+def _apply_edit(scene, node, param, value):
+    """Session.set on the main thread, never while a cook runs (a Session is one call at a time)."""
+    try:
+        _scene_state(scene)["session"].set(node, param, value)
+        scene.atlas.error = ""
+        return True
+    except Exception as e:
+        scene.atlas.error = str(e)
+        return False
 
 
 # ---------------------------------------------------------------- properties
@@ -102,11 +114,14 @@ def _on_param_changed(self, context):
     st = _scene_state(scene)
     if st["session"] is None:
         return
-    try:
-        st["session"].set(self.node, self.name, self.value())
-        props.error = ""
-    except Exception as e:
-        props.error = str(e)
+    job = st["job"]
+    if job is not None and not job.done():
+        # The session is cooking on its thread: stop that cook, edit when it has returned.
+        st["pending"].append((self.node, self.name, self.value()))
+        job.cancel.set()
+        st["again"] = st["again"] or props.auto_cook
+        return
+    if not _apply_edit(scene, self.node, self.name, self.value()):
         return
     if props.auto_cook:
         start_cook(scene, background=not bpy.app.background)
@@ -271,9 +286,13 @@ def start_cook(scene, background=True):
             return 0.1
         wm.progress_end()
         _finish(sc, job)
-        if _scene_state(sc)["again"]:
-            _scene_state(sc)["again"] = False
-            start_cook(sc, background=True)
+        state = _scene_state(sc)
+        edits, state["pending"] = state["pending"], []
+        ok = all([_apply_edit(sc, *e) for e in edits])
+        if state["again"]:
+            state["again"] = False
+            if ok:
+                start_cook(sc, background=True)
         return None
 
     bpy.app.timers.register(poll, first_interval=0.1)
