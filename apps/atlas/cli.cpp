@@ -72,7 +72,7 @@ const std::vector<Command>& commands() {
           {"--quality", "Q", "fast mode step scale (default 1; 2 = half-length steps)"},
           {"--extinction", "PER_M", "extinction per metre at density 1 (default 0.04)"},
           {"--exposure", "E", "PNG tone map exposure (default 1.5)"},
-          {"--noise", "FILE", "Nubis noise volume (4 channels) for the up-rez"},
+          {"--noise", "FILE|auto|none", "voxel up-rez noise: a 4-channel volume file, auto (default: noise/nubis_set 128^3 cooked through the cache) or none"},
           {"--noise-tile", "M", "metres per noise period (default 256)"},
           {"--voxel", "M", "voxel size in metres for files without bounds (TGA stacks)"},
           {"--reference", "", "render the reference mode instead of the fast mode"},

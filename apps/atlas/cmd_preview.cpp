@@ -215,6 +215,21 @@ LayerInputs cook_layer_inputs(int jobs, const std::optional<std::filesystem::pat
     return in;
 }
 
+Field3DPtr cook_voxel_noise(int jobs, const std::optional<std::filesystem::path>& cache_dir, ProgressSink progress, bool quiet) {
+    Session s(builtin_nodes());
+    s.load_text("atlas: 1\nnodes:\n  nubis_noise: {type: noise/nubis_set, params: {size: 128, seed: 0}}\n"
+                "outputs:\n  - {node: nubis_noise, file: nubis_noise.exr}\n",
+                "<preview voxel noise>", ".");
+    CookOptions o;
+    o.write_outputs = false;
+    o.jobs = jobs;
+    o.cache_dir = cache_dir;
+    o.progress = std::move(progress);
+    const CookResult r = s.cook(o);
+    if (!quiet) std::fprintf(stderr, "noise/nubis_set: cooked %zu, cached %zu in %.2f s\n", r.with_status("cooked").size(), r.with_status("cached").size(), r.seconds);
+    return std::get<Field3DPtr>(s.get("nubis_noise", "out", o));
+}
+
 // A sky layer's opacity ramp from the texture's statistics: clear below the
 // mean, opaque two standard deviations above it.
 render::SkyLayer sky_layer_from(Field2DPtr tex, int channel, double altitude, double tile, double opacity) {
@@ -377,7 +392,8 @@ int run_preview(const Args& a) {
     const auto t_start = std::chrono::steady_clock::now();
 
     Field3DPtr noise;
-    if (a.has("--noise")) noise = io::as_field3d(io::read_field_file(a.get("--noise")));
+    const std::string noise_opt = a.has("--noise") ? a.get("--noise") : "auto";
+    if (noise_opt != "auto" && noise_opt != "none") noise = io::as_field3d(io::read_field_file(noise_opt));
     if (a.has("--cache") && a.has("--no-cache")) throw UsageError{"--cache and --no-cache contradict each other", "preview"};
     std::optional<std::filesystem::path> cache_dir;
     if (a.has("--cache")) cache_dir = a.get("--cache");
@@ -436,6 +452,9 @@ int run_preview(const Args& a) {
         have_voxel = true;
     }
     if (have_voxel) {
+        // Voxel up-rez by default: the Nubis noise set (noise/nubis_set 128^3),
+        // cooked through the same cache as the graph.
+        if (noise_opt == "auto") noise = cook_voxel_noise(jobs, cache_dir, sink, quiet);
         scene.noise = noise;
         if (a.has("--noise-tile")) scene.noise_tile = numbers(a.get("--noise-tile"), 1, "--noise-tile")[0];
         render::validate_scene(scene);

@@ -80,20 +80,20 @@ std::vector<std::string> leftovers(const fs::path& dir) {
 TEST(PreviewCli, SecondPreviewOfAGraphComesFromTheDiskCache) {
     write_graph();
     fs::remove_all(work_dir() / "cache");
-    CliRun first = run_atlas("preview tiny.yaml --size 32x18 --cache cache -o first.png");
+    CliRun first = run_atlas("preview tiny.yaml --noise none --size 32x18 --cache cache -o first.png");
     ASSERT_EQ(first.status, 0) << first.err;
     EXPECT_NE(first.err.find("graph: cooked 4, cached 0"), std::string::npos) << first.err;
     EXPECT_FALSE(fs::is_empty(work_dir() / "cache"));
     // A new process: only the disk cache can save the cook.
-    CliRun second = run_atlas("preview tiny.yaml --size 32x18 --cache cache -o second.png");
+    CliRun second = run_atlas("preview tiny.yaml --noise none --size 32x18 --cache cache -o second.png");
     ASSERT_EQ(second.status, 0) << second.err;
     EXPECT_NE(second.err.find("graph: cooked 0, cached 1"), std::string::npos) << second.err;
     EXPECT_EQ(atlas::read_file_bytes(work_dir() / "first.png"), atlas::read_file_bytes(work_dir() / "second.png"));
     EXPECT_FALSE(fs::exists(work_dir() / "nvdf.vdb")) << "a preview must not write the graph's outputs";
-    CliRun nocache = run_atlas("preview tiny.yaml --size 32x18 --no-cache -o third.png");
+    CliRun nocache = run_atlas("preview tiny.yaml --noise none --size 32x18 --no-cache -o third.png");
     ASSERT_EQ(nocache.status, 0) << nocache.err;
     EXPECT_NE(nocache.err.find("graph: cooked 4, cached 0"), std::string::npos) << nocache.err;
-    EXPECT_EQ(run_atlas("preview tiny.yaml --cache c --no-cache -o x.png").status, 2);
+    EXPECT_EQ(run_atlas("preview tiny.yaml --noise none --cache c --no-cache -o x.png").status, 2);
 }
 
 TEST(PreviewCli, FailedRenderOrWriteLeavesNoPartialFile) {
@@ -103,30 +103,30 @@ TEST(PreviewCli, FailedRenderOrWriteLeavesNoPartialFile) {
     fs::create_directories(dir);
     std::ofstream(dir / "keep.png") << "the previous picture";
     // The render fails (a negative light intensity): the old file is untouched.
-    CliRun bad_light = run_atlas("preview tiny.yaml --size 16x9 --light 1,2,3,1,1,1,-5 -o atomic/keep.png");
+    CliRun bad_light = run_atlas("preview tiny.yaml --noise none --size 16x9 --light 1,2,3,1,1,1,-5 -o atomic/keep.png");
     EXPECT_EQ(bad_light.status, 1) << bad_light.err;
     EXPECT_NE(bad_light.err.find("intensity"), std::string::npos) << bad_light.err;
     EXPECT_EQ(atlas::read_file_bytes(dir / "keep.png"), "the previous picture");
     // The write fails (no writer for the extension): nothing is left behind.
-    CliRun bad_ext = run_atlas("preview tiny.yaml --size 16x9 -o atomic/out.unknownext");
+    CliRun bad_ext = run_atlas("preview tiny.yaml --noise none --size 16x9 -o atomic/out.unknownext");
     EXPECT_EQ(bad_ext.status, 1) << bad_ext.err;
     EXPECT_EQ(leftovers(dir), std::vector<std::string>{"keep.png"});
-    CliRun bad_turntable = run_atlas("preview tiny.yaml --size 16x9 --turntable 2 -o atomic/spin.unknownext");
+    CliRun bad_turntable = run_atlas("preview tiny.yaml --noise none --size 16x9 --turntable 2 -o atomic/spin.unknownext");
     EXPECT_EQ(bad_turntable.status, 1);
     EXPECT_EQ(leftovers(dir), std::vector<std::string>{"keep.png"});
-    CliRun ok = run_atlas("preview tiny.yaml --size 16x9 --turntable 2 -o atomic/spin.png");
+    CliRun ok = run_atlas("preview tiny.yaml --noise none --size 16x9 --turntable 2 -o atomic/spin.png");
     ASSERT_EQ(ok.status, 0) << ok.err;
     EXPECT_TRUE(fs::exists(dir / "spin_000.png") && fs::exists(dir / "spin_001.png"));
 }
 
 TEST(PreviewCli, LightAndSkyOptions) {
     write_graph();
-    CliRun r = run_atlas("preview tiny.yaml --size 24x14 --sky 0.1,0.3,0.9,0.9,0.8,0.6 --light 480,480,160,1,0.3,0.1,1e5 "
+    CliRun r = run_atlas("preview tiny.yaml --noise none --size 24x14 --sky 0.1,0.3,0.9,0.9,0.8,0.6 --light 480,480,160,1,0.3,0.1,1e5 "
                   "--light 100,100,100,0,0,1,1e4,200 -o lit.exr");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find("point_lights"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("sky_gradient"), std::string::npos) << r.err;
-    CliRun plain = run_atlas("preview tiny.yaml --size 24x14 -o plain.exr");
+    CliRun plain = run_atlas("preview tiny.yaml --noise none --size 24x14 -o plain.exr");
     ASSERT_EQ(plain.status, 0) << plain.err;
     EXPECT_EQ(plain.err.find("point_lights"), std::string::npos) << plain.err;
     // The graph has clouds in view, and the lights brighten them (the same
