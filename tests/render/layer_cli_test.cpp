@@ -79,24 +79,32 @@ const char* kVoxelNodes = R"(
 
 void write(const std::string& name, const std::string& text) { std::ofstream(work_dir() / name) << text; }
 
+// The work directory holds a cache with the HZD and Nubis noise (~100 MB): removed at exit.
+struct RemoveWorkDir {
+    ~RemoveWorkDir() {
+        std::error_code ec;
+        fs::remove_all(work_dir(), ec);
+    }
+} remove_work_dir;
+
 } // namespace
 
 TEST(LayerCli, NdfSetGraphRendersInLayerModeSameBytesForAnyJobs) {
     write("layer.yaml", kLayerGraph);
-    const CliRun a = run_atlas("preview layer.yaml --size 64x36 --jobs 1 -o a.png");
+    const CliRun a = run_atlas("preview layer.yaml --size 48x27 --jobs 1 -o a.png");
     ASSERT_EQ(a.status, 0) << a.err;
     EXPECT_NE(a.err.find("(2.5D)"), std::string::npos) << a.err;
     EXPECT_NE(a.err.find("curved_earth"), std::string::npos) << a.err;
-    const CliRun b = run_atlas("preview layer.yaml --size 64x36 --jobs 2 -o b.png");
+    const CliRun b = run_atlas("preview layer.yaml --size 48x27 --jobs 2 -o b.png");
     ASSERT_EQ(b.status, 0) << b.err;
     EXPECT_EQ(atlas::read_file_bytes(work_dir() / "a.png"), atlas::read_file_bytes(work_dir() / "b.png"));
     // The graph's own outputs are not written.
     EXPECT_FALSE(fs::exists(work_dir() / "set.exr"));
     // --set reaches the graph: a different seed, a different picture.
-    const CliRun c = run_atlas("preview layer.yaml --size 64x36 --set coverage_noise.seed=9 -o c.png");
+    const CliRun c = run_atlas("preview layer.yaml --size 48x27 --set coverage_noise.seed=9 -o c.png");
     ASSERT_EQ(c.status, 0) << c.err;
     EXPECT_NE(atlas::read_file_bytes(work_dir() / "a.png"), atlas::read_file_bytes(work_dir() / "c.png"));
-    for (const char* v : {"aerial", "orbit:120,30"}) {
+    for (const char* v : {"orbit:120,30"}) {
         const CliRun d = run_atlas(std::string("preview layer.yaml --size 32x18 --view ") + v + " -o d.png");
         EXPECT_EQ(d.status, 0) << v << ": " << d.err;
     }
