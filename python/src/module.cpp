@@ -4,6 +4,7 @@
 
 #include "atlas/graph/node_docs.h"
 
+#include <atomic>
 #include <cmath>
 
 namespace atlas::python {
@@ -171,6 +172,29 @@ py::list graph_outputs(const Session& s) {
     return out;
 }
 
+// A Session as Python holds it: calls on one Session from two Python threads
+// at once (possible, since cook releases the GIL) are refused, not a data race.
+struct PySession {
+    explicit PySession(NodeRegistry registry) : session(std::move(registry)) {}
+    Session session;
+    std::atomic<bool> busy{false};
+};
+
+class BusyGuard {
+public:
+    explicit BusyGuard(PySession& p) : p_(p) {
+        if (p_.busy.exchange(true))
+            throw Error("this atlas.Session is in use by another thread (one call at a time per Session; "
+                        "use one Session per thread)");
+    }
+    ~BusyGuard() { p_.busy = false; }
+    BusyGuard(const BusyGuard&) = delete;
+    BusyGuard& operator=(const BusyGuard&) = delete;
+
+private:
+    PySession& p_;
+};
+
 } // namespace
 
 std::string python_error_message(py::error_already_set& e) {
@@ -309,22 +333,28 @@ PYBIND11_MODULE(_atlas, m) {
     bind_fields(m);
     bind_python_nodes(m);
 
-    py::class_<Session>(m, "Session", R"doc(
+    py::class_<PySession>(m, "Session", R"doc(
 A loaded graph and its in-memory cache (atlas::Session). Edit parameters and
 re-cook: only what changed cooks again. Not thread-safe: one call at a time
 per Session (cook releases the GIL, so other Python threads run meanwhile).)doc")
         .def(py::init([](const py::object& registry) {
-                 if (registry.is_none()) return std::make_unique<Session>(builtin_nodes());
-                 return std::make_unique<Session>(registry.cast<const NodeRegistry&>());
+                 if (registry.is_none()) return std::make_unique<PySession>(builtin_nodes());
+                 return std::make_unique<PySession>(registry.cast<const NodeRegistry&>());
              }),
              py::arg("registry") = py::none(), "A session over `registry` (an atlas.NodeRegistry; default: the built-in node types).")
-        .def("load", [](Session& s, const py::object& path) { s.load(py::str(path).cast<std::string>()); }, py::arg("path"),
+        .def("load", [](PySession& ps, const py::object& path) {
+                 BusyGuard guard(ps);
+                 Session& s = ps.session; s.load(py::str(path).cast<std::string>()); }, py::arg("path"),
              "Loads (parses and validates) a graph file; raises atlas.ParseError with file:line:col.")
-        .def("load_text", [](Session& s, const std::string& text, const std::string& name, const py::object& base_dir) {
+        .def("load_text", [](PySession& ps, const std::string& text, const std::string& name, const py::object& base_dir) {
+                 BusyGuard guard(ps);
+                 Session& s = ps.session;
                  s.load_text(text, name, base_dir.is_none() ? std::filesystem::current_path() : std::filesystem::path(py::str(base_dir).cast<std::string>()));
              }, py::arg("text"), py::arg("name") = "<text>", py::arg("base_dir") = py::none(),
              "Loads a graph from YAML text; `name` is used in messages, relative paths resolve against base_dir (default: the current directory).")
-        .def("set", [](Session& s, const std::string& node, const std::string& param, const py::object& value) {
+        .def("set", [](PySession& ps, const std::string& node, const std::string& param, const py::object& value) {
+                 BusyGuard guard(ps);
+                 Session& s = ps.session;
                  const ParamDecl* d = find_decl(s, node, param);
                  if (!d) {
                      // Let the library name what is wrong (unknown node or parameter, with a hint).
@@ -334,11 +364,16 @@ per Session (cook releases the GIL, so other Python threads run meanwhile).)doc"
                  s.set(node, param, param_from_python(value, d->type, node + "." + param));
              }, py::arg("node"), py::arg("param"), py::arg("value"),
              "Overrides NODE.PARAM with a Python value, validated against the declaration (type, range, choices).")
-        .def("set_text", &Session::set_text, py::arg("node"), py::arg("param"), py::arg("text"),
+        .def("set_text", [](PySession& ps, const std::string& node, const std::string& param, const std::string& text) {
+                 BusyGuard guard(ps);
+                 ps.session.set_text(node, param, text);
+             }, py::arg("node"), py::arg("param"), py::arg("text"),
              "Overrides NODE.PARAM from text as the CLI's --set spells it ('0.5', '[1, 2, 3]', 'name').")
-        .def("cook", [](Session& s, const py::object& outputs, int jobs, bool write_outputs, const py::object& out_dir,
+        .def("cook", [](PySession& ps, const py::object& outputs, int jobs, bool write_outputs, const py::object& out_dir,
                         const py::object& cache_dir, bool checked, const py::object& memory_budget, const py::object& progress,
                         const py::object& cancel) {
+                 BusyGuard guard(ps);
+                 Session& s = ps.session;
                  CookOptions o = make_options(outputs, jobs, write_outputs, out_dir, cache_dir, checked, memory_budget, progress, cancel);
                  CookResult r;
                  {
@@ -355,8 +390,10 @@ per Session (cook releases the GIL, so other Python threads run meanwhile).)doc"
 write_outputs=True also writes the output files into out_dir (atomically). The GIL is released while
 cooking; progress(fraction, task, done, total) and cancel() -> bool are called from worker threads
 with the GIL taken. Raises atlas.CancelledError when cancel() returns true.)doc")
-        .def("get", [](Session& s, const std::string& node, const py::object& port, int jobs, const py::object& cache_dir,
+        .def("get", [](PySession& ps, const std::string& node, const py::object& port, int jobs, const py::object& cache_dir,
                        const py::object& memory_budget, const py::object& progress, const py::object& cancel) {
+                 BusyGuard guard(ps);
+                 Session& s = ps.session;
                  std::string port_name = port.is_none() ? "" : port.cast<std::string>();
                  if (port_name.empty()) {
                      const GraphNode* n = s.graph().find(node);
@@ -375,22 +412,30 @@ with the GIL taken. Raises atlas.CancelledError when cancel() returns true.)doc"
              py::arg("memory_budget") = py::none(), py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
              "Cooks what one node output needs (port default: the node's first output) and returns it: an atlas.Field2D or "
              "Field3D (channels as read-only NumPy views), or for a mesh / points a dict of read-only arrays.")
-        .def("nodes", &graph_nodes, "The graph's nodes in file order: [{name, type, where, params (resolved), explicit, inputs}].")
-        .def("outputs", &graph_outputs, "The graph's outputs: [{node, port, file, format, options, where}].")
-        .def("node_types", [](const Session& s) {
+        .def("nodes", [](PySession& ps) { BusyGuard guard(ps); return graph_nodes(ps.session); }, "The graph's nodes in file order: [{name, type, where, params (resolved), explicit, inputs}].")
+        .def("outputs", [](PySession& ps) { BusyGuard guard(ps); return graph_outputs(ps.session); }, "The graph's outputs: [{node, port, file, format, options, where}].")
+        .def("node_types", [](PySession& ps) {
+                 BusyGuard guard(ps);
+                 const Session& s = ps.session;
                  py::list l;
                  for (const NodeType* t : s.registry().all()) l.append(declaration_to_python(*t));
                  return l;
              }, "Every node type's declaration as plain data (see atlas.node_types()).")
-        .def("declaration", [](const Session& s, const std::string& type) {
+        .def("declaration", [](PySession& ps, const std::string& type) {
+                 BusyGuard guard(ps);
+                 const Session& s = ps.session;
                  const NodeType* t = s.registry().find(type);
                  if (!t) throw Error("unknown node type '" + type + "'" + name_hint(type, s.registry().names()));
                  return declaration_to_python(*t);
              }, py::arg("type"), "One node type's declaration as plain data.")
-        .def("node_hashes", [](const Session& s) {
+        .def("node_hashes", [](PySession& ps) {
+                 BusyGuard guard(ps);
+                 const Session& s = ps.session;
                  std::map<std::string, std::string> out;
                  for (const auto& [name, h] : s.node_hashes()) out[name] = h.hex();
                  return out;
              }, "Each node's content hash (hex).")
-        .def_property_readonly("file", [](const Session& s) { return s.graph().file.string(); }, "The graph file ('' when loaded from text).");
+        .def_property_readonly("file", [](PySession& ps) {
+                 BusyGuard guard(ps);
+                 const Session& s = ps.session; return s.graph().file.string(); }, "The graph file ('' when loaded from text).");
 }

@@ -268,3 +268,38 @@ def test_field_from_numpy():
     assert g.channels == 2 and g.shape == (5, 4)
     with pytest.raises(ValueError):
         atlas.Field3D(np.zeros((2, 2)), ((0, 0, 0), (1, 1, 1)))
+
+
+def test_one_call_at_a_time_per_session(small_graph):
+    s = atlas.Session()
+    s.load_text(small_graph, "small.yaml")
+    started, release = threading.Event(), threading.Event()
+    errors = []
+
+    def hold():  # the cancel callback keeps the cook running until released
+        started.set()
+        release.wait(10)
+        return False
+
+    def cook():
+        try:
+            s.cook(jobs=1, cancel=hold)
+        except Exception as e:  # pragma: no cover - reported below
+            errors.append(e)
+
+    t = threading.Thread(target=cook)
+    t.start()
+    try:
+        assert started.wait(10)
+        with pytest.raises(atlas.Error, match="in use by another thread"):
+            s.set("coverage", "in_min", 0.5)
+        with pytest.raises(atlas.Error, match="in use by another thread"):
+            s.nodes()
+        other = atlas.Session()  # another Session is independent
+        other.load_text(small_graph, "other.yaml")
+        assert other.get("coverage").resolution == (16, 8, 4)
+    finally:
+        release.set()
+        t.join()
+    assert not errors
+    s.set("coverage", "in_min", 0.5)  # free again
