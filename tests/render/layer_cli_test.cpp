@@ -3,6 +3,7 @@
 // overrides; a graph that writes neither, a camera under the ground and
 // --set reach the user as clear messages; --jobs never changes the bytes.
 #include "atlas/core/files.h"
+#include "atlas/io/exr.h"
 #include "atlas/io/readers.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -161,4 +163,17 @@ TEST(LayerCli, TimeSequenceWritesNumberedFramesThatMove) {
     EXPECT_NE(atlas::read_file_bytes(work_dir() / "seq_000.png"), atlas::read_file_bytes(work_dir() / "seq_001.png"));
     const CliRun bad = run_atlas("preview layer.yaml --size 32x18 --frames 2 --turntable 2 -o x.png");
     EXPECT_NE(bad.status, 0);
+}
+
+TEST(LayerCli, NonFiniteChannelNamesNodeAndChannel) {
+    atlas::Field2D f({{4, 4}}, 3, atlas::Box2d{{{0, 0}}, {{4000, 4000}}}, {"coverage", "min_height", "max_height"});
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) f.at(0, x, y) = 0.5f, f.at(1, x, y) = 1500, f.at(2, x, y) = 3000;
+    f.at(0, 2, 3) = std::numeric_limits<float>::infinity();
+    atlas::io::write_exr(f, work_dir() / "inf_set.exr");
+    write("inf.yaml", "atlas: 1\nnodes:\n  weather: {type: import/exr, params: {file: inf_set.exr}}\noutputs:\n  - {node: weather, file: w.exr}\n");
+    const CliRun r = run_atlas("preview inf.yaml --size 16x9 -o x.png");
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("node 'weather' output 'out': channel 'coverage' holds Inf at texel (2, 3)"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(work_dir() / "x.png"));
 }
