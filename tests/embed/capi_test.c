@@ -9,6 +9,8 @@
 #include "atlas/atlas.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -236,6 +238,58 @@ static void test_quickstart(const char* path) {
     atlas_session_destroy(s);
 }
 
+/* One call at a time per session: a second thread gets ATLAS_BUSY, another session works. */
+struct Hold {
+    atomic_int started, release;
+    AtlasSession* s;
+    AtlasStatus status;
+};
+
+static int hold_cancel(void* user) {
+    struct Hold* h = (struct Hold*)user;
+    atomic_store(&h->started, 1);
+    while (!atomic_load(&h->release)) {
+    }
+    return 0;
+}
+
+static void* hold_cook(void* user) {
+    struct Hold* h = (struct Hold*)user;
+    AtlasCookOptions o;
+    atlas_cook_options_init(&o);
+    o.jobs = 1;
+    o.cancel = hold_cancel;
+    o.user = h;
+    h->status = atlas_session_cook(h->s, &o);
+    return NULL;
+}
+
+static void test_one_call_at_a_time(void) {
+    struct Hold h;
+    atomic_init(&h.started, 0);
+    atomic_init(&h.release, 0);
+    h.s = NULL;
+    h.status = ATLAS_ERROR;
+    CHECK(atlas_session_create(&h.s) == ATLAS_OK);
+    CHECK_OK(h.s, atlas_session_load_text(h.s, kGraph, "busy.yaml", NULL));
+    pthread_t t;
+    CHECK(pthread_create(&t, NULL, hold_cook, &h) == 0);
+    while (!atomic_load(&h.started)) {
+    }
+    CHECK(atlas_session_set_float(h.s, "coverage", "in_min", 0.5) == ATLAS_BUSY);
+    CHECK(strcmp(atlas_status_name(ATLAS_BUSY), "busy") == 0);
+    AtlasSession* other = NULL;
+    CHECK(atlas_session_create(&other) == ATLAS_OK);
+    CHECK_OK(other, atlas_session_load_text(other, kGraph, "other.yaml", NULL));
+    CHECK_OK(other, atlas_session_cook(other, NULL));
+    atlas_session_destroy(other);
+    atomic_store(&h.release, 1);
+    pthread_join(t, NULL);
+    CHECK(h.status == ATLAS_OK);
+    CHECK_OK(h.s, atlas_session_set_float(h.s, "coverage", "in_min", 0.5)); /* free again */
+    atlas_session_destroy(h.s);
+}
+
 /* Runs the CLI and returns its combined output (static buffer). */
 static const char* run_cli(const char* command) {
     static char out[8192];
@@ -290,6 +344,7 @@ int main(int argc, char** argv) {
     test_inline_graph();
     test_errors();
     test_quickstart(argv[1]);
+    test_one_call_at_a_time();
     if (argc == 4) test_same_messages_as_the_cli(argv[2], argv[3]);
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;

@@ -17,8 +17,9 @@
  *   the session keeps the message (atlas_session_error), which is the same
  *   text the CLI prints (file:line:col, node, parameter, what was expected).
  * - Handles are opaque. A session is not thread-safe: one call at a time per
- *   session (different sessions are independent and may be used from
- *   different threads at once). A field is immutable and may be read from any
+ *   session (a call made while another thread is inside one returns
+ *   ATLAS_BUSY and does nothing). Different sessions are independent and may
+ *   be used from different threads at once. A field is immutable and may be read from any
  *   number of threads; it stays valid after its session is destroyed, until
  *   atlas_field_release.
  * - Strings returned by the library are owned by it: a session's strings stay
@@ -47,10 +48,12 @@ typedef enum AtlasStatus {
     ATLAS_PARSE_ERROR = 2,      /* a graph file or text that cannot be used: the error has a location */
     ATLAS_INVALID_ARGUMENT = 3, /* a NULL handle or string, a port that is not a field, no graph loaded */
     ATLAS_CANCELLED = 4,        /* the cancel callback asked to stop */
-    ATLAS_OUT_OF_MEMORY = 5     /* the memory budget (or the machine) refused an allocation */
+    ATLAS_OUT_OF_MEMORY = 5,    /* the memory budget (or the machine) refused an allocation */
+    ATLAS_BUSY = 6              /* another thread is inside a call on this session: nothing was done,
+                                   and atlas_session_error still describes that thread's calls */
 } AtlasStatus;
 
-/* "ok", "error", "parse error", "invalid argument", "cancelled", "out of memory". */
+/* "ok", "error", "parse error", "invalid argument", "cancelled", "out of memory", "busy". */
 ATLAS_API const char* atlas_status_name(AtlasStatus status);
 /* The library's version, "MAJOR.MINOR.PATCH". */
 ATLAS_API const char* atlas_version(void);

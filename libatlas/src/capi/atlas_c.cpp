@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <new>
@@ -20,6 +21,7 @@
 
 struct AtlasSession {
     atlas::Session session{atlas::builtin_nodes()};
+    std::atomic<bool> busy{false}; // a call is running (ATLAS_BUSY for a second thread)
     std::string error;
     atlas::SourceLocation error_where;
     atlas::CookResult last;
@@ -53,6 +55,12 @@ AtlasStatus fail(AtlasSession* s, AtlasStatus status, std::string message) {
 template <typename Body>
 AtlasStatus guarded(AtlasSession* s, Body&& body) {
     if (!s) return ATLAS_INVALID_ARGUMENT;
+    // Another thread is inside a call on this session: touch nothing (not even the message).
+    if (s->busy.exchange(true)) return ATLAS_BUSY;
+    struct Release {
+        std::atomic<bool>& b;
+        ~Release() { b = false; }
+    } release{s->busy};
     s->error.clear();
     s->error_where = {};
     try {
@@ -159,6 +167,7 @@ const char* atlas_status_name(AtlasStatus status) {
     case ATLAS_INVALID_ARGUMENT: return "invalid argument";
     case ATLAS_CANCELLED: return "cancelled";
     case ATLAS_OUT_OF_MEMORY: return "out of memory";
+    case ATLAS_BUSY: return "busy";
     }
     return "unknown status";
 }
