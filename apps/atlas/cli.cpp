@@ -89,6 +89,8 @@ const std::vector<Command>& commands() {
           {"--time", "S", "2.5D: seconds of wind scroll (map and noise)"},
           {"--wind", "X,Y", "2.5D: wind velocity in m/s (default 8,0)"},
           {"--earth-radius", "M", "2.5D: Earth radius in metres (default 6360000)"},
+          {"--watch", "", "after the preview, re-cook and re-render whenever the graph or a file it reads changes (prints each step's time)"},
+          {"--watch-max", "N", "with --watch: stop after N re-renders"},
           {"--frames", "N", "a time sequence OUT_000.png ..: frame i at --time + i x --time-step (wind scroll) with flash index --flash + i"},
           {"--time-step", "S", "seconds between --frames (default 60)"},
           {"--lightning", "COUNT[,I[,RADIUS]]", "2.5D: COUNT flashes placed by the set's superstorm_coverage (else precipitation, coverage), intensity I (default 5e6), reach (default 4000 m)"},

@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <limits>
+#include <thread>
 #include <optional>
 #include <sstream>
 #include <variant>
@@ -67,6 +68,7 @@ struct GraphContent {
     Field3DPtr distance;
     std::string ndf_node;
     std::vector<std::string> written; // "node 'n' (type) port 'p' -> file"
+    std::vector<std::filesystem::path> depends; // the graph file and every file the cook read (--watch)
 };
 
 void apply_sets(Session& s, const Args& a) {
@@ -138,6 +140,8 @@ GraphContent cook_graph(Session& session, const std::string& file, int jobs, Pro
         o.progress = progress;
         for (const Want* w : now) o.outputs.push_back(w->file);
         const CookResult r = session.cook(o);
+        for (const auto& d : r.depends(file))
+            if (std::find(g.depends.begin(), g.depends.end(), d) == g.depends.end()) g.depends.push_back(d);
         if (!quiet)
             std::fprintf(stderr, "graph: cooked %zu, cached %zu nodes in %.2f s%s\n", r.with_status("cooked").size(), r.with_status("cached").size(),
                          r.seconds, cache_dir ? (" (cache " + cache_dir->string() + ")").c_str() : "");
@@ -367,7 +371,9 @@ render::Camera voxel_camera(const render::CloudScene& scene, const View& v, doub
 
 } // namespace
 
-int run_preview(const Args& a) {
+// One preview: cook, render, write. `depends` receives the files a --watch
+// loop polls (the graph file and every file the cook read).
+int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
     if (a.positional.empty()) throw UsageError{"expected a graph file or NVDF files", "preview"};
     if (!a.has("--out") && !a.has("--sweep")) throw UsageError{"expected -o OUT.png (or OUT.exr)", "preview"};
     int jobs = 0;
@@ -407,7 +413,10 @@ int run_preview(const Args& a) {
         Session session(builtin_nodes());
         session.load(file);
         apply_sets(session, a);
+        depends = {file};
         GraphContent g = cook_graph(session, file, jobs, sink, cache_dir, quiet);
+        for (const auto& d : g.depends)
+            if (std::find(depends.begin(), depends.end(), d) == depends.end()) depends.push_back(d);
         const bool layerish = g.ndf || g.cirrus || g.sky2d;
         if (!g.nvdf && !layerish) {
             std::string list;
@@ -666,6 +675,62 @@ int run_preview(const Args& a) {
         std::fprintf(stderr, "rendered %dx%d%s (%s) in %.2f s (%.2f s with cooking); features:%s\n", w, h,
                      frames ? (" x" + std::to_string(frames)).c_str() : "",
                      have_layer && have_voxel ? "2.5D + voxel composited" : (have_layer ? "2.5D" : "voxel"), secs, total, features.c_str());
+    }
+    return 0;
+}
+
+namespace {
+
+using FileStamps = std::vector<std::pair<std::filesystem::path, std::filesystem::file_time_type>>;
+
+FileStamps stamps_of(const std::vector<std::filesystem::path>& files) {
+    FileStamps st;
+    for (const auto& f : files) {
+        std::error_code ec;
+        st.emplace_back(f, std::filesystem::last_write_time(f, ec));
+    }
+    return st;
+}
+
+} // namespace
+
+// --watch: preview, then poll the graph and its input files twice a second;
+// on a change re-cook (through the cache: only what changed) and re-render,
+// printing each step's time (the cook and render summaries). A failing
+// round prints its error and waits for the next change. --watch-max N stops
+// after N re-renders (scripts, tests).
+int run_preview(const Args& a) {
+    std::vector<std::filesystem::path> depends;
+    if (!a.has("--watch")) return preview_once(a, depends);
+    if (a.positional.size() != 1 || !is_graph(a.positional[0])) throw UsageError{"--watch needs one graph file", "preview"};
+    const int max_rounds = a.has("--watch-max") ? static_cast<int>(numbers(a.get("--watch-max"), 1, "--watch-max")[0]) : -1;
+    depends = {a.positional[0]};
+    auto round = [&] {
+        try {
+            preview_once(a, depends);
+        } catch (const UsageError&) {
+            throw;
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "watch: error: %s\n", e.what());
+        }
+    };
+    round();
+    for (int n = 0; max_rounds < 0 || n < max_rounds; ++n) {
+        const FileStamps before = stamps_of(depends);
+        std::fprintf(stderr, "watch: waiting for a change in %zu file(s)\n", depends.size());
+        for (;;) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(500));
+            const FileStamps now = stamps_of(depends);
+            if (now != before) {
+                for (size_t i = 0; i < now.size() && i < before.size(); ++i)
+                    if (now[i].second != before[i].second) std::fprintf(stderr, "watch: %s changed\n", now[i].first.string().c_str());
+                break;
+            }
+        }
+        const auto t = std::chrono::steady_clock::now();
+        round();
+        std::fprintf(stderr, "watch: re-cooked and re-rendered in %.2f s\n",
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count());
     }
     return 0;
 }

@@ -10,8 +10,10 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -176,4 +178,33 @@ TEST(LayerCli, NonFiniteChannelNamesNodeAndChannel) {
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.err.find("node 'weather' output 'out': channel 'coverage' holds Inf at texel (2, 3)"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(work_dir() / "x.png"));
+}
+
+TEST(LayerCli, WatchReRendersWhenTheGraphChanges) {
+    const fs::path dir = work_dir();
+    write("watch.yaml", kLayerGraph);
+    fs::remove(dir / "w.png");
+    // In the background (timeout: never outlives the test): one preview, then one re-render.
+    const std::string cmd = "cd " + dir.string() + " && ATLAS_CACHE_DIR= timeout 120 " + std::string(ATLAS_BINARY_DIR) +
+                            "/bin/atlas preview watch.yaml --size 24x14 --watch --watch-max 1 --cache cache -o w.png 2>watch_err.txt &";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    auto log_text = [&] {
+        std::ifstream in(dir / "watch_err.txt");
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    auto wait_for = [&](auto&& ok) {
+        for (int i = 0; i < 1200 && !ok(); ++i) ::usleep(50000);
+        return ok();
+    };
+    ASSERT_TRUE(wait_for([&] { return log_text().find("watch: waiting") != std::string::npos; }))
+        << log_text();
+    const std::string first = atlas::read_file_bytes(dir / "w.png");
+    std::string g = kLayerGraph;
+    g.replace(g.find("seed: 5"), 7, "seed: 6");
+    write("watch.yaml", g);
+    ASSERT_TRUE(wait_for([&] { return log_text().find("re-cooked and re-rendered") != std::string::npos; }))
+        << log_text();
+    const std::string log = log_text();
+    EXPECT_NE(log.find("watch.yaml changed"), std::string::npos) << log;
+    EXPECT_NE(atlas::read_file_bytes(dir / "w.png"), first);
 }
