@@ -13,9 +13,12 @@
 //               Boussinesq, neutral, no buoyancy): advection, projection, time
 //               splitting and the explicit viscosity. Exact answer: the initial
 //               field times exp(-2 nu k^2 t) (steady when nu = 0).
-//  Thermal:     a dry 2 K cos^2 warm bubble (radius L/5) in a neutral 300 K
-//               slab, anelastic, 2 km x 2 km, 120 s; answer: the finest run
-//               (theta' at cell centres box-averaged onto each coarser grid).
+//  Thermal:     a dry 2 K cos^2 warm bubble (radius 400 m, 500 m up) in a
+//               neutral 300 K slab, anelastic, 2 km x 2 km, 120 s; answer: the
+//               finest run (theta' at cell centres box-averaged onto each
+//               coarser grid).
+//  BryanFritsch: their dry case (20 x 10 km, 2 K, radius 2 km, 2 km up, 1000 s)
+//               at 400/200/100 m against the 50 m run, the same way.
 //
 // Run:   build-sim/bench/sim_convergence_bench --benchmark_filter=Convergence
 //        (ConvergenceRotation, ConvergenceTaylorGreen[Viscous], ConvergenceThermal;
@@ -174,10 +177,17 @@ void taylor_green_study(benchmark::State& state, std::vector<int> ns, double cfl
 
 // ---- Thermal (self-convergence) -----------------------------------------------
 
-std::vector<float> thermal(int n, AdvectionScheme scheme, TimeScheme ts, double cfl) {
-    const double L = 2000;
+// A dry cos^2 warm bubble in a neutral 300 K slab of Lx x Lz (nx = n Lx / Lz
+// cells), anelastic; theta' at cell centres after `seconds`.
+struct ThermalCase {
+    double Lx, Lz, radius, zc, amp, seconds;
+};
+const ThermalCase kSmallThermal{2000, 2000, 400, 500, 2, 120};
+const ThermalCase kBryanFritsch{20000, 10000, 2000, 2000, 2, 1000}; // B&F (2002) dry, full width
+
+std::vector<float> thermal(int n, AdvectionScheme scheme, TimeScheme ts, double cfl, const ThermalCase& tc = kSmallThermal) {
     GridSpec s;
-    s.nx = n, s.ny = 1, s.nz = n, s.dx = L / n;
+    s.nz = n, s.ny = 1, s.dx = tc.Lz / n, s.nx = int(std::lround(tc.Lx / s.dx));
     Sounding snd;
     SimOptions o;
     o.moist = false;
@@ -190,29 +200,30 @@ std::vector<float> thermal(int n, AdvectionScheme scheme, TimeScheme ts, double 
     o.projection.max_iterations = 1000;
     Simulation sim(s, snd, o);
     std::vector<float> d(s.cells(), 0.f);
-    for (int k = 0; k < n; ++k)
-        for (int i = 0; i < n; ++i) {
-            const double x = (i + 0.5) * s.dx - L / 2, z = (k + 0.5) * s.dx - L / 4;
-            const double r = std::sqrt(x * x + z * z) / (L / 5);
-            if (r < 1) d[size_t(k) * n + i] = float(2 * std::pow(std::cos(0.5 * M_PI * r), 2));
+    for (int k = 0; k < s.nz; ++k)
+        for (int i = 0; i < s.nx; ++i) {
+            const double x = (i + 0.5) * s.dx - tc.Lx / 2, z = (k + 0.5) * s.dx - tc.zc;
+            const double r = std::sqrt(x * x + z * z) / tc.radius;
+            if (r < 1) d[size_t(k) * s.nx + i] = float(tc.amp * std::pow(std::cos(0.5 * M_PI * r), 2));
         }
     sim.add_theta(d);
-    sim.step(120);
+    for (double t = 0; t < tc.seconds - 1e-9; t += 50) sim.step(std::min(50.0, tc.seconds - t));
     const atlas::Field3D tp = sim.theta_perturbation();
     return std::vector<float>(tp.channel(0).begin(), tp.channel(0).end());
 }
 
-Norms against(const std::vector<float>& coarse, int nc, const std::vector<float>& fine, int nf) {
-    const int f = nf / nc;
+// coarse (nxc x nzc) against the fine field box-averaged onto it.
+Norms against(const std::vector<float>& coarse, int nc, const std::vector<float>& fine, int nf, double aspect = 1) {
+    const int f = nf / nc, nxc = int(std::lround(nc * aspect)), nxf = int(std::lround(nf * aspect));
     Norms e;
     double sum2 = 0;
     size_t cnt = 0;
     for (int k = 0; k < nc; ++k)
-        for (int i = 0; i < nc; ++i) {
+        for (int i = 0; i < nxc; ++i) {
             double m = 0;
             for (int b = 0; b < f; ++b)
-                for (int a = 0; a < f; ++a) m += fine[size_t(k * f + b) * nf + size_t(i * f + a)];
-            add(e, coarse[size_t(k) * nc + i] - m / (f * f), sum2, cnt);
+                for (int a = 0; a < f; ++a) m += fine[size_t(k * f + b) * nxf + size_t(i * f + a)];
+            add(e, coarse[size_t(k) * nxc + i] - m / (f * f), sum2, cnt);
         }
     e.l2 = std::sqrt(sum2 / double(cnt));
     return e;
@@ -307,6 +318,23 @@ void density_current_study(benchmark::State& state, double dx) {
     }
 }
 
+void bryan_fritsch_study(benchmark::State& state, std::vector<int> ns, int nref, double cfl) {
+    for (auto _ : state) {
+        char title[240];
+        std::snprintf(title, sizeof title,
+                      "Bryan & Fritsch (2002) dry thermal, 20 x 10 km, 1000 s, theta' (K) against the %g m run, CFL %.2g "
+                      "(rows: %g m down to %g m)",
+                      10000.0 / nref, cfl, 10000.0 / ns.front(), 10000.0 / ns.back());
+        print_header(title);
+        for (TimeScheme ts : {TimeScheme::Split, TimeScheme::Trapezoidal}) {
+            const std::vector<float> ref = thermal(nref, AdvectionScheme::MacCormack, ts, cfl, kBryanFritsch);
+            std::vector<Norms> e;
+            for (int n : ns) e.push_back(against(thermal(n, AdvectionScheme::MacCormack, ts, cfl, kBryanFritsch), n, ref, nref, 2.0));
+            print_rows(std::string("MacCormack, ") + time_name(ts), ns, e);
+        }
+    }
+}
+
 } // namespace
 
 BENCHMARK_CAPTURE(rotation_study, Smoke, std::vector<int>{16, 32}, 1.0)->Iterations(1)->Unit(benchmark::kSecond);
@@ -320,6 +348,9 @@ BENCHMARK_CAPTURE(taylor_green_study, ConvergenceTaylorGreenViscous, std::vector
     ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(thermal_study, ConvergenceThermal, std::vector<int>{32, 64, 128}, 256, 1.0)->Iterations(1)->Unit(benchmark::kSecond);
 
+BENCHMARK_CAPTURE(bryan_fritsch_study, ConvergenceBryanFritsch, std::vector<int>{25, 50, 100}, 200, 1.0)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(density_current_study, DensityCurrent_200, 200.0)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(density_current_study, DensityCurrent_100, 100.0)->Iterations(1)->Unit(benchmark::kSecond);
 
