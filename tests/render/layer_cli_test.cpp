@@ -119,13 +119,13 @@ TEST(LayerCli, BothSetsComposeOneImageAndModeOverrides) {
     g.insert(g.find("outputs:"), std::string(kVoxelNodes).substr(1));
     g += "  - {node: nvdf, port: vdb_set, file: nvdf.vdb}\n";
     write("both.yaml", g);
-    const CliRun both = run_atlas("preview both.yaml --size 48x27 -o both.png");
+    const CliRun both = run_atlas("preview both.yaml --noise none --size 48x27 -o both.png");
     ASSERT_EQ(both.status, 0) << both.err;
     EXPECT_NE(both.err.find("2.5D + voxel composited"), std::string::npos) << both.err;
-    const CliRun layer = run_atlas("preview both.yaml --size 48x27 --mode layer -o layer.png");
+    const CliRun layer = run_atlas("preview both.yaml --noise none --size 48x27 --mode layer -o layer.png");
     ASSERT_EQ(layer.status, 0) << layer.err;
     EXPECT_NE(layer.err.find("(2.5D)"), std::string::npos) << layer.err;
-    const CliRun voxel = run_atlas("preview both.yaml --size 48x27 --mode voxel -o voxel.png");
+    const CliRun voxel = run_atlas("preview both.yaml --noise none --size 48x27 --mode voxel -o voxel.png");
     ASSERT_EQ(voxel.status, 0) << voxel.err;
     EXPECT_NE(voxel.err.find("(voxel)"), std::string::npos) << voxel.err;
     const CliRun bad = run_atlas("preview layer.yaml --size 48x27 --mode voxel -o x.png");
