@@ -93,6 +93,7 @@ const std::vector<Command>& commands() {
           {"--watch-max", "N", "with --watch: stop after N re-renders"},
           {"--frames", "N", "a time sequence OUT_000.png ..: frame i at --time + i x --time-step (wind scroll) with flash index --flash + i"},
           {"--time-step", "S", "seconds between --frames (default 60)"},
+          {"--slice", "K", "2.5D: draw time slice K of the graph's ndf/forecast maps (--frames steps one slice per frame)"},
           {"--lightning", "COUNT[,I[,RADIUS]]", "2.5D: COUNT flashes placed by the set's superstorm_coverage (else precipitation, coverage), intensity I (default 5e6), reach (default 4000 m)"},
           {"--flash", "N", "flash index of --lightning (default 0): the same index gives the same flash positions"},
           {"--edge", "wrap|clamp|empty", "2.5D: the map beyond its bounds (default: empty for a superstorm set, else wrap)"},

@@ -66,6 +66,7 @@ struct GraphContent {
     Field3DPtr nvdf;
     Field2DPtr ndf, lut, cone, cirrus, sky2d, anvil, vortex;
     Field3DPtr distance;
+    Field3DPtr forecast; // ndf/forecast maps: z = time slice, channels coverage, precipitation, type, ...
     std::string ndf_node;
     std::vector<std::string> written; // "node 'n' (type) port 'p' -> file"
     std::vector<std::filesystem::path> depends; // the graph file and every file the cook read (--watch)
@@ -122,7 +123,8 @@ GraphContent cook_graph(Session& session, const std::string& file, int jobs, Pro
         g.written.push_back("node '" + out.node + "' (" + n->type + ") port '" + port->name + "' -> " + out.file);
         const bool nvdf = n->type == "volume/nvdf" && port->name == "vdb_set";
         const bool dist = n->type == "ndf/distance_map";
-        if (nvdf || dist || port->type == PortType::Field2D || port->type == PortType::Field)
+        const bool forecast = port->type == PortType::Field3D && n->type.rfind("ndf/", 0) == 0;
+        if (nvdf || dist || forecast || port->type == PortType::Field2D || port->type == PortType::Field)
             wants.push_back({out.node, port->name, n->type, out.file, port->type == PortType::Field && !nvdf && !dist});
     }
     // Two passes: typed outputs first; generic field outputs (which may be
@@ -152,6 +154,7 @@ GraphContent cook_graph(Session& session, const std::string& file, int jobs, Pro
             if (auto* f3 = std::get_if<Field3DPtr>(&v); f3 && *f3) {
                 if (w.type == "volume/nvdf" && !g.nvdf) render::check_finite(**f3, what), g.nvdf = *f3;
                 else if (w.type == "ndf/distance_map" && !g.distance) render::check_finite(**f3, what), g.distance = *f3;
+                else if ((*f3)->find_channel("coverage") >= 0 && !g.forecast) render::check_finite(**f3, what), g.forecast = *f3;
                 continue;
             }
             auto* f2 = std::get_if<Field2DPtr>(&v);
@@ -183,6 +186,16 @@ GraphContent cook_graph(Session& session, const std::string& file, int jobs, Pro
         }
     }
     return g;
+}
+
+// Slice z of a stack of weather maps (ndf/forecast's maps) as a 2D map.
+Field2D forecast_slice(const Field3D& f, int z) {
+    const Box3d& b = f.bounds();
+    Field2D m({{f.nx(), f.ny()}}, f.channels(), Box2d{{{b.min[0], b.min[1]}}, {{b.max[0], b.max[1]}}}, f.channel_names());
+    for (int c = 0; c < f.channels(); ++c)
+        for (int y = 0; y < f.ny(); ++y)
+            for (int x = 0; x < f.nx(); ++x) m.at(c, x, y) = f.at(c, x, y, z);
+    return m;
 }
 
 // The HZD noise set and the default profile LUT, cooked through the same
@@ -406,6 +419,8 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
     else if (const char* env = std::getenv("ATLAS_CACHE_DIR"); env && *env && !a.has("--no-cache")) cache_dir = env;
 
     bool have_voxel = false, have_layer = false;
+    Field3DPtr forecast; // time slices, when the preview steps a forecast
+    int slice0 = 0;
     render::CloudScene scene;
     render::LayerScene layer;
     if (a.positional.size() == 1 && is_graph(a.positional[0])) {
@@ -417,6 +432,14 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
         GraphContent g = cook_graph(session, file, jobs, sink, cache_dir, quiet);
         for (const auto& d : g.depends)
             if (std::find(depends.begin(), depends.end(), d) == depends.end()) depends.push_back(d);
+        // A forecast (ndf/forecast) is drawn when asked for (--slice, --frames) or when nothing else is there.
+        if (g.forecast && (a.has("--slice") || a.has("--frames") || !g.ndf)) {
+            forecast = g.forecast;
+            slice0 = a.has("--slice") ? static_cast<int>(numbers(a.get("--slice"), 1, "--slice")[0]) : 0;
+            if (slice0 < 0 || slice0 >= forecast->nz())
+                throw UsageError{"--slice expects 0.." + std::to_string(forecast->nz() - 1) + " (the forecast's time slices)", "preview"};
+            g.ndf = weather_map_as_set(forecast_slice(*forecast, slice0));
+        }
         const bool layerish = g.ndf || g.cirrus || g.sky2d;
         if (!g.nvdf && !layerish) {
             std::string list;
@@ -648,8 +671,13 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
         std::vector<std::filesystem::path> paths;
         for (int i = 0; i < frames; ++i) {
             if (sequence) {
-                // A time sequence: the wind scroll advances, each frame a new flash.
+                // A time sequence: the wind scroll advances, each frame a new flash,
+                // and a forecast its next time slice (the envelope follows the slice).
                 layer.time = time0 + i * time_step;
+                if (forecast) {
+                    layer.ndf = weather_map_as_set(forecast_slice(*forecast, (slice0 + i) % forecast->nz()));
+                    if (layer.envelope.cone_map) layer.envelope.cone_map = cloud_top_cone_map(*layer.ndf);
+                }
                 for (auto& f : s.light_fields) f.flash = flash0 + i;
             } else if (have_layer) {
                 s.camera = render::layer_camera(layer, render::LayerView::Orbit, double(w) / h, 30 + 360.0 * i / frames, view.el);

@@ -208,3 +208,19 @@ TEST(LayerCli, WatchReRendersWhenTheGraphChanges) {
     EXPECT_NE(log.find("watch.yaml changed"), std::string::npos) << log;
     EXPECT_NE(atlas::read_file_bytes(dir / "w.png"), first);
 }
+
+TEST(LayerCli, ForecastSequenceStepsTheSlices) {
+    // ndf/forecast writes a stack of weather maps; --frames draws one slice per frame.
+    const std::string fc = std::string(ATLAS_SOURCE_DIR) + "/graphs/fc6/forecast.yaml";
+    write("forecast.yaml", "atlas: 1\nnodes:\n  f: {type: ndf/forecast, params: {forecast: '" + fc +
+                               "', resolution: [24, 24], bounds_max: [30000, 30000], start_hour: 60, step_hours: 6, slices: 3, octaves: 2}}\n"
+                               "outputs:\n  - {node: f, port: maps, file: maps.exr}\n");
+    const CliRun r = run_atlas("preview forecast.yaml --size 24x14 --view aerial --frames 2 --time-step 0 -o fc.png");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("(2.5D)"), std::string::npos) << r.err;
+    // Same time, different slices: different pictures.
+    EXPECT_NE(atlas::read_file_bytes(work_dir() / "fc_000.png"), atlas::read_file_bytes(work_dir() / "fc_001.png"));
+    const CliRun bad = run_atlas("preview forecast.yaml --size 24x14 --slice 3 -o x.png");
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE(bad.err.find("--slice expects 0..2"), std::string::npos) << bad.err;
+}
