@@ -238,6 +238,61 @@ static void test_quickstart(const char* path) {
     atlas_session_destroy(s);
 }
 
+/* Meshes and points: a box mesh and samples filling it. */
+static void test_mesh_and_points(void) {
+    static const char* graph =
+        "atlas: 1\n"
+        "nodes:\n"
+        "  box:\n"
+        "    type: volume/mesh_primitive\n"
+        "    params: {shape: box, center: [100, 200, 50], half_size: [10, 20, 5]}\n"
+        "  fill:\n"
+        "    type: volume/interior_fill\n"
+        "    inputs: {mesh: box}\n"
+        "    params: {target_samples: 200}\n"
+        "outputs: []\n";
+    AtlasSession* s = NULL;
+    CHECK(atlas_session_create(&s) == ATLAS_OK);
+    CHECK_OK(s, atlas_session_load_text(s, graph, "mesh.yaml", NULL));
+    AtlasMesh* m = NULL;
+    CHECK_OK(s, atlas_session_get_mesh(s, "box", NULL, NULL, &m));
+    if (m) {
+        size_t nv = atlas_mesh_vertex_count(m), nt = atlas_mesh_triangle_count(m), bad = 0;
+        const float* v = atlas_mesh_vertices(m);
+        const uint32_t* t = atlas_mesh_triangles(m);
+        CHECK(nv >= 8 && nt >= 12 && v && t);
+        for (size_t i = 0; i < nv; ++i) /* every vertex on the box's surface */
+            if (fabs(fabs(v[3 * i] - 100) - 10) > 1e-3 && fabs(fabs(v[3 * i + 1] - 200) - 20) > 1e-3 &&
+                fabs(fabs(v[3 * i + 2] - 50) - 5) > 1e-3)
+                ++bad;
+        for (size_t i = 0; i < 3 * nt; ++i) bad += t[i] >= nv;
+        CHECK(bad == 0);
+        atlas_mesh_release(m);
+    }
+    AtlasField* not_a_field = NULL;
+    CHECK(atlas_session_get(s, "box", NULL, NULL, &not_a_field) == ATLAS_INVALID_ARGUMENT && !not_a_field);
+    CHECK(strstr(atlas_session_error(s), "is a mesh, not a field") != NULL);
+
+    AtlasPoints* p = NULL;
+    CHECK_OK(s, atlas_session_get_points(s, "fill", NULL, NULL, &p));
+    if (p) {
+        size_t n = atlas_points_count(p), outside = 0;
+        const float* x = atlas_points_positions(p);
+        CHECK(n > 10 && x);
+        for (size_t i = 0; i < n; ++i)
+            outside += fabs(x[3 * i] - 100) > 10.001 || fabs(x[3 * i + 1] - 200) > 20.001 || fabs(x[3 * i + 2] - 50) > 5.001;
+        CHECK(outside == 0);
+        CHECK(atlas_points_attribute_count(p) >= 2);
+        const float* r = atlas_points_attribute(p, "radius");
+        CHECK(r && r[0] > 0);
+        CHECK(atlas_points_attribute(p, "nothing") == NULL && atlas_points_attribute_name(p, 99) == NULL);
+        CHECK(strcmp(atlas_points_attribute_name(p, 0), "radius") == 0); /* name order */
+        atlas_points_release(p);
+    }
+    CHECK(atlas_session_get_points(s, "box", NULL, NULL, &p) == ATLAS_INVALID_ARGUMENT && !p);
+    atlas_session_destroy(s);
+}
+
 /* One call at a time per session: a second thread gets ATLAS_BUSY, another session works. */
 struct Hold {
     atomic_int started, release;
@@ -345,6 +400,7 @@ int main(int argc, char** argv) {
     test_errors();
     test_quickstart(argv[1]);
     test_one_call_at_a_time();
+    test_mesh_and_points();
     if (argc == 4) test_same_messages_as_the_cli(argv[2], argv[3]);
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;

@@ -161,6 +161,36 @@ ATLAS_API const char* atlas_field_channel_name(const AtlasField* field, int chan
 ATLAS_API size_t atlas_field_voxel_count(const AtlasField* field);
 ATLAS_API const float* atlas_field_channel_data(const AtlasField* field, int channel);
 
+/* ------------------------------------------------------------------ meshes and points
+ * The values that are not fields: a triangle mesh and a point set with named
+ * per-point float attributes (e.g. "radius"), coordinates in metres. Like
+ * fields they are immutable, outlive their session and are released by the
+ * host. atlas_session_get_mesh / _points return ATLAS_INVALID_ARGUMENT when
+ * the port holds another kind of value. Accessors return 0 / NULL on NULL. */
+typedef struct AtlasMesh AtlasMesh;
+typedef struct AtlasPoints AtlasPoints;
+
+ATLAS_API AtlasStatus atlas_session_get_mesh(AtlasSession* session, const char* node, const char* port,
+                                             const AtlasCookOptions* options, AtlasMesh** out);
+ATLAS_API void atlas_mesh_release(AtlasMesh* mesh);
+ATLAS_API size_t atlas_mesh_vertex_count(const AtlasMesh* mesh);
+/* x, y, z of each vertex: 3 * vertex_count floats. */
+ATLAS_API const float* atlas_mesh_vertices(const AtlasMesh* mesh);
+ATLAS_API size_t atlas_mesh_triangle_count(const AtlasMesh* mesh);
+/* Three vertex indices per triangle: 3 * triangle_count values. */
+ATLAS_API const uint32_t* atlas_mesh_triangles(const AtlasMesh* mesh);
+
+ATLAS_API AtlasStatus atlas_session_get_points(AtlasSession* session, const char* node, const char* port,
+                                               const AtlasCookOptions* options, AtlasPoints** out);
+ATLAS_API void atlas_points_release(AtlasPoints* points);
+ATLAS_API size_t atlas_points_count(const AtlasPoints* points);
+/* x, y, z of each point: 3 * count floats. */
+ATLAS_API const float* atlas_points_positions(const AtlasPoints* points);
+/* Attributes in name order; atlas_points_attribute gives count floats, NULL for an unknown name. */
+ATLAS_API int atlas_points_attribute_count(const AtlasPoints* points);
+ATLAS_API const char* atlas_points_attribute_name(const AtlasPoints* points, int index);
+ATLAS_API const float* atlas_points_attribute(const AtlasPoints* points, const char* name);
+
 #ifdef __cplusplus
 }
 #endif

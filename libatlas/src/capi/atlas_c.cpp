@@ -39,6 +39,14 @@ struct AtlasField {
     }
 };
 
+struct AtlasMesh {
+    atlas::MeshPtr m;
+};
+
+struct AtlasPoints {
+    atlas::PointsPtr p;
+};
+
 namespace {
 
 // A caller's mistake (NULL argument, a value that is not a field): ATLAS_INVALID_ARGUMENT.
@@ -155,6 +163,26 @@ std::string node_types_json(const atlas::NodeRegistry& registry) {
     return types.dump();
 }
 
+// Cooks what NODE.PORT needs (PORT empty: the node's first output) and checks the kind of value.
+atlas::Value get_value(AtlasSession* s, const char* node, const char* port, const AtlasCookOptions* options,
+                       const char* expected, bool (*is_expected)(const atlas::Value&)) {
+    std::string port_name = port ? port : "";
+    if (port_name.empty()) {
+        const atlas::GraphNode* n = s->session.graph().find(node);
+        const atlas::NodeType* t = n ? s->session.registry().find(n->type) : nullptr;
+        if (t && !t->decl.outputs().empty()) port_name = t->decl.outputs().front().name;
+    }
+    s->has_last = false;
+    atlas::Value v = s->session.get(node, port_name, cook_options(options));
+    if (!is_expected(v))
+        throw InvalidArgument("node '" + std::string(node) + "' port '" + port_name + "' is a " +
+                              (v.index() == 0 ? std::string("empty value")
+                                              : std::string(atlas::port_type_name(atlas::value_type(v)))) +
+                              ", not " + expected);
+    return v;
+}
+
+
 } // namespace
 
 extern "C" {
@@ -255,29 +283,71 @@ AtlasStatus atlas_session_cook(AtlasSession* s, const AtlasCookOptions* options)
     });
 }
 
+
 AtlasStatus atlas_session_get(AtlasSession* s, const char* node, const char* port, const AtlasCookOptions* options,
                               AtlasField** out) {
     if (out) *out = nullptr;
     return guarded(s, [&] {
         if (!node || !out) throw InvalidArgument("atlas_session_get: NULL argument");
-        std::string port_name = port ? port : "";
-        if (port_name.empty()) {
-            const atlas::GraphNode* n = s->session.graph().find(node);
-            const atlas::NodeType* t = n ? s->session.registry().find(n->type) : nullptr;
-            if (t && !t->decl.outputs().empty()) port_name = t->decl.outputs().front().name;
-        }
-        s->has_last = false;
-        atlas::Value v = s->session.get(node, port_name, cook_options(options));
+        atlas::Value v = get_value(s, node, port, options, "a field", [](const atlas::Value& x) {
+            return std::holds_alternative<atlas::Field3DPtr>(x) || std::holds_alternative<atlas::Field2DPtr>(x);
+        });
         auto f = std::make_unique<AtlasField>();
         if (auto* p3 = std::get_if<atlas::Field3DPtr>(&v)) f->f3 = *p3;
-        else if (auto* p2 = std::get_if<atlas::Field2DPtr>(&v)) f->f2 = *p2;
-        if (!f->f3 && !f->f2)
-            throw InvalidArgument("node '" + std::string(node) + "' port '" + port_name + "' is a " +
-                                        (v.index() == 0 ? std::string("empty value")
-                                                        : std::string(atlas::port_type_name(atlas::value_type(v)))) +
-                                        ", not a field");
+        else f->f2 = std::get<atlas::Field2DPtr>(v);
         *out = f.release();
     });
+}
+
+AtlasStatus atlas_session_get_mesh(AtlasSession* s, const char* node, const char* port, const AtlasCookOptions* options,
+                                   AtlasMesh** out) {
+    if (out) *out = nullptr;
+    return guarded(s, [&] {
+        if (!node || !out) throw InvalidArgument("atlas_session_get_mesh: NULL argument");
+        atlas::Value v = get_value(s, node, port, options, "a mesh",
+                                   [](const atlas::Value& x) { return std::holds_alternative<atlas::MeshPtr>(x); });
+        *out = new AtlasMesh{std::get<atlas::MeshPtr>(v)};
+    });
+}
+
+AtlasStatus atlas_session_get_points(AtlasSession* s, const char* node, const char* port,
+                                     const AtlasCookOptions* options, AtlasPoints** out) {
+    if (out) *out = nullptr;
+    return guarded(s, [&] {
+        if (!node || !out) throw InvalidArgument("atlas_session_get_points: NULL argument");
+        atlas::Value v = get_value(s, node, port, options, "points",
+                                   [](const atlas::Value& x) { return std::holds_alternative<atlas::PointsPtr>(x); });
+        *out = new AtlasPoints{std::get<atlas::PointsPtr>(v)};
+    });
+}
+
+void atlas_mesh_release(AtlasMesh* mesh) { delete mesh; }
+size_t atlas_mesh_vertex_count(const AtlasMesh* m) { return m ? m->m->vertices.size() : 0; }
+const float* atlas_mesh_vertices(const AtlasMesh* m) {
+    static_assert(sizeof(atlas::Vec3f) == 3 * sizeof(float), "vertices are read as packed floats");
+    return m && !m->m->vertices.empty() ? &m->m->vertices[0][0] : nullptr;
+}
+size_t atlas_mesh_triangle_count(const AtlasMesh* m) { return m ? m->m->triangles.size() : 0; }
+const uint32_t* atlas_mesh_triangles(const AtlasMesh* m) {
+    return m && !m->m->triangles.empty() ? m->m->triangles[0].data() : nullptr;
+}
+
+void atlas_points_release(AtlasPoints* points) { delete points; }
+size_t atlas_points_count(const AtlasPoints* p) { return p ? p->p->positions.size() : 0; }
+const float* atlas_points_positions(const AtlasPoints* p) {
+    return p && !p->p->positions.empty() ? &p->p->positions[0][0] : nullptr;
+}
+int atlas_points_attribute_count(const AtlasPoints* p) { return p ? int(p->p->attributes.size()) : 0; }
+const char* atlas_points_attribute_name(const AtlasPoints* p, int index) {
+    if (!p || index < 0 || index >= int(p->p->attributes.size())) return nullptr;
+    auto it = p->p->attributes.begin();
+    std::advance(it, index);
+    return it->first.c_str();
+}
+const float* atlas_points_attribute(const AtlasPoints* p, const char* name) {
+    if (!p || !name) return nullptr;
+    auto it = p->p->attributes.find(name);
+    return it == p->p->attributes.end() || it->second.empty() ? nullptr : it->second.data();
 }
 
 const char* atlas_session_node_status(const AtlasSession* s, const char* node) {
