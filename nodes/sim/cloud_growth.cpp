@@ -48,8 +48,9 @@ void declare(NodeDeclaration& d) {
     d.param_int3("resolution", {{64, 64, 64}}).range(1, 4096).with_unit("cells").describe("cells along x, y, z (at least 2 along two axes)");
     d.param_float("dx", 40).range(1e-3, 1e5).with_unit("m").describe("cubic cell edge; the top cell centre, (nz - 1/2) dx, must lie inside the modelled atmosphere (Exner > 0.05, about 29 km for 300 K), else an error names that height");
     d.param_float3("origin", {{0, 0, 0}}).with_unit("m").describe("world position of the grid's minimum corner");
-    d.param_enum("boundary", {"closed", "open_top", "open_sides_top"}, "closed")
-        .describe("closed: free-slip walls everywhere; open_top: the top is open; open_sides_top: only the floor is a wall");
+    d.param_enum("boundary", {"closed", "open_top", "open_sides_top", "open_sides"}, "closed")
+        .describe("closed: free-slip walls everywhere; open_top: the top is open; open_sides_top: only the floor is a wall; "
+                  "open_sides: free-slip floor and lid, open (ambient-pressure) x and y faces");
     d.param_float("duration", 300).range(1e-6, 1e7).with_unit("s").describe("simulated time");
     d.param_float("frame_dt", 10).range(1e-6, 1e5).with_unit("s").describe("time per step (one report row, one potential sequence frame)");
     d.param_float("cfl", 1).range(0.1, 5).with_unit("cells").describe("max cells travelled per substep");
@@ -341,6 +342,10 @@ void cook(CookContext& ctx) {
     if (bnd == "open_sides_top") {
         spec.boundary = sim::all_open();
         spec.boundary[4] = sim::Boundary::Closed;
+    }
+    if (bnd == "open_sides") {
+        spec.boundary = sim::all_open();
+        spec.boundary[4] = spec.boundary[5] = sim::Boundary::Closed;
     }
     spec.validate(); // library errors: the evaluator prefixes the node
     const Vec3d origin = ctx.get_float3("origin");
