@@ -51,9 +51,17 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
     }
 }
 
-// Bump when any writer changes the bytes it writes for the same value and
-// options: every output is written again on the next cook.
+// Bump when the output records' meaning changes (every output is written again on
+// the next cook); one writer's byte changes bump that writer's version instead.
 constexpr int kOutputFormatVersion = 1;
+// The format's own writer version (io::OutputFormat::version; the DDS encoder's
+// compress::kEncoderVersion), so a changed writer rewrites its outputs by itself.
+int writer_version(const std::string& format) {
+    for (const io::OutputFormat& f : io::output_formats())
+        if (f.name == format) return f.version;
+    return 0;
+}
+
 // Formats whose encoded files the disk cache keeps (costly to encode).
 const std::set<std::string> kCachedOutputFormats = {"dds"};
 
@@ -309,7 +317,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             }
             p.name = p.rel.generic_string();
             Hasher spec;
-            spec.add("atlas-output").add(int64_t(kOutputFormatVersion)).add(o->port).add(o->format).add(p.name);
+            spec.add("atlas-output").add(int64_t(kOutputFormatVersion)).add(int64_t(writer_version(o->format))).add(o->port).add(o->format).add(p.name);
             for (const auto& [k, v] : o->options) spec.add(k).add(v);
             p.spec = spec.finish().hex();
             p.key = Hasher(spec).add(state.at(o->node).hash).finish();

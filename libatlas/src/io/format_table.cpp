@@ -2,6 +2,7 @@
 // the end (the order is what `atlas` and docs list).
 #include "format_table.h"
 
+#include "atlas/compress/texture.h"
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
 #include "atlas/io/output_options.h"
@@ -127,16 +128,17 @@ const std::vector<FormatEntry>& format_table() {
           {".dds"},
           {PortType::Field2D, PortType::Field3D},
           "DDS texture (2D, array or volume) through the error-bounded compressor, with its manifest FILE.dds.json",
-          {{"encoding", "bc1, bc1-scalar, bc4, bc4-snorm, r8, r16, r16f, r32f, rgba8, rgba16f, rgba4 (default rgba16f)"},
+          {{"encoding", compress::format_names() + " (default rgba16f)"},
            {"quality", "fast, normal (default) or best"},
            {"max_error", "guarantee |decoded - source| <= E for every texel, in source units (else the cook fails)"},
            {"one_sided", "'below': guarantee decoded <= source (SDF field data)"},
            {"allow_over_bound", "true: write even when blocks miss max_error"},
-           {"decoders", "decoder models the bounds hold for (default all: reference,nvidia,amd,tool8,conformant)"},
+           {"decoders", "comma-separated decoder models the bounds hold for: " + compress::decoder_names() + " (default all)"},
            {"mips", "mip levels, or 'full' (default 1)"},
            {"range", "'lo,hi': source values mapped to 0..1 (default: the data's min and max)"},
            {"array", "true: a 3D field becomes a 2D texture array instead of a volume"},
-           kChannels}},
+           kChannels},
+          compress::kEncoderVersion},
          write_dds_output},
         {{"json",
           {".json"},

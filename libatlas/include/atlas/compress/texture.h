@@ -26,6 +26,12 @@ namespace atlas::compress {
 
 namespace fs = std::filesystem;
 
+// Bump whenever the encoder writes other bytes for the same field and options, so
+// cooked outputs and cached textures from an older encoder are not reused.
+// 2: DDS rows top-down; exact (double) one-sided and max-error bounds; bc1-scalar
+// one-sided search that never falls back to black.
+constexpr int kEncoderVersion = 2;
+
 enum class Format {
     Bc1,       // RGB, 4 bpp
     Bc1Scalar, // one channel across RGB565 (Nubis field data), 4 bpp

@@ -27,6 +27,9 @@ struct OutputFormat {
     std::vector<PortType> accepts;                             // value types it writes
     std::string doc;                                           // one line
     std::vector<std::pair<std::string, std::string>> options;  // option name, doc
+    // The writer's version: part of every output's key, so files written by an
+    // older writer (other bytes for the same value and options) are written again.
+    int version = 1;
 };
 
 // Every output format, in a fixed order.
