@@ -67,7 +67,7 @@ const std::vector<Command>& commands() {
           {"--size", "WxH", "image size (default 960x540)"},
           {"--camera", "X,Y,Z,LX,LY,LZ", "camera position and look-at point in metres (default: framing the volume)"},
           {"--fov", "DEG", "vertical field of view (default 50)"},
-          {"--sun", "AZ,EL", "sun azimuth and elevation in degrees (default 60,35)"},
+          {"--sun", "AZ,EL", "sun azimuth and elevation in degrees (default 60,35; 230,20 for a 2.5D layer)"},
           {"--sun-colour", "R,G,B", "sun radiance, linear (default 1,0.95,0.88; 2.6,2.45,2.25 for a 2.5D layer)"},
           {"--quality", "Q", "fast mode step scale (default 1; 2 = half-length steps)"},
           {"--extinction", "PER_M", "extinction per metre at density 1 (default 0.04)"},
