@@ -327,10 +327,15 @@ TEST(CliUnattended, FullDiskFailsLoudlyAndLeavesNoPartialFile) {
         {"vdb", "  - {node: n, file: v.vdb}\n"},
         {"tga-slices", "  - {node: n, file: s/stack, format: tga-slices, options: {compression: none}}\n"},
         {"exr", "  - {node: n, file: v.exr}\n"},
+        // Two frames of one grid each, named as sim/cloud_growth's sequence names them.
+        {"vdb-sequence", "  - {node: seq, file: frames/f, format: vdb-sequence}\n"},
     };
     for (const auto& [fmt, line] : outputs) {
         const fs::path d = fresh_dir("fulldisk");
-        auto g = write_graph("full_" + fmt + ".yaml", std::string(kNoiseGraph) + line);
+        std::string graph = kNoiseGraph;
+        if (fmt == "vdb-sequence")
+            graph.insert(graph.find("outputs:"), "  seq:\n    type: field/pack\n    inputs: {r: n, g: n}\n    params: {names: '0000:density,0001:density'}\n");
+        auto g = write_graph("full_" + fmt + ".yaml", graph + line);
         // Without the limit the cook succeeds (the test can fail for the right reason).
         CliRun ok = run("cook " + g.string() + " --out " + (d / "ok").string() + " --no-cache --quiet");
         ASSERT_EQ(ok.status, 0) << fmt << ": " << ok.err;

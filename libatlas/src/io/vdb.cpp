@@ -43,6 +43,24 @@ void add_atlas_meta(openvdb::GridBase& g, const Field3D& f) {
 
 // OpenVDB writes a random UUID into every archive header. Replace it with one
 // derived from what was written, so the same field gives the same bytes.
+void write_vdb_grids(const fs::path& path, const openvdb::GridPtrVec& grids) {
+    // Same bytes as openvdb::io::File::write, through a stream whose state is checked.
+    struct CheckedArchive : openvdb::io::Archive {
+        void write_to(std::ostream& os, const openvdb::GridPtrVec& g) const { Archive::write(os, g, /*seekable=*/true); }
+    };
+    try {
+        std::ofstream file(path, std::ios::out | std::ios::binary | std::ios::trunc);
+        if (!file) throw Error("cannot create the file");
+        CheckedArchive().write_to(file, grids);
+        file.close();
+        if (!file) throw Error(std::string("write failed (") + std::strerror(errno) + "; disk full?)");
+    } catch (...) {
+        std::error_code ec;
+        fs::remove(path, ec);
+        throw;
+    }
+}
+
 void make_uuid_deterministic(const fs::path& path, const Hash128& content) {
     // Header: magic (8), file version (4), library version (4 + 4), grid offsets flag (1), UUID text (36).
     constexpr size_t at = 21, len = 36;
@@ -68,6 +86,7 @@ using detail::add_atlas_meta;
 using detail::field_transform;
 using detail::init_openvdb;
 using detail::make_uuid_deterministic;
+using detail::write_vdb_grids;
 
 
 // The name of a vector grid: the channels' shared "NAME." prefix (vel.x,
@@ -175,19 +194,8 @@ void write_vdb(const Field3D& f, const fs::path& path, const VdbOptions& o) {
         }
     }
     try {
-        // openvdb::io::File::write does not check its stream: a full disk gave
-        // a truncated file and success. Same bytes through a checked stream.
-        struct CheckedArchive : openvdb::io::Archive {
-            void write_to(std::ostream& os, const openvdb::GridPtrVec& g) const { Archive::write(os, g, /*seekable=*/true); }
-        };
-        std::ofstream file(path, std::ios::out | std::ios::binary | std::ios::trunc);
-        if (!file) throw Error("cannot create the file");
-        CheckedArchive().write_to(file, grids);
-        file.close();
-        if (!file) throw Error(std::string("write failed (") + std::strerror(errno) + "; disk full?)");
+        write_vdb_grids(path, grids);
     } catch (const std::exception& e) {
-        std::error_code ec;
-        fs::remove(path, ec);
         throw Error(where + e.what());
     }
     Hasher h;

@@ -126,9 +126,7 @@ void write_frame(const Field3D& f, const Frame& fr, const fs::path& path, float 
         grids.push_back(base);
     }
     try {
-        openvdb::io::File file(path.string());
-        file.write(grids);
-        file.close();
+        write_vdb_grids(path, grids);
     } catch (const std::exception& e) {
         throw Error(o.prefix() + "cannot write " + path.filename().string() + ": " + e.what());
     }
