@@ -191,6 +191,66 @@ ATLAS_API int atlas_points_attribute_count(const AtlasPoints* points);
 ATLAS_API const char* atlas_points_attribute_name(const AtlasPoints* points, int index);
 ATLAS_API const float* atlas_points_attribute(const AtlasPoints* points, const char* name);
 
+/* ------------------------------------------------------------------ node types written in C
+ * A host adds node types to a registry and creates sessions over it. The
+ * declaration is JSON in the shape atlas_session_node_types_json lists:
+ *   {"name": "host/scale", "version": 1, "doc": "...",
+ *    "inputs":  [{"name": "in", "type": "field3d", "doc": "...", "optional": false}],
+ *    "outputs": [{"name": "out", "type": "field3d", "doc": "..."}],
+ *    "params":  [{"name": "gain", "type": "float", "default": 2, "min": 0, "max": 10, "unit": "", "doc": "..."}]}
+ * Such a node is validated, hashed (type, version, parameters, inputs) and
+ * cached like a built-in one; Atlas cannot see into the cook function, so bump
+ * "version" whenever it changes what it computes. */
+typedef struct AtlasRegistry AtlasRegistry;
+typedef struct AtlasCookContext AtlasCookContext;
+typedef struct AtlasFieldBuilder AtlasFieldBuilder;
+
+/* Cooks one node: reads parameters and inputs, sets every output. Returns 0 on
+ * success; on failure call atlas_cook_fail (or return nonzero). Called from
+ * worker threads, concurrently for different nodes. */
+typedef int (*AtlasNodeCookFn)(void* user, AtlasCookContext* context);
+
+/* A registry of the built-in node types. */
+ATLAS_API AtlasStatus atlas_registry_create(AtlasRegistry** out);
+ATLAS_API void atlas_registry_destroy(AtlasRegistry* registry);
+/* Adds a node type; `user` is passed to every call of `cook`. On failure the
+ * message is atlas_registry_error. */
+ATLAS_API AtlasStatus atlas_registry_add_node(AtlasRegistry* registry, const char* declaration_json,
+                                              AtlasNodeCookFn cook, void* user);
+ATLAS_API const char* atlas_registry_error(const AtlasRegistry* registry);
+/* A session over a copy of `registry` (later additions do not reach it). */
+ATLAS_API AtlasStatus atlas_session_create_with_registry(const AtlasRegistry* registry, AtlasSession** out);
+
+/* Inside a cook function (the context is valid only during that call). */
+ATLAS_API const char* atlas_cook_node_name(const AtlasCookContext* context);
+/* Resolved parameter values; ATLAS_INVALID_ARGUMENT for an undeclared name or another type.
+ * A vector parameter fills values[0..n-1] (n = 2 or 3) and *n. A string's pointer lives
+ * as long as the context. */
+ATLAS_API AtlasStatus atlas_cook_param_float(const AtlasCookContext* context, const char* name, double* value);
+ATLAS_API AtlasStatus atlas_cook_param_int(const AtlasCookContext* context, const char* name, int64_t* value);
+ATLAS_API AtlasStatus atlas_cook_param_bool(const AtlasCookContext* context, const char* name, int* value);
+ATLAS_API AtlasStatus atlas_cook_param_string(const AtlasCookContext* context, const char* name, const char** value);
+ATLAS_API AtlasStatus atlas_cook_param_vector(const AtlasCookContext* context, const char* name, double values[3],
+                                              int* n);
+/* The field on an input port, borrowed for the call (do not release it); NULL
+ * when the port is unconnected or holds no field. */
+ATLAS_API const AtlasField* atlas_cook_input(AtlasCookContext* context, const char* port);
+/* A new zero-filled field (dimensions 2: resolution[2] and z bounds are
+ * ignored), checked against the memory budget; NULL on failure (the cook
+ * then fails with the budget's message). Fill it, then atlas_cook_set_output. */
+ATLAS_API AtlasFieldBuilder* atlas_cook_new_field(AtlasCookContext* context, int dimensions, const int resolution[3],
+                                                  int channels, const double min[3], const double max[3]);
+/* Channel c's voxel_count floats, x fastest, then y, then z. */
+ATLAS_API float* atlas_field_builder_channel(AtlasFieldBuilder* builder, int channel);
+/* Makes the builder's field the output (the builder is consumed). */
+ATLAS_API AtlasStatus atlas_cook_set_output(AtlasCookContext* context, const char* port, AtlasFieldBuilder* builder);
+/* Passes an input's field through unchanged (no copy). */
+ATLAS_API AtlasStatus atlas_cook_set_output_input(AtlasCookContext* context, const char* port, const char* input_port);
+/* Progress 0..1 within the node; returns nonzero when the host cancelled (return soon). */
+ATLAS_API int atlas_cook_progress(AtlasCookContext* context, double fraction);
+/* The node's error message (the cook fails with it, prefixed with the node). */
+ATLAS_API void atlas_cook_fail(AtlasCookContext* context, const char* message);
+
 #ifdef __cplusplus
 }
 #endif

@@ -12,7 +12,11 @@
 #include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <algorithm>
 #include <cmath>
+#include <deque>
+#include <exception>
+#include <map>
 #include <memory>
 #include <new>
 #include <stdexcept>
@@ -20,6 +24,8 @@
 #include <variant>
 
 struct AtlasSession {
+    AtlasSession() = default;
+    explicit AtlasSession(atlas::NodeRegistry registry) : session(std::move(registry)) {}
     atlas::Session session{atlas::builtin_nodes()};
     std::atomic<bool> busy{false}; // a call is running (ATLAS_BUSY for a second thread)
     std::string error;
@@ -422,6 +428,388 @@ size_t atlas_field_voxel_count(const AtlasField* f) { return f ? f->storage().vo
 const float* atlas_field_channel_data(const AtlasField* f, int channel) {
     if (!f || channel < 0 || channel >= f->storage().channels()) return nullptr;
     return f->storage().channel(channel).data();
+}
+
+} // extern "C"
+
+// ------------------------------------------------------------------ node types written in C
+
+struct AtlasRegistry {
+    atlas::NodeRegistry registry = atlas::builtin_nodes();
+    std::string error;
+};
+
+struct AtlasFieldBuilder {
+    std::shared_ptr<atlas::Field2D> f2;
+    std::shared_ptr<atlas::Field3D> f3;
+    atlas::detail::FieldStorage& storage() {
+        if (f3) return *f3;
+        return *f2;
+    }
+};
+
+struct AtlasCookContext {
+    atlas::CookContext* ctx = nullptr;
+    const atlas::NodeDeclaration* decl = nullptr;
+    std::exception_ptr failure;                  // the first error; rethrown when the cook function returns
+    std::map<std::string, std::unique_ptr<AtlasField>> inputs;
+    std::vector<std::unique_ptr<AtlasFieldBuilder>> builders;
+    std::deque<std::string> strings;             // string parameters handed out
+    void fail_with(std::exception_ptr e) {
+        if (!failure) failure = e;
+    }
+};
+
+namespace {
+
+// The declaration, parsed from JSON once, at registration.
+struct JsonDeclaration {
+    std::string doc;
+    std::vector<atlas::PortDecl> inputs, outputs;
+    std::vector<atlas::ParamDecl> params;
+};
+
+atlas::PortType port_type_from(const std::string& s) {
+    for (atlas::PortType t : {atlas::PortType::Field2D, atlas::PortType::Field3D, atlas::PortType::Field,
+                              atlas::PortType::Mesh, atlas::PortType::Points})
+        if (atlas::port_type_name(t) == s) return t;
+    throw InvalidArgument("unknown port type '" + s + "' (expected field2d, field3d, field, mesh or points)");
+}
+
+atlas::ParamType param_type_from(const std::string& s) {
+    using T = atlas::ParamType;
+    for (T t : {T::Float, T::Int, T::Bool, T::String, T::Enum, T::Path, T::Float2, T::Float3, T::Int2, T::Int3})
+        if (atlas::param_type_name(t) == s) return t;
+    throw InvalidArgument("unknown parameter type '" + s + "'");
+}
+
+atlas::ParamValue param_from_json(const nlohmann::json& j, atlas::ParamType t, const std::string& what) {
+    using T = atlas::ParamType;
+    auto bad = [&](const char* expected) { return InvalidArgument(what + ": expected " + expected + ", got " + j.dump()); };
+    switch (t) {
+    case T::Float:
+        if (!j.is_number()) throw bad("a number");
+        return j.get<double>();
+    case T::Int:
+        if (!j.is_number_integer()) throw bad("an integer");
+        return j.get<int64_t>();
+    case T::Bool:
+        if (!j.is_boolean()) throw bad("true or false");
+        return j.get<bool>();
+    case T::String:
+    case T::Enum:
+    case T::Path:
+        if (!j.is_string()) throw bad("a string");
+        return j.get<std::string>();
+    default: {
+        const size_t n = size_t(atlas::param_components(t));
+        if (!j.is_array() || j.size() != n) throw bad(n == 2 ? "2 numbers" : "3 numbers");
+        std::vector<double> v;
+        for (const auto& x : j) {
+            if (!x.is_number()) throw bad("numbers");
+            v.push_back(x.get<double>());
+        }
+        return v;
+    }
+    }
+}
+
+JsonDeclaration parse_declaration(const nlohmann::json& j, const std::string& node) {
+    JsonDeclaration d;
+    d.doc = j.value("doc", "");
+    auto ports = [&](const char* key, std::vector<atlas::PortDecl>& out) {
+        if (!j.contains(key)) return;
+        for (const auto& p : j.at(key)) {
+            if (!p.contains("name")) throw InvalidArgument(node + ": a port needs a \"name\"");
+            out.push_back({p.at("name").get<std::string>(), port_type_from(p.value("type", "field")), p.value("doc", ""),
+                           p.value("optional", false)});
+        }
+    };
+    ports("inputs", d.inputs);
+    ports("outputs", d.outputs);
+    if (d.outputs.empty()) throw InvalidArgument(node + ": a node needs at least one output");
+    if (j.contains("params")) {
+        for (const auto& p : j.at("params")) {
+            if (!p.contains("name") || !p.contains("type") || !p.contains("default"))
+                throw InvalidArgument(node + ": a parameter needs \"name\", \"type\" and \"default\"");
+            atlas::ParamDecl pd;
+            pd.name = p.at("name").get<std::string>();
+            pd.type = param_type_from(p.at("type").get<std::string>());
+            pd.default_value = param_from_json(p.at("default"), pd.type, node + "." + pd.name + " default");
+            if (p.contains("min") && !p.at("min").is_null()) pd.min = p.at("min").get<double>();
+            if (p.contains("max") && !p.at("max").is_null()) pd.max = p.at("max").get<double>();
+            pd.unit = p.value("unit", "");
+            pd.doc = p.value("doc", "");
+            if (p.contains("choices")) pd.choices = p.at("choices").get<std::vector<std::string>>();
+            if (std::string err = pd.check(pd.default_value); !err.empty())
+                throw InvalidArgument(node + "." + pd.name + ": default: " + err);
+            d.params.push_back(std::move(pd));
+        }
+    }
+    return d;
+}
+
+void declare_from(const JsonDeclaration& j, atlas::NodeDeclaration& d) {
+    using T = atlas::ParamType;
+    d.doc(j.doc);
+    for (const auto& in : j.inputs) d.input(in.name, in.type, in.doc).optional = in.optional;
+    for (const auto& out : j.outputs) d.output(out.name, out.type, out.doc);
+    for (const auto& pd : j.params) {
+        atlas::ParamDecl* q = nullptr;
+        const auto* v = std::get_if<std::vector<double>>(&pd.default_value);
+        switch (pd.type) {
+        case T::Float: q = &d.param_float(pd.name, std::get<double>(pd.default_value)); break;
+        case T::Int: q = &d.param_int(pd.name, std::get<int64_t>(pd.default_value)); break;
+        case T::Bool: q = &d.param_bool(pd.name, std::get<bool>(pd.default_value)); break;
+        case T::String: q = &d.param_string(pd.name, std::get<std::string>(pd.default_value)); break;
+        case T::Enum: q = &d.param_enum(pd.name, pd.choices, std::get<std::string>(pd.default_value)); break;
+        case T::Path: q = &d.param_path(pd.name, std::get<std::string>(pd.default_value)); break;
+        case T::Float2: q = &d.param_float2(pd.name, atlas::Vec2d{{(*v)[0], (*v)[1]}}); break;
+        case T::Float3: q = &d.param_float3(pd.name, atlas::Vec3d{{(*v)[0], (*v)[1], (*v)[2]}}); break;
+        case T::Int2: q = &d.param_int2(pd.name, atlas::Vec2i{{int((*v)[0]), int((*v)[1])}}); break;
+        case T::Int3: q = &d.param_int3(pd.name, atlas::Vec3i{{int((*v)[0]), int((*v)[1]), int((*v)[2])}}); break;
+        }
+        q->min = pd.min;
+        q->max = pd.max;
+        q->unit = pd.unit;
+        q->doc = pd.doc;
+    }
+}
+
+// Runs `body` for an atlas_cook_* call: an exception becomes the node's failure.
+template <typename Body>
+AtlasStatus in_cook(AtlasCookContext* c, Body&& body) {
+    if (!c || !c->ctx) return ATLAS_INVALID_ARGUMENT;
+    try {
+        body();
+        return ATLAS_OK;
+    } catch (const InvalidArgument&) {
+        return ATLAS_INVALID_ARGUMENT; // the caller's mistake: a status, the cook may go on
+    } catch (...) {
+        c->fail_with(std::current_exception());
+        return ATLAS_ERROR;
+    }
+}
+
+const atlas::ParamValue& param_of(const AtlasCookContext* c, const char* name, atlas::ParamType a, atlas::ParamType b) {
+    if (!name) throw InvalidArgument("NULL name");
+    const atlas::ParamDecl* d = c->decl->find_param(name);
+    if (!d || (d->type != a && d->type != b)) throw InvalidArgument("no such parameter of that type");
+    return c->ctx->params().get(name);
+}
+
+} // namespace
+
+extern "C" {
+
+AtlasStatus atlas_registry_create(AtlasRegistry** out) {
+    if (!out) return ATLAS_INVALID_ARGUMENT;
+    *out = nullptr;
+    try {
+        *out = new AtlasRegistry();
+        return ATLAS_OK;
+    } catch (const std::bad_alloc&) {
+        return ATLAS_OUT_OF_MEMORY;
+    } catch (...) {
+        return ATLAS_ERROR;
+    }
+}
+
+void atlas_registry_destroy(AtlasRegistry* registry) { delete registry; }
+
+const char* atlas_registry_error(const AtlasRegistry* registry) { return registry ? registry->error.c_str() : "no registry"; }
+
+AtlasStatus atlas_registry_add_node(AtlasRegistry* r, const char* declaration_json, AtlasNodeCookFn cook, void* user) {
+    if (!r) return ATLAS_INVALID_ARGUMENT;
+    r->error.clear();
+    try {
+        if (!declaration_json || !cook) throw InvalidArgument("atlas_registry_add_node: NULL argument");
+        nlohmann::json j;
+        try {
+            j = nlohmann::json::parse(declaration_json);
+        } catch (const nlohmann::json::exception& e) {
+            throw InvalidArgument(std::string("declaration: ") + e.what());
+        }
+        if (!j.is_object() || !j.contains("name") || !j.at("name").is_string())
+            throw InvalidArgument("declaration: an object with a \"name\" string");
+        const std::string name = j.at("name").get<std::string>();
+        auto parsed = std::make_shared<const JsonDeclaration>(parse_declaration(j, name));
+        auto built = std::make_shared<atlas::NodeDeclaration>();
+        declare_from(*parsed, *built);
+        atlas::NodeType t;
+        t.name = name;
+        t.version = j.value("version", 1);
+        t.declare = [parsed](atlas::NodeDeclaration& d) { declare_from(*parsed, d); };
+        t.cook = [cook, user, built](atlas::CookContext& ctx) {
+            AtlasCookContext c;
+            c.ctx = &ctx;
+            c.decl = built.get();
+            const int rc = cook(user, &c);
+            c.ctx = nullptr; // a context kept past the call is refused
+            if (c.failure) std::rethrow_exception(c.failure);
+            if (rc != 0) throw atlas::Error("the cook function returned " + std::to_string(rc));
+            for (const atlas::PortDecl& out : built->outputs())
+                if (!ctx.outputs().count(out.name)) throw atlas::Error("the cook function did not set output '" + out.name + "'");
+        };
+        r->registry.add(std::move(t));
+        return ATLAS_OK;
+    } catch (const InvalidArgument& e) {
+        r->error = e.what();
+        return ATLAS_INVALID_ARGUMENT;
+    } catch (const nlohmann::json::exception& e) {
+        r->error = std::string("declaration: ") + e.what();
+        return ATLAS_INVALID_ARGUMENT;
+    } catch (const std::exception& e) {
+        r->error = e.what();
+        return ATLAS_ERROR;
+    }
+}
+
+AtlasStatus atlas_session_create_with_registry(const AtlasRegistry* registry, AtlasSession** out) {
+    if (!out) return ATLAS_INVALID_ARGUMENT;
+    *out = nullptr;
+    if (!registry) return ATLAS_INVALID_ARGUMENT;
+    try {
+        *out = new AtlasSession(registry->registry);
+        return ATLAS_OK;
+    } catch (const std::bad_alloc&) {
+        return ATLAS_OUT_OF_MEMORY;
+    } catch (...) {
+        return ATLAS_ERROR;
+    }
+}
+
+const char* atlas_cook_node_name(const AtlasCookContext* c) { return c && c->ctx ? c->ctx->node_name().c_str() : ""; }
+
+AtlasStatus atlas_cook_param_float(const AtlasCookContext* c, const char* name, double* value) {
+    return in_cook(const_cast<AtlasCookContext*>(c), [&] {
+        if (!value) throw InvalidArgument("NULL value");
+        *value = std::get<double>(param_of(c, name, atlas::ParamType::Float, atlas::ParamType::Float));
+    });
+}
+
+AtlasStatus atlas_cook_param_int(const AtlasCookContext* c, const char* name, int64_t* value) {
+    return in_cook(const_cast<AtlasCookContext*>(c), [&] {
+        if (!value) throw InvalidArgument("NULL value");
+        *value = std::get<int64_t>(param_of(c, name, atlas::ParamType::Int, atlas::ParamType::Int));
+    });
+}
+
+AtlasStatus atlas_cook_param_bool(const AtlasCookContext* c, const char* name, int* value) {
+    return in_cook(const_cast<AtlasCookContext*>(c), [&] {
+        if (!value) throw InvalidArgument("NULL value");
+        *value = std::get<bool>(param_of(c, name, atlas::ParamType::Bool, atlas::ParamType::Bool)) ? 1 : 0;
+    });
+}
+
+AtlasStatus atlas_cook_param_string(const AtlasCookContext* c, const char* name, const char** value) {
+    auto* m = const_cast<AtlasCookContext*>(c);
+    return in_cook(m, [&] {
+        if (!value || !name) throw InvalidArgument("NULL argument");
+        const atlas::ParamDecl* d = c->decl->find_param(name);
+        if (d && d->type == atlas::ParamType::Path) {
+            m->strings.push_back(c->ctx->get_path(name).string()); // resolved against the graph file
+        } else {
+            m->strings.push_back(std::get<std::string>(param_of(c, name, atlas::ParamType::String, atlas::ParamType::Enum)));
+        }
+        *value = m->strings.back().c_str();
+    });
+}
+
+AtlasStatus atlas_cook_param_vector(const AtlasCookContext* c, const char* name, double values[3], int* n) {
+    return in_cook(const_cast<AtlasCookContext*>(c), [&] {
+        if (!values || !n || !name) throw InvalidArgument("NULL argument");
+        const atlas::ParamDecl* d = c->decl->find_param(name);
+        if (!d || atlas::param_components(d->type) < 2) throw InvalidArgument("not a vector parameter");
+        const auto& v = std::get<std::vector<double>>(c->ctx->params().get(name));
+        *n = int(v.size());
+        for (size_t i = 0; i < v.size() && i < 3; ++i) values[i] = v[i];
+    });
+}
+
+const AtlasField* atlas_cook_input(AtlasCookContext* c, const char* port) {
+    const AtlasField* result = nullptr;
+    in_cook(c, [&] {
+        if (!port) throw InvalidArgument("NULL port");
+        if (!c->decl->find_input(port) || !c->ctx->has_input(port)) return;
+        auto& slot = c->inputs[port];
+        if (!slot) {
+            const atlas::Value& v = c->ctx->input(port);
+            auto f = std::make_unique<AtlasField>();
+            if (auto* p3 = std::get_if<atlas::Field3DPtr>(&v)) f->f3 = *p3;
+            else if (auto* p2 = std::get_if<atlas::Field2DPtr>(&v)) f->f2 = *p2;
+            else return;
+            slot = std::move(f);
+        }
+        result = slot.get();
+    });
+    return result;
+}
+
+AtlasFieldBuilder* atlas_cook_new_field(AtlasCookContext* c, int dimensions, const int resolution[3], int channels,
+                                        const double min[3], const double max[3]) {
+    AtlasFieldBuilder* result = nullptr;
+    AtlasStatus st = in_cook(c, [&] {
+        if (!resolution || !min || !max) throw atlas::Error("atlas_cook_new_field: NULL argument");
+        auto b = std::make_unique<AtlasFieldBuilder>();
+        if (dimensions == 3) {
+            b->f3 = c->ctx->make_field3d(atlas::Vec3i{{resolution[0], resolution[1], resolution[2]}}, channels,
+                                         atlas::Box3d{{{min[0], min[1], min[2]}}, {{max[0], max[1], max[2]}}});
+        } else if (dimensions == 2) {
+            b->f2 = c->ctx->make_field2d(atlas::Vec2i{{resolution[0], resolution[1]}}, channels,
+                                         atlas::Box2d{{{min[0], min[1]}}, {{max[0], max[1]}}});
+        } else {
+            throw atlas::Error("atlas_cook_new_field: dimensions must be 2 or 3");
+        }
+        c->builders.push_back(std::move(b));
+        result = c->builders.back().get();
+    });
+    return st == ATLAS_OK ? result : nullptr;
+}
+
+float* atlas_field_builder_channel(AtlasFieldBuilder* b, int channel) {
+    if (!b || channel < 0 || channel >= b->storage().channels()) return nullptr;
+    return b->storage().channel(channel).data();
+}
+
+AtlasStatus atlas_cook_set_output(AtlasCookContext* c, const char* port, AtlasFieldBuilder* b) {
+    return in_cook(c, [&] {
+        if (!port || !b) throw InvalidArgument("NULL argument");
+        auto it = std::find_if(c->builders.begin(), c->builders.end(), [&](const auto& p) { return p.get() == b; });
+        if (it == c->builders.end()) throw InvalidArgument("not a builder of this cook");
+        const atlas::PortDecl* out = c->decl->find_output(port);
+        if (!out) throw atlas::Error("no output port '" + std::string(port) + "'");
+        atlas::Value v = b->f3 ? atlas::Value(atlas::Field3DPtr(b->f3)) : atlas::Value(atlas::Field2DPtr(b->f2));
+        if (!atlas::port_accepts(out->type, atlas::value_type(v)))
+            throw atlas::Error("output '" + std::string(port) + "' is a " + std::string(atlas::port_type_name(out->type)) +
+                               ", got a " + std::string(atlas::port_type_name(atlas::value_type(v))));
+        c->ctx->set_output(port, std::move(v));
+        c->builders.erase(it);
+    });
+}
+
+AtlasStatus atlas_cook_set_output_input(AtlasCookContext* c, const char* port, const char* input_port) {
+    return in_cook(c, [&] {
+        if (!port || !input_port) throw InvalidArgument("NULL argument");
+        if (!c->decl->find_output(port)) throw atlas::Error("no output port '" + std::string(port) + "'");
+        c->ctx->set_output(port, c->ctx->input(input_port));
+    });
+}
+
+int atlas_cook_progress(AtlasCookContext* c, double fraction) {
+    if (!c || !c->ctx) return 1;
+    try {
+        c->ctx->progress(fraction);
+        return 0;
+    } catch (...) {
+        c->fail_with(std::current_exception()); // CancelledError: the cook ends as cancelled
+        return 1;
+    }
+}
+
+void atlas_cook_fail(AtlasCookContext* c, const char* message) {
+    if (!c) return;
+    c->fail_with(std::make_exception_ptr(atlas::Error(message && *message ? message : "the cook function failed")));
 }
 
 } // extern "C"
