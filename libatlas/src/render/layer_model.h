@@ -1,0 +1,465 @@
+// Internal to the render module: the 2.5D density model (layer.cpp marches it).
+// LayerModel turns a LayerScene into density at a point of the shell: coverage
+// and the vertical profile from the NDF set and its LUT, the HZD base noise
+// eroded by curl-distorted detail noise, wind, anvil and vortex rings
+// (formulas in docs/render.md, "2.5D mode").
+#pragma once
+
+#include "atlas/core/error.h"
+#include "atlas/render/layer.h"
+#include "render_common.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace atlas::render::layer_detail {
+
+
+inline void need(bool ok, const std::string& what) {
+    if (!ok) throw Error("render (2.5D): " + what);
+}
+
+inline bool positive_finite(double v) { return v > 0 && std::isfinite(v); }
+
+// Bilinear lookup of a 2D field at texel coordinate (u, v) (centres at
+// i + 0.5) with wrap or clamp addressing.
+struct Bilinear {
+    int x0, x1, y0, y1;
+    float tx, ty;
+};
+
+inline void axis_wrap(double u, int n, int& i0, int& i1, float& t) {
+    u -= 0.5;
+    const double f = std::floor(u);
+    t = static_cast<float>(u - f);
+    long long i = static_cast<long long>(f) % n;
+    if (i < 0) i += n;
+    i0 = static_cast<int>(i);
+    i1 = i0 + 1 == n ? 0 : i0 + 1;
+}
+
+inline void axis_clamp(double u, int n, int& i0, int& i1, float& t) {
+    u -= 0.5;
+    if (u <= 0) { i0 = i1 = 0; t = 0; return; }
+    if (u >= n - 1) { i0 = i1 = n - 1; t = 0; return; }
+    i0 = static_cast<int>(u);
+    i1 = i0 + 1;
+    t = static_cast<float>(u - i0);
+}
+
+inline float lerp2(const float* p, int nx, const Bilinear& b) {
+    const float* r0 = p + size_t(b.y0) * size_t(nx);
+    const float* r1 = p + size_t(b.y1) * size_t(nx);
+    const float a = r0[b.x0] + (r0[b.x1] - r0[b.x0]) * b.tx;
+    const float c = r1[b.x0] + (r1[b.x1] - r1[b.x0]) * b.tx;
+    return a + (c - a) * b.ty;
+}
+
+// A tiling 3D noise with up to 4 channels, trilinear, stored interleaved
+// (one 16-byte texel per voxel: 8 loads per lookup instead of 32).
+struct Noise3 {
+    std::vector<std::array<float, 4>> texels;
+    int n = 0, nx = 0, ny = 0, nz = 0;
+    double inv_tile = 0;
+    bool ok() const { return n > 0; }
+    void init(const Field3D* f, double tile) {
+        if (!f) return;
+        n = std::min(4, f->channels());
+        nx = f->nx();
+        ny = f->ny();
+        nz = f->nz();
+        texels.resize(size_t(nx) * size_t(ny) * size_t(nz));
+        for (int c = 0; c < 4; ++c) {
+            auto ch = f->channel(std::min(c, n - 1));
+            for (size_t i = 0; i < texels.size(); ++i) texels[i][size_t(c)] = ch[i];
+        }
+        inv_tile = 1.0 / tile;
+    }
+    void sample(double x, double y, double z, float out[4]) const {
+        int x0, x1, y0, y1, z0, z1;
+        float tx, ty, tz;
+        axis_wrap(x * inv_tile * nx, nx, x0, x1, tx);
+        axis_wrap(y * inv_tile * ny, ny, y0, y1, ty);
+        axis_wrap(z * inv_tile * nz, nz, z0, z1, tz);
+        const size_t sy = size_t(nx), sz = size_t(nx) * size_t(ny);
+        const std::array<float, 4>* t = texels.data();
+        const size_t r0 = size_t(z0) * sz + size_t(y0) * sy, r1 = size_t(z0) * sz + size_t(y1) * sy;
+        const size_t r2 = size_t(z1) * sz + size_t(y0) * sy, r3 = size_t(z1) * sz + size_t(y1) * sy;
+        const auto& a0 = t[r0 + size_t(x0)];
+        const auto& a1 = t[r0 + size_t(x1)];
+        const auto& b0 = t[r1 + size_t(x0)];
+        const auto& b1 = t[r1 + size_t(x1)];
+        const auto& c0 = t[r2 + size_t(x0)];
+        const auto& c1 = t[r2 + size_t(x1)];
+        const auto& d0 = t[r3 + size_t(x0)];
+        const auto& d1 = t[r3 + size_t(x1)];
+        for (size_t c = 0; c < 4; ++c) {
+            const float a = a0[c] + (a1[c] - a0[c]) * tx;
+            const float b = b0[c] + (b1[c] - b0[c]) * tx;
+            const float cc = c0[c] + (c1[c] - c0[c]) * tx;
+            const float d = d0[c] + (d1[c] - d0[c]) * tx;
+            const float ab = a + (b - a) * ty, cd = cc + (d - cc) * ty;
+            out[c] = ab + (cd - ab) * tz;
+        }
+    }
+};
+
+inline int channel_of(const Field2D& f, const char* name) { return f.find_channel(name); }
+
+// The weather at one map position.
+struct Column {
+    double coverage = 0, type = 0, top_type = 0, bottom_type = 0, min_h = 0, max_h = 0, precip = 0;
+};
+
+// bottom(bottom_type, f) * top(top_type, f) from the LUT's two channels,
+// end-aligned texels (ndf/profile_lut): texel i at type i / (W - 1); the
+// height axis is shared by both lookups.
+inline double profile_split(const Field2D& lut, const float* bottom, const float* top, double bottom_type, double top_type, double f) {
+    const int w = lut.width(), h = lut.height();
+    Bilinear b;
+    axis_clamp(0.5 + detail::saturate(f) * (h - 1), h, b.y0, b.y1, b.ty);
+    axis_clamp(0.5 + detail::saturate(bottom_type) * (w - 1), w, b.x0, b.x1, b.tx);
+    const double lo = lerp2(bottom, w, b);
+    if (!(lo > 0)) return 0;
+    axis_clamp(0.5 + detail::saturate(top_type) * (w - 1), w, b.x0, b.x1, b.tx);
+    return lo * lerp2(top, w, b);
+}
+
+// Everything the march reads, prepared once per render.
+class LayerModel {
+public:
+    LayerModel(const LayerScene& s) : s_(s), ndf_(*s.ndf), lut_(*s.profile_lut) {
+        const int cc = channel_of(ndf_, "coverage"), cmin = channel_of(ndf_, "min_height"), cmax = channel_of(ndf_, "max_height");
+        const int ct = channel_of(ndf_, "type"), ctt = channel_of(ndf_, "top_type"), cbt = channel_of(ndf_, "bottom_type");
+        const int cp = channel_of(ndf_, "precipitation");
+        ch_cov_ = ndf_.channel(cc).data();
+        ch_min_ = ndf_.channel(cmin).data();
+        ch_max_ = ndf_.channel(cmax).data();
+        ch_type_ = ct >= 0 ? ndf_.channel(ct).data() : nullptr;
+        ch_top_ = ctt >= 0 ? ndf_.channel(ctt).data() : ch_type_;
+        ch_bot_ = cbt >= 0 ? ndf_.channel(cbt).data() : ch_type_;
+        ch_precip_ = cp >= 0 ? ndf_.channel(cp).data() : nullptr;
+        // Interleaved copy: coverage, min, max, type, top type, bottom type, precipitation.
+        texels_.resize(size_t(ndf_.width()) * size_t(ndf_.height()));
+        for (size_t i = 0; i < texels_.size(); ++i)
+            texels_[i] = {ch_cov_[i], ch_min_[i], ch_max_[i], ch_type_ ? ch_type_[i] : 0.0f, ch_top_ ? ch_top_[i] : 0.0f,
+                          ch_bot_ ? ch_bot_[i] : 0.0f, ch_precip_ ? ch_precip_[i] : 0.0f, 0.0f};
+        lut_bottom_ = lut_.channel(lut_.find_channel("bottom")).data();
+        lut_top_ = lut_.channel(lut_.find_channel("top")).data();
+        const Box2d& b = ndf_.bounds();
+        origin_ = {{b.min[0], b.min[1]}};
+        size_ = {{b.max[0] - b.min[0], b.max[1] - b.min[1]}};
+        inv_texel_ = {{ndf_.width() / size_[0], ndf_.height() / size_[1]}};
+        centre_ = {{0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), -s.earth_radius}};
+        bottom_ = std::numeric_limits<double>::infinity();
+        top_ = -bottom_;
+        auto cov = ndf_.channel(cc), mn = ndf_.channel(cmin), mx = ndf_.channel(cmax);
+        for (size_t i = 0; i < cov.size(); ++i) {
+            if (!(cov[i] > 0) || !(mx[i] > mn[i])) continue;
+            bottom_ = std::min(bottom_, double(mn[i]));
+            top_ = std::max(top_, double(mx[i]));
+            any_cloud_ = true;
+        }
+        if (!any_cloud_) bottom_ = top_ = 0;
+        if (ch_precip_) {
+            auto p = ndf_.channel(cp);
+            precipitation_ = std::any_of(p.begin(), p.end(), [](float v) { return v > 0; });
+        }
+        base_.init(s.base_noise.get(), s.base_tile);
+        if (base_.ok()) build_coverage_table(*s.base_noise);
+        detail_.init(s.detail_noise.get(), s.detail_tile);
+        if (s.curl) {
+            curl_ = s.curl.get();
+            curl_r_ = curl_->channel(0).data();
+            curl_g_ = curl_->channel(std::min(1, curl_->channels() - 1)).data();
+        }
+        const double w = std::hypot(s.wind[0], s.wind[1]);
+        wind_dir_ = w > 0 ? Vec2d{{s.wind[0] / w, s.wind[1] / w}} : Vec2d{{1, 0}};
+        map_shift_ = {{s.wind[0] * s.time, s.wind[1] * s.time}};
+        if (s.envelope.cone_map) {
+            cone_ = s.envelope.cone_map.get();
+            const int ca = cone_->find_channel("apex_height"), cr = cone_->find_channel("cone_ratio");
+            cone_apex_ = cone_->channel(ca).data();
+            cone_ratio_ = cone_->channel(cr).data();
+        }
+        if (s.envelope.distance_map) dist_ = s.envelope.distance_map.get();
+        if (s.vortex_table && s.time != 0) {
+            const Field2D& t = *s.vortex_table;
+            const int ci = t.find_channel("inner"), co = t.find_channel("outer"), cs = t.find_channel("speed"), ce = t.find_channel("overlap_end");
+            for (int i = 0; i < t.width(); ++i)
+                rings_.push_back({t.at(ci, i, 0), t.at(co, i, 0), t.at(cs, i, 0), t.at(ce, i, 0)});
+            const Box2d& tb = t.bounds();
+            vortex_centre_ = {{0.5 * (tb.min[0] + tb.max[0]), 0.5 * (tb.min[1] + tb.max[1])}};
+        }
+        if (s.anvil) {
+            const Field2D& a = *s.anvil;
+            const int c = std::max(0, a.find_channel("anvil_bias"));
+            auto ch = a.channel(c);
+            if (std::any_of(ch.begin(), ch.end(), [](float v) { return v > 0; })) {
+                anvil_ = &a;
+                anvil_ch_ = ch.data();
+                const Box2d& ab = a.bounds();
+                anvil_origin_ = {{ab.min[0], ab.min[1]}};
+                anvil_inv_ = {{a.width() / (ab.max[0] - ab.min[0]), a.height() / (ab.max[1] - ab.min[1])}};
+            }
+        }
+    }
+    bool has_anvil() const { return anvil_ != nullptr; }
+    bool has_vortex() const { return !rings_.empty(); }
+
+    // Vortex rings: the angle (radians) the map turns by at radius r.
+    double vortex_angle(double r) const {
+        const size_t n = rings_.size();
+        for (size_t i = 0; i < n; ++i) {
+            const Ring& g = rings_[i];
+            if (r < g.inner) break;
+            const double a = g.speed * s_.time;
+            if (r < g.outer) {
+                // Inside ring i: the previous ring's overlap band reaches in.
+                if (i > 0 && r < rings_[i - 1].overlap_end) {
+                    const Ring& pr = rings_[i - 1];
+                    const double w = (r - pr.outer) / std::max(1e-9, pr.overlap_end - pr.outer);
+                    return pr.speed * s_.time + (a - pr.speed * s_.time) * w;
+                }
+                return a;
+            }
+            if (i + 1 == n && r < g.overlap_end) return a * (1 - (r - g.outer) / std::max(1e-9, g.overlap_end - g.outer));
+        }
+        return 0;
+    }
+    // p with its x, y turned about the vortex centre by -angle(r).
+    Vec3d unrotate(const Vec3d& p) const {
+        const double dx = p[0] - vortex_centre_[0], dy = p[1] - vortex_centre_[1];
+        const double a = -vortex_angle(std::hypot(dx, dy));
+        if (a == 0) return p;
+        const double c = std::cos(a), sn = std::sin(a);
+        return {{vortex_centre_[0] + c * dx - sn * dy, vortex_centre_[1] + sn * dx + c * dy, p[2]}};
+    }
+
+    const Vec3d& centre() const { return centre_; }
+    double bottom() const { return bottom_; }
+    double top() const { return top_; }
+    bool any_cloud() const { return any_cloud_; }
+    bool precipitation() const { return precipitation_; }
+    bool has_base() const { return base_.ok(); }
+    bool has_detail() const { return detail_.ok(); }
+    bool has_curl() const { return curl_ != nullptr; }
+    bool has_cone() const { return cone_ != nullptr; }
+    bool has_distance() const { return dist_ != nullptr; }
+
+    double altitude(const Vec3d& p) const { return length(p - centre_) - s_.earth_radius; }
+
+    // The weather at world (x, y); false outside an Empty-edged map.
+    bool column(double x, double y, Column& c) const {
+        double u = (x - map_shift_[0] - origin_[0]) * inv_texel_[0], v = (y - map_shift_[1] - origin_[1]) * inv_texel_[1];
+        const int nx = ndf_.width(), ny = ndf_.height();
+        Bilinear b;
+        if (s_.edge == MapEdge::Empty && (u < 0 || v < 0 || u > nx || v > ny)) return false;
+        if (s_.edge == MapEdge::Wrap) {
+            axis_wrap(u, nx, b.x0, b.x1, b.tx);
+            axis_wrap(v, ny, b.y0, b.y1, b.ty);
+        } else {
+            axis_clamp(u, nx, b.x0, b.x1, b.tx);
+            axis_clamp(v, ny, b.y0, b.y1, b.ty);
+        }
+        // One 32-byte texel per corner (channels interleaved at construction).
+        const std::array<float, 8>* t = texels_.data();
+        const auto& a0 = t[size_t(b.y0) * size_t(nx) + size_t(b.x0)];
+        const auto& a1 = t[size_t(b.y0) * size_t(nx) + size_t(b.x1)];
+        const auto& b0 = t[size_t(b.y1) * size_t(nx) + size_t(b.x0)];
+        const auto& b1 = t[size_t(b.y1) * size_t(nx) + size_t(b.x1)];
+        auto at = [&](size_t k) {
+            const float lo = a0[k] + (a1[k] - a0[k]) * b.tx, hi = b0[k] + (b1[k] - b0[k]) * b.tx;
+            return double(lo + (hi - lo) * b.ty);
+        };
+        c.coverage = at(0);
+        if (!(c.coverage > 0)) return false;
+        c.min_h = at(1);
+        c.max_h = at(2);
+        c.type = at(3);
+        c.top_type = at(4);
+        c.bottom_type = at(5);
+        c.precip = detail::saturate(at(6));
+        return c.max_h > c.min_h;
+    }
+
+    // Coverage is the probability of cloud (ndf_set.h): the threshold the
+    // coverage remap uses is the (1 - coverage) quantile of the dilated base
+    // shape over the noise texture, so coverage c leaves a fraction c of a
+    // full-profile column cloudy (the noise's own range, 0.39..0.97 for the
+    // HZD Perlin-Worley, would otherwise turn coverage 0.3 into overcast).
+    void build_coverage_table(const Field3D& n) {
+        const int c = n.channels();
+        auto r = n.channel(0), g = n.channel(std::min(1, c - 1)), b = n.channel(std::min(2, c - 1)), a = n.channel(std::min(3, c - 1));
+        std::vector<float> v;
+        const size_t stride = std::max<size_t>(1, r.size() / 65536);
+        for (size_t i = 0; i < r.size(); i += stride) v.push_back(float(dilated_base(r[i], g[i], b[i], a[i])));
+        std::sort(v.begin(), v.end());
+        for (int k = 0; k <= kQuantiles; ++k) quantile_[size_t(k)] = v[std::min(v.size() - 1, size_t(double(k) / kQuantiles * double(v.size() - 1) + 0.5))];
+        equalised_ = true;
+        base_max_ = quantile_[kQuantiles];
+    }
+    static double dilated_base(double r, double g, double b, double a) {
+        const double low_fbm = g * 0.625 + b * 0.25 + a * 0.125;
+        // Dilate the Perlin-Worley shape by the Worley FBM (GPU Pro 7).
+        return detail::remap_unclamped(r, -(1.0 - low_fbm), 1.0, 0.0, 1.0);
+    }
+    // The base value above which a fraction `coverage` of the texture lies.
+    double coverage_threshold(double coverage) const {
+        if (!equalised_) return 1.0 - coverage;
+        const double u = (1.0 - detail::saturate(coverage)) * kQuantiles;
+        const int i = std::min(kQuantiles - 1, int(u));
+        return quantile_[size_t(i)] + (quantile_[size_t(i + 1)] - quantile_[size_t(i)]) * (u - i);
+    }
+
+    // Density at p (altitude h). full = false: the cheap base shape only
+    // (HZD's "cheap" sample). shape_out: the base shape with coverage (the
+    // sample's profile for ambient and multiple scattering).
+    double density(const Vec3d& p_in, double h, bool full, Column* col_out = nullptr, double* shape_out = nullptr) const {
+        const Vec3d p = rings_.empty() ? p_in : unrotate(p_in);
+        Column c;
+        if (!column(p[0], p[1], c)) return 0;
+        if (h <= c.min_h || h >= c.max_h) return 0;
+        const double f = (h - c.min_h) / (c.max_h - c.min_h);
+        if (anvil_ && f > 0.7) {
+            // HZD's anvil bias: the top of the column spreads.
+            Bilinear b;
+            axis_clamp((p[0] - map_shift_[0] - anvil_origin_[0]) * anvil_inv_[0], anvil_->width(), b.x0, b.x1, b.tx);
+            axis_clamp((p[1] - map_shift_[1] - anvil_origin_[1]) * anvil_inv_[1], anvil_->height(), b.y0, b.y1, b.ty);
+            const double bias = detail::saturate(lerp2(anvil_ch_, anvil_->width(), b));
+            c.coverage = std::pow(c.coverage, detail::remap(f, 0.7, 0.8, 1.0, 1.0 - 0.5 * bias));
+        }
+        const double profile = profile_split(lut_, lut_bottom_, lut_top_, c.bottom_type, c.top_type, f);
+        if (!(profile > 0)) return 0;
+        // Wind: tops pushed downwind, the noise scrolled (detail faster, a
+        // little upward: clouds seem to grow).
+        const double skew = f * s_.cloud_top_offset;
+        const double qx = p[0] + wind_dir_[0] * skew - s_.wind[0] * s_.time;
+        const double qy = p[1] + wind_dir_[1] * skew - s_.wind[1] * s_.time;
+        const double qz = h - 0.1 * std::hypot(s_.wind[0], s_.wind[1]) * s_.time;
+        const double thr = coverage_threshold(c.coverage);
+        // The base is at most the texture's largest value: skip the lookup
+        // where even that stays under the coverage threshold.
+        if (profile * base_max_ <= thr) return 0;
+        double base = 1;
+        if (base_.ok()) {
+            float n[4];
+            base_.sample(qx, qy, qz, n);
+            base = dilated_base(n[0], n[1], n[2], n[3]);
+        }
+        base *= profile;
+        // Coverage grows the shape and scales its density: HZD's
+        // remap(base, 1 - coverage, 1, 0, 1) * coverage with the equalised threshold.
+        double shaped = thr < 1.0 ? (base - thr) / (1.0 - thr) * c.coverage : 0.0;
+        if (!(shaped > 0)) return 0;
+        shaped = std::min(shaped, 1.0);
+        if (col_out) *col_out = c;
+        if (shape_out) *shape_out = shaped;
+        if (!full || !detail_.ok()) return shaped * s_.density_scale;
+        double dx = qx * 1.3, dy = qy * 1.3, dz = qz * 1.3; // detail moves faster than the base
+        if (curl_) {
+            // Turbulence at the cloud base: curl-distorted detail coordinates.
+            Bilinear b;
+            axis_wrap(dx / s_.curl_tile * curl_->width(), curl_->width(), b.x0, b.x1, b.tx);
+            axis_wrap(dy / s_.curl_tile * curl_->height(), curl_->height(), b.y0, b.y1, b.ty);
+            const double k = s_.curl_amount * (1.0 - f);
+            dx += (2.0 * lerp2(curl_r_, curl_->width(), b) - 1.0) * k;
+            dy += (2.0 * lerp2(curl_g_, curl_->width(), b) - 1.0) * k;
+        }
+        float n[4];
+        detail_.sample(dx, dy, dz, n);
+        const double high_fbm = n[0] * 0.625 + n[1] * 0.25 + n[2] * 0.125;
+        // Wispy (FBM) at the base to billowy (inverted) above 10 % height.
+        const double mod = high_fbm + ((1.0 - high_fbm) - high_fbm) * detail::saturate(f * 10.0);
+        const double final_density = detail::saturate(detail::remap_unclamped(shaped, mod * s_.erosion, 1.0, 0.0, 1.0));
+        return final_density * s_.density_scale;
+    }
+
+    // Envelope: a distance along the unit ray that surely holds no cloud, 0
+    // when none is known. p at altitude h.
+    double skip_distance(const Vec3d& p, const Vec3d& d, double h) const {
+        double best = 0;
+        const double u = (p[0] - map_shift_[0] - origin_[0]) / size_[0], v = (p[1] - map_shift_[1] - origin_[1]) / size_[1];
+        if (!(u >= 0 && u <= 1 && v >= 0 && v <= 1)) return 0; // the maps cover one tile
+        // Never jump past the map tile (its neighbours are other data).
+        double to_edge = std::numeric_limits<double>::infinity();
+        for (int a = 0; a < 2; ++a) {
+            const double lo = origin_[a] + map_shift_[a], hi = lo + size_[a];
+            if (d[a] > 1e-12) to_edge = std::min(to_edge, (hi - p[a]) / d[a]);
+            else if (d[a] < -1e-12) to_edge = std::min(to_edge, (lo - p[a]) / d[a]);
+        }
+        if (cone_) {
+            Bilinear b;
+            axis_clamp(u * cone_->width(), cone_->width(), b.x0, b.x1, b.tx);
+            axis_clamp(v * cone_->height(), cone_->height(), b.y0, b.y1, b.ty);
+            const double apex = lerp2(cone_apex_, cone_->width(), b), c = lerp2(cone_ratio_, cone_->width(), b);
+            if (h > apex && c > 0) {
+                const double hl = std::hypot(d[0], d[1]);
+                const double denom = hl - c * d[2];
+                const double s = denom > 1e-12 ? c * (h - apex) / denom : std::numeric_limits<double>::infinity();
+                best = std::max(best, s);
+            }
+        }
+        if (dist_) {
+            const Box3d& bb = dist_->bounds();
+            const Vec3d vs = dist_->voxel_size();
+            const double z = h;
+            if (z >= bb.min[2] && z <= bb.max[2]) {
+                // Trilinear distance minus a voxel diagonal: interpolation
+                // and voxel-centre solids are each off by less than that.
+                const double fx = u * dist_->nx() - 0.5, fy = v * dist_->ny() - 0.5, fz = (z - bb.min[2]) / vs[2] - 0.5;
+                auto cl = [](double t, int n) { return std::clamp(t, 0.0, double(n - 1)); };
+                const double cx = cl(fx, dist_->nx()), cy = cl(fy, dist_->ny()), cz = cl(fz, dist_->nz());
+                const int x0 = int(cx), y0 = int(cy), z0 = int(cz);
+                const int x1 = std::min(x0 + 1, dist_->nx() - 1), y1 = std::min(y0 + 1, dist_->ny() - 1), z1 = std::min(z0 + 1, dist_->nz() - 1);
+                const double tx = cx - x0, ty = cy - y0, tz = cz - z0;
+                auto at = [&](int x, int y, int zz) { return double(dist_->at(0, x, y, zz)); };
+                const double c00 = at(x0, y0, z0) + (at(x1, y0, z0) - at(x0, y0, z0)) * tx;
+                const double c10 = at(x0, y1, z0) + (at(x1, y1, z0) - at(x0, y1, z0)) * tx;
+                const double c01 = at(x0, y0, z1) + (at(x1, y0, z1) - at(x0, y0, z1)) * tx;
+                const double c11 = at(x0, y1, z1) + (at(x1, y1, z1) - at(x0, y1, z1)) * tx;
+                const double c0 = c00 + (c10 - c00) * ty, c1 = c01 + (c11 - c01) * ty;
+                const double dd = c0 + (c1 - c0) * tz - length(vs);
+                best = std::max(best, dd);
+            }
+        }
+        return std::min(best, to_edge);
+    }
+
+private:
+    const LayerScene& s_;
+    const Field2D& ndf_;
+    const Field2D& lut_;
+    const float *ch_cov_, *ch_min_, *ch_max_, *ch_type_, *ch_top_, *ch_bot_, *ch_precip_;
+    const float *lut_bottom_, *lut_top_;
+    std::vector<std::array<float, 8>> texels_;
+    Vec2d origin_, size_, inv_texel_;
+    Vec3d centre_;
+    double bottom_ = 0, top_ = 0;
+    bool any_cloud_ = false, precipitation_ = false;
+    Noise3 base_, detail_;
+    const Field2D* curl_ = nullptr;
+    const float *curl_r_ = nullptr, *curl_g_ = nullptr;
+    Vec2d wind_dir_, map_shift_;
+    const Field2D* cone_ = nullptr;
+    const float *cone_apex_ = nullptr, *cone_ratio_ = nullptr;
+    const Field3D* dist_ = nullptr;
+    static constexpr int kQuantiles = 256;
+    std::array<double, kQuantiles + 1> quantile_{};
+    bool equalised_ = false;
+    double base_max_ = 1; // largest dilated base value (1 without noise)
+    struct Ring {
+        double inner, outer, speed, overlap_end;
+    };
+    std::vector<Ring> rings_;
+    Vec2d vortex_centre_{{0, 0}};
+    const Field2D* anvil_ = nullptr;
+    const float* anvil_ch_ = nullptr;
+    Vec2d anvil_origin_{{0, 0}}, anvil_inv_{{1, 1}};
+};
+
+} // namespace atlas::render::layer_detail
