@@ -128,6 +128,7 @@ TEST(LayerCli, BothSetsComposeOneImageAndModeOverrides) {
     const CliRun voxel = run_atlas("preview both.yaml --noise none --size 48x27 --mode voxel -o voxel.png");
     ASSERT_EQ(voxel.status, 0) << voxel.err;
     EXPECT_NE(voxel.err.find("(voxel)"), std::string::npos) << voxel.err;
+    write("layer.yaml", kLayerGraph); // ctest runs each test in its own process and directory
     const CliRun bad = run_atlas("preview layer.yaml --size 48x27 --mode voxel -o x.png");
     EXPECT_NE(bad.status, 0);
     EXPECT_NE(bad.err.find("no volume/nvdf"), std::string::npos) << bad.err;
