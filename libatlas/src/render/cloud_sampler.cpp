@@ -1,4 +1,5 @@
 #include "cloud_sampler.h"
+#include "render_common.h"
 
 #include "atlas/core/error.h"
 
@@ -11,27 +12,6 @@ namespace {
 int channel_or(const Field3D& f, const char* name, int fallback) {
     int c = f.find_channel(name);
     return c >= 0 ? c : fallback;
-}
-
-// Trilinear weights for continuous voxel coordinate u (centres at i + 0.5),
-// clamped to the grid.
-inline void axis(double u, int n, int& i0, int& i1, float& t) {
-    u -= 0.5;
-    if (u <= 0) { i0 = i1 = 0; t = 0; return; }
-    if (u >= n - 1) { i0 = i1 = n - 1; t = 0; return; }
-    i0 = static_cast<int>(u);
-    i1 = i0 + 1;
-    t = static_cast<float>(u - i0);
-}
-
-inline void axis_wrap(double u, int n, int& i0, int& i1, float& t) {
-    u -= 0.5;
-    double f = std::floor(u);
-    t = static_cast<float>(u - f);
-    long long i = static_cast<long long>(f) % n;
-    if (i < 0) i += n;
-    i0 = static_cast<int>(i);
-    i1 = i0 + 1 == n ? 0 : i0 + 1;
 }
 
 } // namespace
@@ -72,9 +52,9 @@ CloudSampler::CloudSampler(const CloudScene& scene) {
 VoxelSample CloudSampler::voxel(double x, double y, double z) const {
     int x0, x1, y0, y1, z0, z1;
     float tx, ty, tz;
-    axis((x - grid_.min[0]) * grid_.inv_voxel[0], grid_.nx, x0, x1, tx);
-    axis((y - grid_.min[1]) * grid_.inv_voxel[1], grid_.ny, y0, y1, ty);
-    axis((z - grid_.min[2]) * grid_.inv_voxel[2], grid_.nz, z0, z1, tz);
+    detail::axis_clamp((x - grid_.min[0]) * grid_.inv_voxel[0], grid_.nx, x0, x1, tx);
+    detail::axis_clamp((y - grid_.min[1]) * grid_.inv_voxel[1], grid_.ny, y0, y1, ty);
+    detail::axis_clamp((z - grid_.min[2]) * grid_.inv_voxel[2], grid_.nz, z0, z1, tz);
     const size_t sx = 1, sy = size_t(grid_.nx), sz = size_t(grid_.nx) * size_t(grid_.ny);
     const size_t i000 = size_t(z0) * sz + size_t(y0) * sy + size_t(x0) * sx;
     const size_t dx = size_t(x1 - x0), dy = size_t(y1 - y0) * sy, dz = size_t(z1 - z0) * sz;
@@ -95,9 +75,9 @@ VoxelSample CloudSampler::voxel(double x, double y, double z) const {
 std::array<float, 4> CloudSampler::noise(double x, double y, double z) const {
     int x0, x1, y0, y1, z0, z1;
     float tx, ty, tz;
-    axis_wrap(x * noise_.scale[0], noise_.nx, x0, x1, tx);
-    axis_wrap(y * noise_.scale[1], noise_.ny, y0, y1, ty);
-    axis_wrap(z * noise_.scale[2], noise_.nz, z0, z1, tz);
+    detail::axis_wrap(x * noise_.scale[0], noise_.nx, x0, x1, tx);
+    detail::axis_wrap(y * noise_.scale[1], noise_.ny, y0, y1, ty);
+    detail::axis_wrap(z * noise_.scale[2], noise_.nz, z0, z1, tz);
     const size_t sy = size_t(noise_.nx), sz = size_t(noise_.nx) * size_t(noise_.ny);
     const size_t r0 = size_t(z0) * sz + size_t(y0) * sy, r1 = size_t(z0) * sz + size_t(y1) * sy;
     const size_t r2 = size_t(z1) * sz + size_t(y0) * sy, r3 = size_t(z1) * sz + size_t(y1) * sy;

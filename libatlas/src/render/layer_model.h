@@ -32,24 +32,8 @@ struct Bilinear {
     float tx, ty;
 };
 
-inline void axis_wrap(double u, int n, int& i0, int& i1, float& t) {
-    u -= 0.5;
-    const double f = std::floor(u);
-    t = static_cast<float>(u - f);
-    long long i = static_cast<long long>(f) % n;
-    if (i < 0) i += n;
-    i0 = static_cast<int>(i);
-    i1 = i0 + 1 == n ? 0 : i0 + 1;
-}
-
-inline void axis_clamp(double u, int n, int& i0, int& i1, float& t) {
-    u -= 0.5;
-    if (u <= 0) { i0 = i1 = 0; t = 0; return; }
-    if (u >= n - 1) { i0 = i1 = n - 1; t = 0; return; }
-    i0 = static_cast<int>(u);
-    i1 = i0 + 1;
-    t = static_cast<float>(u - i0);
-}
+using detail::axis_clamp;
+using detail::axis_wrap;
 
 inline float lerp2(const float* p, int nx, const Bilinear& b) {
     const float* r0 = p + size_t(b.y0) * size_t(nx);

@@ -24,6 +24,27 @@
 
 namespace atlas::render::detail {
 
+// Linear-interpolation weights along one axis for a continuous texel coordinate u
+// (texel centres at i + 0.5): clamped to the grid, or wrapped (tiling textures).
+inline void axis_clamp(double u, int n, int& i0, int& i1, float& t) {
+    u -= 0.5;
+    if (u <= 0) { i0 = i1 = 0; t = 0; return; }
+    if (u >= n - 1) { i0 = i1 = n - 1; t = 0; return; }
+    i0 = static_cast<int>(u);
+    i1 = i0 + 1;
+    t = static_cast<float>(u - i0);
+}
+
+inline void axis_wrap(double u, int n, int& i0, int& i1, float& t) {
+    u -= 0.5;
+    const double f = std::floor(u);
+    t = static_cast<float>(u - f);
+    long long i = static_cast<long long>(f) % n;
+    if (i < 0) i += n;
+    i0 = static_cast<int>(i);
+    i1 = i0 + 1 == n ? 0 : i0 + 1;
+}
+
 inline bool finite3(const Vec3d& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 
 inline Vec3d normalized(const Vec3d& v) { return v / length(v); }
