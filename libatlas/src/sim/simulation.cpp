@@ -520,6 +520,42 @@ Lattice component_lattice(const GridSpec& g, int c) { return c == 0 ? u_lattice(
 bool component_moves(const GridSpec& g, int c) { return (c == 0 ? g.nx : c == 1 ? g.ny : g.nz) > 1; }
 } // namespace
 
+// Advects theta, qv, qc (and qr) by `vel` over dt on the cell lattice. Reversible
+// mode: theta_e (conserved by reversible moist adiabatic motion) is what gets
+// advected; theta is recovered afterwards at the new level.
+void Simulation::advect_scalars(const MacVelocity& vel, const Lattice& cl, double dt) {
+    const int nz = spec_.nz;
+    const size_t plane = size_t(spec_.nx) * spec_.ny;
+    if (opt_.reversible_theta_e && opt_.moist) {
+        for_slices(nz, [&](int k) {
+            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
+            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
+                theta_[c] = float(equivalent_potential_temperature(theta_[c] * pi, p, qv_[c], double(qv_[c]) + qc_[c]));
+        });
+    }
+    {
+        std::vector<float>&a = scalar_tmp_[0], &b = scalar_tmp_[1], &c = scalar_tmp_[2];
+        a.resize(theta_.size());
+        b.resize(theta_.size());
+        c.resize(qr_.size());
+        std::span<const float> in[4] = {theta_, qv_, qc_, qr_};
+        std::span<float> out[4] = {tmp_, a, b, c};
+        advect_many(vel, cl, std::span(in, qr_.empty() ? 3 : 4), std::span(out, qr_.empty() ? 3 : 4), dt, opt_.scheme,
+                    *scratch_);
+        theta_.swap(tmp_);
+        qv_.swap(a);
+        qc_.swap(b);
+        qr_.swap(c);
+    }
+    if (opt_.reversible_theta_e && opt_.moist) {
+        for_slices(nz, [&](int k) {
+            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
+            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
+                theta_[c] = float(temperature_from_theta_e(theta_[c], p, qv_[c], double(qv_[c]) + qc_[c]) / pi);
+        });
+    }
+}
+
 void Simulation::substep_trapezoidal(double dt, StepReport& rep) {
     const int nz = spec_.nz;
     const size_t plane = size_t(spec_.nx) * spec_.ny;
@@ -565,34 +601,7 @@ void Simulation::substep_trapezoidal(double dt, StepReport& rep) {
     // 1. Advection along the time-centred trajectory.
     t0 = Clock::now();
     const Lattice cl = cell_lattice(spec_);
-    if (opt_.reversible_theta_e && opt_.moist) {
-        for_slices(nz, [&](int k) {
-            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
-            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
-                theta_[c] = float(equivalent_potential_temperature(theta_[c] * pi, p, qv_[c], double(qv_[c]) + qc_[c]));
-        });
-    }
-    {
-        std::vector<float>&a = scalar_tmp_[0], &b = scalar_tmp_[1], &c = scalar_tmp_[2];
-        a.resize(theta_.size());
-        b.resize(theta_.size());
-        c.resize(qr_.size());
-        std::span<const float> in[4] = {theta_, qv_, qc_, qr_};
-        std::span<float> out[4] = {tmp_, a, b, c};
-        advect_many(vel_prev_, cl, std::span(in, qr_.empty() ? 3 : 4), std::span(out, qr_.empty() ? 3 : 4), dt,
-                    opt_.scheme, *scratch_);
-        theta_.swap(tmp_);
-        qv_.swap(a);
-        qc_.swap(b);
-        qr_.swap(c);
-    }
-    if (opt_.reversible_theta_e && opt_.moist) {
-        for_slices(nz, [&](int k) {
-            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
-            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
-                theta_[c] = float(temperature_from_theta_e(theta_[c], p, qv_[c], double(qv_[c]) + qc_[c]) / pi);
-        });
-    }
+    advect_scalars(vel_prev_, cl, dt);
     for_components(grad_, [&](std::vector<float>& g, int c) {
         if (!component_moves(spec_, c)) return;
         std::span<const float> qs[1] = {g};
@@ -688,36 +697,7 @@ void Simulation::substep(double dt, StepReport& rep) {
         refl(vel_tmp_.v, vel_.v);
         refl(vel_tmp_.w, vel_.w);
     }
-    // Reversible mode: theta_e (conserved by reversible moist adiabatic motion)
-    // is what gets advected; theta is recovered afterwards at the new level.
-    if (opt_.reversible_theta_e && opt_.moist) {
-        for_slices(nz, [&](int k) {
-            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
-            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
-                theta_[c] = float(equivalent_potential_temperature(theta_[c] * pi, p, qv_[c], double(qv_[c]) + qc_[c]));
-        });
-    }
-    {
-        std::vector<float>&a = scalar_tmp_[0], &b = scalar_tmp_[1], &c = scalar_tmp_[2];
-        a.resize(theta_.size());
-        b.resize(theta_.size());
-        c.resize(qr_.size());
-        std::span<const float> in[4] = {theta_, qv_, qc_, qr_};
-        std::span<float> out[4] = {tmp_, a, b, c};
-        advect_many(vel_, cl, std::span(in, qr_.empty() ? 3 : 4), std::span(out, qr_.empty() ? 3 : 4), dt, opt_.scheme,
-                    *scratch_);
-        theta_.swap(tmp_);
-        qv_.swap(a);
-        qc_.swap(b);
-        qr_.swap(c);
-    }
-    if (opt_.reversible_theta_e && opt_.moist) {
-        for_slices(nz, [&](int k) {
-            const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
-            for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
-                theta_[c] = float(temperature_from_theta_e(theta_[c], p, qv_[c], double(qv_[c]) + qc_[c]) / pi);
-        });
-    }
+    advect_scalars(vel_, cl, dt);
     if (!reflect) {
         advect_velocity(vel_, vel_tmp_, dt, opt_.scheme, *scratch_);
         std::swap(vel_, vel_tmp_);

@@ -245,6 +245,7 @@ public:
 private:
     void substep(double dt, StepReport& rep);
     void substep_trapezoidal(double dt, StepReport& rep);
+    void advect_scalars(const MacVelocity& vel, const Lattice& cl, double dt);
     void buoyancy(double dt) { buoyancy_into(vel_, dt); }
     void buoyancy_into(MacVelocity& v, double dt);
     void add_sources(double dt, StepReport& rep);
