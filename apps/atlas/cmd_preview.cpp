@@ -204,26 +204,36 @@ struct LayerInputs {
     Field3DPtr low, high;
     Field2DPtr curl, lut;
 };
-LayerInputs cook_layer_inputs(int jobs, const std::optional<std::filesystem::path>& cache_dir, ProgressSink progress, bool quiet) {
-    Session s(builtin_nodes());
-    s.load_text("atlas: 1\n"
-                "nodes:\n"
-                "  hzd_noise: {type: noise/hzd_set, params: {low_size: 128, high_size: 32, curl_size: 128, seed: 0}}\n"
-                "  profile_lut: {type: ndf/profile_lut, params: {resolution: [97, 128]}}\n"
-                "outputs:\n"
-                "  - {node: hzd_noise, port: low, file: low.exr}\n"
-                "  - {node: hzd_noise, port: high, file: high.exr}\n"
-                "  - {node: hzd_noise, port: curl, file: curl.exr}\n"
-                "  - {node: profile_lut, file: lut.exr}\n",
-                "<preview layer inputs>", ".");
+// Cooks a small built-in graph (no files written) through the same cache as the
+// previewed graph, so a second preview cooks nothing; prints what it did.
+CookOptions cook_builtin(Session& s, const std::string& text, const std::string& what, int jobs,
+                         const std::optional<std::filesystem::path>& cache_dir, ProgressSink progress, bool quiet) {
+    s.load_text(text, "<preview " + what + ">", ".");
     CookOptions o;
     o.write_outputs = false;
     o.jobs = jobs;
     o.cache_dir = cache_dir;
     o.progress = std::move(progress);
     const CookResult r = s.cook(o);
-    if (!quiet) std::fprintf(stderr, "noise/hzd_set + ndf/profile_lut: cooked %zu, cached %zu in %.2f s\n", r.with_status("cooked").size(),
-                             r.with_status("cached").size(), r.seconds);
+    if (!quiet)
+        std::fprintf(stderr, "%s: cooked %zu, cached %zu in %.2f s\n", what.c_str(), r.with_status("cooked").size(), r.with_status("cached").size(),
+                     r.seconds);
+    return o;
+}
+
+LayerInputs cook_layer_inputs(int jobs, const std::optional<std::filesystem::path>& cache_dir, ProgressSink progress, bool quiet) {
+    Session s(builtin_nodes());
+    const CookOptions o = cook_builtin(s,
+                                       "atlas: 1\n"
+                                       "nodes:\n"
+                                       "  hzd_noise: {type: noise/hzd_set, params: {low_size: 128, high_size: 32, curl_size: 128, seed: 0}}\n"
+                                       "  profile_lut: {type: ndf/profile_lut, params: {resolution: [97, 128]}}\n"
+                                       "outputs:\n"
+                                       "  - {node: hzd_noise, port: low, file: low.exr}\n"
+                                       "  - {node: hzd_noise, port: high, file: high.exr}\n"
+                                       "  - {node: hzd_noise, port: curl, file: curl.exr}\n"
+                                       "  - {node: profile_lut, file: lut.exr}\n",
+                                       "noise/hzd_set + ndf/profile_lut", jobs, cache_dir, std::move(progress), quiet);
     LayerInputs in;
     in.low = std::get<Field3DPtr>(s.get("hzd_noise", "low", o));
     in.high = std::get<Field3DPtr>(s.get("hzd_noise", "high", o));
@@ -234,16 +244,10 @@ LayerInputs cook_layer_inputs(int jobs, const std::optional<std::filesystem::pat
 
 Field3DPtr cook_voxel_noise(int jobs, const std::optional<std::filesystem::path>& cache_dir, ProgressSink progress, bool quiet) {
     Session s(builtin_nodes());
-    s.load_text("atlas: 1\nnodes:\n  nubis_noise: {type: noise/nubis_set, params: {size: 128, seed: 0}}\n"
-                "outputs:\n  - {node: nubis_noise, file: nubis_noise.exr}\n",
-                "<preview voxel noise>", ".");
-    CookOptions o;
-    o.write_outputs = false;
-    o.jobs = jobs;
-    o.cache_dir = cache_dir;
-    o.progress = std::move(progress);
-    const CookResult r = s.cook(o);
-    if (!quiet) std::fprintf(stderr, "noise/nubis_set: cooked %zu, cached %zu in %.2f s\n", r.with_status("cooked").size(), r.with_status("cached").size(), r.seconds);
+    const CookOptions o = cook_builtin(s,
+                                       "atlas: 1\nnodes:\n  nubis_noise: {type: noise/nubis_set, params: {size: 128, seed: 0}}\n"
+                                       "outputs:\n  - {node: nubis_noise, file: nubis_noise.exr}\n",
+                                       "noise/nubis_set", jobs, cache_dir, std::move(progress), quiet);
     return std::get<Field3DPtr>(s.get("nubis_noise", "out", o));
 }
 
