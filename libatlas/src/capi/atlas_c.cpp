@@ -189,6 +189,21 @@ atlas::Value get_value(AtlasSession* s, const char* node, const char* port, cons
 }
 
 
+// Creates a handle: no exception crosses into C (a failed allocation is a status).
+template <class T>
+AtlasStatus create_handle(T** out) {
+    if (!out) return ATLAS_INVALID_ARGUMENT;
+    *out = nullptr;
+    try {
+        *out = new T();
+        return ATLAS_OK;
+    } catch (const std::bad_alloc&) {
+        return ATLAS_OUT_OF_MEMORY;
+    } catch (...) {
+        return ATLAS_ERROR;
+    }
+}
+
 } // namespace
 
 extern "C" {
@@ -208,18 +223,7 @@ const char* atlas_status_name(AtlasStatus status) {
 
 const char* atlas_version(void) { return ATLAS_VERSION_STRING; }
 
-AtlasStatus atlas_session_create(AtlasSession** out) {
-    if (!out) return ATLAS_INVALID_ARGUMENT;
-    *out = nullptr;
-    try {
-        *out = new AtlasSession();
-        return ATLAS_OK;
-    } catch (const std::bad_alloc&) {
-        return ATLAS_OUT_OF_MEMORY;
-    } catch (...) {
-        return ATLAS_ERROR;
-    }
-}
+AtlasStatus atlas_session_create(AtlasSession** out) { return create_handle(out); }
 
 void atlas_session_destroy(AtlasSession* session) { delete session; }
 
@@ -602,18 +606,7 @@ const atlas::ParamValue& param_of(const AtlasCookContext* c, const char* name, a
 
 extern "C" {
 
-AtlasStatus atlas_registry_create(AtlasRegistry** out) {
-    if (!out) return ATLAS_INVALID_ARGUMENT;
-    *out = nullptr;
-    try {
-        *out = new AtlasRegistry();
-        return ATLAS_OK;
-    } catch (const std::bad_alloc&) {
-        return ATLAS_OUT_OF_MEMORY;
-    } catch (...) {
-        return ATLAS_ERROR;
-    }
-}
+AtlasStatus atlas_registry_create(AtlasRegistry** out) { return create_handle(out); }
 
 void atlas_registry_destroy(AtlasRegistry* registry) { delete registry; }
 
