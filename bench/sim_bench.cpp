@@ -1,6 +1,6 @@
 // Cloud solver benchmarks: time per step at 64^3 / 128^3 (256^3 on request)
 // with the divergence residual, and the dry Bryan & Fritsch (2002) case.
-// Run:  build-sim/bench/sim_bench --benchmark_filter=...
+// Run:  build/bench/sim_bench --benchmark_filter=...
 #include "atlas/sim/simulation.h"
 #include "atlas/sim/thermo.h"
 

@@ -20,10 +20,10 @@
 //  BryanFritsch: their dry case (20 x 10 km, 2 K, radius 2 km, 2 km up, 1000 s)
 //               at 400/200/100 m against the 50 m run, the same way.
 //
-// Run:   build-sim/bench/sim_convergence_bench --benchmark_filter=Convergence
+// Run:   build/bench/sim_convergence_bench --benchmark_filter=Convergence
 //        (ConvergenceRotation, ConvergenceTaylorGreen[Viscous], ConvergenceThermal;
 //         Smoke for CI, < 1 s)
-//        build-sim/bench/sim_convergence_bench --benchmark_filter=DensityCurrent_200
+//        build/bench/sim_convergence_bench --benchmark_filter=DensityCurrent_200
 //        (Straka et al. 1993 density current: peak w against CFL and the step
 //         tolerance, both time schemes; DensityCurrent_100 at the published 100 m)
 #include "atlas/sim/simulation.h"
