@@ -190,12 +190,12 @@ atlas::Value get_value(AtlasSession* s, const char* node, const char* port, cons
 
 
 // Creates a handle: no exception crosses into C (a failed allocation is a status).
-template <class T>
-AtlasStatus create_handle(T** out) {
+template <class T, class... Args>
+AtlasStatus create_handle(T** out, const Args&... args) {
     if (!out) return ATLAS_INVALID_ARGUMENT;
     *out = nullptr;
     try {
-        *out = new T();
+        *out = new T(args...);
         return ATLAS_OK;
     } catch (const std::bad_alloc&) {
         return ATLAS_OUT_OF_MEMORY;
@@ -659,17 +659,9 @@ AtlasStatus atlas_registry_add_node(AtlasRegistry* r, const char* declaration_js
 }
 
 AtlasStatus atlas_session_create_with_registry(const AtlasRegistry* registry, AtlasSession** out) {
-    if (!out) return ATLAS_INVALID_ARGUMENT;
-    *out = nullptr;
+    if (out) *out = nullptr;
     if (!registry) return ATLAS_INVALID_ARGUMENT;
-    try {
-        *out = new AtlasSession(registry->registry);
-        return ATLAS_OK;
-    } catch (const std::bad_alloc&) {
-        return ATLAS_OUT_OF_MEMORY;
-    } catch (...) {
-        return ATLAS_ERROR;
-    }
+    return create_handle(out, registry->registry);
 }
 
 const char* atlas_cook_node_name(const AtlasCookContext* c) { return c && c->ctx ? c->ctx->node_name().c_str() : ""; }
