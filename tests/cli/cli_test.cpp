@@ -5,6 +5,8 @@
 #include "atlas/core/files.h"
 #include "atlas/compress/texture.h"
 
+#include "../support/cli_run.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -23,25 +25,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-    int status = -1;
-    std::string out, err;
-};
+using atlas::test::CliRun;
 
 CliRun run(const std::string& args) {
     // ctest runs the tests of this file as parallel processes: one directory each.
     fs::path dir = fs::temp_directory_path() / ("atlas_cli_test_" + std::to_string(::getpid()));
     fs::create_directories(dir);
-    std::string cmd = std::string(ATLAS_BINARY_DIR) + "/bin/atlas " + args + " 2>" + (dir / "err").string();
-    CliRun r;
-    FILE* p = popen(cmd.c_str(), "r");
-    std::array<char, 4096> buf;
-    size_t n;
-    while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-    int st = pclose(p);
-    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    r.err = atlas::read_file_bytes(dir / "err");
-    return r;
+    return atlas::test::run_shell(atlas::test::atlas_program() + " " + args + " 2>" + (dir / "err").string(), dir / "err");
 }
 
 fs::path write_graph(const std::string& name, const std::string& text) {

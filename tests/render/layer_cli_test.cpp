@@ -6,6 +6,8 @@
 #include "atlas/io/exr.h"
 #include "atlas/io/readers.h"
 
+#include "../support/cli_run.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -22,10 +24,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-    int status = -1;
-    std::string out, err;
-};
+using atlas::test::CliRun;
 
 fs::path work_dir() {
     fs::path d = fs::temp_directory_path() / ("atlas_layer_cli_" + std::to_string(::getpid()));
@@ -37,17 +36,9 @@ fs::path work_dir() {
 // cooks once).
 CliRun run_atlas(const std::string& args) {
     const fs::path dir = work_dir();
-    const std::string cmd = "cd " + dir.string() + " && ATLAS_CACHE_DIR= " + std::string(ATLAS_BINARY_DIR) + "/bin/atlas " + args +
-                            " --cache " + (dir / "cache").string() + " 2>err.txt";
-    CliRun r;
-    FILE* p = popen(cmd.c_str(), "r");
-    std::array<char, 4096> buf;
-    size_t n;
-    while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-    const int st = pclose(p);
-    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    r.err = atlas::read_file_bytes(dir / "err.txt");
-    return r;
+    return atlas::test::run_shell("cd " + dir.string() + " && ATLAS_CACHE_DIR= " + atlas::test::atlas_program() + " " + args + " --cache " +
+                                      (dir / "cache").string() + " 2>err.txt",
+                                  dir / "err.txt");
 }
 
 const char* kLayerGraph = R"(atlas: 1

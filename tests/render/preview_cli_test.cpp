@@ -5,6 +5,8 @@
 #include "atlas/core/files.h"
 #include "atlas/io/readers.h"
 
+#include "../support/cli_run.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -18,10 +20,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-    int status = -1;
-    std::string out, err;
-};
+using atlas::test::CliRun;
 
 fs::path work_dir() {
     fs::path d = fs::temp_directory_path() / ("atlas_preview_cli_" + std::to_string(::getpid()));
@@ -31,16 +30,8 @@ fs::path work_dir() {
 
 CliRun run_atlas(const std::string& args) {
     const fs::path dir = work_dir();
-    const std::string cmd = "cd " + dir.string() + " && ATLAS_CACHE_DIR= " + std::string(ATLAS_BINARY_DIR) + "/bin/atlas " + args + " 2>err.txt";
-    CliRun r;
-    FILE* p = popen(cmd.c_str(), "r");
-    std::array<char, 4096> buf;
-    size_t n;
-    while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-    const int st = pclose(p);
-    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    r.err = atlas::read_file_bytes(dir / "err.txt");
-    return r;
+    return atlas::test::run_shell("cd " + dir.string() + " && ATLAS_CACHE_DIR= " + atlas::test::atlas_program() + " " + args + " 2>err.txt",
+                                  dir / "err.txt");
 }
 
 // A tiny graph: noise -> remap -> sdf -> nvdf, writing the NVDF set.
