@@ -44,7 +44,7 @@ const std::vector<Command>& commands() {
           {"--one-sided", "below", "guarantee decoded <= source (SDFs for sphere tracing); mips are min-reduced"},
           {"--allow-over-bound", "", "write the texture even when some blocks miss --max-error (they are listed)"},
           {"--decoders", "LIST", "comma-separated decoder models the bounds hold for: " + compress::decoder_names() + " (default all)"},
-          {"--mips", "N|full", "mip levels (default 1)"},
+          {"--mips", "N|full", "mip levels: 1.." + std::to_string(compress::kMaxMipLevels) + " or full (default 1, as the dds output's 'mips')"},
           {"--range", "LO,HI", "source values mapped to the format's 0..1 (default: the data's min and max)"},
           {"--channels", "NAMES", "comma-separated input channels to store"},
           {"--array", "", "store a 3D input as a 2D texture array instead of a volume"},

@@ -7,6 +7,7 @@
 #include "atlas/io/readers.h"
 #include "atlas/io/writers.h"
 
+#include <charconv>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -49,9 +50,20 @@ compress::CompressOptions parse_compress_options(const Args& a, const Field3D& f
     }
     o.allow_over_bound = a.has("--allow-over-bound");
     if (a.has("--mips")) {
+        // The same rule as the graph's dds option `mips`: a whole number of levels
+        // 1..kMaxMipLevels, or 'full'.
         const std::string m = a.get("--mips");
-        o.mip_levels = m == "full" ? 0 : int(parse_float(m, "--mips"));
-        if (o.mip_levels < 0) throw UsageError{"--mips expects a level count >= 1 or 'full'", "compress"};
+        const std::string expected = "--mips expects a whole number of levels from 1 to " + std::to_string(compress::kMaxMipLevels) +
+                                     ", or 'full', got '" + m + "'";
+        if (m == "full") {
+            o.mip_levels = 0;
+        } else {
+            int n = 0;
+            const auto [end, ec] = std::from_chars(m.data(), m.data() + m.size(), n);
+            if (ec != std::errc() || end != m.data() + m.size() || n < 1 || n > compress::kMaxMipLevels)
+                throw UsageError{expected, "compress"};
+            o.mip_levels = n;
+        }
     }
     if (a.has("--range")) {
         auto parts = split(a.get("--range"), ',');

@@ -474,3 +474,32 @@ TEST(CliUnattended, OutDotWritesIntoNewDirectories) {
     EXPECT_EQ(std::system(("cd " + d.string() + " && " + cook + " >/dev/null").c_str()), 0);
     EXPECT_TRUE(fs::exists(d / "new" / "sub" / "n.exr"));
 }
+
+// `atlas compress --mips` takes what the graph's dds option `mips` takes (issue 13:
+// the CLI gave a full chain for 0, truncated 2.7 and accepted 17).
+TEST(CliForeign, CompressMipsAgreesWithTheGraphOption) {
+    fs::path dir = fs::temp_directory_path() / ("atlas_cli_mips_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    auto g = write_graph("mips.yaml", "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params: {resolution: [32, 32, 1]}\noutputs:\n"
+                                      "  - {node: n, file: n.exr}\n");
+    ASSERT_EQ(run("cook " + g.string() + " --out " + dir.string() + " --quiet").status, 0);
+    const std::string in = (dir / "n.exr").string();
+    for (const std::string bad : {"0", "2.7", "17", "-1", "two", ""}) {
+        CliRun c = run("compress " + in + " --format r8 --quiet --mips '" + bad + "' -o " + (dir / "x.dds").string());
+        EXPECT_EQ(c.status, 2) << "--mips " << bad << " was accepted";
+        EXPECT_NE(c.err.find("--mips expects a whole number of levels from 1 to 16"), std::string::npos) << c.err;
+        EXPECT_FALSE(fs::exists(dir / "x.dds"));
+        // The graph's option refuses the same value (validate cooks nothing).
+        auto gb = write_graph("mips_bad.yaml", "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params: {resolution: [32, 32, 1]}\noutputs:\n"
+                                               "  - {node: n, file: x.dds, options: {encoding: r8, mips: '" + bad + "'}}\n");
+        EXPECT_NE(run("cook " + gb.string() + " --out " + (dir / "g").string() + " --quiet --no-cache").status, 0) << "graph mips " << bad;
+    }
+    for (const std::string good : {"1", "3", "full"}) {
+        CliRun c = run("compress " + in + " --format r8 --quiet --mips " + good + " -o " + (dir / "y.dds").string());
+        EXPECT_EQ(c.status, 0) << good << ": " << c.err;
+        const atlas::compress::DdsTexture t = atlas::compress::read_dds_file(dir / "y.dds");
+        EXPECT_EQ(t.mip_levels, good == "full" ? 6 : std::stoi(good)) << good;
+    }
+    fs::remove_all(dir);
+}

@@ -28,7 +28,7 @@ std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path,
         c.one_sided_below = true;
     }
     c.allow_over_bound = o.flag("allow_over_bound");
-    if (o.has("mips")) c.mip_levels = o.text("mips") == "full" ? 0 : o.integer("mips", 1, 1, 16);
+    if (o.has("mips")) c.mip_levels = o.text("mips") == "full" ? 0 : o.integer("mips", 1, 1, compress::kMaxMipLevels);
     if (o.has("range")) c.value_range = o.range("range", 0.0f, 1.0f);
     for (const auto& name : o.list("channels")) {
         const int ch = field->find_channel(name);

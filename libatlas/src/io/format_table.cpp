@@ -134,7 +134,7 @@ const std::vector<FormatEntry>& format_table() {
            {"one_sided", "'below': guarantee decoded <= source (SDF field data)"},
            {"allow_over_bound", "true: write even when blocks miss max_error"},
            {"decoders", "comma-separated decoder models the bounds hold for: " + compress::decoder_names() + " (default all)"},
-           {"mips", "mip levels, or 'full' (default 1)"},
+           {"mips", "mip levels 1.." + std::to_string(compress::kMaxMipLevels) + ", or 'full' (default 1)"},
            {"range", "'lo,hi': source values mapped to 0..1 (default: the data's min and max)"},
            {"array", "true: a 3D field becomes a 2D texture array instead of a volume"},
            kChannels},

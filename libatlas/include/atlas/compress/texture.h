@@ -32,6 +32,10 @@ namespace fs = std::filesystem;
 // one-sided search that never falls back to black.
 constexpr int kEncoderVersion = 2;
 
+// The most mip levels a front end asks for by number (a 65536 texture has 17
+// levels; "full" asks for all of them).
+constexpr int kMaxMipLevels = 16;
+
 enum class Format {
     Bc1,       // RGB, 4 bpp
     Bc1Scalar, // one channel across RGB565 (Nubis field data), 4 bpp
@@ -61,7 +65,8 @@ struct CompressOptions {
     // Mips are then min-reduced so every mip texel is <= the level-0 texels it covers.
     bool one_sided_below = false;
     bool allow_over_bound = false;
-    // 1 = no mips, 0 = full chain, n = n levels. Volumes get 3D mips (2x2x2).
+    // 1 = no mips, 0 = full chain, n = n levels (front ends accept 1..kMaxMipLevels or
+    // "full"). Volumes get 3D mips (2x2x2).
     int mip_levels = 1;
     DecoderSet decoders = kAllDecoders;
     // Source range mapped to the normalized range; empty = the data's min and max.
