@@ -28,9 +28,7 @@ namespace {
 using atlas::test::CliRun;
 
 CliRun run(const std::string& args) {
-    // ctest runs the tests of this file as parallel processes: one directory each.
-    fs::path dir = fs::temp_directory_path() / ("atlas_cli_test_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
+    const fs::path dir = atlas::test::process_dir("atlas_cli_test");
     return atlas::test::run_shell(atlas::test::atlas_program() + " " + args + " 2>" + (dir / "err").string(), dir / "err");
 }
 

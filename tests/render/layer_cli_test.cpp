@@ -26,11 +26,7 @@ namespace {
 
 using atlas::test::CliRun;
 
-fs::path work_dir() {
-    fs::path d = fs::temp_directory_path() / ("atlas_layer_cli_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-}
+fs::path work_dir() { return atlas::test::process_dir("atlas_layer_cli"); }
 
 // Runs atlas with a cache shared by the tests of this file (the HZD noise
 // cooks once).

@@ -22,11 +22,7 @@ namespace {
 
 using atlas::test::CliRun;
 
-fs::path work_dir() {
-    fs::path d = fs::temp_directory_path() / ("atlas_preview_cli_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-}
+fs::path work_dir() { return atlas::test::process_dir("atlas_preview_cli"); }
 
 CliRun run_atlas(const std::string& args) {
     const fs::path dir = work_dir();

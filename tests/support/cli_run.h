@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace atlas::test {
 
@@ -16,6 +17,14 @@ struct CliRun {
     int status = -1; // exit status, -1 when the program did not exit normally
     std::string out, err;
 };
+
+// A scratch directory for this test process (ctest runs every test of a file as
+// its own process, in parallel): TEMP/NAME_PID, created if missing.
+inline std::filesystem::path process_dir(const std::string& name) {
+    std::filesystem::path d = std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(d);
+    return d;
+}
 
 // The build's atlas program (ATLAS_BINARY_DIR is set for every test target).
 inline std::string atlas_program() { return std::string(ATLAS_BINARY_DIR) + "/bin/atlas"; }
