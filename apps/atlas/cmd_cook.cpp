@@ -5,6 +5,7 @@
 #include "atlas/core/files.h"
 #include "atlas/core/memory.h"
 #include "atlas/graph/evaluator.h"
+#include "atlas/graph/tiling.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -58,6 +59,57 @@ void write_text_atomic(const std::string& path, const std::string& text, const s
 }
 } // namespace
 
+namespace {
+// "NX,NY" / "I,J" of --tiles and --tile.
+Vec2i parse_pair(const Args& a, const std::string& flag, int min) {
+    const std::string v = a.get(flag);
+    const auto comma = v.find(',');
+    try {
+        size_t u0 = 0, u1 = 0;
+        if (comma == std::string::npos) throw 0;
+        const int x = std::stoi(v.substr(0, comma), &u0), y = std::stoi(v.substr(comma + 1), &u1);
+        if (u0 != comma || u1 != v.size() - comma - 1 || x < min || y < min) throw 0;
+        return {{x, y}};
+    } catch (...) {
+        throw UsageError{flag + " expects two integers >= " + std::to_string(min) + " as X,Y, got '" + v + "'", "cook"};
+    }
+}
+
+// atlas cook GRAPH --tiles NX,NY [--tile I,J] [--assemble] (docs/scale.md).
+int run_cook_tiled(const Args& a, CookOptions o) {
+    if (a.positional.size() != 1) throw UsageError{"--tiles cooks one graph file, got " + std::to_string(a.positional.size()), "cook"};
+    if (!a.has("--tiles")) throw UsageError{"--tile and --assemble need --tiles NX,NY", "cook"};
+    for (const char* f : {"--report", "--depfile"})
+        if (a.has(f)) throw UsageError{std::string(f) + " is not supported with --tiles (the tile index lists every file)", "cook"};
+    TileOptions t;
+    t.tiles = parse_pair(a, "--tiles", 1);
+    if (a.has("--tile")) t.only = parse_pair(a, "--tile", 0);
+    t.assemble = a.has("--assemble");
+    if (t.only && t.assemble) throw UsageError{"--assemble needs every tile: it cannot be combined with --tile", "cook"};
+    t.graph_name = a.positional[0];
+    Session session(builtin_nodes());
+    session.load(a.positional[0]);
+    apply_sets(session, a, "cook");
+    o.outputs = a.all("--output");
+    ProgressBar bar(!a.has("--quiet"));
+    o.progress = bar.sink();
+    TiledCookResult r;
+    try {
+        r = cook_tiled(session, o, t);
+    } catch (...) {
+        bar.finish();
+        throw;
+    }
+    bar.finish();
+    size_t cooked = 0;
+    for (const auto& tr : r.tiles_done) cooked += tr.status == "cooked";
+    std::cout << "cooked " << cooked << " of " << r.tiles_done.size() << " tiles (" << r.tiles[0] << " x " << r.tiles[1] << " over " << r.grid[0]
+              << " x " << r.grid[1] << " texels) in " << r.seconds << " s; wrote " << r.written.size() << " files to " << o.out_dir.string() << "\n";
+    for (const auto& p : r.written) std::cout << p.string() << "\n";
+    return 0;
+}
+} // namespace
+
 int run_cook(const Args& a) {
     if (a.positional.empty()) throw UsageError{"expected a graph file (or several)", "cook"};
     const bool quiet = a.has("--quiet");
@@ -83,6 +135,8 @@ int run_cook(const Args& a) {
         if (!o.cache_dir) throw UsageError{"--cache-max-size needs a cache (--cache DIR or ATLAS_CACHE_DIR)", "cook"};
         o.cache_max_bytes = parse_byte_size(a.get("--cache-max-size"));
     }
+
+    if (a.has("--tiles") || a.has("--tile") || a.has("--assemble")) return run_cook_tiled(a, o);
 
     // Every graph cooks in its own session (one graph's nodes never see
     // another's) with the same options, so they share the disk cache.

@@ -6,6 +6,7 @@ using namespace atlas;
 
 void declare(NodeDeclaration& d) {
     d.doc("A 3D field of the given resolution and world bounds, every voxel set to `value`.");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field3D, "the constant field");
     d.param_int3("resolution", {{64, 64, 16}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z");
     d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");

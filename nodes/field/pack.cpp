@@ -13,6 +13,7 @@ void declare(NodeDeclaration& d) {
           "e.g. four noises into an RGBA noise volume.");
     d.input("r", PortType::Field, "first channel");
     for (int i = 1; i < 4; ++i) d.input(kPorts[i], PortType::Field, std::string("channel ") + kPorts[i] + " (optional)").optional = true;
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field, "the packed field, same dimensionality as the inputs");
     d.param_string("names", "r,g,b,a").describe("comma-separated channel names of the result, one per connected input");
 }

@@ -8,6 +8,7 @@ using namespace atlas;
 void declare(NodeDeclaration& d) {
     d.doc("Trilinear (bilinear for 2D) resampling onto a new resolution; bounds default to the input's.");
     d.input("in", PortType::Field, "field to resample");
+    d.tiling(TileRule::none("it changes the grid (tiles are regions of one grid)"));
     d.output("out", PortType::Field, "resampled field, same dimensionality");
     d.param_int3("resolution", {{64, 64, 16}}).range(1, 65536).with_unit("voxels").describe("new resolution (z ignored for 2D)");
     d.param_bool("keep_bounds", true).describe("keep the input's world bounds (else use bounds_min/bounds_max)");

@@ -9,6 +9,7 @@ using namespace atlas;
 
 void declare(NodeDeclaration& d) {
     d.doc("Reads an OpenEXR file: Atlas's 3D layout (slices stacked, bounds in the header) or a plain 2D image.");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field, "the field (3D when the file carries atlas:resolution, else 2D)");
     d.param_path("file").describe("EXR file, relative to the graph file");
 }

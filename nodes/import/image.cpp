@@ -9,6 +9,7 @@ using namespace atlas;
 
 void declare(NodeDeclaration& d) {
     d.doc("Reads an image through OpenImageIO as a 2D field over the given world bounds; 8/16-bit values map to 0..1.");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field2D, "the image as a 2D field (row 0 is the bottom row)");
     d.param_path("file").describe("image file, relative to the graph file");
     d.param_float2("bounds_min", {{0, 0}}).with_unit("m").describe("world-space minimum corner");

@@ -10,6 +10,7 @@ using namespace atlas;
 void declare(NodeDeclaration& d) {
     d.doc("Reads a stack of TGA slices (NAME.001.tga, NAME.002.tga, ... or the Nubis pack's NAME(0).tga, NAME(1).tga, ...; one per z; "
           "uncompressed or RLE, 8-bit grey, 24 or 32 bits) as a 3D field with 8-bit values mapped to 0..1 (channels r, g, b, a).");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field3D, "the stack as a 3D field (x = column, y = row from the bottom, z = slice)");
     d.param_path("file").describe("the first slice (NAME.001.tga or NAME(0).tga), a pattern or DIR/NAME, relative to the graph file");
     d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");

@@ -19,6 +19,7 @@ std::vector<std::string> split_names(const std::string& s) {
 
 void declare(NodeDeclaration& d) {
     d.doc("Reads float (and Vec3f) grids from a VDB file, densified over their active bounds, one channel per grid.");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field3D, "dense field, one channel per grid (3 for a vector grid)");
     d.param_path("file").describe("VDB file, relative to the graph file");
     d.param_string("grids", "").describe("comma-separated grid names to read (empty: every float grid)");

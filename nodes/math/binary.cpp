@@ -11,6 +11,7 @@ void declare(NodeDeclaration& d) {
     d.doc("Per-voxel arithmetic a (op) b on 2D or 3D fields; b is a field of the same resolution (1 or N channels) or the constant `b`.");
     d.input("a", PortType::Field, "left operand");
     d.input("b", PortType::Field, "right operand; when unconnected the parameter `b` is used").optional = true;
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field, "result, same dimensionality and channels as a");
     d.param_enum("op", kOps, "add").describe("operation: add, sub, mul, div, min, max, pow");
     d.param_float("b", 0.0).describe("constant right operand when input b is unconnected");

@@ -8,6 +8,7 @@ using namespace atlas;
 void declare(NodeDeclaration& d) {
     d.doc("Clamps every value into [min, max]; NaN becomes min. With the defaults this is saturate (0..1).");
     d.input("in", PortType::Field, "field to clamp");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field, "clamped field");
     d.param_float("min", 0.0).describe("lower bound");
     d.param_float("max", 1.0).describe("upper bound (must be >= min)");

@@ -10,6 +10,7 @@ void declare(NodeDeclaration& d) {
     d.input("a", PortType::Field, "field at t = 0");
     d.input("b", PortType::Field, "field at t = 1, same resolution as a");
     d.input("t", PortType::Field, "blend mask; when unconnected the parameter `t` is used").optional = true;
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field, "the blend");
     d.param_float("t", 0.5).describe("constant blend factor when input t is unconnected (values outside 0..1 extrapolate)");
 }

@@ -8,6 +8,7 @@ using namespace atlas;
 void declare(NodeDeclaration& d) {
     d.doc("Fit range: maps [in_min, in_max] linearly onto [out_min, out_max], optionally clamping to the output range.");
     d.input("in", PortType::Field, "field to remap");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field, "remapped field");
     d.param_float("in_min", 0.0).describe("input value mapped to out_min");
     d.param_float("in_max", 1.0).describe("input value mapped to out_max (equal to in_min: everything maps to out_min)");

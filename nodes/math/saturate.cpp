@@ -8,6 +8,7 @@ using namespace atlas;
 void declare(NodeDeclaration& d) {
     d.doc("Clamps every value into [0, 1] (HLSL saturate); NaN becomes 0.");
     d.input("in", PortType::Field, "field to saturate");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field, "values in [0, 1]");
 }
 

@@ -2,6 +2,8 @@
 #include "atlas/ndf/operators.h"
 #include "ndf/ndf_params.h"
 
+#include <cmath>
+
 namespace {
 using namespace atlas;
 using namespace atlas::ndf_nodes;
@@ -9,6 +11,7 @@ using namespace atlas::ndf_nodes;
 void declare(NodeDeclaration& d) {
     d.doc("Separable Gaussian blur of every channel; kernel radius ceil(3 sigma).");
     d.input("in", PortType::Field2D, "map");
+    d.tiling(TileRule::with_halo([](const NodeParams& p) { return int(std::ceil(3 * p.get_float("sigma"))); }, [](const NodeParams& p) { return p.get_bool("tileable") ? std::string("tileable: true wraps around the map edges (set tileable: false to tile)") : std::string(); }));
     d.output("out", PortType::Field2D, "blurred map");
     d.param_float("sigma", 2.0).range(0, 4096).with_unit("texels").describe("standard deviation (0 copies)");
     d.param_bool("tileable", true).describe("wrap around the edges (keeps tileable maps tileable); else clamp");

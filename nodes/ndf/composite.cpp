@@ -12,6 +12,7 @@ void declare(NodeDeclaration& d) {
     d.input("a", PortType::Field2D, "base map");
     d.input("b", PortType::Field2D, "layer (a's channel count or 1 channel, a's resolution)");
     d.input("mask", PortType::Field2D, "optional 1-channel weight (default 1)").optional = true;
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field2D, "composited map");
     d.param_enum("mode", {"add", "multiply", "max", "min", "over", "lerp"}, "max").describe("how b combines with a");
     d.param_float("opacity", 1.0).describe("global weight of the layer");

@@ -7,6 +7,7 @@ using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
     d.doc("A 1-channel 2D map over the world XY plane, every texel set to `value`.");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field2D, "the constant map");
     declare_map(d);
     d.param_float("value", 0.0).describe("value of every texel");

@@ -11,6 +11,7 @@ using namespace atlas::ndf_nodes;
 void declare(NodeDeclaration& d) {
     d.doc("Maps every value through a monotone cubic spline (Fritsch-Carlson: no overshoot) through `points`; constant beyond the ends.");
     d.input("in", PortType::Field2D, "map");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field2D, "curved map");
     d.param_string("points", "0 0; 0.5 0.5; 1 1").describe("control points 'x y; x y; ...', x strictly increasing");
 }

@@ -8,6 +8,7 @@ using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
     d.doc("A ramp in [0, 1]: linear (0 at `start`, 1 at `end`, clamped) or radial (1 at `center`, 0 at `radius` and beyond).");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field2D, "the gradient (1 channel)");
     declare_map(d);
     d.param_enum("mode", {"linear", "radial"}, "linear").describe("ramp shape");

@@ -8,6 +8,7 @@ using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
     d.doc("Tileable 2D value-noise FBM in [0, 1] (atlas/noise value noise, z fixed); the map tiles exactly every `period` lattice cells.");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field2D, "noise map (1 channel)");
     declare_map(d);
     d.param_int2("period", {{8, 8}}).range(1, 4096).with_unit("cells").describe("lattice cells across the map per axis");

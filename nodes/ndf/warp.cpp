@@ -10,6 +10,7 @@ void declare(NodeDeclaration& d) {
     d.doc("Domain warp: out(p) = in(p + amount * (2 * warp(p) - 1)), bilinear; warp channel 0 moves x, channel 1 (or 0) moves y.");
     d.input("in", PortType::Field2D, "map to warp");
     d.input("warp", PortType::Field2D, "offsets in [0, 1] (0.5 = none), the resolution of `in`");
+    d.tiling(TileRule::none("it maps texels through the map's world bounds, which a cropped tile changes in the last bit (docs/scale.md)"));
     d.output("out", PortType::Field2D, "warped map");
     d.param_float("amount", 1000).with_unit("m").describe("largest offset");
     d.param_bool("tileable", true).describe("wrap lookups around the map (keeps tileable maps tileable); else clamp");

@@ -9,6 +9,7 @@ void declare(NodeDeclaration& d) {
     d.doc("The Horizon Zero Dawn noise set (GPU Pro 7): `low` RGBA = Perlin-Worley + 3 inverted-Worley FBMs, "
           "`high` RGB = 3 higher inverted-Worley FBMs, `curl` RG = 2D curl noise remapped to [0, 1]; all tile exactly. "
           "The recipe is noise::make_hzd_noise (docs/noise.md).");
+    d.tiling(TileRule::pointwise());
     d.output("low", PortType::Field3D, "low-frequency RGBA volume");
     d.output("high", PortType::Field3D, "high-frequency RGB volume");
     d.output("curl", PortType::Field2D, "2D curl texture (RG)");

@@ -10,6 +10,7 @@
 namespace atlas::noise_nodes {
 
 inline void declare_common(NodeDeclaration& d, Vec3i period = {{4, 4, 4}}) {
+    d.tiling(TileRule::pointwise()); // cooked whole and cropped (normalize included)
     d.output("out", PortType::Field, "the noise field (Field3D, or Field2D when dimensions = 2d)");
     d.param_enum("dimensions", {"3d", "2d"}, "3d").describe("Field3D, or Field2D over x, y");
     d.param_int3("resolution", {{128, 128, 128}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z (z unused in 2D)");

@@ -9,6 +9,7 @@ void declare(NodeDeclaration& d) {
     d.doc("The Nubis³ voxel cloud noise: size^3 x 4 channels, R/G low/high-frequency Curly-Alligator (wisps), "
           "B/A low/high-frequency Alligator (billows), each normalised to the full 0..1 range; tiles exactly. "
           "The recipe is noise::make_nubis_noise (docs/noise.md).");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field3D, "RGBA noise volume over the unit box");
     d.param_int("size", 128).range(1, 1024).with_unit("voxels").describe("voxels per axis");
     d.param_int("seed", 0).range(0, 4294967295.0).describe("random seed");

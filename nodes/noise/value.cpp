@@ -9,6 +9,7 @@ using namespace atlas;
 
 void declare(NodeDeclaration& d) {
     d.doc("Tileable value noise with FBM octaves over a 3D field; values in [0, 1]. Tiles exactly every `period` lattice cells.");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field3D, "noise field (1 channel)");
     d.param_int3("resolution", {{64, 64, 16}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z");
     d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");

@@ -10,6 +10,7 @@ void declare(NodeDeclaration& d) {
           "`world`: max, add, over (c + w (1 - saturate(c))) or subtract (max(w - c, 0)).");
     d.input("world", PortType::Field3D, "the world grid");
     d.input("cloud", PortType::Field3D, "the cloud (any grid)");
+    d.tiling(TileRule::none("it resamples the cloud at world positions derived from the world grid's bounds, which a cropped tile changes in the last bit (docs/scale.md)"));
     d.output("out", PortType::Field3D, "the world with the cloud");
     d.param_enum("op", {"max", "add", "over", "subtract"}, "max").describe("composite operation");
     d.param_float("opacity", 1).range(0, 1e6).describe("multiplies the cloud");

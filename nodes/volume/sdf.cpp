@@ -12,6 +12,7 @@ void declare(NodeDeclaration& d) {
           "holds, at any voxel size). A dimensional profile's surface is where it leaves 0 (default iso 2/255). Reports 'seconds', "
           "'crossings' and 'iso'.");
     d.input("in", PortType::Field3D, "density");
+    d.tiling(TileRule::none("an exact distance transform reads the whole grid, not a local halo; a distributed exact EDT is not written yet (docs/scale.md)"));
     d.output("out", PortType::Field3D, "signed distance, metres, channel 'sdf'");
     d.param_enum("method", {"edt", "fast_sweeping"}, "edt").describe("distance method");
     d.param_enum("input", {"auto", "density", "dimensional_profile"}, "auto")

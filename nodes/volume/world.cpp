@@ -6,6 +6,7 @@ using namespace atlas;
 
 void declare(NodeDeclaration& d) {
     d.doc("An empty (zero) density grid over the world; the default is the Nubis cloudscape, 4 km x 4 km x 512 m at 8 m voxels (512x512x64).");
+    d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field3D, "zero density, channel 'density'");
     volume_nodes::declare_grid(d);
 }

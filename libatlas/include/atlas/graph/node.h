@@ -38,10 +38,40 @@ struct PortDecl {
     bool optional = false;
 };
 
+class NodeParams;
+
+// How a node cooks in tiles (atlas cook --tiles, docs/scale.md). The default
+// is "does not tile": a graph that needs such a node is refused for tiling
+// with a message naming it. A node without inputs that declares pointwise is
+// cooked whole and cropped (exact for any generator); a node with inputs is
+// cooked on cropped inputs: pointwise ones on the tile itself, halo ones on
+// the tile grown by halo() texels/voxels in x and y (clipped to the grid),
+// and their result is cropped back. Such a node must compute each output
+// voxel from its own index's neighbourhood only (never from the field's
+// world bounds or extent), so the crop of its result equals the crop of the
+// untiled result bit for bit.
+struct TileRule {
+    enum class Kind { None, Pointwise, Halo };
+    Kind kind = Kind::None;
+    std::function<int(const NodeParams&)> halo;           // Halo: texels/voxels in x and y
+    std::function<std::string(const NodeParams&)> refuse; // optional: why these parameters cannot tile ("" = they can)
+    std::string why_not;                                  // None: why the node does not tile
+
+    static TileRule pointwise(std::function<std::string(const NodeParams&)> refuse = {}) {
+        return {Kind::Pointwise, {}, std::move(refuse), {}};
+    }
+    static TileRule with_halo(std::function<int(const NodeParams&)> halo, std::function<std::string(const NodeParams&)> refuse = {}) {
+        return {Kind::Halo, std::move(halo), std::move(refuse), {}};
+    }
+    static TileRule none(std::string why) { return {Kind::None, {}, {}, std::move(why)}; }
+};
+
 class NodeDeclaration {
 public:
     NodeDeclaration& doc(std::string text) { doc_ = std::move(text); return *this; }
     NodeDeclaration& category(std::string c) { category_ = std::move(c); return *this; }
+    NodeDeclaration& tiling(TileRule rule) { tiling_ = std::move(rule); return *this; }
+    const TileRule& tiling() const { return tiling_; }
 
     PortDecl& input(std::string name, PortType type, std::string doc);
     PortDecl& output(std::string name, PortType type, std::string doc);
@@ -71,6 +101,7 @@ private:
     // deque: references returned by the builders stay valid as more are added.
     std::deque<PortDecl> inputs_, outputs_;
     std::deque<ParamDecl> params_;
+    TileRule tiling_;
 };
 
 // The resolved parameters of one node instance (explicit values over

@@ -1,0 +1,564 @@
+// Tiled cooking (atlas/graph/tiling.h, docs/scale.md): regions per node,
+// crops, tile files, fragments, the tile index and assembly.
+#include "atlas/graph/tiling.h"
+
+#include "atlas/core/files.h"
+#include "atlas/core/hash.h"
+#include "atlas/io/writers.h"
+#include "value_cache.h"
+
+#include <nlohmann/json.hpp>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <set>
+
+namespace atlas {
+
+namespace {
+
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+std::string tile_name(Vec2i t) { return std::to_string(t[0]) + "," + std::to_string(t[1]); }
+
+std::vector<const GraphNode*> topological_order(const Graph& g) {
+    std::vector<const GraphNode*> order;
+    std::set<std::string> done;
+    std::function<void(const GraphNode&)> visit = [&](const GraphNode& n) {
+        if (done.count(n.name)) return;
+        done.insert(n.name);
+        for (const auto& [port, b] : n.inputs) visit(*g.find(b.node));
+        order.push_back(&n);
+    };
+    for (const auto& n : g.nodes) visit(n);
+    return order;
+}
+
+std::string source_port(const Graph& g, const NodeRegistry& reg, const InputBinding& b) {
+    if (!b.port.empty()) return b.port;
+    return reg.find(g.find(b.node)->type)->decl.outputs().front().name;
+}
+
+// What the requested outputs need: the outputs and the nodes, inputs first.
+struct Plan {
+    std::vector<const GraphOutput*> outputs;
+    std::vector<const GraphNode*> order;
+    std::map<std::string, int> halo; // per node
+};
+
+std::string node_label(const GraphNode& n) {
+    return (n.where.str().empty() ? "" : n.where.str() + ": ") + "node '" + n.name + "' (" + n.type + ")";
+}
+
+Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::string>& wanted) {
+    Plan p;
+    std::set<std::string> requested(wanted.begin(), wanted.end()), matched;
+    for (const auto& o : g.outputs) {
+        const bool take = requested.empty() || requested.count(o.file) || requested.count(o.node);
+        if (requested.count(o.file)) matched.insert(o.file);
+        if (requested.count(o.node)) matched.insert(o.node);
+        if (take) p.outputs.push_back(&o);
+    }
+    for (const auto& r : requested)
+        if (!matched.count(r)) {
+            std::vector<std::string> names;
+            for (const auto& o : g.outputs) names.push_back(o.file);
+            throw Error("unknown output '" + r + "'" + name_hint(r, names, "the graph writes"));
+        }
+    if (p.outputs.empty()) throw Error("tiling: the graph writes no outputs");
+    std::set<std::string> needed;
+    std::function<void(const std::string&)> mark = [&](const std::string& name) {
+        if (!needed.insert(name).second) return;
+        for (const auto& [port, b] : g.find(name)->inputs) mark(b.node);
+    };
+    for (const GraphOutput* o : p.outputs) mark(o->node);
+    for (const GraphNode* n : topological_order(g))
+        if (needed.count(n->name)) p.order.push_back(n);
+
+    for (const GraphOutput* o : p.outputs) {
+        const NodeType* t = reg.find(g.find(o->node)->type);
+        const PortDecl* port = t->decl.find_output(o->port);
+        if (port && (port->type == PortType::Mesh || port->type == PortType::Points))
+            throw Error(o->where.str() + ": output '" + o->file + "' writes a " + std::string(port_type_name(port->type)) +
+                        ", which does not tile (only fields do)");
+    }
+    for (const GraphNode* n : p.order) {
+        const NodeType* t = reg.find(n->type);
+        const TileRule& rule = t->decl.tiling();
+        if (rule.kind == TileRule::Kind::None)
+            throw Error(node_label(*n) + " cannot be cooked in tiles: " +
+                        (rule.why_not.empty() ? std::string("its type declares no tiling rule (docs/scale.md lists the nodes that tile)") : rule.why_not));
+        NodeParams params(&t->decl, resolved_params(*n, *t), g.base_dir);
+        if (rule.refuse)
+            if (std::string why = rule.refuse(params); !why.empty()) throw Error(node_label(*n) + " cannot be cooked in tiles: " + why);
+        int h = 0;
+        if (rule.kind == TileRule::Kind::Halo && !n->inputs.empty()) h = rule.halo(params);
+        if (h < 0) throw Error(node_label(*n) + ": internal: negative tiling halo");
+        p.halo[n->name] = h;
+    }
+    return p;
+}
+
+// ----------------------------------------------------------------- geometry
+
+struct Grid {
+    Vec2i res{{0, 0}};
+    Vec2d lo{{0, 0}}, hi{{0, 0}};
+    std::string from; // the node that set it
+};
+
+double edge(double lo, double hi, int i, int n) {
+    if (i <= 0) return lo;
+    if (i >= n) return hi;
+    return lo + (hi - lo) * double(i) / double(n);
+}
+
+Box2d rect_bounds(const Grid& g, const TileRect& r) {
+    return {{{edge(g.lo[0], g.hi[0], r.x0, g.res[0]), edge(g.lo[1], g.hi[1], r.y0, g.res[1])}},
+            {{edge(g.lo[0], g.hi[0], r.x1, g.res[0]), edge(g.lo[1], g.hi[1], r.y1, g.res[1])}}};
+}
+
+TileRect grow(const TileRect& r, int h, Vec2i res) {
+    return {std::max(0, r.x0 - h), std::max(0, r.y0 - h), std::min(res[0], r.x1 + h), std::min(res[1], r.y1 + h)};
+}
+
+TileRect unite(const TileRect& a, const TileRect& b) {
+    if (a.empty()) return b;
+    if (b.empty()) return a;
+    return {std::min(a.x0, b.x0), std::min(a.y0, b.y0), std::max(a.x1, b.x1), std::max(a.y1, b.y1)};
+}
+
+// A held value: a field over `rect` of the grid, or a value that is not
+// tiled (passed whole).
+struct Held {
+    Value v;
+    TileRect rect;
+    bool whole = false;
+};
+
+Value crop(const Value& v, const TileRect& have, const TileRect& want, const Grid& g, const MemoryBudget& budget) {
+    if (have == want) return v;
+    const Box2d b = rect_bounds(g, want);
+    const int ox = want.x0 - have.x0, oy = want.y0 - have.y0, w = want.width(), h = want.height();
+    if (auto f2 = std::get_if<Field2DPtr>(&v)) {
+        const Field2D& f = **f2;
+        auto out = std::make_shared<Field2D>(Vec2i{{w, h}}, f.channels(), b, f.channel_names(), &budget);
+        for (int c = 0; c < f.channels(); ++c)
+            for (int y = 0; y < h; ++y) {
+                const float* src = f.channel(c).data() + f.index(ox, oy + y);
+                std::copy(src, src + w, out->channel(c).data() + out->index(0, y));
+            }
+        return Field2DPtr(out);
+    }
+    const Field3D& f = *std::get<Field3DPtr>(v);
+    Box3d b3{{{b.min[0], b.min[1], f.bounds().min[2]}}, {{b.max[0], b.max[1], f.bounds().max[2]}}};
+    auto out = std::make_shared<Field3D>(Vec3i{{w, h, f.nz()}}, f.channels(), b3, f.channel_names(), &budget);
+    for (int c = 0; c < f.channels(); ++c)
+        for (int z = 0; z < f.nz(); ++z)
+            for (int y = 0; y < h; ++y) {
+                const float* src = f.channel(c).data() + f.index(ox, oy + y, z);
+                std::copy(src, src + w, out->channel(c).data() + out->index(0, y, z));
+            }
+    return Field3DPtr(out);
+}
+
+bool is_field(const Value& v) { return std::holds_alternative<Field2DPtr>(v) || std::holds_alternative<Field3DPtr>(v); }
+
+// XY resolution and bounds of a field value.
+void field_xy(const Value& v, Vec2i& res, Vec2d& lo, Vec2d& hi) {
+    if (auto f2 = std::get_if<Field2DPtr>(&v)) {
+        res = (*f2)->resolution();
+        lo = (*f2)->bounds().min;
+        hi = (*f2)->bounds().max;
+    } else {
+        const Field3D& f = *std::get<Field3DPtr>(v);
+        res = {{f.nx(), f.ny()}};
+        lo = {{f.bounds().min[0], f.bounds().min[1]}};
+        hi = {{f.bounds().max[0], f.bounds().max[1]}};
+    }
+}
+
+std::string xy_text(Vec2i r) { return std::to_string(r[0]) + " x " + std::to_string(r[1]); }
+
+// --------------------------------------------------------------- file names
+
+// tiles/DIR/STEM.I_J.EXT for output DIR/STEM.EXT.
+fs::path tile_rel(const GraphOutput& o, Vec2i t, const std::string& suffix = "") {
+    fs::path p = fs::path(o.file).lexically_normal();
+    if (p.is_absolute() || (!p.empty() && p.begin()->string() == "..")) p = p.filename();
+    const std::string tag = "." + std::to_string(t[0]) + "_" + std::to_string(t[1]);
+    return fs::path("tiles") / p.parent_path() / (p.stem().string() + tag + p.extension().string() + suffix);
+}
+
+fs::path fragment_rel(Vec2i t) { return fs::path("tiles") / (std::to_string(t[0]) + "_" + std::to_string(t[1]) + ".json"); }
+
+json file_entry(const fs::path& root, const fs::path& final_path, const fs::path& on_disk) {
+    return {{"path", final_path.lexically_relative(root).generic_string()},
+            {"bytes", uint64_t(fs::file_size(on_disk))},
+            {"hash", file_content_hash(on_disk).hex()}};
+}
+
+// A fragment's files are all present with the recorded sizes and hashes.
+bool files_current(const fs::path& root, const json& files) {
+    for (const auto& f : files) {
+        const fs::path p = root / f.at("path").get<std::string>();
+        std::error_code ec;
+        if (fs::file_size(p, ec) != f.at("bytes").get<uint64_t>() || ec) return false;
+        if (file_content_hash(p).hex() != f.at("hash").get<std::string>()) return false;
+    }
+    return true;
+}
+
+std::optional<json> current_fragment(const fs::path& root, Vec2i t, const std::string& key) {
+    const fs::path p = root / fragment_rel(t);
+    if (!fs::exists(p)) return std::nullopt;
+    try {
+        json j = json::parse(read_file_bytes(p));
+        if (j.at("key").get<std::string>() != key) return std::nullopt;
+        for (const auto& o : j.at("outputs")) {
+            if (!files_current(root, o.at("files"))) return std::nullopt;
+            if (!files_current(root, json::array({o.at("raw")}))) return std::nullopt;
+        }
+        return j;
+    } catch (const std::exception&) {
+        return std::nullopt; // unreadable: the tile is cooked again
+    }
+}
+
+json grid_json(const Grid& g) {
+    return {{"resolution", {g.res[0], g.res[1]}}, {"bounds_min", {g.lo[0], g.lo[1]}}, {"bounds_max", {g.hi[0], g.hi[1]}}};
+}
+
+Grid grid_from_json(const json& j) {
+    Grid g;
+    g.res = {{j.at("resolution")[0].get<int>(), j.at("resolution")[1].get<int>()}};
+    g.lo = {{j.at("bounds_min")[0].get<double>(), j.at("bounds_min")[1].get<double>()}};
+    g.hi = {{j.at("bounds_max")[0].get<double>(), j.at("bounds_max")[1].get<double>()}};
+    g.from = "the tile fragments";
+    return g;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+} // namespace
+
+TileRect tile_rect(Vec2i grid, Vec2i tiles, Vec2i t) {
+    const int w = grid[0] / tiles[0], h = grid[1] / tiles[1];
+    return {t[0] * w, t[1] * h, (t[0] + 1) * w, (t[1] + 1) * h};
+}
+
+void check_tileable(const Session& session, const std::vector<std::string>& outputs) {
+    make_plan(session.graph(), session.registry(), outputs);
+}
+
+TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileOptions& topt) {
+    const auto t_start = std::chrono::steady_clock::now();
+    const Graph& g = session.graph();
+    const NodeRegistry& reg = session.registry();
+    const Vec2i tiles = topt.tiles;
+    if (tiles[0] < 1 || tiles[1] < 1 || tiles[0] > 4096 || tiles[1] > 4096)
+        throw Error("--tiles " + tile_name(tiles) + ": tile counts must be in [1, 4096]");
+    if (topt.only && ((*topt.only)[0] < 0 || (*topt.only)[0] >= tiles[0] || (*topt.only)[1] < 0 || (*topt.only)[1] >= tiles[1]))
+        throw Error("--tile " + tile_name(*topt.only) + " is out of range: --tiles " + tile_name(tiles) + " has tiles 0.." +
+                    std::to_string(tiles[0] - 1) + ", 0.." + std::to_string(tiles[1] - 1));
+    if (topt.only && topt.assemble) throw Error("--assemble needs every tile: it cannot be combined with --tile");
+    const Plan plan = make_plan(g, reg, opt.outputs);
+    const MemoryBudget budget(opt.memory_budget);
+    const fs::path root = opt.out_dir;
+    remove_stale_staging(root);
+
+    TiledCookResult result;
+    result.tiles = tiles;
+    const auto hashes = session.node_hashes();
+
+    std::vector<Vec2i> selection;
+    if (topt.only) selection.push_back(*topt.only);
+    else
+        for (int j = 0; j < tiles[1]; ++j)
+            for (int i = 0; i < tiles[0]; ++i) selection.push_back({{i, j}});
+
+    auto tile_key = [&](Vec2i t) {
+        Hasher h;
+        h.add("atlas-tile").add(int64_t(kTileFormatVersion)).add(int64_t(tiles[0])).add(int64_t(tiles[1])).add(int64_t(t[0])).add(int64_t(t[1]));
+        for (const GraphOutput* o : plan.outputs) {
+            h.add(hashes.at(o->node)).add(o->port).add(o->format).add(o->file).add(int64_t(io::output_formats().size()));
+            for (const auto& f : io::output_formats())
+                if (f.name == o->format) h.add(int64_t(f.version));
+            for (const auto& [k, v] : o->options) h.add(k).add(v);
+        }
+        return h.finish().hex();
+    };
+
+    // Tiles already on disk (e.g. cooked by other workers).
+    std::map<std::pair<int, int>, json> fragments;
+    std::vector<Vec2i> to_cook;
+    for (Vec2i t : selection) {
+        if (opt.reuse_outputs && !opt.checked)
+            if (auto f = current_fragment(root, t, tile_key(t))) {
+                fragments[{t[0], t[1]}] = std::move(*f);
+                continue;
+            }
+        to_cook.push_back(t);
+    }
+
+    // Generators: cooked whole (through the session's caches) and cropped.
+    std::map<std::pair<std::string, std::string>, Held> sources;
+    Grid grid;
+    if (!to_cook.empty()) {
+        for (const GraphNode* n : plan.order) {
+            if (!n->inputs.empty()) continue;
+            std::set<std::string> ports;
+            for (const GraphNode* m : plan.order)
+                for (const auto& [port, b] : m->inputs)
+                    if (b.node == n->name) ports.insert(source_port(g, reg, b));
+            for (const GraphOutput* o : plan.outputs)
+                if (o->node == n->name) ports.insert(o->port);
+            for (const std::string& port : ports) {
+                Value v = session.get(n->name, port, opt);
+                if (!is_field(v))
+                    throw Error(node_label(*n) + ": output '" + port + "' is a " + std::string(port_type_name(value_type(v))) +
+                                ", which does not tile (only fields do)");
+                Vec2i res;
+                Vec2d lo, hi;
+                field_xy(v, res, lo, hi);
+                if (grid.from.empty()) {
+                    grid = {res, lo, hi, n->name};
+                } else if (res != grid.res || lo != grid.lo || hi != grid.hi) {
+                    throw Error(node_label(*n) + ": tiling needs one XY grid for the whole graph, but its " + xy_text(res) +
+                                " grid over its bounds differs from the " + xy_text(grid.res) + " grid of node '" + grid.from + "'");
+                }
+                sources[{n->name, port}] = {v, {0, 0, res[0], res[1]}, false};
+            }
+        }
+    } else {
+        grid = grid_from_json(fragments.begin()->second.at("grid"));
+    }
+    result.grid = grid.res;
+
+    // The tile count must divide the grid; BC-compressed outputs need 4x4-block-aligned tiles.
+    for (int a = 0; a < 2; ++a)
+        if (grid.res[a] % tiles[a] != 0)
+            throw Error("--tiles " + tile_name(tiles) + ": the " + xy_text(grid.res) + " grid (of node '" + grid.from + "') does not divide into " +
+                        std::to_string(tiles[a]) + " tiles along " + (a ? "y" : "x") + " (" + std::to_string(grid.res[a]) + " is not a multiple of " +
+                        std::to_string(tiles[a]) + ")");
+    const Vec2i tile_size{{grid.res[0] / tiles[0], grid.res[1] / tiles[1]}};
+    for (const GraphOutput* o : plan.outputs)
+        if (o->format == "dds" && (tile_size[0] % 4 || tile_size[1] % 4))
+            throw Error(o->where.str() + ": --tiles " + tile_name(tiles) + ": output '" + o->file +
+                        "' is BC-compressed in 4x4 blocks, and tiles of " + xy_text(tile_size) + " texels are not block-aligned");
+
+    tbb::task_arena arena(opt.jobs > 0 ? opt.jobs : int(tbb::info::default_concurrency()));
+    const int total_tiles = int(selection.size());
+    int tiles_finished = int(selection.size() - to_cook.size());
+
+    for (Vec2i t : to_cook) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::string tname = "tile " + tile_name(t);
+        opt.progress.poll();
+        if (opt.progress.on_progress) opt.progress.on_progress({tname, double(tiles_finished) / total_tiles, tiles_finished, total_tiles});
+        const TileRect tr = tile_rect(grid.res, tiles, t);
+        // Regions: outputs need the tile; a node needs its region grown by its halo from each input.
+        std::map<std::string, TileRect> region;
+        for (const GraphOutput* o : plan.outputs) region[o->node] = unite(region[o->node], tr);
+        for (auto it = plan.order.rbegin(); it != plan.order.rend(); ++it) {
+            const GraphNode& n = **it;
+            const TileRect need = grow(region[n.name], plan.halo.at(n.name), grid.res);
+            for (const auto& [port, b] : n.inputs) region[b.node] = unite(region[b.node], need);
+        }
+        std::map<std::pair<std::string, std::string>, Held> held;
+        try {
+            for (const GraphNode* n : plan.order) {
+                const TileRect r = region.at(n->name);
+                if (n->inputs.empty()) {
+                    for (const auto& [key, h] : sources)
+                        if (key.first == n->name) held[key] = {crop(h.v, h.rect, r, grid, budget), r, false};
+                    continue;
+                }
+                const NodeType& type = *reg.find(n->type);
+                const TileRect in_rect = grow(r, plan.halo.at(n->name), grid.res);
+                std::map<std::string, Value> inputs;
+                for (const auto& [port, b] : n->inputs) {
+                    const Held& h = held.at({b.node, source_port(g, reg, b)});
+                    inputs[port] = h.whole ? h.v : crop(h.v, h.rect, in_rect, grid, budget);
+                }
+                NodeParams params(&type.decl, resolved_params(*n, type), g.base_dir);
+                ProgressSink node_progress;
+                node_progress.is_cancelled = opt.progress.is_cancelled;
+                CookContext ctx(n->name, n->type, type.decl, params, std::move(inputs), budget, node_progress);
+                try {
+                    arena.execute([&] { type.cook(ctx); });
+                } catch (const CancelledError&) {
+                    throw;
+                } catch (const std::exception& e) {
+                    const std::string msg = e.what();
+                    throw Error(node_label(*n) + ": " + msg);
+                }
+                const Box2d want = rect_bounds(grid, in_rect);
+                for (const auto& out : type.decl.outputs()) {
+                    auto it = ctx.outputs().find(out.name);
+                    if (it == ctx.outputs().end()) throw Error(node_label(*n) + ": internal: node did not set its output '" + out.name + "'");
+                    if (!is_field(it->second)) {
+                        throw Error(node_label(*n) + ": output '" + out.name + "' is not a field, so it does not tile");
+                    }
+                    Vec2i res;
+                    Vec2d lo, hi;
+                    field_xy(it->second, res, lo, hi);
+                    if (res != Vec2i{{in_rect.width(), in_rect.height()}} || lo != want.min || hi != want.max)
+                        throw Error(node_label(*n) + ": its output '" + out.name + "' is not on the grid of its inputs (" + xy_text(res) +
+                                    " texels for a " + xy_text({{in_rect.width(), in_rect.height()}}) +
+                                    " region), so it cannot be cooked in tiles");
+                    held[{n->name, out.name}] = {crop(it->second, in_rect, r, grid, budget), r, false};
+                }
+            }
+
+            // Write the tile: every output in its format, the exact values, the fragment.
+            StagedOutputs st(root);
+            json frag = {{"atlas_tile", kTileFormatVersion}, {"key", tile_key(t)}, {"tile", {t[0], t[1]}},
+                         {"tiles", {tiles[0], tiles[1]}}, {"texels", {tr.x0, tr.y0, tr.x1, tr.y1}}, {"grid", grid_json(grid)},
+                         {"outputs", json::array()}};
+            const Box2d tb = rect_bounds(grid, tr);
+            for (const GraphOutput* o : plan.outputs) {
+                const Held& h = held.at({o->node, o->port});
+                const Value v = crop(h.v, h.rect, tr, grid, budget);
+                io::OutputMetrics metrics;
+                std::vector<fs::path> staged;
+                try {
+                    staged = io::write_value(v, st.stage(tile_rel(*o, t)), o->format, o->options, &metrics);
+                } catch (const std::exception& e) {
+                    throw Error(o->where.str() + ": output '" + o->file + "': " + e.what());
+                }
+                json files = json::array();
+                for (const auto& s : staged) files.push_back(file_entry(root, st.final_path(s), s));
+                const fs::path raw = st.stage(tile_rel(*o, t, ".atlastile"));
+                const std::string bytes = disk_cache::serialize({{"value", v}});
+                write_file_checked(raw, bytes.data(), bytes.size());
+                frag["outputs"].push_back({{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format},
+                                           {"bounds_min", {tb.min[0], tb.min[1]}}, {"bounds_max", {tb.max[0], tb.max[1]}},
+                                           {"files", files}, {"raw", file_entry(root, st.final_path(raw), raw)}});
+            }
+            const std::string text = frag.dump(2) + "\n";
+            write_file_checked(st.stage(fragment_rel(t)), text.data(), text.size());
+            for (const auto& p : st.commit()) result.written.push_back(p);
+            fragments[{t[0], t[1]}] = std::move(frag);
+        } catch (const CancelledError&) {
+            throw;
+        } catch (const std::exception& e) {
+            const std::string msg = e.what();
+            if (dynamic_cast<const MemoryBudgetError*>(&e)) throw MemoryBudgetError(tname + ": " + msg);
+            throw Error(tname + ": " + msg);
+        }
+        result.tiles_done.push_back({t, tr, "cooked", seconds_since(t0)});
+        ++tiles_finished;
+        if (opt.progress.on_progress) opt.progress.on_progress({tname, double(tiles_finished) / total_tiles, tiles_finished, total_tiles});
+    }
+    for (Vec2i t : selection)
+        if (std::none_of(to_cook.begin(), to_cook.end(), [&](Vec2i c) { return c == t; }))
+            result.tiles_done.push_back({t, tile_rect(grid.res, tiles, t), "up to date", 0.0});
+
+    if (topt.only) {
+        result.seconds = seconds_since(t_start);
+        return result;
+    }
+
+    // Every tile is present: the tile index, then (optionally) the untiled outputs.
+    {
+        json index = {{"atlas_tile_index", kTileFormatVersion}, {"graph", topt.graph_name}, {"tiles", {tiles[0], tiles[1]}},
+                      {"grid", grid_json(grid)}, {"outputs", json::array()}};
+        for (size_t k = 0; k < plan.outputs.size(); ++k) {
+            const GraphOutput* o = plan.outputs[k];
+            json entry = {{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format}, {"options", o->options}, {"tiles", json::array()}};
+            for (int j = 0; j < tiles[1]; ++j)
+                for (int i = 0; i < tiles[0]; ++i) {
+                    const json& f = fragments.at({i, j});
+                    const json& fo = f.at("outputs").at(k);
+                    entry["tiles"].push_back({{"tile", {i, j}}, {"texels", f.at("texels")}, {"bounds_min", fo.at("bounds_min")},
+                                              {"bounds_max", fo.at("bounds_max")}, {"files", fo.at("files")}, {"raw", fo.at("raw")}});
+                }
+            index["outputs"].push_back(entry);
+        }
+        const fs::path p = root / "tiles" / "index.json";
+        const std::string text = index.dump(2) + "\n";
+        write_file_atomic(p, [&](const fs::path& tmp) { write_file_checked(tmp, text.data(), text.size()); });
+        result.index = p;
+        result.written.push_back(p);
+    }
+
+    if (topt.assemble) {
+        std::map<fs::path, std::unique_ptr<StagedOutputs>> staging;
+        for (size_t k = 0; k < plan.outputs.size(); ++k) {
+            const GraphOutput* o = plan.outputs[k];
+            if (opt.progress.on_progress) opt.progress.on_progress({"assembling " + o->file, 1.0, total_tiles, total_tiles});
+            try {
+                std::shared_ptr<Field2D> full2;
+                std::shared_ptr<Field3D> full3;
+                for (int j = 0; j < tiles[1]; ++j)
+                    for (int i = 0; i < tiles[0]; ++i) {
+                        const json& fo = fragments.at({i, j}).at("outputs").at(k);
+                        const fs::path raw = root / fo.at("raw").at("path").get<std::string>();
+                        std::string why;
+                        auto vals = disk_cache::deserialize(read_file_bytes(raw), &why);
+                        if (!vals || !vals->count("value")) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' is unreadable (" + why + ")");
+                        const Value& v = vals->at("value");
+                        const TileRect r = tile_rect(grid.res, tiles, {{i, j}});
+                        const Box2d gb = rect_bounds(grid, {0, 0, grid.res[0], grid.res[1]});
+                        if (auto t2 = std::get_if<Field2DPtr>(&v)) {
+                            const Field2D& f = **t2;
+                            if (f.resolution() != Vec2i{{r.width(), r.height()}}) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' has the wrong size");
+                            if (full3) throw Error("tile " + tile_name({{i, j}}) + ": a 2D tile among 3D ones");
+                            if (!full2) full2 = std::make_shared<Field2D>(grid.res, f.channels(), gb, f.channel_names(), &budget);
+                            Field2D& dst = *full2;
+                            if (dst.channels() != f.channels()) throw Error("tile " + tile_name({{i, j}}) + ": channel count differs from tile 0,0");
+                            for (int c = 0; c < f.channels(); ++c)
+                                for (int y = 0; y < r.height(); ++y) {
+                                    const float* s = f.channel(c).data() + f.index(0, y);
+                                    std::copy(s, s + r.width(), dst.channel(c).data() + dst.index(r.x0, r.y0 + y));
+                                }
+                        } else if (auto t3 = std::get_if<Field3DPtr>(&v)) {
+                            const Field3D& f = **t3;
+                            if (f.nx() != r.width() || f.ny() != r.height()) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' has the wrong size");
+                            if (full2) throw Error("tile " + tile_name({{i, j}}) + ": a 3D tile among 2D ones");
+                            if (!full3) {
+                                Box3d b{{{gb.min[0], gb.min[1], f.bounds().min[2]}}, {{gb.max[0], gb.max[1], f.bounds().max[2]}}};
+                                full3 = std::make_shared<Field3D>(Vec3i{{grid.res[0], grid.res[1], f.nz()}}, f.channels(), b, f.channel_names(), &budget);
+                            }
+                            Field3D& dst = *full3;
+                            if (dst.channels() != f.channels() || dst.nz() != f.nz()) throw Error("tile " + tile_name({{i, j}}) + ": shape differs from tile 0,0");
+                            for (int c = 0; c < f.channels(); ++c)
+                                for (int z = 0; z < f.nz(); ++z)
+                                    for (int y = 0; y < r.height(); ++y) {
+                                        const float* s = f.channel(c).data() + f.index(0, y, z);
+                                        std::copy(s, s + r.width(), dst.channel(c).data() + dst.index(r.x0, r.y0 + y, z));
+                                    }
+                        } else {
+                            throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' holds no field");
+                        }
+                    }
+                fs::path final_path = resolve_output_path(root, o->file, opt.allow_outside_out);
+                fs::path out_root = root, rel = fs::path(o->file).lexically_normal();
+                if (fs::path(o->file).is_absolute() || rel.begin()->string() == "..") {
+                    out_root = final_path.parent_path();
+                    rel = final_path.filename();
+                }
+                auto& st = staging[out_root];
+                if (!st) st = std::make_unique<StagedOutputs>(out_root);
+                const Value full = full2 ? Value(Field2DPtr(full2)) : Value(Field3DPtr(full3));
+                io::write_value(full, st->stage(rel), o->format, o->options, nullptr);
+            } catch (const CancelledError&) {
+                throw;
+            } catch (const std::exception& e) {
+                throw Error(o->where.str() + ": assembling output '" + o->file + "': " + e.what());
+            }
+        }
+        for (auto& [r, st] : staging)
+            for (const auto& p : st->commit()) result.written.push_back(p);
+    }
+    result.seconds = seconds_since(t_start);
+    return result;
+}
+
+} // namespace atlas
