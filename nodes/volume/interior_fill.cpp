@@ -6,12 +6,13 @@ namespace {
 using namespace atlas;
 
 void declare(NodeDeclaration& d) {
-    d.doc("Tetrahedralises a closed mesh with TetGen and places one sample per tetrahedron (hash-random, uniform in it); "
+    d.doc("Tetrahedralises a closed mesh with TetGen, draws 8 x target_samples uniform candidates in its volume and keeps exactly "
+          "target_samples of them by farthest-point selection (evenly spread: separate puffs); "
           "each sample's 'radius' is its distance to the surface ('thickness') times radius_scale. Feed to volume/metaballs "
           "to grow a billowy cloud that fills the shape.");
     d.input("mesh", PortType::Mesh, "closed, non-self-intersecting mesh");
     d.output("out", PortType::Points, "samples with attributes 'radius' and 'thickness' (metres)");
-    d.param_int("target_samples", 2000).range(1, 10000000).describe("approximate number of tetrahedra / samples");
+    d.param_int("target_samples", 2000).range(1, 10000000).describe("number of samples returned (exactly; evenly spread up to 20,000)");
     d.param_float("radius_scale", 0.9).range(1e-6, 100).describe("radius = thickness x radius_scale");
     d.param_float("min_radius", 0).range(0, 1e9).with_unit("m").describe("lower clamp on radii");
     d.param_int("seed", 1).range(0, 4294967295.0).describe("sampling seed");
@@ -26,6 +27,7 @@ void cook(CookContext& ctx) {
     volume::InteriorFillStats st;
     auto pts = std::make_shared<Points>(volume::fill_mesh_interior(*ctx.input_mesh("mesh"), o, &st));
     ctx.metric("tetrahedra", double(st.tetrahedra));
+    ctx.metric("samples", double(st.samples));
     ctx.metric("interior_volume_m3", st.interior_volume);
     ctx.metric("max_thickness_m", st.max_thickness);
     ctx.set_output("out", PointsPtr(pts));
@@ -33,5 +35,5 @@ void cook(CookContext& ctx) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "volume/interior_fill", .version = 1, .declare = declare, .cook = cook});
+    registry.add({.name = "volume/interior_fill", .version = 2, .declare = declare, .cook = cook});
 }

@@ -19,6 +19,8 @@
 #include <tetgen.h>
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -30,6 +32,12 @@ using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Triangle = K::Triangle_3;
 using TriIt = std::vector<Triangle>::const_iterator;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, CGAL::AABB_triangle_primitive<K, TriIt>>>;
+
+// Candidates per sample for the farthest-point selection, and the sample
+// count above which the selection (n x candidates distance updates) is
+// skipped and the candidates are the samples.
+constexpr size_t kCandidatesPerSample = 8;
+constexpr size_t kSpreadLimit = 20000;
 
 Vec3d to_d(const Vec3f& v) { return {{v[0], v[1], v[2]}}; }
 
@@ -81,11 +89,10 @@ Points fill_mesh_interior(const Mesh& m, const InteriorFillOptions& o, InteriorF
         fc.polygonlist[0].vertexlist = new int[3];
         for (int k = 0; k < 3; ++k) fc.polygonlist[0].vertexlist[k] = int(m.triangles[f][size_t(k)]);
     }
-    // p: piecewise linear complex; q: quality (radius-edge <= 2); a: max volume; Q: quiet.
-    std::ostringstream sw;
-    sw.precision(17);
-    sw << "pq2a" << volume / o.target_samples << "Q";
-    std::string switches = sw.str();
+    // p: piecewise linear complex (constrained Delaunay of the surface, no
+    // Steiner points for quality: the tetrahedra only carry the volume we
+    // draw from, so the fewest is the cheapest); Q: quiet.
+    std::string switches = "pQ";
     try {
         tetrahedralize(switches.data(), &in, &out);
     } catch (int code) {
@@ -98,6 +105,63 @@ Points fill_mesh_interior(const Mesh& m, const InteriorFillOptions& o, InteriorF
     }
     if (out.numberoftetrahedra <= 0) throw Error("interior fill: TetGen produced no tetrahedra");
 
+    // Tetrahedra and their cumulative volume: candidates are drawn uniformly
+    // in the interior (a tet by volume, a point uniform in it).
+    const size_t nt = size_t(out.numberoftetrahedra);
+    const int corners = out.numberofcorners;
+    std::vector<std::array<Vec3d, 4>> tets(nt);
+    std::vector<double> cum(nt);
+    double tet_volume = 0;
+    for (size_t t = 0; t < nt; ++t) {
+        for (int k = 0; k < 4; ++k) {
+            const int idx = out.tetrahedronlist[t * size_t(corners) + size_t(k)] - out.firstnumber;
+            tets[t][size_t(k)] = {{out.pointlist[idx * 3], out.pointlist[idx * 3 + 1], out.pointlist[idx * 3 + 2]}};
+        }
+        const auto& v = tets[t];
+        tet_volume += std::abs(dot(v[1] - v[0], cross(v[2] - v[0], v[3] - v[0]))) / 6;
+        cum[t] = tet_volume;
+    }
+    const size_t n = size_t(o.target_samples);
+    const size_t ncand = n <= kSpreadLimit ? std::max<size_t>(n * kCandidatesPerSample, 64) : n;
+    std::vector<Vec3d> cand(ncand);
+    for (size_t i = 0; i < ncand; ++i) {
+        const int32_t ii = int32_t(i);
+        // 48-bit uniform from two hashes: a tet by volume.
+        const double r = (double(hash_coords(o.seed, ii, 3) >> 8) + double(hash_coords(o.seed, ii, 4) >> 8) / 16777216.0) / 16777216.0;
+        const size_t t = std::min(nt - 1, size_t(std::upper_bound(cum.begin(), cum.end(), r * tet_volume) - cum.begin()));
+        const auto& v = tets[t];
+        // Uniform point in the tetrahedron (Rocchini & Cignoni folding of the unit cube).
+        double s = hash_to_unit(hash_coords(o.seed, ii, 0)), u = hash_to_unit(hash_coords(o.seed, ii, 1)), w = hash_to_unit(hash_coords(o.seed, ii, 2));
+        if (s + u > 1) s = 1 - s, u = 1 - u;
+        if (u + w > 1) { const double tmp = w; w = 1 - s - u; u = 1 - tmp; }
+        else if (s + u + w > 1) { const double tmp = w; w = s + u + w - 1; s = 1 - u - tmp; }
+        cand[i] = v[0] + (v[1] - v[0]) * s + (v[2] - v[0]) * u + (v[3] - v[0]) * w;
+    }
+    // Farthest-point selection of exactly n of the candidates: each new sample
+    // is the candidate farthest from every sample taken so far, so the samples
+    // are evenly spread (no two closer than about half the spacing
+    // (volume / n)^(1/3)) and become separate puffs, not a uniform-random fuzz.
+    std::vector<size_t> chosen;
+    chosen.reserve(n);
+    if (ncand == n) {
+        for (size_t i = 0; i < n; ++i) chosen.push_back(i);
+    } else {
+        std::vector<double> d2(ncand, std::numeric_limits<double>::infinity());
+        size_t next = 0;
+        for (size_t k = 0; k < n; ++k) {
+            chosen.push_back(next);
+            const Vec3d c = cand[next];
+            double best = -1;
+            size_t arg = 0;
+            for (size_t i = 0; i < ncand; ++i) {
+                const Vec3d d = cand[i] - c;
+                d2[i] = std::min(d2[i], dot(d, d));
+                if (d2[i] > best) best = d2[i], arg = i;
+            }
+            next = arg;
+        }
+    }
+
     std::vector<Triangle> tris;
     tris.reserve(m.triangles.size());
     for (const auto& t : m.triangles) {
@@ -109,23 +173,9 @@ Points fill_mesh_interior(const Mesh& m, const InteriorFillOptions& o, InteriorF
 
     Points pts;
     std::vector<float> radius, thickness;
-    const size_t nt = size_t(out.numberoftetrahedra);
-    const int corners = out.numberofcorners;
-    double tet_volume = 0, max_thick = 0;
-    for (size_t t = 0; t < nt; ++t) {
-        Vec3d v[4];
-        for (int k = 0; k < 4; ++k) {
-            const int idx = out.tetrahedronlist[t * size_t(corners) + size_t(k)] - out.firstnumber;
-            v[k] = {{out.pointlist[idx * 3], out.pointlist[idx * 3 + 1], out.pointlist[idx * 3 + 2]}};
-        }
-        tet_volume += std::abs(dot(v[1] - v[0], cross(v[2] - v[0], v[3] - v[0]))) / 6;
-        // Uniform point in the tetrahedron (Rocchini & Cignoni folding of the unit cube).
-        double s = hash_to_unit(hash_coords(o.seed, int32_t(t), 0)), u = hash_to_unit(hash_coords(o.seed, int32_t(t), 1)),
-               w = hash_to_unit(hash_coords(o.seed, int32_t(t), 2));
-        if (s + u > 1) s = 1 - s, u = 1 - u;
-        if (u + w > 1) { const double tmp = w; w = 1 - s - u; u = 1 - tmp; }
-        else if (s + u + w > 1) { const double tmp = w; w = s + u + w - 1; s = 1 - u - tmp; }
-        const Vec3d p = v[0] + (v[1] - v[0]) * s + (v[2] - v[0]) * u + (v[3] - v[0]) * w;
+    double max_thick = 0;
+    for (size_t i : chosen) {
+        const Vec3d p = cand[i];
         const double th = std::sqrt(tree.squared_distance(K::Point_3(p[0], p[1], p[2])));
         max_thick = std::max(max_thick, th);
         pts.positions.push_back({{float(p[0]), float(p[1]), float(p[2])}});
@@ -136,6 +186,8 @@ Points fill_mesh_interior(const Mesh& m, const InteriorFillOptions& o, InteriorF
     pts.attributes["thickness"] = std::move(thickness);
     if (stats) {
         stats->tetrahedra = nt;
+        stats->candidates = ncand;
+        stats->samples = pts.positions.size();
         stats->interior_volume = tet_volume;
         stats->max_thickness = max_thick;
     }

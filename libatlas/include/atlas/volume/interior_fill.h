@@ -15,10 +15,12 @@
 namespace atlas::volume {
 
 struct InteriorFillOptions {
-    // Sets TetGen's maximum tetrahedron volume to (enclosed volume / target_samples),
-    // 1..10^7. TetGen's quality refinement and the surface triangulation add
-    // tetrahedra, so the sample count is usually higher (a 4096-triangle torus
-    // with target 250 gave 7849).
+    // The number of samples returned, exactly, 1..10^7. Up to 20,000 they are
+    // farthest-point selected from 8x as many uniform candidates (spacing about
+    // (volume / target)^(1/3)); above that the candidates are returned as drawn
+    // (uniform, unspread: the selection would cost target x 8 target).
+    // (Before node version 2 this was TetGen's volume bound, and TetGen's
+    // refinement gave 3-230x more samples than asked for.)
     int target_samples = 2000;
     double radius_scale = 0.9;  // sample radius = thickness * radius_scale (> 0)
     double min_radius = 0;      // metres, lower clamp on radii (>= 0)
@@ -26,7 +28,9 @@ struct InteriorFillOptions {
 };
 
 struct InteriorFillStats {
-    uint64_t tetrahedra = 0;
+    uint64_t tetrahedra = 0;    // TetGen's tetrahedra (the volume drawn from)
+    uint64_t candidates = 0;    // uniform candidates drawn
+    uint64_t samples = 0;       // samples returned (= target_samples)
     double interior_volume = 0; // m^3, from the tetrahedra
     double max_thickness = 0;   // m
 };
