@@ -186,11 +186,11 @@ std::string xy_text(Vec2i r) { return std::to_string(r[0]) + " x " + std::to_str
 // --------------------------------------------------------------- file names
 
 // tiles/DIR/STEM.I_J.EXT for output DIR/STEM.EXT.
-fs::path tile_rel(const GraphOutput& o, Vec2i t, const std::string& suffix = "") {
+fs::path tile_rel(const GraphOutput& o, Vec2i t) {
     fs::path p = fs::path(o.file).lexically_normal();
     if (p.is_absolute() || (!p.empty() && p.begin()->string() == "..")) p = p.filename();
     const std::string tag = "." + std::to_string(t[0]) + "_" + std::to_string(t[1]);
-    return fs::path("tiles") / p.parent_path() / (p.stem().string() + tag + p.extension().string() + suffix);
+    return fs::path("tiles") / p.parent_path() / (p.stem().string() + tag + p.extension().string());
 }
 
 fs::path fragment_rel(Vec2i t) { return fs::path("tiles") / (std::to_string(t[0]) + "_" + std::to_string(t[1]) + ".json"); }
@@ -434,9 +434,13 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
                 }
                 json files = json::array();
                 for (const auto& s : staged) files.push_back(file_entry(root, st.final_path(s), s));
-                const fs::path raw = st.stage(tile_rel(*o, t, ".atlastile"));
-                const std::string bytes = disk_cache::serialize({{"value", v}});
-                write_file_checked(raw, bytes.data(), bytes.size());
+                // The exact values, once per node port (several outputs may write one).
+                const fs::path raw_rel = fs::path("tiles") / "values" / (o->node + "." + o->port + "." + std::to_string(t[0]) + "_" + std::to_string(t[1]) + ".atlastile");
+                const fs::path raw = st.stage(raw_rel);
+                if (!fs::exists(raw)) {
+                    const std::string bytes = disk_cache::serialize({{"value", v}});
+                    write_file_checked(raw, bytes.data(), bytes.size());
+                }
                 frag["outputs"].push_back({{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format},
                                            {"bounds_min", {tb.min[0], tb.min[1]}}, {"bounds_max", {tb.max[0], tb.max[1]}},
                                            {"files", files}, {"raw", file_entry(root, st.final_path(raw), raw)}});
