@@ -18,6 +18,8 @@ PACKAGES=(
   python3-openimageio python3-openvdb python3-numpy python3-pytest
   # The atlas Python module (python/) for the same system Python, and its headers.
   pybind11-dev python3-dev
+  # The tile-sharded cook's cluster driver (python/atlas_dask, docs/scale.md): Dask and distributed 2022.12.
+  python3-dask python3-distributed
   # The Blender add-on's headless test (plugins/blender/): Debian's Blender 3.4 runs the same Python.
   blender
 )

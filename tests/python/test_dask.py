@@ -1,0 +1,153 @@
+"""atlas-dask (python/atlas_dask) on a LocalCluster with two worker processes:
+the assembled files are byte-identical to one untiled `atlas cook` of the same
+graph (the reference is that cook), a failed tile is retried, a worker killed
+mid-tile has its tile cooked elsewhere, a tile that keeps failing is named and
+leaves no index and no assembled output. Also the CLI's tile flags' errors.
+
+Run by ctest as `dask_driver` (tests/CMakeLists.txt), with ATLAS_BIN and
+ATLAS_SOURCE_DIR set; PYTHONPATH holds python/ of the source tree.
+"""
+import os
+import pathlib
+import stat
+import subprocess
+import sys
+
+import pytest
+
+SOURCE_DIR = pathlib.Path(os.environ.get("ATLAS_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
+sys.path.insert(0, str(SOURCE_DIR / "python"))
+ATLAS = os.environ.get("ATLAS_BIN", "atlas")
+WORLD = SOURCE_DIR / "tests" / "graph" / "tiling" / "world.yaml"
+
+distributed = pytest.importorskip("distributed")
+import atlas_dask  # noqa: E402
+
+
+def files_under(d: pathlib.Path):
+    return sorted(p.relative_to(d) for p in d.rglob("*")
+                  if p.is_file() and ".atlas-outputs.json" not in p.name and ".atlas-staging" not in str(p))
+
+
+@pytest.fixture(scope="module")
+def single(tmp_path_factory):
+    out = tmp_path_factory.mktemp("single")
+    subprocess.run([ATLAS, "cook", str(WORLD), "--out", str(out), "--quiet"], check=True, capture_output=True)
+    return out
+
+
+def assert_same_files(single: pathlib.Path, tiled: pathlib.Path):
+    files = files_under(single)
+    assert len(files) >= 16
+    for f in files:
+        assert (tiled / f).exists(), f
+        assert (single / f).read_bytes() == (tiled / f).read_bytes(), f"{f} differs from the untiled cook"
+
+
+def wrapper(tmp_path: pathlib.Path, body: str) -> str:
+    """An 'atlas' program that runs `body` (Python) before exec'ing the real one."""
+    p = tmp_path / "atlas-wrapper"
+    p.write_text(f"""#!{sys.executable}
+import os, signal, sys
+args = sys.argv[1:]
+tile = args[args.index('--tile') + 1] if '--tile' in args else None
+marks = {str(tmp_path / 'marks')!r}
+os.makedirs(marks, exist_ok=True)
+{body}
+os.execv({ATLAS!r}, [{ATLAS!r}] + args)
+""")
+    p.chmod(p.stat().st_mode | stat.S_IXUSR)
+    return str(p)
+
+
+def test_local_cluster_matches_single_cook(single, tmp_path):
+    out = tmp_path / "out"
+    summary = atlas_dask.run(str(WORLD), (3, 2), "local", str(out), cache=str(tmp_path / "cache"), atlas=ATLAS,
+                             workers=2, report=str(tmp_path / "report.json"))
+    assert len(summary["tile_results"]) == 6
+    assert sorted(tuple(r["tile"]) for r in summary["tile_results"]) == [(i, j) for i in range(3) for j in range(2)]
+    assert (out / "tiles" / "index.json").exists()
+    assert_same_files(single, out)
+
+
+def test_failed_tile_is_retried(single, tmp_path):
+    # Tile 1,0 fails on its first attempt only.
+    atlas = wrapper(tmp_path, """
+if tile == '1,0' and not os.path.exists(os.path.join(marks, 'failed')):
+    open(os.path.join(marks, 'failed'), 'w').close()
+    sys.exit('simulated failure')
+""")
+    out = tmp_path / "out"
+    atlas_dask.run(str(WORLD), (2, 2), "local", str(out), atlas=atlas, workers=2, retries=2)
+    assert (tmp_path / "marks" / "failed").exists()
+    assert_same_files(single, out)
+
+
+def test_worker_killed_mid_tile(single, tmp_path):
+    # The first attempt at tile 0,1 kills the worker process that runs it.
+    atlas = wrapper(tmp_path, """
+if tile == '0,1' and not os.path.exists(os.path.join(marks, 'killed')):
+    open(os.path.join(marks, 'killed'), 'w').close()
+    os.kill(os.getppid(), signal.SIGKILL)
+    sys.exit('worker killed')
+""")
+    out = tmp_path / "out"
+    atlas_dask.run(str(WORLD), (2, 2), "local", str(out), atlas=atlas, workers=2, retries=1)
+    assert (tmp_path / "marks" / "killed").exists()
+    assert_same_files(single, out)
+
+
+def test_tile_that_keeps_failing_is_named_and_nothing_is_assembled(tmp_path):
+    atlas = wrapper(tmp_path, """
+if tile == '1,1':
+    sys.exit('simulated failure of tile 1,1')
+""")
+    out = tmp_path / "out"
+    with pytest.raises(atlas_dask.TileError, match=r"tile 1,1: atlas exited with 1 .*simulated failure of tile 1,1"):
+        atlas_dask.run(str(WORLD), (2, 2), "local", str(out), atlas=atlas, workers=2, retries=1)
+    assert not (out / "tiles" / "index.json").exists()
+    assert not (out / "tiles" / "1_1.json").exists()
+    assert not (out / "density.exr").exists()
+    assert all("1_1" not in str(f) for f in files_under(out))
+    # The other tiles are complete, each with its fragment.
+    for t in ("0_0", "1_0", "0_1"):
+        assert (out / "tiles" / f"{t}.json").exists()
+
+
+def test_main_reports_errors_with_exit_status(tmp_path, capsys):
+    atlas = wrapper(tmp_path, "sys.exit('nope') if tile == '0,0' else None")
+    assert atlas_dask.main([str(WORLD), "--tiles", "1,1", "--scheduler", "local", "--out", str(tmp_path / "o"),
+                            "--atlas", atlas, "--retries", "0"]) == 1
+    assert "tile 0,0" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        atlas_dask.main([str(WORLD), "--tiles", "0,2"])
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--tiles", "3,2", "--tile", "3,0"], "--tile 3,0 is out of range: --tiles 3,2 has tiles 0..2, 0..1"),
+    (["--tiles", "5,2"], "does not divide into 5 tiles along x (48 is not a multiple of 5)"),
+    (["--tiles", "8,2"], "output 'maps/cover_bc4.dds' is BC-compressed in 4x4 blocks"),
+    (["--tiles", "2,2", "--tile", "0,0", "--assemble"], "--assemble needs every tile"),
+    (["--tiles", "2"], "--tiles expects two integers"),
+    (["--tile", "0,0"], "--tile and --assemble need --tiles"),
+])
+def test_cli_tile_errors(tmp_path, args, message):
+    out = tmp_path / "out"
+    r = subprocess.run([ATLAS, "cook", str(WORLD), "--out", str(out), "--quiet", *args], capture_output=True, text=True)
+    assert r.returncode != 0
+    assert message in r.stderr, r.stderr
+    assert not out.exists() or not files_under(out)
+
+
+def test_cli_refuses_untileable_graph(tmp_path):
+    g = tmp_path / "warp.yaml"
+    g.write_text("""atlas: 1
+nodes:
+  a: { type: ndf/noise, params: { resolution: [32, 32] } }
+  w: { type: ndf/warp, inputs: { in: a, warp: a } }
+outputs:
+  - { node: w, file: w.exr }
+""")
+    r = subprocess.run([ATLAS, "cook", str(g), "--tiles", "2,2", "--out", str(tmp_path / "o"), "--quiet"], capture_output=True, text=True)
+    assert r.returncode != 0
+    assert "node 'w' (ndf/warp) cannot be cooked in tiles" in r.stderr, r.stderr
