@@ -2,6 +2,7 @@
 // ray-marcher (libatlas/render) to PNG or EXR; --sweep prints fast-vs-
 // reference error and time per quality; --turntable writes N frames.
 #include "cli.h"
+#include "export_scene.h"
 #include "progress_bar.h"
 
 #include "atlas/core/error.h"
@@ -179,7 +180,9 @@ GraphContent cook_graph(Session& session, const std::string& file, int jobs, Pro
             } else if (has_channels(f, {"cirrus"})) {
                 render::check_finite(f, what);
                 if (!g.cirrus) g.cirrus = *f2;
-            } else if (f.channels() == 1) {
+            } else if (f.channels() == 1 && w.type.rfind("volume/", 0) != 0) {
+                // (A volume node's 2D output is a picture of the volume, e.g.
+                // volume/projection's top view, not a sky texture.)
                 render::check_finite(f, what);
                 g.sky2d = *f2; // the last one written
             }
@@ -334,6 +337,28 @@ void write_picture_atomic(const Field2D& image, const std::filesystem::path& pat
     write_file_atomic(path, [&](const std::filesystem::path& tmp) { write_picture(image, tmp, exposure); });
 }
 
+// --artistic on|off, --ms-octaves N, --light-grid NX,NY,NZ (docs/render.md, "Reference: Cycles").
+void apply_physics_options(const Args& a, render::RenderSettings& s) {
+    if (a.has("--artistic")) {
+        const std::string v = a.get("--artistic");
+        if (v != "on" && v != "off") throw UsageError{"--artistic expects on or off, got '" + v + "'", "preview"};
+        if (v == "off") {
+            s.artistic = false;
+            s.ms_octaves = render::kPhysicalMsOctaves;
+            s.multiple_scattering = 1;
+            s.ambient_strength = 1;
+        }
+    }
+    if (a.has("--ms-octaves")) {
+        if (s.artistic) throw UsageError{"--ms-octaves sets the physical model's multiple scattering; it needs --artistic off", "preview"};
+        s.ms_octaves = static_cast<int>(numbers(a.get("--ms-octaves"), 1, "--ms-octaves")[0]);
+    }
+    if (a.has("--light-grid")) {
+        auto v = numbers(a.get("--light-grid"), 3, "--light-grid");
+        s.light_grid = {{int(v[0]), int(v[1]), int(v[2])}};
+    }
+}
+
 render::PointLight parse_light(const std::string& text) {
     const size_t n = std::count(text.begin(), text.end(), ',') + 1;
     if (n != 7 && n != 8) throw UsageError{"--light expects X,Y,Z,R,G,B,INTENSITY[,RADIUS], got '" + text + "'", "preview"};
@@ -374,12 +399,16 @@ View parse_view(const Args& a) {
 
 render::Camera voxel_camera(const render::CloudScene& scene, const View& v, double aspect) {
     const Box3d b = cloud_bounds(scene);
-    if (v.kind == "ground") {
+    if (v.kind == "ground" || v.kind == "auto") {
+        // From the ground at the south edge of the clouds, 2 m up (or under the
+        // lowest base when the clouds float high), pitched up so the bases and
+        // the lit flanks fill the frame: how cumulus is seen and photographed.
         render::Camera c;
         c.fov_deg = 60;
         const Vec3d size = b.max - b.min;
-        c.position = {{0.5 * (b.min[0] + b.max[0]), b.min[1] - 0.4 * size[1], std::max(2.0, b.min[2] - 0.25 * size[2])}};
-        c.look_at = (b.min + b.max) * 0.5;
+        const double ground = scene.modeling->bounds().min[2];
+        c.position = {{0.5 * (b.min[0] + b.max[0]), b.min[1] - 0.1 * size[1], std::max(ground + 2.0, b.min[2] - 0.25 * size[2])}};
+        c.look_at = {{0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), b.max[2] + 0.25 * size[2]}};
         return c;
     }
     if (v.kind == "aerial") return render::framing_camera(b, aspect, 30, 55);
@@ -538,6 +567,16 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
     } else if (have_voxel && (view.kind != "auto" || (a.positional.size() == 1 && is_graph(a.positional[0])))) {
         s.camera = voxel_camera(scene, view, aspect);
     }
+    if (have_voxel && !have_layer && a.positional.size() == 1 && is_graph(a.positional[0])) {
+        // A graph's voxel clouds get the 2.5D mode's daylight: the sky gradient,
+        // a sun bright enough that lit flanks stand out against the sky and
+        // shadowed bases fall below it, low in the south-west (side and back
+        // light show the billows; a sun behind the camera flattens them).
+        s.sky_colour = {{0.07f, 0.17f, 0.50f}};
+        s.sky_horizon = Vec3f{{0.45f, 0.55f, 0.70f}};
+        s.sun_direction = render::sun_direction(230, 25);
+        s.sun_colour = {{2.6f, 2.45f, 2.25f}};
+    }
     if (a.has("--camera")) {
         auto v = numbers(a.get("--camera"), 6, "--camera");
         s.camera.position = {{v[0], v[1], v[2]}};
@@ -583,6 +622,12 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
     }
     for (const auto& l : a.all("--light")) s.lights.push_back(parse_light(l));
     const double exposure = a.has("--exposure") ? numbers(a.get("--exposure"), 1, "--exposure")[0] : 1.5;
+    apply_physics_options(a, s); // --artistic, --ms-octaves, --light-grid
+    if (a.has("--export-scene")) {
+        if (!have_voxel || have_layer) throw UsageError{"--export-scene exports a voxel scene; this preview has no (or not only a) volume/nvdf set", "preview"};
+        const std::string note = export_scene(a.get("--export-scene"), scene, s);
+        if (!quiet) std::fprintf(stderr, "%s\n", note.c_str());
+    }
 
     if (a.has("--sweep")) {
         if (!have_voxel) throw UsageError{"--sweep measures the voxel renderer; the graph has no volume/nvdf output", "preview"};
