@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Regenerates the pictures of docs/render.md's "Gallery: what each graph should
+# look like" (docs/images/look_*.png, 640x360) with `atlas preview` at its
+# defaults unless a camera is named. Usage: scripts/make_gallery.sh [ATLAS_BIN]
+# (default build/bin/atlas). Cooks through $ATLAS_CACHE_DIR when set; the
+# cumulus tower is grown at 64^3 first (about 40 s on the 2-core machine).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ATLAS="${1:-build/bin/atlas}"
+OUT=docs/images
+WORK="$(mktemp -d)"
+trap 'rm -rf "$WORK"' EXIT
+P() { "$ATLAS" preview "$@" --size 640x360 --quiet; }
+
+P examples/quickstart.yaml -o "$OUT/look_quickstart.png"
+P graphs/cloudscape.yaml --camera 2000,-300,2,2000,2000,300 -o "$OUT/look_cloudscape.png"
+P graphs/hzd_weather.yaml -o "$OUT/look_hzd_weather.png"
+P graphs/hzd_weather.yaml --camera 30000,-20000,9000,30000,60000,6000 --fov 60 -o "$OUT/look_hzd_horizon.png"
+P graphs/superstorm.yaml -o "$OUT/look_superstorm.png"
+P graphs/superstorm.yaml --view orbit:20,10 -o "$OUT/look_superstorm_anvil.png"
+P graphs/fc6_forecast.yaml -o "$OUT/look_fc6_forecast.png"
+# cumulus_cloudscape composites the solver's tower: grow it (64^3 quick cook) first.
+"$ATLAS" cook graphs/cumulus_growth.yaml --out "$WORK/cumulus_out" --set 'cloud.resolution=[64,64,64]' --set cloud.dx=62.5 --quiet >/dev/null
+P graphs/cumulus_cloudscape.yaml --set "tower.file=$WORK/cumulus_out/cumulus_final.vdb" --view orbit:20,8 -o "$OUT/look_cumulus_cloudscape.png"
+ls -l "$OUT"/look_*.png
