@@ -6,7 +6,11 @@ using namespace atlas;
 
 void declare(NodeDeclaration& d) {
     d.doc("A 3D field of the given resolution and world bounds, every voxel set to `value`.");
-    d.tiling(TileRule::pointwise());
+    d.tiling(TileRule::pointwise().windowed([](const NodeParams& p) -> std::optional<TileGrid> {
+        const Vec3i r = p.get_int3("resolution");
+        const Vec3d lo = p.get_float3("bounds_min"), hi = p.get_float3("bounds_max");
+        return TileGrid{{{r[0], r[1]}}, Box2d{{{lo[0], lo[1]}}, {{hi[0], hi[1]}}}};
+    }));
     d.output("out", PortType::Field3D, "the constant field");
     d.param_int3("resolution", {{64, 64, 16}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z");
     d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");
@@ -18,7 +22,12 @@ void declare(NodeDeclaration& d) {
 void cook(CookContext& ctx) {
     Box3d box{ctx.get_float3("bounds_min"), ctx.get_float3("bounds_max")};
     if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in every axis");
-    auto f = ctx.make_field3d(ctx.get_int3("resolution"), int(ctx.get_int("channels")), box);
+    Vec3i res = ctx.get_int3("resolution");
+    if (const TileWindow* w = ctx.window()) { // a tiled cook's window of the grid
+        res = {{w->size()[0], w->size()[1], res[2]}};
+        box = {{{w->bounds().min[0], w->bounds().min[1], box.min[2]}}, {{w->bounds().max[0], w->bounds().max[1], box.max[2]}}};
+    }
+    auto f = ctx.make_field3d(res, int(ctx.get_int("channels")), box);
     const float v = float(ctx.get_float("value"));
     for (int c = 0; c < f->channels(); ++c) std::fill(f->channel(c).begin(), f->channel(c).end(), v);
     ctx.set_output("out", Field3DPtr(f));

@@ -10,7 +10,14 @@
 namespace atlas::noise_nodes {
 
 inline void declare_common(NodeDeclaration& d, Vec3i period = {{4, 4, 4}}) {
-    d.tiling(TileRule::pointwise()); // cooked whole and cropped (normalize included)
+    // Tiles: each window is filled on its own (cook_noise), except with
+    // normalize, which needs the whole field's min/max: cooked whole and cropped.
+    d.tiling(TileRule::pointwise().windowed([](const NodeParams& p) -> std::optional<TileGrid> {
+        if (p.get_bool("normalize")) return std::nullopt;
+        const Vec3i r = p.get_int3("resolution");
+        const Vec3d lo = p.get_float3("bounds_min"), hi = p.get_float3("bounds_max");
+        return TileGrid{{{r[0], r[1]}}, Box2d{{{lo[0], lo[1]}}, {{hi[0], hi[1]}}}};
+    }));
     d.output("out", PortType::Field, "the noise field (Field3D, or Field2D when dimensions = 2d)");
     d.param_enum("dimensions", {"3d", "2d"}, "3d").describe("Field3D, or Field2D over x, y");
     d.param_int3("resolution", {{128, 128, 128}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z (z unused in 2D)");
@@ -60,17 +67,22 @@ inline void cook_noise(CookContext& ctx, noise::NoiseSpec spec) {
     // Library errors need no wrapping: the evaluator prefixes them with the node.
     spec.validate(two_d ? 2 : 3);
     const int comps = noise::noise_components(spec.kernel, two_d ? 2 : 3);
+    // A tiled cook's window of the grid (docs/scale.md), else the whole grid.
+    const TileWindow* w = ctx.window();
+    const noise::FillWindow fw = w ? noise::FillWindow{w->x0, w->y0, res[0], res[1]} : noise::FillWindow{0, 0, res[0], res[1]};
+    const Vec2i wres = w ? w->size() : Vec2i{{res[0], res[1]}};
     if (two_d) {
         Box2d box{{{lo[0], lo[1]}}, {{hi[0], hi[1]}}};
         if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in x and y");
-        auto f = ctx.make_field2d({{res[0], res[1]}}, comps, box);
-        noise::fill_noise(*f, 0, spec, &ctx.progress_sink());
+        auto f = ctx.make_field2d(wres, comps, w ? w->bounds() : box);
+        noise::fill_noise(*f, 0, spec, &ctx.progress_sink(), &fw);
         ctx.set_output("out", Field2DPtr(f));
     } else {
         Box3d box{lo, hi};
         if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in every axis");
-        auto f = ctx.make_field3d(res, comps, box);
-        noise::fill_noise(*f, 0, spec, &ctx.progress_sink());
+        if (w) box = {{{w->bounds().min[0], w->bounds().min[1], lo[2]}}, {{w->bounds().max[0], w->bounds().max[1], hi[2]}}};
+        auto f = ctx.make_field3d({{wres[0], wres[1], res[2]}}, comps, box);
+        noise::fill_noise(*f, 0, spec, &ctx.progress_sink(), &fw);
         ctx.set_output("out", Field3DPtr(f));
     }
 }

@@ -310,3 +310,65 @@ TEST(Tiling, TilesCookedSeparatelyAreReusedAndAssembled) {
     EXPECT_EQ(cooked, 1);
     for (const auto& f : files_under(single)) EXPECT_TRUE(bytes_of(single / f) == bytes_of(tiled / f)) << f;
 }
+
+// Every noise kernel fills each tile's window itself (2D and 3D, a
+// non-integer frequency and an offset, tiles of 10 texels): the assembled
+// bytes are the untiled cook's.
+TEST(Tiling, WindowedNoiseKernelsAreBitIdentical) {
+    std::string text = "atlas: 1\nnodes:\n";
+    std::string outs = "outputs:\n";
+    const char* grid = "resolution: [30, 20, 4], bounds_min: [-100, 50, 0], bounds_max: [2900, 2050, 400]";
+    for (const char* k : {"perlin_worley", "worley", "curl", "alligator", "curly_alligator", "gradient"}) {
+        text += std::string("  ") + k + ": { type: noise/" + k + ", params: { " + grid + ", frequency: 1.5, offset: [0.25, 0.5, 0], octaves: 3, seed: 9 } }\n";
+        outs += std::string("  - { node: ") + k + ", file: " + k + ".exr }\n";
+    }
+    text += std::string("  flat: { type: noise/worley, params: { dimensions: 2d, ") + grid + ", octaves: 2 } }\n";
+    text += std::string("  norm: { type: noise/gradient, params: { ") + grid + ", normalize: true } }\n";
+    outs += "  - { node: flat, file: flat.exr }\n  - { node: norm, file: norm.exr }\n";
+    const fs::path single = scratch("single"), tiled = scratch("tiled");
+    Session a = load_text(text + outs, single);
+    a.cook(options(single));
+    Session b = load_text(text + outs, tiled);
+    TileOptions t;
+    t.tiles = {{3, 2}};
+    t.assemble = true;
+    cook_tiled(b, options(tiled), t);
+    const auto files = files_under(single);
+    ASSERT_EQ(files.size(), size_t(8));
+    for (const auto& f : files) EXPECT_TRUE(bytes_of(single / f) == bytes_of(tiled / f)) << f;
+}
+
+// A windowed generator never makes its whole grid: under a memory budget
+// smaller than the whole field (which the untiled cook is refused), the tiles
+// cook, and each tile file holds the crop of the untiled value.
+TEST(Tiling, WindowedGeneratorsStayWithinATilesMemory) {
+    const std::string text = R"(atlas: 1
+nodes:
+  n: { type: noise/perlin_worley, params: { resolution: [64, 64, 16], bounds_max: [6400, 6400, 1600], seed: 2 } }
+  d: { type: math/remap, inputs: { in: n }, params: { in_min: 0.3, in_max: 0.8 } }
+outputs:
+  - { node: d, file: d.exr }
+)";
+    const uint64_t whole = 64ull * 64 * 16 * 4, tile = whole / 4;
+    const fs::path single = scratch("single"), tiled = scratch("tiled");
+    CookOptions small = options(single);
+    small.memory_budget = tile + tile / 2;
+    Session a = load_text(text, single);
+    EXPECT_THROW(a.cook(small), MemoryBudgetError);
+    const Field3DPtr ref = std::get<Field3DPtr>(a.get("d", "out"));
+    Session b = load_text(text, tiled);
+    TileOptions t;
+    t.tiles = {{2, 2}};
+    CookOptions o = options(tiled);
+    o.memory_budget = tile + tile / 2;
+    cook_tiled(b, o, t);
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+            const fs::path p = tiled / ("tiles/d." + std::to_string(i) + "_" + std::to_string(j) + ".exr");
+            const Field3DPtr f = io::as_field3d(io::read_field_file(p));
+            ASSERT_EQ(f->resolution(), (Vec3i{{32, 32, 16}}));
+            for (int z = 0; z < 16; ++z)
+                for (int y = 0; y < 32; ++y)
+                    for (int x = 0; x < 32; ++x) ASSERT_EQ(f->at(0, x, y, z), ref->at(0, 32 * i + x, 32 * j + y, z)) << p;
+        }
+}

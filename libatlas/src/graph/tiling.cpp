@@ -47,6 +47,7 @@ struct Plan {
     std::vector<const GraphOutput*> outputs;
     std::vector<const GraphNode*> order;
     std::map<std::string, int> halo; // per node
+    std::map<std::string, TileGrid> windowed; // generators that cook each tile's window themselves
 };
 
 std::string node_label(const GraphNode& n) {
@@ -98,6 +99,8 @@ Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::s
         if (rule.kind == TileRule::Kind::Halo && !n->inputs.empty()) h = rule.halo(params);
         if (h < 0) throw Error(node_label(*n) + ": internal: negative tiling halo");
         p.halo[n->name] = h;
+        if (n->inputs.empty() && rule.window_grid)
+            if (auto grid = rule.window_grid(params)) p.windowed[n->name] = *grid;
     }
     return p;
 }
@@ -110,16 +113,9 @@ struct Grid {
     std::string from; // the node that set it
 };
 
-double edge(double lo, double hi, int i, int n) {
-    if (i <= 0) return lo;
-    if (i >= n) return hi;
-    return lo + (hi - lo) * double(i) / double(n);
-}
+TileWindow window_of(const Grid& g, const TileRect& r) { return {{g.res, {g.lo, g.hi}}, r.x0, r.y0, r.x1, r.y1}; }
 
-Box2d rect_bounds(const Grid& g, const TileRect& r) {
-    return {{{edge(g.lo[0], g.hi[0], r.x0, g.res[0]), edge(g.lo[1], g.hi[1], r.y0, g.res[1])}},
-            {{edge(g.lo[0], g.hi[0], r.x1, g.res[0]), edge(g.lo[1], g.hi[1], r.y1, g.res[1])}}};
-}
+Box2d rect_bounds(const Grid& g, const TileRect& r) { return window_of(g, r).bounds(); }
 
 TileRect grow(const TileRect& r, int h, Vec2i res) {
     return {std::max(0, r.x0 - h), std::max(0, r.y0 - h), std::min(res[0], r.x1 + h), std::min(res[1], r.y1 + h)};
@@ -312,6 +308,16 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
     if (!to_cook.empty()) {
         for (const GraphNode* n : plan.order) {
             if (!n->inputs.empty()) continue;
+            if (auto it = plan.windowed.find(n->name); it != plan.windowed.end()) {
+                const TileGrid& tg = it->second;
+                if (grid.from.empty()) {
+                    grid = {tg.res, tg.bounds.min, tg.bounds.max, n->name};
+                } else if (tg.res != grid.res || tg.bounds.min != grid.lo || tg.bounds.max != grid.hi) {
+                    throw Error(node_label(*n) + ": tiling needs one XY grid for the whole graph, but its " + xy_text(tg.res) +
+                                " grid over its bounds differs from the " + xy_text(grid.res) + " grid of node '" + grid.from + "'");
+                }
+                continue; // cooked per tile, on the tile's window
+            }
             std::set<std::string> ports;
             for (const GraphNode* m : plan.order)
                 for (const auto& [port, b] : m->inputs)
@@ -374,13 +380,15 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
         try {
             for (const GraphNode* n : plan.order) {
                 const TileRect r = region.at(n->name);
-                if (n->inputs.empty()) {
+                const bool windowed = plan.windowed.count(n->name) > 0;
+                if (n->inputs.empty() && !windowed) {
                     for (const auto& [key, h] : sources)
                         if (key.first == n->name) held[key] = {crop(h.v, h.rect, r, grid, budget), r, false};
                     continue;
                 }
                 const NodeType& type = *reg.find(n->type);
-                const TileRect in_rect = grow(r, plan.halo.at(n->name), grid.res);
+                const TileRect in_rect = windowed ? r : grow(r, plan.halo.at(n->name), grid.res);
+                const TileWindow window = window_of(grid, r);
                 std::map<std::string, Value> inputs;
                 for (const auto& [port, b] : n->inputs) {
                     const Held& h = held.at({b.node, source_port(g, reg, b)});
@@ -390,6 +398,7 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
                 ProgressSink node_progress;
                 node_progress.is_cancelled = opt.progress.is_cancelled;
                 CookContext ctx(n->name, n->type, type.decl, params, std::move(inputs), budget, node_progress);
+                if (windowed) ctx.set_window(&window);
                 try {
                     arena.execute([&] { type.cook(ctx); });
                 } catch (const CancelledError&) {

@@ -44,6 +44,13 @@ void normalize_channel(std::span<float> v, const OutputParams& o) {
     });
 }
 
+void check_window(const FillWindow& w, int nx, int ny, const NoiseSpec& spec) {
+    if (w.x0 < 0 || w.y0 < 0 || w.x0 + nx > w.full_nx || w.y0 + ny > w.full_ny)
+        throw Error("noise: the window does not fit its grid");
+    if (spec.output.normalize && (nx != w.full_nx || ny != w.full_ny))
+        throw Error("noise: 'normalize' needs the whole field, not a window of it");
+}
+
 void report(const ProgressSink* progress, std::atomic<int>& done, int total) {
     if (!progress) return;
     const int d = ++done;
@@ -52,14 +59,17 @@ void report(const ProgressSink* progress, std::atomic<int>& done, int total) {
 
 } // namespace
 
-void fill_noise(Field3D& out, int channel, const NoiseSpec& spec, const ProgressSink* progress) {
+void fill_noise(Field3D& out, int channel, const NoiseSpec& spec, const ProgressSink* progress, const FillWindow* window) {
     spec.validate(3);
     const int comps = noise_components(spec.kernel, 3);
     check_channels(out.channels(), channel, comps);
-    const Plan<3> plan(spec, int64_t(out.voxel_count()));
     const int nx = out.nx(), ny = out.ny(), nz = out.nz();
+    const FillWindow w = window ? *window : FillWindow{0, 0, nx, ny};
+    check_window(w, nx, ny, spec);
+    // The whole grid's voxel count: a window tabulates what the whole grid does.
+    const Plan<3> plan(spec, int64_t(w.full_nx) * w.full_ny * nz);
     std::vector<double> xs(size_t(nx), 0.0);
-    for (int i = 0; i < nx; ++i) xs[size_t(i)] = voxel_coord(spec, 0, i, nx);
+    for (int i = 0; i < nx; ++i) xs[size_t(i)] = voxel_coord(spec, 0, w.x0 + i, w.full_nx);
     std::atomic<int> done{0};
     // One z-slice per task: fixed work units, results independent of the split.
     tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
@@ -69,7 +79,7 @@ void fill_noise(Field3D& out, int channel, const NoiseSpec& spec, const Progress
             if (progress) progress->poll();
             std::fill(zs.begin(), zs.end(), voxel_coord(spec, 2, z, nz));
             for (int y = 0; y < ny; ++y) {
-                std::fill(ys.begin(), ys.end(), voxel_coord(spec, 1, y, ny));
+                std::fill(ys.begin(), ys.end(), voxel_coord(spec, 1, w.y0 + y, w.full_ny));
                 float* dst[3];
                 for (int c = 0; c < comps; ++c) dst[c] = out.channel(channel + c).data() + out.index(0, y, z);
                 detail::evaluate<3>(plan, {xs.data(), ys.data(), zs.data()}, size_t(nx), dst, sc);
@@ -81,21 +91,23 @@ void fill_noise(Field3D& out, int channel, const NoiseSpec& spec, const Progress
         for (int c = 0; c < comps; ++c) normalize_channel(out.channel(channel + c), spec.output);
 }
 
-void fill_noise(Field2D& out, int channel, const NoiseSpec& spec, const ProgressSink* progress) {
+void fill_noise(Field2D& out, int channel, const NoiseSpec& spec, const ProgressSink* progress, const FillWindow* window) {
     spec.validate(2);
     const int comps = noise_components(spec.kernel, 2);
     check_channels(out.channels(), channel, comps);
-    const Plan<2> plan(spec, int64_t(out.voxel_count()));
     const int nx = out.width(), ny = out.height();
+    const FillWindow w = window ? *window : FillWindow{0, 0, nx, ny};
+    check_window(w, nx, ny, spec);
+    const Plan<2> plan(spec, int64_t(w.full_nx) * w.full_ny);
     std::vector<double> xs(size_t(nx), 0.0);
-    for (int i = 0; i < nx; ++i) xs[size_t(i)] = voxel_coord(spec, 0, i, nx);
+    for (int i = 0; i < nx; ++i) xs[size_t(i)] = voxel_coord(spec, 0, w.x0 + i, w.full_nx);
     std::atomic<int> done{0};
     tbb::parallel_for(tbb::blocked_range<int>(0, ny, 1), [&](const tbb::blocked_range<int>& r) {
         Scratch sc;
         std::vector<double> ys(static_cast<size_t>(nx), 0.0);
         for (int y = r.begin(); y != r.end(); ++y) {
             if (progress) progress->poll();
-            std::fill(ys.begin(), ys.end(), voxel_coord(spec, 1, y, ny));
+            std::fill(ys.begin(), ys.end(), voxel_coord(spec, 1, w.y0 + y, w.full_ny));
             float* dst[2];
             for (int c = 0; c < comps; ++c) dst[c] = out.channel(channel + c).data() + out.index(0, y);
             detail::evaluate<2>(plan, {xs.data(), ys.data()}, size_t(nx), dst, sc);

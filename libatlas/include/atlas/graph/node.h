@@ -26,6 +26,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,20 +51,58 @@ class NodeParams;
 // voxel from its own index's neighbourhood only (never from the field's
 // world bounds or extent), so the crop of its result equals the crop of the
 // untiled result bit for bit.
+// The full XY grid a node's output covers (resolution and world bounds).
+struct TileGrid {
+    Vec2i res{{0, 0}};
+    Box2d bounds;
+};
+
+// A window of a node's full XY grid that a tiled cook asks a generator for
+// (CookContext::window()): texels [x0, x1) x [y0, y1), all of z. The field it
+// makes has resolution size() in x, y and XY bounds bounds(), and each voxel
+// holds what voxel (x0 + i, y0 + j, k) of the whole grid would hold.
+struct TileWindow {
+    TileGrid grid;
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    Vec2i size() const { return {{x1 - x0, y1 - y0}}; }
+    // Texel edge i of n between lo and hi (exactly lo at 0, hi at n): the one
+    // formula for the bounds of every tile, crop and window.
+    static double edge(double lo, double hi, int i, int n) {
+        if (i <= 0) return lo;
+        if (i >= n) return hi;
+        return lo + (hi - lo) * double(i) / double(n);
+    }
+    Box2d bounds() const {
+        const Box2d& b = grid.bounds;
+        return {{{edge(b.min[0], b.max[0], x0, grid.res[0]), edge(b.min[1], b.max[1], y0, grid.res[1])}},
+                {{edge(b.min[0], b.max[0], x1, grid.res[0]), edge(b.min[1], b.max[1], y1, grid.res[1])}}};
+    }
+};
+
 struct TileRule {
     enum class Kind { None, Pointwise, Halo };
     Kind kind = Kind::None;
     std::function<int(const NodeParams&)> halo;           // Halo: texels/voxels in x and y
     std::function<std::string(const NodeParams&)> refuse; // optional: why these parameters cannot tile ("" = they can)
     std::string why_not;                                  // None: why the node does not tile
+    // Optional, for generators: the grid the node makes with these
+    // parameters when its cook honours CookContext::window() for them
+    // (nullopt: it is cooked whole and cropped). Only such generators keep a
+    // tile's memory to the tile: the others are cooked whole once per process.
+    std::function<std::optional<TileGrid>(const NodeParams&)> window_grid;
+
+    TileRule& windowed(std::function<std::optional<TileGrid>(const NodeParams&)> grid) {
+        window_grid = std::move(grid);
+        return *this;
+    }
 
     static TileRule pointwise(std::function<std::string(const NodeParams&)> refuse = {}) {
-        return {Kind::Pointwise, {}, std::move(refuse), {}};
+        return {Kind::Pointwise, {}, std::move(refuse), {}, {}};
     }
     static TileRule with_halo(std::function<int(const NodeParams&)> halo, std::function<std::string(const NodeParams&)> refuse = {}) {
-        return {Kind::Halo, std::move(halo), std::move(refuse), {}};
+        return {Kind::Halo, std::move(halo), std::move(refuse), {}, {}};
     }
-    static TileRule none(std::string why) { return {Kind::None, {}, {}, std::move(why)}; }
+    static TileRule none(std::string why) { return {Kind::None, {}, {}, std::move(why), {}}; }
 };
 
 class NodeDeclaration {
@@ -181,6 +220,11 @@ public:
     // An error about this node's parameter, e.g. error_param("radius", "must be > 0").
     [[noreturn]] void fail(const std::string& message) const;
 
+    // In a tiled cook, the window of its grid a generator whose TileRule is
+    // windowed() is asked for (null otherwise: make the whole grid).
+    const TileWindow* window() const { return window_; }
+    void set_window(const TileWindow* w) { window_ = w; }
+
 private:
     std::string name_, type_;
     const NodeDeclaration& decl_;
@@ -191,6 +235,7 @@ private:
     const ProgressSink& progress_;
     std::map<std::string, double> metrics_;
     std::vector<std::string> warnings_;
+    const TileWindow* window_ = nullptr;
 };
 
 class Hasher;

@@ -22,12 +22,21 @@
 
 namespace atlas::noise {
 
+// A window of a larger grid (tiled cooks, docs/scale.md): voxel (i, j, k) of
+// the field filled is voxel (x0 + i, y0 + j, k) of a full_nx x full_ny grid,
+// with the same value bit for bit. `normalize` needs the whole grid: an error.
+struct FillWindow {
+    int x0 = 0, y0 = 0, full_nx = 0, full_ny = 0;
+};
+
 // Writes noise_components(spec.kernel, 3) channels starting at `channel`.
 // Throws atlas::Error on an invalid spec or when the field lacks channels.
-void fill_noise(Field3D& out, int channel, const NoiseSpec& spec, const ProgressSink* progress = nullptr);
+void fill_noise(Field3D& out, int channel, const NoiseSpec& spec, const ProgressSink* progress = nullptr,
+                const FillWindow* window = nullptr);
 
 // 2D version: uses period[0..1], offset[0..1]; Curl writes 2 channels.
-void fill_noise(Field2D& out, int channel, const NoiseSpec& spec, const ProgressSink* progress = nullptr);
+void fill_noise(Field2D& out, int channel, const NoiseSpec& spec, const ProgressSink* progress = nullptr,
+                const FillWindow* window = nullptr);
 
 // Point lookups (tests, sparse use). Points are field positions p in tile
 // units (lattice coordinate = offset + frequency * p * period), so p and
