@@ -48,6 +48,8 @@ struct Plan {
     std::vector<const GraphNode*> order;
     std::map<std::string, int> halo; // per node
     std::map<std::string, TileGrid> windowed; // generators that cook each tile's window themselves
+    std::map<std::string, std::string> last_use; // node -> the last node (in order) that reads it
+    std::set<std::string> output_nodes;
 };
 
 std::string node_label(const GraphNode& n) {
@@ -78,6 +80,9 @@ Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::s
     for (const GraphOutput* o : p.outputs) mark(o->node);
     for (const GraphNode* n : topological_order(g))
         if (needed.count(n->name)) p.order.push_back(n);
+    for (const GraphNode* n : p.order)
+        for (const auto& [port, b] : n->inputs) p.last_use[b.node] = n->name;
+    for (const GraphOutput* o : p.outputs) p.output_nodes.insert(o->node);
 
     for (const GraphOutput* o : p.outputs) {
         const NodeType* t = reg.find(g.find(o->node)->type);
@@ -423,6 +428,10 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
                                     " region), so it cannot be cooked in tiles");
                     held[{n->name, out.name}] = {crop(it->second, in_rect, r, grid, budget), r, false};
                 }
+                // Memory: drop what no later node and no output reads.
+                for (const auto& [port, b] : n->inputs)
+                    if (plan.last_use.at(b.node) == n->name && !plan.output_nodes.count(b.node))
+                        for (auto h = held.begin(); h != held.end();) h = h->first.first == b.node ? held.erase(h) : std::next(h);
             }
 
             // Write the tile: every output in its format, the exact values, the fragment.
