@@ -2,6 +2,7 @@
 
 #include "atlas/compress/texture.h"
 #include "atlas/graph/graph.h"
+#include "atlas/render/renderer.h"
 
 #include <sstream>
 
@@ -101,6 +102,10 @@ const std::vector<Command>& commands() {
           {"--flash", "N", "flash index of --lightning (default 0): the same index gives the same flash positions"},
           {"--edge", "wrap|clamp|empty", "2.5D: the map beyond its bounds (default: empty for a superstorm set, else wrap)"},
           {"--envelope", "on|off|auto", "2.5D: skip empty space with a cone map over the cloud tops (the graph's ndf/cone_map if it writes one); auto (default) = on above the lowest cloud base"},
+          {"--artistic", "on|off", "off: the physical lighting a path tracer computes (no powder, octave multiple scattering; docs/render.md \"Reference: Cycles\")"},
+          {"--ms-octaves", "N", "with --artistic off: octaves of multiple scattering (0 = single scattering; default " + std::to_string(render::kPhysicalMsOctaves) + ")"},
+          {"--light-grid", "NX,NY,NZ", "voxel light grid resolution (default 128,128,32, capped at the volume's)"},
+          {"--export-scene", "DIR", "also write DIR/density.vdb and DIR/scene.json for scripts/cycles_reference.py (Blender Cycles)"},
           {"--quiet", "", "no progress bar or summary"}},
          run_preview},
     };

@@ -16,6 +16,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <numbers>
@@ -75,10 +76,19 @@ struct SunTerms {
     double sun_phase;  // dual-lobe HG
     double powder_mix; // 0.5 + 0.5 cos: no powder darkening looking toward the sun
     double ms_sun;     // clamp(cos, 0, 0.9)
+    std::array<double, 16> ms_phase{}; // physical mode: the octaves' phase (g x ms_anisotropy^n)
 };
 
 inline SunTerms sun_terms(const RenderSettings& s, double cos_theta) {
-    return {dual_hg(s, cos_theta), 0.5 + 0.5 * cos_theta, std::clamp(cos_theta, 0.0, 0.9)};
+    SunTerms t{dual_hg(s, cos_theta), 0.5 + 0.5 * cos_theta, std::clamp(cos_theta, 0.0, 0.9), {}};
+    if (!s.artistic) {
+        double c = 1;
+        for (int n = 1; n <= s.ms_octaves; ++n) {
+            c *= s.ms_anisotropy;
+            t.ms_phase[size_t(n - 1)] = s.hg_forward_weight * hg(cos_theta, s.hg_forward * c) + (1 - s.hg_forward_weight) * hg(cos_theta, s.hg_back * c);
+        }
+    }
+    return t;
 }
 
 // The Nubis lighting of one sample: weights of the sun colour and of the
@@ -89,6 +99,20 @@ inline SunTerms sun_terms(const RenderSettings& s, double cos_theta) {
 //   sky_tau     optical depth toward the sky
 inline void shade(const RenderSettings& s, const SunTerms& st, double tau, double dp, double ms_relax, double sky_tau, double& sun_w,
                   double& sky_w) {
+    if (!s.artistic) {
+        // The physical model (docs/render.md, "Reference: Cycles"): single
+        // scattering of the sun plus the octave series; st.ms_phase[n] holds
+        // the dual-lobe phase with both g scaled by ms_anisotropy^n.
+        double direct = std::exp(-tau) * st.sun_phase, ms = 0, a = 1, b = 1;
+        for (int n = 1; n <= s.ms_octaves; ++n) {
+            a *= s.ms_energy;
+            b *= s.ms_extinction;
+            ms += a * std::exp(-b * tau) * st.ms_phase[size_t(n - 1)];
+        }
+        sun_w = direct + s.multiple_scattering * ms;
+        sky_w = s.ambient_strength * (s.ms_octaves > 0 ? 1.0 : std::exp(-sky_tau));
+        return;
+    }
     const double beer = std::exp(-tau);
     const double powder = 1 - std::exp(-2 * tau);
     const double direct = beer * (powder + (1 - powder) * st.powder_mix) * st.sun_phase;
@@ -133,7 +157,11 @@ struct Sky {
     double ambient[3]; // cosine-weighted upper-hemisphere mean
 
     explicit Sky(const RenderSettings& s) : zenith(s.sky_colour), horizon(s.sky_horizon.value_or(s.sky_colour)) {
-        for (int c = 0; c < 3; ++c) ambient[c] = double(horizon[c]) + (double(zenith[c]) - double(horizon[c])) * (2.0 / 3.0);
+        // Physical mode: the mean over the whole sphere (the horizon colour
+        // below the horizon, mean saturate(z) = 1/4), which multiple
+        // scattering spreads through a cloud.
+        const double k = s.artistic ? 2.0 / 3.0 : 0.25;
+        for (int c = 0; c < 3; ++c) ambient[c] = double(horizon[c]) + (double(zenith[c]) - double(horizon[c])) * k;
     }
     double at(int c, double up_t) const { return double(horizon[c]) + (double(zenith[c]) - double(horizon[c])) * up_t; }
 };

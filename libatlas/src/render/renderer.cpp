@@ -8,19 +8,22 @@
 #include <memory>
 #include <optional>
 
+#include <tbb/parallel_for.h>
+
 namespace atlas::render {
 
 std::vector<std::string> RenderReport::active_features() const {
     std::vector<std::string> f;
+    if (physical) f.push_back("physical");
     if (noise_uprez) f.push_back("noise_uprez");
     if (billowy) f.push_back("billowy");
     if (near_camera_detail) f.push_back("near_camera_detail");
     if (sdf_skipping) f.push_back("sdf_skipping");
     f.push_back(light_grid ? "light_grid" : "marched_light");
-    f.push_back("beer_powder");
+    f.push_back(physical ? "beer" : "beer_powder");
     f.push_back("dual_hg");
     f.push_back("ambient");
-    f.push_back("multiple_scattering");
+    f.push_back(physical ? "ms_octaves" : "multiple_scattering");
     if (point_lights) f.push_back("point_lights");
     if (sky_gradient) f.push_back("sky_gradient");
     return f;
@@ -59,6 +62,9 @@ void check_settings(const RenderSettings& s) {
     if (!(s.min_transmittance >= 0 && s.min_transmittance < 1)) bad("min_transmittance must be in [0, 1)");
     if (s.threads < 0) bad("threads must be >= 0 (0 = all cores)");
     if (s.light_samples < 1 || s.light_samples > 64) bad("light_samples must be 1..64");
+    if (s.ms_octaves < 0 || s.ms_octaves > 16) bad("ms_octaves must be 0..16");
+    for (double v : {s.ms_energy, s.ms_extinction, s.ms_anisotropy})
+        if (!(v >= 0 && v <= 1)) bad("ms_energy, ms_extinction and ms_anisotropy must be in [0, 1]");
     for (size_t i = 0; i < s.lights.size(); ++i) validate_light(s.lights[i], "lights[" + std::to_string(i) + "]");
 }
 
@@ -241,6 +247,7 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     report.billowy = cloud.has_noise() && cloud.billowy();
     report.sdf_skipping = fast;
     report.light_grid = fast;
+    report.physical = !settings.artistic;
     {
         // Near-camera detail only matters when the camera is within its 198 m range.
         const Box3d& b = cloud.bounds();
@@ -301,6 +308,56 @@ RenderSettings preview_settings(const Box3d& bounds, int width, int height) {
     s.width = width;
     s.height = height;
     s.camera = framing_camera(bounds, double(width) / double(height));
+    return s;
+}
+
+} // namespace atlas::render
+
+namespace atlas::render {
+
+Field3D sample_density(const CloudScene& scene, Vec3i res) {
+    for (int a = 0; a < 3; ++a)
+        if (res[a] < 1 || res[a] > 2048) throw Error("render: sample_density resolution must be 1..2048 per axis");
+    detail::CloudSampler cloud(scene);
+    const Box3d b = cloud.bounds();
+    Field3D out(res, 1, b, {"density"});
+    const Vec3d v = out.voxel_size();
+    tbb::parallel_for(0, res[2], [&](int z) {
+        for (int y = 0; y < res[1]; ++y)
+            for (int x = 0; x < res[0]; ++x)
+                out.at(0, x, y, z) =
+                    cloud.density_at(b.min[0] + (x + 0.5) * v[0], b.min[1] + (y + 0.5) * v[1], b.min[2] + (z + 0.5) * v[2], 1e30);
+    });
+    return out;
+}
+
+CloudScene density_scene(const Field3D& density) {
+    if (density.channels() < 1) throw Error("render: density_scene needs a field with a density channel");
+    // The sampler's density is (profile x scale)^(0.3 + 0.3 min(1, scale)^4):
+    // with scale S >= 1 the power is 0.6, so profile = D^(1/0.6) / S gives D.
+    float dmax = 0;
+    for (float d : density.channel(0)) {
+        if (!(d >= 0) || !std::isfinite(d)) throw Error("render: density_scene needs finite densities >= 0");
+        dmax = std::max(dmax, d);
+    }
+    const double S = std::max(1.0, std::pow(double(dmax), 1.0 / 0.6));
+    auto m = std::make_shared<Field3D>(density.resolution(), 3, density.bounds(),
+                                       std::vector<std::string>{"dimensional_profile", "detail_type", "density_scale"});
+    auto sdf = std::make_shared<Field3D>(density.resolution(), 1, density.bounds(), std::vector<std::string>{"sdf"});
+    const Vec3d vox = density.voxel_size();
+    const float inside = -static_cast<float>(std::min({vox[0], vox[1], vox[2]}));
+    auto d = density.channel(0);
+    auto p = m->channel(0), t = m->channel(1), sc = m->channel(2), sd = sdf->channel(0);
+    for (size_t i = 0; i < d.size(); ++i) {
+        p[i] = static_cast<float>(std::pow(double(d[i]), 1.0 / 0.6) / S);
+        t[i] = 0;
+        sc[i] = static_cast<float>(S);
+        sd[i] = inside;
+    }
+    CloudScene s;
+    s.modeling = m;
+    s.sdf = sdf;
+    validate_scene(s);
     return s;
 }
 

@@ -39,6 +39,9 @@ enum class RenderMode {
     Reference, // small fixed steps, marched light rays, no grid
 };
 
+// Octaves of multiple scattering the CLI's --artistic off uses.
+inline constexpr int kPhysicalMsOctaves = 8;
+
 struct RenderSettings {
     Camera camera;
     Vec3d sun_direction{{0.4, -0.6, 0.5}}; // toward the sun, normalised internally
@@ -77,6 +80,22 @@ struct RenderSettings {
     // Fast mode: density samples on the segment toward each point light
     // (reference mode marches it at 2 x reference_step), 1..64.
     int light_samples = 4;
+    // The artistic terms of the Nubis lighting: the powder darkening, the
+    // dimensional-profile multiple-scattering term and the in-scatter
+    // probability sqrt(1 - profile) on the ambient. false: the physical model
+    // a path tracer computes (docs/render.md, "Reference: Cycles"): albedo 1,
+    // direct sun = Beer x phase, multiple scattering from ms_octaves, the sky
+    // in-scattered as its radiance times the transmittance toward it (single
+    // scattering) or fully (ms_octaves > 0: a conservative medium under a
+    // uniform sky is as bright as the sky). multiple_scattering and
+    // ambient_strength still scale the two terms.
+    bool artistic = true;
+    // Physical mode: octaves of the multiple-scattering series (Wrenninge,
+    // "Art-directable multiple volumetric scattering", 2015): octave n >= 1
+    // adds ms_energy^n x Beer(ms_extinction^n tau) x phase with both g
+    // scaled by ms_anisotropy^n. 0 = single scattering only, 0..16.
+    int ms_octaves = 0;
+    double ms_energy = 0.5, ms_extinction = 0.5, ms_anisotropy = 0.5; // each in [0, 1]
 };
 
 // Which parts of the method ran (features the scene does not need are left
@@ -90,6 +109,7 @@ struct RenderReport {
     bool point_lights = false;     // at least one point light (given or from a light field)
     int point_light_count = 0;     // lights integrated (after resolving light fields)
     bool sky_gradient = false;     // sky_horizon set
+    bool physical = false;         // artistic = false: the physical model (no powder, octave multiple scattering)
     uint64_t density_samples = 0;  // view-ray density evaluations
     // "noise_uprez billowy ..." - the active features, space separated.
     std::vector<std::string> active_features() const;
@@ -117,5 +137,20 @@ namespace atlas::render {
 // framing camera (framing_camera with its defaults), the default sun and
 // sky, fast mode. Throws atlas::Error on a non-positive size.
 RenderSettings preview_settings(const Box3d& bounds, int width, int height);
+
+// The density the voxel renderer sees (after the noise up-rez, without the
+// near-camera detail; 0 outside the SDF), sampled at the voxel centres of a
+// res grid over the scene's bounds: one channel "density" (extinction per
+// metre = RenderSettings::extinction x density). For exporting the scene to
+// another renderer (scripts/cycles_reference.py). Throws atlas::Error on a
+// resolution outside 1..2048 per axis or an invalid scene.
+Field3D sample_density(const CloudScene& scene, Vec3i res);
+
+// A scene the voxel renderer draws with exactly `density` (channel 0, >= 0)
+// at its voxel centres: no noise, detail type 0, the dimensional profile and
+// density scale chosen so the renderer's sharpening power returns the value,
+// an SDF that is inside everywhere (no empty-space skipping). Between voxel
+// centres the renderer interpolates the profile, not the density.
+CloudScene density_scene(const Field3D& density);
 
 } // namespace atlas::render

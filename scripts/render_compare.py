@@ -1,0 +1,79 @@
+#!/usr/bin/python3
+"""Luminance error of a preview EXR against a reference EXR (docs/render.md, "Reference: Cycles").
+
+    /usr/bin/python3 scripts/render_compare.py PREVIEW.exr REFERENCE.exr [--threshold T] [--json]
+
+Both images are linear radiance (Atlas's preview EXR: channels r, g, b, transmittance; Cycles: R, G, B).
+Luminance Y = 0.2126 R + 0.7152 G + 0.0722 B (Rec. 709 primaries, the linear space of both).
+Prints the mean relative error mean(|Y - Yref| / Yref) over the pixels with Yref > threshold x
+mean(Yref) (default 0.05), the RMSE of Y, the RMSE relative to mean(Yref), the signed mean ratio
+sum(Y) / sum(Yref) - 1 (a brightness bias), and the pixel count used; when PREVIEW has a
+transmittance channel, also cloud_* = the same over the pixels where the preview sees cloud
+(transmittance < 0.9), which leaves out the sky the two renderers draw identically.
+"""
+import json
+import sys
+
+import numpy as np
+import OpenImageIO as oiio
+
+
+def channels(path):
+    """{lower-case channel name: H x W float64 array}, row 0 at the top."""
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        raise SystemExit(f"{path}: {oiio.geterror()}")
+    spec = inp.spec()
+    px = np.asarray(inp.read_image(0, 0, 0, spec.nchannels, oiio.FLOAT), dtype=np.float64).reshape(spec.height, spec.width, spec.nchannels)
+    inp.close()
+    return {n.lower(): px[..., i] for i, n in enumerate(spec.channelnames)}
+
+
+def luminance(path):
+    c = channels(path)
+    return 0.2126 * c["r"] + 0.7152 * c["g"] + 0.0722 * c["b"]
+
+
+def cloud_mask(path, max_transmittance=0.9):
+    """Pixels where an Atlas preview EXR sees cloud (transmittance below max_transmittance)."""
+    return channels(path)["transmittance"] < max_transmittance
+
+
+def metrics(y, ref, threshold=0.05, cloud=None):
+    """Errors of y against ref over pixels with ref > threshold x mean(ref); with a cloud mask,
+    also the same errors over the cloud pixels only (keys cloud_*)."""
+    if y.shape != ref.shape:
+        raise SystemExit(f"image sizes differ: {y.shape} vs {ref.shape}")
+    mask = ref > threshold * ref.mean()
+    rel = np.abs(y[mask] - ref[mask]) / ref[mask]
+    rmse = float(np.sqrt(np.mean((y - ref) ** 2)))
+    m = {"mean_rel": float(rel.mean()) if mask.any() else float("nan"), "rmse": rmse, "rmse_rel": rmse / float(ref.mean()),
+         "bias": float(y.sum() / ref.sum() - 1), "pixels": int(mask.sum())}
+    if cloud is not None:
+        cm = mask & cloud
+        if cm.any():
+            m["cloud_mean_rel"] = float((np.abs(y[cm] - ref[cm]) / ref[cm]).mean())
+            m["cloud_rmse"] = float(np.sqrt(np.mean((y[cm] - ref[cm]) ** 2)))
+            m["cloud_bias"] = float(y[cm].sum() / ref[cm].sum() - 1)
+        m["cloud_pixels"] = int(cm.sum())
+    return m
+
+
+def main(argv):
+    args = [a for a in argv[1:] if not a.startswith("--")]
+    threshold = 0.05
+    if "--threshold" in argv:
+        threshold = float(argv[argv.index("--threshold") + 1])
+        args.remove(argv[argv.index("--threshold") + 1])
+    if len(args) != 2:
+        raise SystemExit(__doc__)
+    cloud = cloud_mask(args[0]) if "transmittance" in channels(args[0]) else None
+    m = metrics(luminance(args[0]), luminance(args[1]), threshold, cloud)
+    if "--json" in argv:
+        print(json.dumps(m))
+    else:
+        print(" ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in m.items()))
+
+
+if __name__ == "__main__":
+    main(sys.argv)
