@@ -13,13 +13,14 @@ trap 'rm -rf "$WORK"' EXIT
 P() { "$ATLAS" preview "$@" --size 640x360 --quiet; }
 
 P examples/quickstart.yaml -o "$OUT/look_quickstart.png"
-P graphs/cloudscape.yaml --camera 2000,-300,2,2000,2000,300 -o "$OUT/look_cloudscape.png"
+P graphs/cloudscape.yaml --camera 1900,400,2,1800,1800,300 -o "$OUT/look_cloudscape.png"
 P graphs/hzd_weather.yaml -o "$OUT/look_hzd_weather.png"
 P graphs/hzd_weather.yaml --camera 30000,-20000,9000,30000,60000,6000 --fov 60 -o "$OUT/look_hzd_horizon.png"
+P graphs/hzd_weather.yaml --set type.out_max=0 -o "$OUT/look_hzd_stratus.png"
 P graphs/superstorm.yaml -o "$OUT/look_superstorm.png"
 P graphs/superstorm.yaml --view orbit:20,10 -o "$OUT/look_superstorm_anvil.png"
 P graphs/fc6_forecast.yaml -o "$OUT/look_fc6_forecast.png"
 # cumulus_cloudscape composites the solver's tower: grow it (64^3 quick cook) first.
 "$ATLAS" cook graphs/cumulus_growth.yaml --out "$WORK/cumulus_out" --set 'cloud.resolution=[64,64,64]' --set cloud.dx=62.5 --quiet >/dev/null
-P graphs/cumulus_cloudscape.yaml --set "tower.file=$WORK/cumulus_out/cumulus_final.vdb" --view orbit:20,8 -o "$OUT/look_cumulus_cloudscape.png"
+P graphs/cumulus_cloudscape.yaml --set "tower.file=$WORK/cumulus_out/cumulus_final.vdb" --camera 3200,800,400,2400,3000,1500 --fov 45 -o "$OUT/look_cumulus_cloudscape.png"
 ls -l "$OUT"/look_*.png
