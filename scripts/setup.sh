@@ -22,6 +22,8 @@ PACKAGES=(
   python3-dask python3-distributed
   # The Blender add-on's headless test (plugins/blender/): Debian's Blender 3.4 runs the same Python.
   blender
+  # The Cycles reference (scripts/cycles_reference.py, bench/render_vs_cycles.sh): its error plots.
+  python3-matplotlib
 )
 
 missing=()
