@@ -23,6 +23,20 @@ std::string range_text(const ParamDecl& p) {
     return "";
 }
 
+// How the node cooks in tiles (docs/scale.md).
+std::string tiling_text(const NodeType& t) {
+    const TileRule& r = t.decl.tiling();
+    const bool source = t.decl.inputs().empty();
+    switch (r.kind) {
+    case TileRule::Kind::Pointwise:
+        if (!source) return "pointwise";
+        return r.window_grid ? "generator, makes each tile's window" : "generator, cooked whole and cropped";
+    case TileRule::Kind::Halo: return "halo from its parameters";
+    case TileRule::Kind::None: break;
+    }
+    return "not tileable" + (r.why_not.empty() ? std::string() : ": " + r.why_not);
+}
+
 std::string port_line(const PortDecl& p) {
     return std::string(port_type_name(p.type)) + (p.optional ? ", optional" : "");
 }
@@ -39,7 +53,7 @@ std::string node_list_text(const NodeRegistry& registry) {
 
 std::string node_reference_text(const NodeType& t) {
     std::ostringstream out;
-    out << t.name << " (version " << t.version << ")\n  " << t.decl.doc() << "\n";
+    out << t.name << " (version " << t.version << ")\n  " << t.decl.doc() << "\n  tiling: " << tiling_text(t) << "\n";
     if (!t.decl.inputs().empty()) {
         out << "\ninputs:\n";
         for (const auto& p : t.decl.inputs()) out << "  " << p.name << " (" << port_line(p) << "): " << p.doc << "\n";
@@ -71,7 +85,8 @@ std::string node_reference_markdown(const NodeRegistry& registry) {
             return a;
         }() << ")\n";
     for (const NodeType* t : registry.all()) {
-        out << "\n## " << t->name << "\n\n" << t->decl.doc() << " (version " << t->version << ")\n\n";
+        out << "\n## " << t->name << "\n\n" << t->decl.doc() << " (version " << t->version << ")\n\n"
+            << "Tiling: " << tiling_text(*t) << ".\n\n";
         if (!t->decl.inputs().empty()) {
             out << "| input | type | description |\n|---|---|---|\n";
             for (const auto& p : t->decl.inputs()) out << "| `" << p.name << "` | " << port_line(p) << " | " << p.doc << " |\n";
