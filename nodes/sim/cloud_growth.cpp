@@ -51,6 +51,13 @@ void declare(NodeDeclaration& d) {
     d.param_enum("boundary", {"closed", "open_top", "open_sides_top", "open_sides"}, "closed")
         .describe("closed: free-slip walls everywhere; open_top: the top is open; open_sides_top: only the floor is a wall; "
                   "open_sides: free-slip floor and lid, open (ambient-pressure) x and y faces");
+    d.param_enum("boundary_x", {"as_boundary", "closed", "open", "periodic"}, "as_boundary")
+        .describe("both x faces: as_boundary (what 'boundary' says), closed (free-slip walls), open (ambient pressure), "
+                  "periodic (x- glued to x+: what leaves one side enters the other; needs an even resolution x; the "
+                  "built-in patch, the bubble, the emitter and initial inputs wrap too)");
+    d.param_enum("boundary_y", {"as_boundary", "closed", "open", "periodic"}, "as_boundary")
+        .describe("both y faces, as boundary_x (periodic needs an even resolution y; a one-cell-thick y is a 2D slab "
+                  "and stays closed)");
     d.param_float("duration", 300).range(1e-6, 1e7).with_unit("s").describe("simulated time");
     d.param_float("frame_dt", 10).range(1e-6, 1e5).with_unit("s").describe("time per step (one report row, one potential sequence frame)");
     d.param_float("cfl", 1).range(0.1, 5).with_unit("cells").describe("max cells travelled per substep");
@@ -166,10 +173,13 @@ sim::SimOptions options_from(const CookContext& ctx, int nz, double dx) {
 // Channel `c` of `e` sampled at the grid's cell centres (world positions):
 // copied cell by cell when the cells line up, else trilinear; 0 outside it.
 // NaN/Inf is an error naming the input and channel.
+std::vector<float> on_grid_periodic(const Field3D& e, int c, const sim::GridSpec& s, const Vec3d& origin);
+
 std::vector<float> on_grid(const CookContext& ctx, const Field3D& e, int c, const sim::GridSpec& s, const Vec3d& origin,
                            const std::string& port) {
     for (float v : e.channel(c))
         if (!std::isfinite(v)) ctx.fail("input '" + port + "' channel '" + e.channel_name(c) + "' holds NaN/Inf; values must be finite");
+    if (s.periodic(0) || s.periodic(1)) return on_grid_periodic(e, c, s, origin);
     std::vector<float> out(s.cells(), 0.f);
     const Box3d& b = e.bounds();
     bool aligned = true;
@@ -194,6 +204,55 @@ std::vector<float> on_grid(const CookContext& ctx, const Field3D& e, int c, cons
                 bool inside = true;
                 for (int a = 0; a < 3; ++a) inside = inside && p[a] >= b.min[a] && p[a] <= b.max[a];
                 if (inside) out[n] = e.sample_world(c, p, WrapMode::Clamp);
+            }
+    return out;
+}
+
+// on_grid for a grid with periodic x and/or y: a cell also sees the field
+// through its periodic images (cell centre + m L along a periodic axis of
+// length L), the values of every image inside the field added (copied when
+// the cells line up, else trilinear), so a field reaching over a periodic face
+// wraps around.
+std::vector<float> on_grid_periodic(const Field3D& e, int c, const sim::GridSpec& s, const Vec3d& origin) {
+    std::vector<float> out(s.cells(), 0.f);
+    const Box3d& b = e.bounds();
+    const double L[3] = {s.nx * s.dx, s.ny * s.dx, s.nz * s.dx};
+    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int a = 0; a < 2; ++a)
+        if (s.periodic(a)) {
+            // Images whose domain copy [origin + m L, origin + (m + 1) L] meets the field's box.
+            lo[a] = int(std::floor((b.min[a] - origin[a]) / L[a])) - 1;
+            hi[a] = int(std::ceil((b.max[a] - origin[a]) / L[a])) + 1;
+        }
+    bool aligned = true;
+    std::array<long, 3> off{};
+    for (int a = 0; a < 3; ++a) {
+        const double vs = e.voxel_size()[a], o = (b.min[a] - origin[a]) / s.dx;
+        off[size_t(a)] = std::lround(o);
+        aligned = aligned && std::fabs(vs - s.dx) <= 1e-9 * s.dx && std::fabs(o - double(off[size_t(a)])) <= 1e-6;
+    }
+    const Vec3i er = e.resolution();
+    const int n3[3] = {s.nx, s.ny, s.nz};
+    size_t n = 0;
+    for (int k = 0; k < s.nz; ++k)
+        for (int j = 0; j < s.ny; ++j)
+            for (int i = 0; i < s.nx; ++i, ++n) {
+                double sum = 0;
+                for (int my = lo[1]; my <= hi[1]; ++my)
+                    for (int mx = lo[0]; mx <= hi[0]; ++mx) {
+                        const int idx[3] = {i + mx * n3[0], j + my * n3[1], k};
+                        if (aligned) {
+                            const long x = idx[0] - off[0], y = idx[1] - off[1], z = idx[2] - off[2];
+                            if (x < 0 || y < 0 || z < 0 || x >= er[0] || y >= er[1] || z >= er[2]) continue;
+                            sum += e.at(c, int(x), int(y), int(z));
+                            continue;
+                        }
+                        const Vec3d p{{origin[0] + (idx[0] + 0.5) * s.dx, origin[1] + (idx[1] + 0.5) * s.dx, origin[2] + (k + 0.5) * s.dx}};
+                        bool inside = true;
+                        for (int a = 0; a < 3; ++a) inside = inside && p[a] >= b.min[a] && p[a] < b.max[a];
+                        if (inside) sum += e.sample_world(c, p, WrapMode::Clamp);
+                    }
+                out[n] = float(sum);
             }
     return out;
 }
@@ -243,8 +302,10 @@ void apply_initial_state(CookContext& ctx, sim::Simulation& sim, const Vec3d& or
             c[a] = on_grid(ctx, *f, ch >= 0 ? ch : a, s, origin, "initial_velocity");
         }
         sim::MacVelocity& v = sim.velocity();
-        auto cell = [&](int a, int i, int j, int k) {
-            i = std::clamp(i, 0, s.nx - 1), j = std::clamp(j, 0, s.ny - 1), k = std::clamp(k, 0, s.nz - 1);
+        auto cell = [&](int a, int i, int j, int k) { // clamped; wrapped along a periodic axis
+            i = s.periodic(0) ? (i + s.nx) % s.nx : std::clamp(i, 0, s.nx - 1);
+            j = s.periodic(1) ? (j + s.ny) % s.ny : std::clamp(j, 0, s.ny - 1);
+            k = std::clamp(k, 0, s.nz - 1);
             return double(c[a][v.ic(i, j, k)]);
         };
         for (int k = 0; k < s.nz; ++k)
@@ -266,8 +327,11 @@ std::vector<float> bubble(const sim::GridSpec& s, const Vec3d& origin, double am
     for (int k = 0; k < s.nz; ++k)
         for (int j = 0; j < s.ny; ++j)
             for (int i = 0; i < s.nx; ++i, ++n) {
-                const double x = origin[0] + (i + 0.5) * s.dx - c[0], y = origin[1] + (j + 0.5) * s.dx - c[1],
-                             z = origin[2] + (k + 0.5) * s.dx - c[2];
+                double x = origin[0] + (i + 0.5) * s.dx - c[0], y = origin[1] + (j + 0.5) * s.dx - c[1];
+                const double z = origin[2] + (k + 0.5) * s.dx - c[2];
+                // Periodic axes: the nearest image of the centre (the bubble wraps).
+                if (s.periodic(0)) x -= s.nx * s.dx * std::round(x / (s.nx * s.dx));
+                if (s.periodic(1)) y -= s.ny * s.dx * std::round(y / (s.ny * s.dx));
                 const double ex = x / r[0], ey = y / r[1], ez = z / r[2];
                 const double l = std::sqrt(ex * ex + (s.ny > 1 ? ey * ey : 0.0) + ez * ez);
                 if (l < 1) d[n] = float(amp * std::pow(std::cos(0.5 * M_PI * l), 2));
@@ -346,6 +410,17 @@ void cook(CookContext& ctx) {
     if (bnd == "open_sides") {
         spec.boundary = sim::all_open();
         spec.boundary[4] = spec.boundary[5] = sim::Boundary::Closed;
+    }
+    for (int a = 0; a < 2; ++a) {
+        const char* name = a == 0 ? "boundary_x" : "boundary_y";
+        const std::string& v = ctx.get_string(name);
+        if (v == "as_boundary") continue;
+        const sim::Boundary f = v == "closed" ? sim::Boundary::Closed : v == "open" ? sim::Boundary::Open : sim::Boundary::Periodic;
+        spec.boundary[size_t(2 * a)] = spec.boundary[size_t(2 * a + 1)] = f;
+        const int n = a == 0 ? res[0] : res[1];
+        if (f == sim::Boundary::Periodic && n > 1 && n % 2 != 0)
+            ctx.fail(std::string("parameter '") + name + "': periodic needs an even resolution " + (a == 0 ? "x" : "y") + ", got " +
+                     std::to_string(n));
     }
     spec.validate(); // library errors: the evaluator prefixes the node
     const Vec3d origin = ctx.get_float3("origin");

@@ -34,10 +34,17 @@ void confinement_force(const MacVelocity& vel, double eps, std::vector<float>& f
                 cw[c] = 0.5f * (vel.w[vel.iw(i, j, k)] + vel.w[vel.iw(i, j, k + 1)]);
             }
     });
-    // Central differences with clamped neighbours (one-sided at the edges).
+    // Central differences with clamped neighbours (one-sided at the edges;
+    // across the wrap along a periodic axis).
+    const bool wrap[3] = {s.periodic(0), s.periodic(1), false};
     auto d = [&](const std::vector<float>& a, int i, int j, int k, int axis) -> double {
         int lo[3] = {i, j, k}, hi[3] = {i, j, k};
         const int nn[3] = {nx, ny, nz};
+        if (wrap[axis]) {
+            lo[axis] = lo[axis] == 0 ? nn[axis] - 1 : lo[axis] - 1;
+            hi[axis] = hi[axis] == nn[axis] - 1 ? 0 : hi[axis] + 1;
+            return (double(a[vel.ic(hi[0], hi[1], hi[2])]) - a[vel.ic(lo[0], lo[1], lo[2])]) / (2 * h);
+        }
         lo[axis] = std::max(lo[axis] - 1, 0);
         hi[axis] = std::min(hi[axis] + 1, nn[axis] - 1);
         int span = hi[axis] - lo[axis];
@@ -75,17 +82,27 @@ void add_confinement(MacVelocity& vel, double eps, double dt) {
     std::vector<float> fx, fy, fz;
     confinement_force(vel, eps, fx, fy, fz);
     const GridSpec& s = vel.spec;
+    // Periodic axes: face 0 (= face n) lies between the last and the first cell.
+    const bool wx = s.periodic(0), wy = s.periodic(1);
     for_slices(s.nz, [&](int k) {
         for (int j = 0; j < s.ny; ++j) {
             for (int i = 1; i < s.nx; ++i)
                 vel.u[vel.iu(i, j, k)] += float(dt * 0.5 * (fx[vel.ic(i - 1, j, k)] + fx[vel.ic(i, j, k)]));
-            if (j > 0)
+            if (wx) {
+                vel.u[vel.iu(0, j, k)] += float(dt * 0.5 * (fx[vel.ic(s.nx - 1, j, k)] + fx[vel.ic(0, j, k)]));
+                vel.u[vel.iu(s.nx, j, k)] = vel.u[vel.iu(0, j, k)];
+            }
+            if (j > 0 || wy) {
+                const int jm = j > 0 ? j - 1 : s.ny - 1;
                 for (int i = 0; i < s.nx; ++i)
-                    vel.v[vel.iv(i, j, k)] += float(dt * 0.5 * (fy[vel.ic(i, j - 1, k)] + fy[vel.ic(i, j, k)]));
+                    vel.v[vel.iv(i, j, k)] += float(dt * 0.5 * (fy[vel.ic(i, jm, k)] + fy[vel.ic(i, j, k)]));
+            }
             if (k > 0)
                 for (int i = 0; i < s.nx; ++i)
                     vel.w[vel.iw(i, j, k)] += float(dt * 0.5 * (fz[vel.ic(i, j, k - 1)] + fz[vel.ic(i, j, k)]));
         }
+        if (wy)
+            for (int i = 0; i < s.nx; ++i) vel.v[vel.iv(i, s.ny, k)] = vel.v[vel.iv(i, 0, k)];
     });
 }
 

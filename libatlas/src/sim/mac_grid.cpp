@@ -22,6 +22,21 @@ void GridSpec::validate() const {
     int big = (nx >= 2) + (ny >= 2) + (nz >= 2);
     if (big < 2) throw Error("sim grid: at least two of nx, ny, nz must be >= 2");
     if (!(dx >= 1e-3 && dx <= 1e5)) throw Error("sim grid: dx = " + std::to_string(dx) + ", expected 1e-3..1e5 m");
+    static const char* kFace[6] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+    for (int a = 0; a < 3; ++a) {
+        const bool lo = boundary[size_t(2 * a)] == Boundary::Periodic, hi = boundary[size_t(2 * a + 1)] == Boundary::Periodic;
+        if (!lo && !hi) continue;
+        if (a == 2)
+            throw Error(std::string("sim grid: boundary ") + kFace[lo ? 4 : 5] +
+                        " is periodic; only the x and y face pairs can be (z carries gravity)");
+        if (lo != hi)
+            throw Error(std::string("sim grid: boundary ") + kFace[2 * a + (lo ? 0 : 1)] + " is periodic but " +
+                        kFace[2 * a + (lo ? 1 : 0)] + " is not; both faces of a pair must be periodic");
+        const int n = a == 0 ? nx : ny;
+        if (n > 1 && n % 2 != 0)
+            throw Error(std::string("sim grid: ") + (a == 0 ? "nx" : "ny") + " = " + std::to_string(n) +
+                        " along a periodic axis; it must be even");
+    }
 }
 
 Boundary GridSpec::face(int f) const {
@@ -42,6 +57,12 @@ MacVelocity::MacVelocity(const GridSpec& s, const MemoryBudget* budget) : spec(s
 
 void MacVelocity::enforce_walls() {
     const int nx = spec.nx, ny = spec.ny, nz = spec.nz;
+    if (spec.periodic(0))
+        for (int k = 0; k < nz; ++k)
+            for (int j = 0; j < ny; ++j) u[iu(nx, j, k)] = u[iu(0, j, k)];
+    if (spec.periodic(1))
+        for (int k = 0; k < nz; ++k)
+            for (int i = 0; i < nx; ++i) v[iv(i, ny, k)] = v[iv(i, 0, k)];
     for (int k = 0; k < nz; ++k)
         for (int j = 0; j < ny; ++j) {
             if (spec.face(0) == Boundary::Closed) u[iu(0, j, k)] = 0;

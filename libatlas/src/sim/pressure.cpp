@@ -38,6 +38,7 @@ struct Level {
     int nx = 0, ny = 0, nz = 0;
     std::vector<double> ax, ay, az; // face coefficients: x/y faces per slice, z faces per face index
     std::array<bool, 6> open{};
+    bool wrap[2] = {false, false}; // periodic x, y: cell 0 and cell n-1 are neighbours
     std::vector<double> diag, x, b, r;
     int fx = 1, fy = 1, fz = 1; // coarsening factors to the next level
     size_t cells() const { return size_t(nx) * ny * nz; }
@@ -48,9 +49,13 @@ struct Level {
         double s = 0;
         size_t c = id(i, j, k);
         if (i > 0) s += ax[size_t(k)] * v[c - 1];
+        else if (wrap[0]) s += ax[size_t(k)] * v[c + size_t(nx - 1)];
         if (i < nx - 1) s += ax[size_t(k)] * v[c + 1];
+        else if (wrap[0]) s += ax[size_t(k)] * v[c - size_t(nx - 1)];
         if (j > 0) s += ay[size_t(k)] * v[c - size_t(nx)];
+        else if (wrap[1]) s += ay[size_t(k)] * v[c + size_t(ny - 1) * nx];
         if (j < ny - 1) s += ay[size_t(k)] * v[c + size_t(nx)];
+        else if (wrap[1]) s += ay[size_t(k)] * v[c - size_t(ny - 1) * nx];
         if (k > 0) s += az[size_t(k)] * v[c - size_t(nx) * ny];
         if (k < nz - 1) s += az[size_t(k + 1)] * v[c + size_t(nx) * ny];
         return s;
@@ -61,10 +66,10 @@ struct Level {
             for (int j = 0; j < ny; ++j)
                 for (int i = 0; i < nx; ++i) {
                     double d = 0;
-                    d += (i > 0 || open[0]) ? ax[size_t(k)] : 0.0;
-                    d += (i < nx - 1 || open[1]) ? ax[size_t(k)] : 0.0;
-                    d += (j > 0 || open[2]) ? ay[size_t(k)] : 0.0;
-                    d += (j < ny - 1 || open[3]) ? ay[size_t(k)] : 0.0;
+                    d += (i > 0 || open[0] || wrap[0]) ? ax[size_t(k)] : 0.0;
+                    d += (i < nx - 1 || open[1] || wrap[0]) ? ax[size_t(k)] : 0.0;
+                    d += (j > 0 || open[2] || wrap[1]) ? ay[size_t(k)] : 0.0;
+                    d += (j < ny - 1 || open[3] || wrap[1]) ? ay[size_t(k)] : 0.0;
                     d += (k > 0 || open[4]) ? az[size_t(k)] : 0.0;
                     d += (k < nz - 1 || open[5]) ? az[size_t(k + 1)] : 0.0;
                     diag[id(i, j, k)] = d;
@@ -81,18 +86,22 @@ struct Level {
     }
     // One row of cells (j, k) with its neighbour rows; a missing neighbour row
     // gets coefficient 0 and points at the row itself (0 * finite adds nothing,
-    // so the sums equal offdiag() term by term, in the same order).
+    // so the sums equal offdiag() term by term, in the same order). Along a
+    // periodic y the first and last rows are neighbours.
     struct Row {
         const double *c, *s, *n, *d, *u;
         double ax, ay_s, ay_n, az_d, az_u;
+        bool wx;
     };
     Row row(const std::vector<double>& v, int j, int k) const {
         const size_t c = id(0, j, k), pl = size_t(nx) * ny;
         Row r;
         r.c = &v[c];
         r.ax = ax[size_t(k)];
-        r.s = j > 0 ? r.c - nx : r.c, r.ay_s = j > 0 ? ay[size_t(k)] : 0.0;
-        r.n = j < ny - 1 ? r.c + nx : r.c, r.ay_n = j < ny - 1 ? ay[size_t(k)] : 0.0;
+        r.wx = wrap[0];
+        const std::ptrdiff_t last = std::ptrdiff_t(ny - 1) * nx;
+        r.s = j > 0 ? r.c - nx : wrap[1] ? r.c + last : r.c, r.ay_s = (j > 0 || wrap[1]) ? ay[size_t(k)] : 0.0;
+        r.n = j < ny - 1 ? r.c + nx : wrap[1] ? r.c - last : r.c, r.ay_n = (j < ny - 1 || wrap[1]) ? ay[size_t(k)] : 0.0;
         r.d = k > 0 ? r.c - pl : r.c, r.az_d = k > 0 ? az[size_t(k)] : 0.0;
         r.u = k < nz - 1 ? r.c + pl : r.c, r.az_u = k < nz - 1 ? az[size_t(k + 1)] : 0.0;
         return r;
@@ -100,7 +109,9 @@ struct Level {
     static double off(const Row& r, int i, int nx_) {
         double s = 0;
         if (i > 0) s += r.ax * r.c[i - 1];
+        else if (r.wx) s += r.ax * r.c[nx_ - 1];
         if (i < nx_ - 1) s += r.ax * r.c[i + 1];
+        else if (r.wx) s += r.ax * r.c[0];
         s += r.ay_s * r.s[i];
         s += r.ay_n * r.n[i];
         s += r.az_d * r.d[i];
@@ -146,8 +157,12 @@ struct PressureSolver::Impl {
         while (true) {
             Level& f = levels.back();
             if (f.cells() <= 512) break;
-            f.fx = (f.nx % 2 == 0 && f.nx >= 4) ? 2 : 1;
-            f.fy = (f.ny % 2 == 0 && f.ny >= 4) ? 2 : 1;
+            // Along a periodic axis only when the coarse count stays even (the
+            // red-black colouring must match across the wrap); the aggregates
+            // (2i, 2i+1) never straddle it, so restriction and prolongation need
+            // no wrap.
+            f.fx = (f.nx % (f.wrap[0] ? 4 : 2) == 0 && f.nx >= 4) ? 2 : 1;
+            f.fy = (f.ny % (f.wrap[1] ? 4 : 2) == 0 && f.ny >= 4) ? 2 : 1;
             f.fz = (f.nz % 2 == 0 && f.nz >= 4) ? 2 : 1;
             if (f.fx * f.fy * f.fz == 1) break;
             Level c;
@@ -155,6 +170,7 @@ struct PressureSolver::Impl {
             c.ny = f.ny / f.fy;
             c.nz = f.nz / f.fz;
             c.open = f.open;
+            c.wrap[0] = f.wrap[0], c.wrap[1] = f.wrap[1];
             // Galerkin coarse operator for piecewise-constant prolongation:
             // a coarse face coefficient is the sum of the fine faces it covers.
             c.ax.assign(size_t(c.nz), 0.0);
@@ -307,6 +323,7 @@ PressureSolver::PressureSolver(const GridSpec& spec, std::vector<double> rho_cel
     l0.ny = spec.ny;
     l0.nz = spec.nz;
     for (int f = 0; f < 6; ++f) l0.open[size_t(f)] = spec.face(f) == Boundary::Open;
+    l0.wrap[0] = spec.periodic(0), l0.wrap[1] = spec.periodic(1);
     l0.ax = rho_cell_;
     l0.ay = rho_cell_;
     l0.az = rho_face_;
@@ -396,21 +413,27 @@ ProjectionReport PressureSolver::project(MacVelocity& vel, const ProjectionOptio
         rep.converged = true;
     }
     if (m.singular) m.remove_mean(m.phi);
-    // u -= grad phi (phi absorbs dt / rho and dx); open faces see phi = 0 outside.
+    // u -= grad phi (phi absorbs dt / rho and dx); open faces see phi = 0
+    // outside, periodic ones the cell across the wrap (faces 0 and n get the
+    // same update).
     const auto& phi = m.phi;
     auto P = [&](int i, int j, int k) -> double {
+        if (L.wrap[0]) i = i < 0 ? i + nx : i >= nx ? i - nx : i;
+        if (L.wrap[1]) j = j < 0 ? j + ny : j >= ny ? j - ny : j;
         if (i < 0 || i >= nx || j < 0 || j >= ny || k < 0 || k >= nz) return 0.0;
         return phi[L.id(i, j, k)];
     };
+    const bool keep_x0 = L.open[0] || L.wrap[0], keep_x1 = L.open[1] || L.wrap[0];
+    const bool keep_y0 = L.open[2] || L.wrap[1], keep_y1 = L.open[3] || L.wrap[1];
     for_slices(nz, [&](int k) {
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i <= nx; ++i) {
-                if ((i == 0 && !L.open[0]) || (i == nx && !L.open[1])) continue;
+                if ((i == 0 && !keep_x0) || (i == nx && !keep_x1)) continue;
                 vel.u[vel.iu(i, j, k)] -= float(P(i, j, k) - P(i - 1, j, k));
             }
         for (int j = 0; j <= ny; ++j)
             for (int i = 0; i < nx; ++i) {
-                if ((j == 0 && !L.open[2]) || (j == ny && !L.open[3])) continue;
+                if ((j == 0 && !keep_y0) || (j == ny && !keep_y1)) continue;
                 vel.v[vel.iv(i, j, k)] -= float(P(i, j, k) - P(i, j - 1, k));
             }
     });

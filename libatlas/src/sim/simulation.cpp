@@ -319,7 +319,11 @@ void Simulation::add_ground_patch(const GroundPatch& g) {
             for (int i = 0; i < spec_.nx; ++i) {
                 double x = (i + 0.5) * h, y = (j + 0.5) * h, z = (k + 0.5) * h;
                 if (spec_.ny == 1) y = g.center_y;
-                double r = std::hypot(x - g.center_x, y - g.center_y) / g.radius;
+                double ddx = x - g.center_x, ddy = y - g.center_y;
+                // Periodic axes: the nearest image of the centre (the patch wraps).
+                if (spec_.periodic(0)) ddx -= spec_.nx * h * std::round(ddx / (spec_.nx * h));
+                if (spec_.periodic(1)) ddy -= spec_.ny * h * std::round(ddy / (spec_.ny * h));
+                double r = std::hypot(ddx, ddy) / g.radius;
                 if (r >= 1 || z > g.depth) continue;
                 double shape = std::pow(std::cos(0.5 * M_PI * r), 2) * (1 - z / g.depth);
                 double nse = value_noise(g.seed, x / g.noise_scale, y / g.noise_scale, 0.0);
@@ -367,11 +371,16 @@ void Simulation::confinement(double dt) { add_confinement(vel_, opt_.vorticity_c
 
 namespace {
 // out += coef_dt_h2 * lap(in - ref) on lattice l, zero-gradient edges (the
-// mirror image across a free-slip wall / no-flux face). out may not alias in.
+// mirror image across a free-slip wall / no-flux face), wrapped along periodic
+// axes (index mod the period: on a face lattice the last sample is the first
+// one's copy). out may not alias in.
 void lap_accumulate(const Lattice& l, const std::vector<float>& in, std::vector<float>& out, double coef_dt_h2,
                     const std::vector<double>* ref_by_k) {
+    auto wrap = [](int i, int p) { return i < 0 ? i + p : i >= p ? i - p : i; };
     auto at = [&](int i, int j, int k) {
-        i = std::clamp(i, 0, l.n[0] - 1), j = std::clamp(j, 0, l.n[1] - 1), k = std::clamp(k, 0, l.n[2] - 1);
+        i = l.period[0] > 0 ? wrap(i, l.period[0]) : std::clamp(i, 0, l.n[0] - 1);
+        j = l.period[1] > 0 ? wrap(j, l.period[1]) : std::clamp(j, 0, l.n[1] - 1);
+        k = std::clamp(k, 0, l.n[2] - 1);
         double v = in[(size_t(k) * l.n[1] + j) * l.n[0] + i];
         return ref_by_k ? v - (*ref_by_k)[size_t(k)] : v;
     };

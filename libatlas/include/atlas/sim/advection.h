@@ -8,7 +8,11 @@
 // create new extrema), and samples whose trace ends within one cell of the
 // domain edge keep the plain semi-Lagrangian value.
 // Back-traces are clamped into the domain (walls and open faces alike read
-// the edge value: zero-gradient inflow). Deterministic for any thread count.
+// the edge value: zero-gradient inflow); along a periodic axis they wrap
+// around instead, and the reads too. Traces along a periodic axis are made
+// relative to their lattice node, so shifting every field by whole cells along
+// it shifts the result by the same cells, bit for bit. Deterministic for any
+// thread count.
 #pragma once
 
 #include "atlas/sim/mac_grid.h"
@@ -28,9 +32,13 @@ enum class AdvectionScheme { SemiLagrangian, MacCormack, CubicLimited };
 
 // A staggered sample lattice: n[] samples per axis, sample (i,j,k) at
 // ((i + offset[0]) dx, ...). Cell centres: n = (nx,ny,nz), offset 0.5.
+// period[a] > 0: axis a wraps with that many samples (the grid's cell count;
+// a face lattice along it has period + 1 samples, the last a copy of the
+// first). The *_lattice(spec) makers set it from the spec's periodic axes.
 struct Lattice {
     int n[3];
     double offset[3];
+    int period[3] = {0, 0, 0};
     size_t size() const { return size_t(n[0]) * n[1] * n[2]; }
 };
 Lattice cell_lattice(const GridSpec& s);
@@ -39,7 +47,8 @@ Lattice v_lattice(const GridSpec& s);
 Lattice w_lattice(const GridSpec& s);
 
 // Trilinear value of `q` (on lattice `l`) at position p given in cell units
-// (world / dx, from the domain's min corner); clamped at the edges.
+// (world / dx, from the domain's min corner); clamped at the edges, wrapped
+// along periodic axes.
 float sample_lattice(const Lattice& l, std::span<const float> q, const double p[3]);
 
 // Velocity in cells per second at position p (cell units).

@@ -2,7 +2,8 @@
 //
 // f = eps dx |omega| (N x omega), N = grad|omega| / |grad|omega||, at cell
 // centres, with omega = curl u from the cell-centred velocity (central
-// differences, one-sided at the domain edges); averaged to the interior faces.
+// differences, one-sided at the domain edges, wrapped along periodic axes);
+// averaged to the interior faces (and the wrapped ones).
 // Why the extra |omega|: the published form eps dx (N x omega) has units of m/s,
 // so as an acceleration its eps is secretly a rate in 1/s; it amplifies
 // grid-scale vortices at eps per second whatever the flow, which is mild for

@@ -22,7 +22,13 @@ namespace atlas::sim {
 //   Closed: a free-slip wall; normal velocity 0, pressure gradient 0 (Neumann).
 //   Open:   an outflow/inflow face held at ambient pressure (Dirichlet p' = 0);
 //           the normal velocity there is whatever the projection makes it.
-enum class Boundary { Closed, Open };
+//   Periodic: the face is glued to the opposite one (x- to x+, y- to y+): what
+//           leaves through one enters through the other. Both faces of the pair
+//           must be periodic, only x and y can be (z carries gravity), and the
+//           axis needs an even number of cells (>= 2; the red-black smoother of
+//           the pressure solver). On a periodic axis the face arrays keep their
+//           n + 1 entries and face n is a copy of face 0 (enforce_walls).
+enum class Boundary { Closed, Open, Periodic };
 
 // Faces in the order x-, x+, y-, y+, z-, z+.
 using BoundarySet = std::array<Boundary, 6>;
@@ -47,6 +53,8 @@ struct GridSpec {
     void validate() const;
     // The boundary actually used: single-cell directions are forced closed.
     Boundary face(int f) const;
+    // True when axis a (0 = x, 1 = y) wraps around (both faces Periodic, > 1 cell).
+    bool periodic(int a) const { return a < 2 && face(2 * a) == Boundary::Periodic; }
 };
 
 // Bytes per cell of a whole Simulation (state, advection scratch, pressure
@@ -75,7 +83,8 @@ struct MacVelocity {
     size_t iw(int i, int j, int k) const { return (size_t(k) * size_t(spec.ny) + size_t(j)) * size_t(spec.nx) + size_t(i); }
     size_t ic(int i, int j, int k) const { return (size_t(k) * size_t(spec.ny) + size_t(j)) * size_t(spec.nx) + size_t(i); }
 
-    // Sets the normal velocity on closed faces (and in single-cell directions) to 0.
+    // Sets the normal velocity on closed faces (and in single-cell directions) to 0;
+    // on a periodic axis copies face 0 onto face n (the same face).
     void enforce_walls();
     // Largest |component| in m/s (NaN if any component is NaN).
     double max_abs() const;

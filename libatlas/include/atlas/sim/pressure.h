@@ -6,7 +6,8 @@
 // red-black Gauss-Seidel smoothing, a dense Cholesky solve on the coarsest
 // grid), then sets u -= grad phi. rho0(z) is the anelastic reference density
 // (all ones = Boussinesq). Closed faces are Neumann, open faces Dirichlet
-// (ambient pressure). In a fully closed box the operator is singular: the
+// (ambient pressure), periodic x/y faces couple the first and last cells. In a
+// box with no open face (closed and periodic) the operator is singular: the
 // right-hand side is made to sum to zero and the mean of phi is removed in
 // every iteration, so the null space cannot drift.
 // Convergence: ||r||_2 <= tolerance * ||b||_2 (relative to the right-hand side,
