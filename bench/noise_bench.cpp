@@ -3,8 +3,13 @@
 // for ctest (--benchmark_filter=Smoke).
 #include "atlas/noise/fill.h"
 #include "atlas/noise/recipes.h"
+#include "atlas/noise/simd.h"
 
 #include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
@@ -21,11 +26,19 @@ NoiseSpec kernel_spec(Kernel k) {
     return s;
 }
 
-// state.range(0): kernel, range(1): threads (0 = all), range(2): edge.
+// state.range(0): kernel, range(1): threads (0 = all), range(2): edge,
+// range(3) (optional): SimdPath (0 = auto; ATLAS_SIMD also selects it).
 void BM_Kernel3D(benchmark::State& state) {
     const Kernel k = Kernel(state.range(0));
     const int threads = state.range(1) == 0 ? tbb::info::default_concurrency() : int(state.range(1));
     const int n = int(state.range(2));
+    const SimdPath path = state.range(3) > 0 ? SimdPath(state.range(3)) : SimdPath::Auto;
+    const auto paths = supported_simd_paths();
+    if (path != SimdPath::Auto && std::find(paths.begin(), paths.end(), path) == paths.end()) {
+        state.SkipWithError("SIMD path not supported here");
+        return;
+    }
+    set_simd_path(path);
     Field3D f({{n, n, n}}, noise_components(k, 3), Box3d{{{0, 0, 0}}, {{1, 1, 1}}});
     const NoiseSpec s = kernel_spec(k);
     tbb::task_arena arena(threads);
@@ -34,7 +47,8 @@ void BM_Kernel3D(benchmark::State& state) {
         benchmark::DoNotOptimize(f.channel(0).data());
     }
     state.SetItemsProcessed(state.iterations() * int64_t(n) * n * n);
-    state.SetLabel(std::string(kernel_name(k)) + ", " + std::to_string(threads) + " thread(s)");
+    state.SetLabel(std::string(kernel_name(k)) + ", " + std::to_string(threads) + " thread(s), " + simd_path_name(simd_path()));
+    set_simd_path(SimdPath::Auto);
 }
 
 void kernel_args(benchmark::internal::Benchmark* b, int edge) {
@@ -44,6 +58,52 @@ void kernel_args(benchmark::internal::Benchmark* b, int edge) {
 
 BENCHMARK(BM_Kernel3D)->Apply([](auto* b) { kernel_args(b, 64); })->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Kernel3D)->Name("BM_Kernel3D_Smoke")->Apply([](auto* b) { kernel_args(b, 8); })->UseRealTime();
+
+// Side by side with FastNoiseLite (-O3 -march=native, noise_peer_fnl.cpp), one
+// thread, period 8 (8 lattice cells per edge, as kernel_spec), edges 32, 64, 128
+// (cost growth), each SIMD path: BM_Peer3D/<kernel>/<edge>/<path>, path 0 = auto.
+// Kernels: 0 Perlin, 2 Worley F1 Euclidean (Kernel enum values).
+void BM_Peer3D_Atlas(benchmark::State& state) {
+    const int64_t k = state.range(0), n = state.range(1), path = state.range(2);
+    const SimdPath p = path > 0 ? SimdPath(path) : SimdPath::Auto;
+    const auto paths = supported_simd_paths();
+    if (p != SimdPath::Auto && std::find(paths.begin(), paths.end(), p) == paths.end()) {
+        state.SkipWithError("SIMD path not supported here");
+        return;
+    }
+    set_simd_path(p);
+    Field3D f({{int(n), int(n), int(n)}}, 1, Box3d{{{0, 0, 0}}, {{1, 1, 1}}});
+    const NoiseSpec s = kernel_spec(Kernel(k));
+    tbb::task_arena arena(1);
+    for (auto _ : state) {
+        arena.execute([&] { fill_noise(f, 0, s); });
+        benchmark::DoNotOptimize(f.channel(0).data());
+    }
+    state.SetItemsProcessed(state.iterations() * n * n * n);
+    state.SetLabel(std::string("atlas ") + std::string(kernel_name(Kernel(k))) + ", " + simd_path_name(simd_path()));
+    set_simd_path(SimdPath::Auto);
+}
+BENCHMARK(BM_Peer3D_Atlas)->ArgsProduct({{int64_t(Kernel::Gradient), int64_t(Kernel::Worley)}, {32, 64, 128}, {1, 2, 3}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Peer3D_Atlas)->Name("BM_Peer3D_Atlas_Smoke")->Args({0, 8, 0})->Args({2, 8, 0});
+
+#if defined(ATLAS_BENCH_FNL)
+} // namespace
+namespace atlas_peer {
+void fnl_fill(int kind, int n, int cells, int seed, float* out);
+}
+namespace {
+void BM_Peer3D_FastNoiseLite(benchmark::State& state) {
+    const int64_t k = state.range(0), n = state.range(1);
+    std::vector<float> out(size_t(n * n * n));
+    for (auto _ : state) {
+        atlas_peer::fnl_fill(k == int64_t(Kernel::Gradient) ? 0 : 1, int(n), 8, 1, out.data());
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.SetItemsProcessed(state.iterations() * n * n * n);
+    state.SetLabel(k == int64_t(Kernel::Gradient) ? "FastNoiseLite Perlin" : "FastNoiseLite cellular F1 Euclidean");
+}
+BENCHMARK(BM_Peer3D_FastNoiseLite)->ArgsProduct({{int64_t(Kernel::Gradient), int64_t(Kernel::Worley)}, {32, 64, 128}})->Unit(benchmark::kMillisecond);
+#endif
 
 void BM_NubisNoise(benchmark::State& state) {
     const int n = int(state.range(0));

@@ -2,6 +2,7 @@
 
 #include "cellular.h"
 #include "gradient.h"
+#include "simd.h"
 #include "value.h"
 
 #include <algorithm>
@@ -60,10 +61,34 @@ void worley_octave(const Lattice<D>& L, const std::array<const double*, D>& u, s
     }
 }
 
+uint64_t view_bits(const void* l, int x, int y, int z) { return static_cast<const Lattice<3>*>(l)->bits(x, y, z); }
+
+LatticeView view_of(const Lattice<3>& L) {
+    return {L.table(), L.period()[0], L.period()[1], L.period()[2], &L, &view_bits};
+}
+
+// The SIMD path of a 3D octave (simd.h): true when it wrote out.
+bool simd_octave(Kernel k, const NoiseSpec& spec, const Lattice<3>& L, const std::array<const double*, 3>& u, size_t n, double scale,
+                 float* out) {
+    if (k != Kernel::Gradient && k != Kernel::Worley && k != Kernel::Alligator && k != Kernel::CurlyAlligator) return false;
+    const SimdKernels* K = active_kernels();
+    if (!K) return false;
+    const LatticeView v = view_of(L);
+    const double* up[3] = {u[0], u[1], u[2]};
+    switch (k) {
+    case Kernel::Gradient: K->gradient3(v, up, n, scale, out); break;
+    case Kernel::Worley: K->worley3[int(spec.worley.metric)](v, up, n, scale, float(spec.worley.jitter), spec.worley.feature, out); break;
+    default: K->alligator3(v, up, n, scale, float(1.0 / (spec.alligator.radius * spec.alligator.radius)), out); break;
+    }
+    return true;
+}
+
 // One octave of a scalar kernel in its native range.
 template <int D>
 void scalar_octave(Kernel k, const NoiseSpec& spec, const Lattice<D>& L, const std::array<const double*, D>& u, size_t n,
                    double scale, float* out) {
+    if constexpr (D == 3)
+        if (simd_octave(k, spec, L, u, n, scale, out)) return;
     switch (k) {
     case Kernel::Gradient: {
         [[maybe_unused]] GradCache3 gc;

@@ -43,6 +43,8 @@ public:
                 for (int x = 0; x < period[0]; ++x) table_[i++] = lattice_bits(seed, stream, x, y, z);
     }
     const IVec<D>& period() const { return period_; }
+    // The tabulated bits (x fastest), or nullptr when they are hashed on the fly.
+    const uint64_t* table() const { return table_.empty() ? nullptr : table_.data(); }
     // c must be wrapped into [0, period).
     uint64_t bits(int x, int y, int z = 0) const {
         if (!table_.empty()) {
