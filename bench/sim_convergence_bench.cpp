@@ -13,6 +13,15 @@
 //               Boussinesq, neutral, no buoyancy): advection, projection, time
 //               splitting and the explicit viscosity. Exact answer: the initial
 //               field times exp(-2 nu k^2 t) (steady when nu = 0).
+//  PeriodicTaylorGreen: the doubly periodic vortex u = U sin(kx) cos(ky),
+//               v = -U cos(kx) sin(ky), k = 2 pi / L, L = 2 km (four 1 km vortex
+//               cells, so n cells here have the dx of n/2 in the closed case), in
+//               an x-y plane one cell thick, periodic x and y: no walls at all.
+//  PeriodicTranslation: a Gaussian blob (sigma = L/10) carried by a uniform
+//               wind (U, U/2) twice round x and once round y of a doubly
+//               periodic square (advect() alone), and once across an x-z slab
+//               (periodic x, closed floor and lid) through the whole Simulation;
+//               exact answer: the initial blob.
 //  Thermal:     a dry 2 K cos^2 warm bubble (radius 400 m, 500 m up) in a
 //               neutral 300 K slab, anelastic, 2 km x 2 km, 120 s; answer: the
 //               finest run (theta' at cell centres box-averaged onto each
@@ -21,8 +30,9 @@
 //               at 400/200/100 m against the 50 m run, the same way.
 //
 // Run:   build/bench/sim_convergence_bench --benchmark_filter=Convergence
-//        (ConvergenceRotation, ConvergenceTaylorGreen[Viscous], ConvergenceThermal;
-//         Smoke for CI, < 1 s)
+//        (ConvergenceRotation, ConvergenceTaylorGreen[Viscous],
+//         ConvergencePeriodicTaylorGreen[Viscous], ConvergencePeriodicTranslation,
+//         ConvergenceThermal; Smoke for CI, < 1 s)
 //        build/bench/sim_convergence_bench --benchmark_filter=DensityCurrent_200
 //        (Straka et al. 1993 density current: peak w against CFL and the step
 //         tolerance, both time schemes; DensityCurrent_100 at the published 100 m)
@@ -175,6 +185,156 @@ void taylor_green_study(benchmark::State& state, std::vector<int> ns, double cfl
     }
 }
 
+// ---- Periodic Taylor-Green and translation ------------------------------------
+
+GridSpec periodic_grid(int nx, int ny, int nz, double dx) {
+    GridSpec s;
+    s.nx = nx, s.ny = ny, s.nz = nz, s.dx = dx;
+    s.boundary = {Boundary::Periodic, Boundary::Periodic, Boundary::Periodic, Boundary::Periodic, Boundary::Closed, Boundary::Closed};
+    return s;
+}
+
+Norms periodic_taylor_green(int n, AdvectionScheme scheme, TimeScheme ts, double cfl, double nu, double T) {
+    const double L = 2000, U = 10, k = 2 * M_PI / L;
+    const GridSpec s = periodic_grid(n, n, 1, L / n);
+    SimOptions o;
+    o.anelastic = false;
+    o.moist = false;
+    o.scheme = scheme;
+    o.time_scheme = ts;
+    o.cfl = cfl;
+    o.viscosity = nu;
+    o.max_substeps = 10000;
+    o.step_error_tolerance = 0;
+    o.projection.tolerance = 1e-10;
+    o.projection.max_iterations = 1000;
+    Simulation sim(s, Sounding{}, o);
+    MacVelocity& v = sim.velocity();
+    auto fu = [&](double x, double y, double a) { return a * U * std::sin(k * x) * std::cos(k * y); };
+    auto fv = [&](double x, double y, double a) { return -a * U * std::cos(k * x) * std::sin(k * y); };
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i <= n; ++i) v.u[v.iu(i, j, 0)] = float(fu(i * s.dx, (j + 0.5) * s.dx, 1));
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i < n; ++i) v.v[v.iv(i, j, 0)] = float(fv((i + 0.5) * s.dx, j * s.dx, 1));
+    sim.step(T);
+    const double a = std::exp(-2 * nu * k * k * T);
+    Norms e;
+    double sum2 = 0;
+    size_t cnt = 0;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) { // faces 0..n-1 (face n is face 0)
+            add(e, v.u[v.iu(i, j, 0)] - fu(i * s.dx, (j + 0.5) * s.dx, a), sum2, cnt);
+            add(e, v.v[v.iv(i, j, 0)] - fv((i + 0.5) * s.dx, j * s.dx, a), sum2, cnt);
+        }
+    e.l2 = std::sqrt(sum2 / double(cnt));
+    return e;
+}
+
+void periodic_taylor_green_study(benchmark::State& state, std::vector<int> ns, double cfl, double nu, double T) {
+    for (auto _ : state) {
+        char title[240];
+        std::snprintf(title, sizeof title,
+                      "Doubly periodic Taylor-Green vortex: U = 10 m/s, L = 2 km (1 km vortices), nu = %g m^2/s, t = %g s, CFL %.2g "
+                      "(velocity error, m/s)",
+                      nu, T, cfl);
+        print_header(title);
+        for (TimeScheme ts : {TimeScheme::Split, TimeScheme::Trapezoidal})
+            for (AdvectionScheme sc : {AdvectionScheme::SemiLagrangian, AdvectionScheme::MacCormack, AdvectionScheme::CubicLimited}) {
+                std::vector<Norms> e;
+                for (int n : ns) e.push_back(periodic_taylor_green(n, sc, ts, cfl, nu, T));
+                print_rows(std::string(scheme_name(sc)) + ", " + time_name(ts), ns, e);
+            }
+    }
+}
+
+std::vector<float> gaussian(int nx, int ny, double dx, double cx, double cy, double sigma, double amp) {
+    std::vector<float> q(size_t(nx) * ny);
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            const double x = (i + 0.5) * dx - cx, y = (j + 0.5) * dx - cy;
+            q[size_t(j) * nx + i] = float(amp * std::exp(-(x * x + y * y) / (2 * sigma * sigma)));
+        }
+    return q;
+}
+
+Norms compare(const std::vector<float>& a, const std::vector<float>& b, double scale) {
+    Norms e;
+    double sum2 = 0;
+    size_t cnt = 0;
+    for (size_t m = 0; m < a.size(); ++m) add(e, (double(a[m]) - b[m]) / scale, sum2, cnt);
+    e.l2 = std::sqrt(sum2 / double(cnt));
+    return e;
+}
+
+// advect() alone: twice round x, once round y of a doubly periodic square.
+Norms periodic_translation(int n, AdvectionScheme scheme, double cfl) {
+    const double L = 1000, U = 10, T = 2 * L / U;
+    const GridSpec s = periodic_grid(n, n, 1, L / n);
+    MacVelocity vel(s);
+    std::fill(vel.u.begin(), vel.u.end(), float(U));
+    std::fill(vel.v.begin(), vel.v.end(), float(U / 2));
+    const Lattice l = cell_lattice(s);
+    const std::vector<float> q0 = gaussian(n, n, s.dx, 0.3 * L, 0.3 * L, L / 10, 1);
+    std::vector<float> q = q0, out(q0.size());
+    const int steps = int(std::ceil(T / (cfl * s.dx / U)));
+    for (int st = 0; st < steps; ++st) {
+        advect(vel, l, q, out, T / steps, scheme);
+        q.swap(out);
+    }
+    return compare(q, q0, 1);
+}
+
+// The whole Simulation: an x-z slab (periodic x, closed floor and lid), dry,
+// Boussinesq, a 10 m/s wind, a 1e-7 kg/kg vapour blob (so its buoyancy moves it
+// by < 1e-4 cells) once across; error relative to the blob's amplitude.
+Norms periodic_translation_sim(int n, AdvectionScheme scheme, TimeScheme ts, double cfl) {
+    const double L = 1000, U = 10;
+    const GridSpec s = periodic_grid(n, 1, n / 2, L / n);
+    SimOptions o;
+    o.moist = false;
+    o.anelastic = false;
+    o.scheme = scheme;
+    o.time_scheme = ts;
+    o.cfl = cfl;
+    o.wind.assign(size_t(s.nz), U);
+    o.step_error_tolerance = 0;
+    o.max_substeps = 10000;
+    Sounding snd;
+    snd.surface_rh = snd.rh_above = snd.rh_lapse = 0;
+    Simulation sim(s, snd, o);
+    const std::vector<float> q0 = gaussian(n, n / 2, s.dx, 0.25 * L, 0.25 * L, L / 12, 1e-7);
+    sim.qv() = q0;
+    for (int st = 0; st < 10; ++st) sim.step(L / U / 10);
+    return compare(sim.qv(), q0, 1e-7);
+}
+
+void periodic_translation_study(benchmark::State& state, std::vector<int> ns, double cfl) {
+    for (auto _ : state) {
+        char title[240];
+        std::snprintf(title, sizeof title,
+                      "Periodic translation: Gaussian blob (sigma = L/10), uniform wind (U, U/2), twice round x and once round y, "
+                      "CFL %.2g (advect() only; error relative to the peak)",
+                      cfl);
+        print_header(title);
+        for (AdvectionScheme sc : {AdvectionScheme::SemiLagrangian, AdvectionScheme::MacCormack, AdvectionScheme::CubicLimited}) {
+            std::vector<Norms> e;
+            for (int n : ns) e.push_back(periodic_translation(n, sc, cfl));
+            print_rows(scheme_name(sc), ns, e);
+        }
+        std::snprintf(title, sizeof title,
+                      "Periodic translation through the Simulation: x-z slab (periodic x, closed floor and lid), 10 m/s wind, one "
+                      "crossing, CFL %.2g (vapour blob sigma = L/12; error relative to the peak)",
+                      cfl);
+        print_header(title);
+        for (TimeScheme ts : {TimeScheme::Split, TimeScheme::Trapezoidal})
+            for (AdvectionScheme sc : {AdvectionScheme::SemiLagrangian, AdvectionScheme::MacCormack, AdvectionScheme::CubicLimited}) {
+                std::vector<Norms> e;
+                for (int n : ns) e.push_back(periodic_translation_sim(n, sc, ts, cfl));
+                print_rows(std::string(scheme_name(sc)) + ", " + time_name(ts), ns, e);
+            }
+    }
+}
+
 // ---- Thermal (self-convergence) -----------------------------------------------
 
 // A dry cos^2 warm bubble in a neutral 300 K slab of Lx x Lz (nx = n Lx / Lz
@@ -318,7 +478,7 @@ void density_current_study(benchmark::State& state, double dx) {
     }
 }
 
-void bryan_fritsch_study(benchmark::State& state, std::vector<int> ns, int nref, double cfl) {
+void bryan_fritsch_study(benchmark::State& state, std::vector<int> ns, int nref, double cfl, bool split_too = true) {
     for (auto _ : state) {
         char title[240];
         std::snprintf(title, sizeof title,
@@ -327,6 +487,7 @@ void bryan_fritsch_study(benchmark::State& state, std::vector<int> ns, int nref,
                       10000.0 / nref, cfl, 10000.0 / ns.front(), 10000.0 / ns.back());
         print_header(title);
         for (TimeScheme ts : {TimeScheme::Split, TimeScheme::Trapezoidal}) {
+            if (ts == TimeScheme::Split && !split_too) continue;
             const std::vector<float> ref = thermal(nref, AdvectionScheme::MacCormack, ts, cfl, kBryanFritsch);
             std::vector<Norms> e;
             for (int n : ns) e.push_back(against(thermal(n, AdvectionScheme::MacCormack, ts, cfl, kBryanFritsch), n, ref, nref, 2.0));
@@ -346,9 +507,23 @@ BENCHMARK_CAPTURE(taylor_green_study, ConvergenceTaylorGreen, std::vector<int>{1
 BENCHMARK_CAPTURE(taylor_green_study, ConvergenceTaylorGreenViscous, std::vector<int>{16, 32, 64, 128}, 1.0, 10.0, 100.0)
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(periodic_taylor_green_study, ConvergencePeriodicTaylorGreen, std::vector<int>{32, 64, 128, 256}, 1.0, 0.0, 100.0)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(periodic_taylor_green_study, ConvergencePeriodicTaylorGreenViscous, std::vector<int>{32, 64, 128, 256}, 1.0, 10.0, 100.0)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(periodic_translation_study, ConvergencePeriodicTranslation, std::vector<int>{32, 64, 128, 256}, 0.8)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(periodic_taylor_green_study, SmokePeriodic, std::vector<int>{16, 32}, 1.0, 10.0, 20.0)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(thermal_study, ConvergenceThermal, std::vector<int>{32, 64, 128}, 256, 1.0)->Iterations(1)->Unit(benchmark::kSecond);
 
 BENCHMARK_CAPTURE(bryan_fritsch_study, ConvergenceBryanFritsch, std::vector<int>{25, 50, 100}, 200, 1.0)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+// 400 / 200 / 100 / 50 m against a 25 m run, the default scheme only (about 6 min of CPU).
+BENCHMARK_CAPTURE(bryan_fritsch_study, ConvergenceBryanFritsch25, std::vector<int>{25, 50, 100, 200}, 400, 1.0, false)
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(density_current_study, DensityCurrent_200, 200.0)->Iterations(1)->Unit(benchmark::kSecond);
