@@ -11,6 +11,7 @@ Options (after the "--"):
     --no-sky           black sky (isolates the sun term)
     --size WxH         override the exported image size
     --threads N        render threads (default 0 = all)
+    --alpha            transparent film: the EXR's A channel is 1 - the view ray's transmittance
     --stats FILE       write {"seconds": wall, "cpu_seconds": process CPU, "samples": N} as JSON
 
 What is matched (docs/render.md, "Reference: Cycles"):
@@ -43,12 +44,12 @@ def parse(argv):
     if len(args) < 2:
         raise SystemExit("usage: blender -b --python cycles_reference.py -- DIR OUT.exr [options]")
     o = {"dir": args[0], "out": args[1], "samples": 1024, "bounces": 128, "step_rate": 0.5, "seed": 0, "sun_scale": 1.0,
-         "sky": True, "size": None, "threads": 0, "stats": None}
+         "sky": True, "alpha": False, "size": None, "threads": 0, "stats": None}
     i = 2
     while i < len(args):
         a = args[i]
-        if a == "--no-sky":
-            o["sky"] = False
+        if a in ("--no-sky", "--alpha"):
+            o["sky" if a == "--no-sky" else "alpha"] = a == "--alpha"
             i += 1
             continue
         if i + 1 >= len(args):
@@ -95,7 +96,7 @@ def build(o):
     cy.film_exposure = 1.0
     w, h = o["size"] or (sc["width"], sc["height"])
     scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = w, h, 100
-    scene.render.film_transparent = False
+    scene.render.film_transparent = o["alpha"]
     scene.render.threads_mode = "FIXED" if o["threads"] > 0 else "AUTO"
     if o["threads"] > 0:
         scene.render.threads = o["threads"]
@@ -105,7 +106,7 @@ def build(o):
     scene.view_settings.gamma = 1.0
     scene.render.image_settings.file_format = "OPEN_EXR"
     scene.render.image_settings.color_depth = "32"
-    scene.render.image_settings.color_mode = "RGB"
+    scene.render.image_settings.color_mode = "RGBA" if o["alpha"] else "RGB"
     scene.render.image_settings.exr_codec = "ZIP"
 
     # Camera: Atlas's pinhole (vertical fov, up = world z).
@@ -176,6 +177,11 @@ def build(o):
     vol.render.space = "WORLD"
     vol.render.step_size = 0.0  # automatic: one voxel x the scene's volume_step_rate
     obj = bpy.data.objects.new("atlas_density", vol)
+    # Measured (a symmetric box, docs/render.md): Blender 3.4's Cycles draws a VDB half a voxel
+    # toward +x, +y, +z of where its transform puts the voxel centres (0.37 px at 160x90, growing
+    # with the image size, so not a pixel convention); moving the object back by half a voxel
+    # puts the centres where Atlas has them.
+    obj.location = [-0.5 * (hi - lo) / n for lo, hi, n in zip(sc["bounds_min"], sc["bounds_max"], sc["resolution"])]
     scene.collection.objects.link(obj)
     mat = bpy.data.materials.new("atlas_cloud")
     mat.use_nodes = True
