@@ -147,6 +147,7 @@ int run_cook(const Args& a) {
     bool cancelled = false;
     ProgressBar bar(!quiet);
     for (const std::string& file : a.positional) {
+        bar.begin_part(int(&file - a.positional.data()), int(a.positional.size()));
         Session session(builtin_nodes());
         try {
             session.load(file);

@@ -37,7 +37,10 @@ int main(int argc, char** argv) {
         std::cerr << "atlas: cancelled; no output was written\n";
         return 130;
     } catch (const std::exception& e) {
-        std::cerr << "atlas: error: " << e.what() << "\n";
+        // A located error already reads "FILE:LINE:COL: error: ..." (the
+        // compiler form editors jump to): say "error" once.
+        const std::string msg = e.what();
+        std::cerr << (msg.find(": error: ") != std::string::npos ? "" : "atlas: error: ") << msg << "\n";
         return 1;
     }
 }

@@ -344,6 +344,53 @@ TEST_F(Fixture, ProgressReachesTheEnd) {
     EXPECT_DOUBLE_EQ(last, 1.0);
 }
 
+// One 0..1 run per cook (issue 17): a node that reports several phases of its
+// own 0..1, nodes of one level running side by side and the outputs written
+// after them never send the bar back or to 100% before the end.
+TEST_F(Fixture, ProgressIsOneMonotoneRun) {
+  for (int jobs : {1, 2}) {
+    NodeRegistry r = test::test_registry(log);
+    r.add({.name = "test/phases", .version = 1,
+           .declare = [](NodeDeclaration& d) {
+               d.doc("Reports three phases of 0..1, then a constant field.");
+               d.output("out", PortType::Field3D, "field");
+               d.param_float("value", 1.0).range(-100, 100).describe("value");
+           },
+           .cook = [](CookContext& ctx) {
+               for (int phase = 0; phase < 3; ++phase)
+                   for (int k = 0; k <= 4; ++k) ctx.progress(k / 4.0);
+               auto f = ctx.make_field3d({{8, 8, 4}}, 1, Box3d{{{0, 0, 0}}, {{8, 8, 4}}});
+               std::fill(f->channel(0).begin(), f->channel(0).end(), float(ctx.get_float("value")));
+               ctx.set_output("out", Field3DPtr(f));
+           }});
+    Session s(std::move(r));
+    s.load_text("atlas: 1\nnodes:\n  p:\n    type: test/phases\n  q:\n    type: test/phases\n    params: {value: 2}\n"
+                "outputs:\n  - {node: p, file: p.exr}\n  - {node: q, file: q.exr}\n",
+                "test.yaml", dir);
+    {
+        CookOptions o = writing_options();
+        o.jobs = jobs;
+        std::mutex m;
+        std::vector<ProgressEvent> events;
+        o.progress.on_progress = [&](const ProgressEvent& e) {
+            std::lock_guard<std::mutex> l(m);
+            events.push_back(e);
+        };
+        s.cook(o);
+        ASSERT_GT(events.size(), 6u);
+        for (size_t i = 1; i < events.size(); ++i) EXPECT_GE(events[i].fraction, events[i - 1].fraction) << "event " << i << " " << events[i].task;
+        EXPECT_DOUBLE_EQ(events.back().fraction, 1.0);
+        EXPECT_EQ(events.back().done, events.back().total);
+        EXPECT_EQ(events.back().total, 4); // two nodes and two outputs
+        // 100% only once everything is done.
+        for (const auto& e : events)
+            if (e.fraction >= 1.0) {
+                EXPECT_EQ(e.done, e.total) << e.task;
+            }
+    }
+  }
+}
+
 TEST_F(Fixture, ReportJsonHasTheDocumentedKeys) {
     Session s = session();
     CookResult r = s.cook(options());

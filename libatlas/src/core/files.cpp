@@ -1,4 +1,6 @@
 #include "atlas/core/files.h"
+#include "atlas/core/memory.h"
+#include "file_limits.h"
 
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
@@ -308,10 +310,16 @@ std::string read_file_bytes(const fs::path& path) {
 namespace atlas {
 namespace {
 thread_local std::vector<FileRead>* t_file_reads = nullptr;
+thread_local detail::FileReadLimits* t_limits = nullptr;
 } // namespace
 
 FileReadRecorder::FileReadRecorder(std::vector<FileRead>* sink) : previous_(t_file_reads) { t_file_reads = sink; }
 FileReadRecorder::~FileReadRecorder() { t_file_reads = previous_; }
+
+detail::FileReadLimits::FileReadLimits(uint64_t max, std::function<bool()> c) : max_bytes(max), cancelled(std::move(c)), previous_(t_limits) {
+    t_limits = this;
+}
+detail::FileReadLimits::~FileReadLimits() { t_limits = previous_; }
 
 void hash_file(Hasher& h, const fs::path& path) {
     std::error_code ec;
@@ -319,6 +327,13 @@ void hash_file(Hasher& h, const fs::path& path) {
     if (!ec && fs::exists(st) && !fs::is_regular_file(st))
         throw Error(path.string() + ": not a regular file (" + (fs::is_directory(st) ? "a directory" : "a device, FIFO or socket") +
                     "); input files must be regular files");
+    if (t_limits && !ec && fs::is_regular_file(st)) {
+        std::error_code sec;
+        const uint64_t size = fs::file_size(path, sec);
+        if (!sec && size > t_limits->max_bytes)
+            throw Error(path.string() + ": the input file is " + format_bytes(size) + ", over the memory budget of " +
+                        format_bytes(t_limits->max_bytes) + " (raise it with --memory-budget)");
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path.string() + ": cannot open input file (does it exist?)");
     h.add(path.filename().string());
@@ -326,6 +341,7 @@ void hash_file(Hasher& h, const fs::path& path) {
     std::vector<char> buf(1 << 20);
     uint64_t total = 0;
     while (in) {
+        if (t_limits && t_limits->cancelled && (total & ((64u << 20) - 1)) == 0 && t_limits->cancelled()) throw CancelledError();
         in.read(buf.data(), std::streamsize(buf.size()));
         const auto n = size_t(in.gcount());
         if (n) {

@@ -5,6 +5,7 @@
 
 #include "atlas/core/files.h"
 #include "atlas/io/writers.h"
+#include "../core/file_limits.h"
 #include "output_records.h"
 #include "value_cache.h"
 
@@ -16,6 +17,7 @@
 #include <chrono>
 #include <exception>
 #include <functional>
+#include <mutex>
 #include <set>
 
 namespace atlas {
@@ -207,7 +209,16 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     result.checked = opt.checked;
     const Graph& g = graph();
     const int jobs = opt.jobs > 0 ? opt.jobs : int(tbb::info::default_concurrency());
+    // One budget per session: the live total of this cook's fields and values
+    // and of the in-memory cache; before refusing it drops cache entries.
     const MemoryBudget budget(opt.memory_budget);
+    const detail::MemoryLedger& ledger = cache_->ledger();
+    const detail::MemoryLedger::Attachment attached(budget, ledger);
+    ledger.set_evictor([cache = cache_.get()](uint64_t missing) { cache->evict(missing); });
+    struct EvictorReset {
+        const detail::MemoryLedger& l;
+        ~EvictorReset() { l.set_evictor(nullptr); }
+    } evictor_reset{ledger};
 
     // 1. Targets: the requested graph outputs, or explicit node ports.
     std::vector<const GraphOutput*> outputs;
@@ -262,7 +273,9 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         NodeState& s = state.at(n->name);
         std::vector<FileRead> reads;
         {
-            FileReadRecorder recorder(&reads); // what hash_extra reads: the cook's input files
+            // What hash_extra reads: the cook's input files (none larger than the budget; Ctrl-C stops a long hash).
+            FileReadRecorder recorder(&reads);
+            const detail::FileReadLimits limits(opt.memory_budget, opt.progress.is_cancelled);
             try {
                 s.hash = node_hash(g, registry_, *n, *s.type, hashes);
             } catch (...) {
@@ -369,7 +382,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         } else if (opt.cache_dir && disk_cache::contains(*opt.cache_dir, s.hash)) {
             std::string why;
             if (auto loaded = disk_cache::load(*opt.cache_dir, s.hash, &why)) {
-                s.cached = std::make_shared<const NodeOutputs>(std::move(*loaded));
+                s.cached = held_outputs(std::move(*loaded), ledger);
                 s.cache_source = "disk cache";
                 cache_->put(s.hash, s.cached);
             } else {
@@ -411,12 +424,38 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     }
 
     // 6. Cook, level by level; nodes of one level in parallel.
-    std::atomic<int> done{0};
-    auto report_progress = [&](const std::string& task, double node_fraction) {
+    // Progress: one unit per node to cook and per output to write; each
+    // running node adds what it reported of itself (never going back), and
+    // the fraction sent never decreases: one 0..1 run per cook.
+    int units = total;
+    for (const auto& p : plans) units += p.action != OutputPlan::current;
+    std::mutex progress_mutex;
+    int done = 0;
+    std::map<std::string, double> in_flight;
+    double shown = 0;
+    auto progress_step = [&](const std::string& task, const std::string& node, double node_fraction, bool finished) {
         if (!opt.progress.on_progress) return;
-        double f = total ? (done.load() + node_fraction) / total : 1.0;
-        opt.progress.on_progress({task, std::min(1.0, f), done.load(), total});
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        if (finished) {
+            ++done;
+            in_flight.erase(node);
+        } else if (!node.empty()) {
+            double& f = in_flight[node];
+            f = std::max(f, std::clamp(node_fraction, 0.0, 1.0));
+        }
+        double sum = done;
+        for (const auto& [name, f] : in_flight) sum += f;
+        shown = std::max(shown, units ? std::min(1.0, sum / units) : 1.0);
+        opt.progress.on_progress({task, shown, done, units});
     };
+    auto report_progress = [&](const std::string& name, double node_fraction) { progress_step("node '" + name + "'", name, node_fraction, false); };
+    std::map<std::string, int> pending; // consumers still to cook, per producer
+    for (const auto& level : levels)
+        for (const GraphNode* n : level)
+            for (const auto& [port, b] : n->inputs) ++pending[b.node];
+    std::set<std::string> target_nodes;
+    for (const auto& t : targets) target_nodes.insert(t.first);
+    std::map<std::string, uint64_t> released_bytes;
     tbb::task_arena arena(jobs);
     for (const auto& level : levels) {
         std::vector<std::exception_ptr> errors(level.size());
@@ -434,24 +473,23 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                     NodeParams params(&s.type->decl, resolved_params(n, *s.type), g.base_dir);
                     ProgressSink node_progress;
                     node_progress.is_cancelled = opt.progress.is_cancelled;
-                    node_progress.on_progress = [&, name = n.name](const ProgressEvent& e) { report_progress("node '" + name + "'", e.fraction); };
+                    node_progress.on_progress = [&, name = n.name](const ProgressEvent& e) { report_progress(name, e.fraction); };
                     CookContext ctx(n.name, n.type, s.type->decl, params, std::move(inputs), budget, node_progress);
-                    report_progress("node '" + n.name + "'", 0.0);
+                    report_progress(n.name, 0.0);
                     const auto t0 = std::chrono::steady_clock::now();
                     s.type->cook(ctx);
                     reports[i].seconds = seconds_since(t0);
                     for (const auto& out : s.type->decl.outputs())
                         if (!ctx.outputs().count(out.name))
                             throw Error("internal: node did not set its output '" + out.name + "'");
-                    auto outs = std::make_shared<NodeOutputs>(ctx.outputs());
+                    auto outs = held_outputs(ctx.outputs(), ledger);
                     reports[i].metrics = ctx.metrics();
                     reports[i].warnings = ctx.warnings();
                     produced[i] = outs;
                 } catch (...) {
                     errors[i] = std::current_exception();
                 }
-                done.fetch_add(1);
-                report_progress("node '" + n.name + "'", 0.0);
+                progress_step("node '" + n.name + "'", n.name, 1.0, true);
             });
         });
         // Deterministic error choice: the first failing node in level order.
@@ -491,6 +529,14 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             r.reason = opt.checked && s.cached ? "checked mode: re-cooked and matched the " + s.cache_source : "";
             result.nodes[n.name] = std::move(r);
         }
+        // A value no node still to cook reads, and no target, is let go here
+        // (the in-memory cache may keep it, and give it up under the budget).
+        for (const GraphNode* n : level)
+            for (const auto& [port, b] : n->inputs)
+                if (--pending[b.node] == 0 && !target_nodes.count(b.node) && values.count(b.node)) {
+                    for (const auto& [p, v] : *values.at(b.node)) released_bytes[b.node] += value_bytes(v);
+                    values.erase(b.node);
+                }
     }
 
     // 7. Report every node of the graph.
@@ -505,6 +551,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         }
         if (values.count(n.name) && values.at(n.name))
             for (const auto& [port, v] : *values.at(n.name)) r.bytes += value_bytes(v);
+        if (released_bytes.count(n.name)) r.bytes = released_bytes.at(n.name);
         if (s.cook) continue;
         if (!s.needed) {
             r.status = "skipped";
@@ -558,6 +605,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 OutputRecord r = *p.same_spec;
                 r.key = p.key.hex();
                 rekeyed.emplace_back(&p, std::move(r));
+                progress_step("up to date: " + o->file, "", 0.0, true);
             }
             if (p.action == OutputPlan::current) {
                 orep.status = "up to date";
@@ -570,7 +618,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 opt.progress.poll();
                 auto& st = staging[p.root];
                 if (!st) st = std::make_unique<StagedOutputs>(p.root);
-                if (opt.progress.on_progress) opt.progress.on_progress({"writing " + o->file, 1.0, total, total});
+                progress_step("writing " + o->file, "", 0.0, false);
                 Written w{result.outputs.size(), &p, st.get(), {}};
                 if (p.action == OutputPlan::restore) {
                     orep.status = "restored";
@@ -583,6 +631,10 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                     p.cached.reset();
                 } else {
                     orep.status = "written";
+                    // A writer may copy the value (a slice stack, a half-float frame): room for one copy.
+                    const uint64_t scratch = value_bytes(values.at(o->node)->at(o->port));
+                    budget.check(scratch, "output '" + o->file + "': the writer's copy of the value");
+                    const auto scratch_held = ledger.hold(&scratch, scratch);
                     w.staged = io::write_value(values.at(o->node)->at(o->port), st->stage(p.rel), o->format, o->options, &orep.metrics);
                 }
                 for (const auto& staged : w.staged) {
@@ -608,6 +660,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 }
                 result.outputs.push_back(orep);
                 written.push_back(std::move(w));
+                progress_step("wrote " + o->file, "", 0.0, true);
             } catch (const CancelledError&) {
                 throw;
             } catch (const std::exception& e) {

@@ -378,7 +378,8 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
         } catch (const ParseError&) {
             throw;
         } catch (const Error& e) {
-            p.fail(o, "output '" + out.file + "': " + e.what());
+            const std::string msg = e.what();
+            p.fail(o, msg.rfind("output '", 0) == 0 ? msg : "output '" + out.file + "': " + msg);
         }
         // An explicit format that the file's extension contradicts (format: png on a .exr name).
         if (o["format"]) {
@@ -393,6 +394,22 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
                                         "' file)" + (out.format == "tga-slices" || out.format == "vdb-sequence"
                                                          ? "; format '" + out.format + "' takes DIR/STEM without an extension"
                                                          : "; rename the file or drop 'format'"));
+        }
+        // Option values, as the writer will parse them: a bad one is refused
+        // here, with the option's file:line, not after cooking everything.
+        try {
+            io::check_output_options(out.format, out.file, out.options, port->type);
+        } catch (const Error& e) {
+            const std::string msg = e.what();
+            const std::string tail = msg.rfind("output '", 0) == 0 ? msg.substr(msg.find("': ") + 3) : msg;
+            const YAML::Node opts = o["options"];
+            SourceLocation at = p.at(opts ? opts : o);
+            for (const auto& kv : out.options)
+                if (tail.find("option '" + kv.first + "'") != std::string::npos || tail.find("options '" + kv.first + "'") != std::string::npos) {
+                    at = p.at(opts[kv.first]);
+                    break;
+                }
+            throw ParseError(at, "output '" + out.file + "': " + tail);
         }
         // Two outputs may not name the same file, however spelled (./v.exr,
         // x/../v.exr, d//v.exr), nor a file another output writes beside its

@@ -1,4 +1,5 @@
 #include "atlas/graph/node.h"
+#include "../core/memory_ledger.h"
 
 #include "atlas/core/hash.h"
 
@@ -163,7 +164,15 @@ template <typename F, typename Res, typename Box>
 std::shared_ptr<F> make_named_field(const CookContext& ctx, const MemoryBudget& budget, Res res, int channels, Box bounds,
                                     std::vector<std::string> names) {
     try {
-        return std::make_shared<F>(res, channels, bounds, std::move(names), &budget);
+        // Held against the budget for as long as the field lives (a scratch
+        // field until the node drops it, an output while a value or the
+        // cache keeps it).
+        auto* raw = new F(res, channels, bounds, std::move(names), &budget);
+        std::shared_ptr<void> token = detail::hold_against(budget, raw, raw->byte_size());
+        return std::shared_ptr<F>(raw, [token](F* p) mutable {
+            delete p;
+            token.reset();
+        });
     } catch (const MemoryBudgetError& e) {
         throw MemoryBudgetError("node '" + ctx.node_name() + "': " + e.what());
     } catch (const Error& e) {

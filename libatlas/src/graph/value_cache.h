@@ -2,12 +2,14 @@
 #pragma once
 
 #include "atlas/core/hash.h"
+#include "../core/memory_ledger.h"
 #include "atlas/core/value.h"
 #include "atlas/graph/disk_cache.h"
 
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
@@ -19,8 +21,19 @@ namespace atlas {
 
 using NodeOutputs = std::map<std::string, Value>;
 
+// The outputs as one shared value whose bytes are held against `budget`
+// while it lives (objects already held, e.g. fields a node made through its
+// CookContext, count once).
+std::shared_ptr<const NodeOutputs> held_outputs(NodeOutputs outputs, const detail::MemoryLedger& ledger);
+
 class ValueCache {
 public:
+    // The session's live memory total: the cache outlives cooks, so what it
+    // keeps counts against the next cook's budget.
+    const detail::MemoryLedger& ledger() const { return ledger_; }
+    // Drops entries, those nothing else holds first, until `bytes` were given
+    // back to the ledger or nothing is left to drop. Thread-safe against itself.
+    void evict(uint64_t bytes);
     std::shared_ptr<const NodeOutputs> find(const Hash128& h) const;
     void put(const Hash128& h, std::shared_ptr<const NodeOutputs> v);
     // Drops every entry whose hash is not in `keep` (results of nodes that
@@ -30,6 +43,8 @@ public:
 
 private:
     std::unordered_map<Hash128, std::shared_ptr<const NodeOutputs>, Hash128Hasher> entries_;
+    detail::MemoryLedger ledger_;
+    std::mutex evict_mutex_;
 };
 
 // On-disk cache: one file per node result, DIR/<hash>.atlascache, written

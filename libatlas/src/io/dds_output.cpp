@@ -8,9 +8,9 @@
 
 namespace atlas::io::detail {
 
-std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path, const OutputOptions& options, OutputMetrics& metrics) {
-    const OptionReader o(options, path);
-    const Field3DPtr field = as_field3d(value);
+namespace {
+// Every option except the channel names' existence (checked when the graph loads too).
+compress::CompressOptions dds_options(const OptionReader& o) {
     compress::CompressOptions c;
     try {
         c.format = compress::parse_format(o.has("encoding") ? o.text("encoding") : std::string("rgba16f"));
@@ -30,12 +30,23 @@ std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path,
     c.allow_over_bound = o.flag("allow_over_bound");
     if (o.has("mips")) c.mip_levels = o.text("mips") == "full" ? 0 : o.integer("mips", 1, 1, compress::kMaxMipLevels);
     if (o.has("range")) c.value_range = o.range("range", 0.0f, 1.0f);
+    o.list("channels");
+    c.as_array = o.flag("array");
+    return c;
+}
+} // namespace
+
+void check_dds_options(const OptionReader& o, const fs::path&, PortType) { dds_options(o); }
+
+std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path, const OutputOptions& options, OutputMetrics& metrics) {
+    const OptionReader o(options, path);
+    const Field3DPtr field = as_field3d(value);
+    compress::CompressOptions c = dds_options(o);
     for (const auto& name : o.list("channels")) {
         const int ch = field->find_channel(name);
         if (ch < 0) o.bad("channels", "names of the value's channels");
         c.channels.push_back(ch);
     }
-    c.as_array = o.flag("array");
     const compress::CompressReport r = compress::compress_to_dds(*field, path, c);
     // Error against run time, for the cook report.
     for (size_t ch = 0; ch < r.max_error.size(); ++ch) {

@@ -12,6 +12,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 
 namespace atlas::io::detail {
 
@@ -71,8 +72,13 @@ std::vector<fs::path> write_json_output(const Value& v, const fs::path& p, const
 }
 } // namespace
 
+void check_json_options(const OptionReader& o, const fs::path&, PortType) { o.list("channels"); }
+
 // vdb_sequence.cpp
 std::vector<fs::path> write_vdb_sequence_output(const Value&, const fs::path&, const OutputOptions&, OutputMetrics&);
+void check_vdb_sequence_options(const OptionReader& o, const fs::path&, PortType) {
+    o.number("tolerance", 0.0f, 0.0f, std::numeric_limits<float>::infinity());
+}
 
 const std::vector<FormatEntry>& format_table() {
     static const std::vector<FormatEntry> table = {
@@ -83,7 +89,8 @@ const std::vector<FormatEntry>& format_table() {
           {{"half", "true: store 16-bit half floats (values beyond +-65504 are an error)"},
            {"meaning", "free text stored in the atlas:channel_meaning attribute"},
            kChannels}},
-         write_exr_output},
+         write_exr_output,
+         check_exr_options},
         {{"png",
           {".png"},
           {PortType::Field2D, PortType::Field3D},
@@ -93,7 +100,8 @@ const std::vector<FormatEntry>& format_table() {
            {"slice", "3D fields: the z index to write (default nz/2)"},
            {"montage", "3D fields: true writes every slice tiled in a grid (slice 0 top left)"},
            kChannels}},
-         write_image_output},
+         write_image_output,
+         check_image_options},
         {{"tga",
           {".tga"},
           {PortType::Field2D, PortType::Field3D},
@@ -103,7 +111,8 @@ const std::vector<FormatEntry>& format_table() {
            {"slice", "3D fields: the z index to write (default nz/2)"},
            {"montage", "3D fields: true writes every slice tiled in a grid (slice 0 top left)"},
            kChannels}},
-         write_image_output},
+         write_image_output,
+         check_image_options},
         {{"vdb",
           {".vdb"},
           {PortType::Field3D},
@@ -112,7 +121,8 @@ const std::vector<FormatEntry>& format_table() {
            {"vector3", "true: a 3-channel field becomes one vec3s grid"},
            {"grids", "comma-separated grid names (default: the channel names)"},
            kChannels}},
-         write_vdb_output},
+         write_vdb_output,
+         check_vdb_options},
         {{"tga-slices",
           {},
           {PortType::Field3D},
@@ -123,7 +133,8 @@ const std::vector<FormatEntry>& format_table() {
            {"naming", "atlas: STEM.001.tga, STEM.002.tga, ... (default); nubis: STEM(0).tga, STEM(1).tga, ... as the pack's own files"},
            {"compression", "rle (default, TGA image type 10/11, what the pack uses) or none (type 2/3)"},
            {"pixels", "rgba (32-bit, default), rgb (24-bit) or gray (8-bit, R only)"}}},
-         write_tga_slices_output},
+         write_tga_slices_output,
+         check_tga_slices_options},
         {{"dds",
           {".dds"},
           {PortType::Field2D, PortType::Field3D},
@@ -139,21 +150,24 @@ const std::vector<FormatEntry>& format_table() {
            {"array", "true: a 3D field becomes a 2D texture array instead of a volume"},
            kChannels},
           compress::kEncoderVersion},
-         write_dds_output},
+         write_dds_output,
+         check_dds_options},
         {{"json",
           {".json"},
           {PortType::Field2D},
           "a small 2D field (at most 65536 texels) as a JSON table, e.g. a sidecar: resolution, world bounds and their centre, "
           "channel names, and rows [{x, y, <channel>: value, ...}] with x fastest (NaN/Inf as null)",
           {kChannels}},
-         write_json_output},
+         write_json_output,
+         check_json_options},
         {{"vdb-sequence",
           {},
           {PortType::Field3D},
           "one VDB per frame, DIR/STEM.NNNN.vdb, from channels named NNNN:GRID (sim/cloud_growth's 'sequence'); GRID.x/.y/.z "
           "become one vec3s grid GRID, others float fog volumes; the path is DIR/STEM",
           {{"tolerance", "values with |v| <= tolerance stay inactive (background 0; default 0)"}}},
-         write_vdb_sequence_output},
+         write_vdb_sequence_output,
+         check_vdb_sequence_options},
     };
     return table;
 }

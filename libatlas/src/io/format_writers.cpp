@@ -87,24 +87,54 @@ std::string lower_extension(const fs::path& p) {
 
 } // namespace
 
-std::vector<fs::path> write_exr_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
-    const OptionReader o(opts, p);
+namespace {
+ExrOptions exr_options(const OptionReader& o) {
     ExrOptions eo;
     eo.half = o.flag("half");
     if (o.has("meaning")) eo.channel_meaning = o.text("meaning");
+    o.list("channels");
+    return eo;
+}
+} // namespace
+
+void check_exr_options(const OptionReader& o, const fs::path&, PortType) { exr_options(o); }
+
+std::vector<fs::path> write_exr_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
+    const OptionReader o(opts, p);
+    const ExrOptions eo = exr_options(o);
     const Value s = selected(v, o);
     if (auto f2 = std::get_if<Field2DPtr>(&s)) write_exr(**f2, p, eo);
     else write_exr(*std::get<Field3DPtr>(s), p, eo);
     return {p};
 }
 
-std::vector<fs::path> write_image_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
-    const OptionReader o(opts, p);
+namespace {
+// The options of png/tga that do not depend on the value (checked when the graph loads too).
+ImageOptions image_options(const OptionReader& o, const fs::path& p) {
     const bool tga = lower_extension(p) == ".tga";
     ImageOptions io;
     io.bits = o.integer("bits", 8, 0, 64);
     if (tga ? io.bits != 8 : (io.bits != 8 && io.bits != 16)) o.bad("bits", tga ? "8 (TGA holds 8 bits per channel)" : "8 or 16");
     std::tie(io.range_min, io.range_max) = o.range("range", 0.0f, 1.0f);
+    o.list("channels");
+    if (o.has("slice")) o.integer("slice", 0, 0, std::numeric_limits<int>::max());
+    if (o.flag("montage") && o.has("slice")) throw Error(o.prefix() + "options 'montage' and 'slice' exclude each other");
+    return io;
+}
+} // namespace
+
+void check_image_options(const OptionReader& o, const fs::path& p, PortType produced) {
+    image_options(o, p);
+    if (produced == PortType::Field2D) {
+        if (o.has("slice")) o.bad("slice", "no slice option for a 2D field");
+        if (o.has("montage")) o.bad("montage", "no montage option for a 2D field");
+    }
+}
+
+std::vector<fs::path> write_image_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
+    const OptionReader o(opts, p);
+    const bool tga = lower_extension(p) == ".tga";
+    const ImageOptions io = image_options(o, p);
     const Value s = selected(v, o);
     const int channels = std::holds_alternative<Field2DPtr>(s) ? std::get<Field2DPtr>(s)->channels() : std::get<Field3DPtr>(s)->channels();
     if (channels > 4 || (tga && channels == 2))
@@ -114,18 +144,29 @@ std::vector<fs::path> write_image_output(const Value& v, const fs::path& p, cons
     return {p};
 }
 
-std::vector<fs::path> write_vdb_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
-    const OptionReader o(opts, p);
+namespace {
+VdbOptions vdb_options(const OptionReader& o) {
     VdbOptions vo;
     vo.tolerance = o.number("tolerance", 0.0f, 0.0f, std::numeric_limits<float>::infinity());
     vo.vector3 = o.flag("vector3");
     vo.grid_names = o.list("grids");
+    o.list("channels");
+    return vo;
+}
+} // namespace
+
+void check_vdb_options(const OptionReader& o, const fs::path&, PortType) { vdb_options(o); }
+
+std::vector<fs::path> write_vdb_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
+    const OptionReader o(opts, p);
+    const VdbOptions vo = vdb_options(o);
     write_vdb(*std::get<Field3DPtr>(selected(v, o)), p, vo);
     return {p};
 }
 
-std::vector<fs::path> write_tga_slices_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
-    const OptionReader o(opts, p);
+namespace {
+// Every option of a slice stack except the channel names' existence; `holds`: channels per pixel.
+SliceOptions slice_options(const OptionReader& o, const fs::path& p, int& holds) {
     if (lower_extension(p) == ".tga")
         throw Error(o.prefix() + "format 'tga-slices' takes DIR/STEM (it writes STEM.001.tga, STEM.002.tga, ... or STEM(0).tga, ...), not a .tga file name");
     SliceOptions so;
@@ -143,7 +184,7 @@ std::vector<fs::path> write_tga_slices_output(const Value& v, const fs::path& p,
         else if (c == "none") so.rle = false;
         else o.bad("compression", "rle or none");
     }
-    int holds = 4;
+    holds = 4;
     if (o.has("pixels")) {
         const std::string& px = o.text("pixels");
         if (px == "rgba") so.pixels = SlicePixels::rgba;
@@ -155,6 +196,20 @@ std::vector<fs::path> write_tga_slices_output(const Value& v, const fs::path& p,
     const std::string kind = holds == 4 ? "RGBA" : (holds == 3 ? "RGB" : "gray");
     if (int(o.list("channels").size()) > holds)
         o.bad("channels", "at most " + std::to_string(holds) + (holds == 1 ? " name (" : " names (") + kind + ")");
+    return so;
+}
+} // namespace
+
+void check_tga_slices_options(const OptionReader& o, const fs::path& p, PortType) {
+    int holds = 4;
+    slice_options(o, p, holds);
+}
+
+std::vector<fs::path> write_tga_slices_output(const Value& v, const fs::path& p, const OutputOptions& opts, OutputMetrics&) {
+    const OptionReader o(opts, p);
+    int holds = 4;
+    SliceOptions so = slice_options(o, p, holds);
+    const std::string kind = holds == 4 ? "RGBA" : (holds == 3 ? "RGB" : "gray");
     const Field3DPtr f = std::get<Field3DPtr>(selected(v, o));
     for (int k = 0; k < 4; ++k) so.channel_map.push_back(k < f->channels() && k < holds ? k : -1);
     if (f->channels() > holds && !o.has("channels"))

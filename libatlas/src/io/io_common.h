@@ -27,6 +27,8 @@ inline void require_regular_file(const fs::path& path, const std::string& kind) 
     const auto st = fs::status(path, ec);
     if (ec || !fs::exists(st)) throw Error(path.string() + ": cannot open " + kind + " file (no such file)");
     if (fs::is_directory(st)) throw Error(path.string() + ": cannot open " + kind + " file (it is a directory)");
+    // A device, FIFO or socket has no end (or blocks): refused before any read.
+    if (!fs::is_regular_file(st)) throw Error(path.string() + ": cannot open " + kind + " file (not a regular file: a device, FIFO or socket)");
 }
 
 // Linear map of [lo, hi] onto 0..full (full = 2^bits - 1), clamped, rounded

@@ -34,6 +34,13 @@ std::string output_format_for_path(const fs::path& path) {
                 " (known: " + known + "); name the format explicitly (e.g. format: tga-slices)");
 }
 
+void check_output_options(const std::string& format, const fs::path& path, const OutputOptions& options, PortType produced) {
+    const auto& table = detail::format_table();
+    const auto it = std::find_if(table.begin(), table.end(), [&](const detail::FormatEntry& e) { return e.format.name == format; });
+    if (it == table.end() || !it->check) return;
+    it->check(OptionReader(options, path), path, produced);
+}
+
 std::vector<fs::path> write_value(const Value& value, const fs::path& path, const std::string& format, const OutputOptions& options,
                                   OutputMetrics* metrics) {
     const auto& table = detail::format_table();

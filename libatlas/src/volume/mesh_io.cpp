@@ -2,6 +2,7 @@
 #include "atlas/volume/mesh_io.h"
 
 #include "atlas/core/error.h"
+#include "ply_header.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/IO/polygon_soup_io.h>
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <array>
 #include <cctype>
@@ -113,6 +115,134 @@ Mesh repair_soup(std::vector<Point> points, std::vector<Polygon> polygons, MeshR
     return out;
 }
 
+
+// PLY and STL go to CGAL's readers, which trust their headers (a property
+// outside any element crashes the PLY reader; a count of 10^12 reserves
+// memory for it): the header is checked here first, against the file's size.
+uint64_t regular_file_size(const std::filesystem::path& file) {
+    std::error_code ec;
+    const auto st = std::filesystem::status(file, ec);
+    if (ec || !std::filesystem::is_regular_file(st))
+        throw Error(file.string() + ": cannot read mesh: not a regular file (a directory, device, FIFO or socket)");
+    return std::filesystem::file_size(file, ec);
+}
+
+} // namespace
+
+void detail::check_ply_header(const std::filesystem::path& file, bool need_faces) {
+    const std::string f = file.string();
+    const uint64_t size = regular_file_size(file);
+    std::ifstream in(file, std::ios::binary);
+    std::string line;
+    size_t line_no = 0;
+    uint64_t header_bytes = 0;
+    auto fail = [&](const std::string& why) -> void { throw Error(f + ":" + std::to_string(line_no) + ": PLY header: " + why); };
+    auto next = [&]() {
+        if (!std::getline(in, line)) {
+            ++line_no;
+            fail("ends before 'end_header'");
+        }
+        ++line_no;
+        header_bytes += line.size() + 1;
+        if (header_bytes > 65536) fail("longer than 64 KiB");
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+    };
+    auto words = [&]() {
+        std::vector<std::string> w;
+        size_t i = 0;
+        while (i < line.size()) {
+            while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+            const size_t b = i;
+            while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+            if (i > b) w.push_back(line.substr(b, i - b));
+        }
+        return w;
+    };
+    next();
+    if (line != "ply") fail("the file does not start with 'ply'");
+    next();
+    auto w = words();
+    if (w.size() != 3 || w[0] != "format" || (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
+        fail("expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
+    const bool ascii = w[1] == "ascii";
+    const std::vector<std::string> scalar = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "uint8",
+                                             "int16", "uint16", "int32", "uint32", "float32", "float64"};
+    auto is_scalar = [&](const std::string& t) { return std::find(scalar.begin(), scalar.end(), t) != scalar.end(); };
+    struct Element {
+        std::string name;
+        uint64_t count = 0;
+        std::vector<std::string> props;
+        bool has_list = false;
+    };
+    std::vector<Element> elements;
+    while (true) {
+        next();
+        w = words();
+        if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
+        if (w[0] == "end_header") break;
+        if (w[0] == "element") {
+            uint64_t n = 0;
+            const auto r = w.size() == 3 ? std::from_chars(w[2].data(), w[2].data() + w[2].size(), n) : std::from_chars_result{nullptr, std::errc::invalid_argument};
+            if (w.size() != 3 || r.ec != std::errc() || r.ptr != w[2].data() + w[2].size()) fail("expected 'element NAME COUNT'");
+            elements.push_back({w[1], n, {}, false});
+        } else if (w[0] == "property") {
+            if (elements.empty()) fail("a property before any element");
+            if (w.size() == 5 && w[1] == "list") {
+                if (!is_scalar(w[2]) || !is_scalar(w[3])) fail("unknown list types '" + w[2] + "', '" + w[3] + "'");
+                elements.back().has_list = true;
+                elements.back().props.push_back(w[4]);
+            } else if (w.size() == 3 && is_scalar(w[1])) {
+                elements.back().props.push_back(w[2]);
+            } else {
+                fail("expected 'property TYPE NAME' or 'property list COUNT_TYPE INDEX_TYPE NAME'");
+            }
+        } else {
+            fail("unknown keyword '" + w[0].substr(0, 40) + "'");
+        }
+    }
+    const Element* vertex = nullptr;
+    const Element* face = nullptr;
+    for (const auto& e : elements) {
+        if (e.props.empty()) throw Error(f + ": PLY header: element '" + e.name + "' has no properties");
+        if (e.name == "vertex") vertex = &e;
+        if (e.name == "face") face = &e;
+    }
+    if (!vertex) throw Error(f + ": PLY header: no 'vertex' element");
+    for (const char* axis : {"x", "y", "z"})
+        if (std::find(vertex->props.begin(), vertex->props.end(), axis) == vertex->props.end())
+            throw Error(f + ": PLY header: the vertex element has no property '" + axis + "'");
+    if (need_faces && (!face || !face->has_list)) throw Error(f + ": PLY header: no 'face' element with a list of vertex indices");
+    // Every property takes at least one byte (binary) or two (ascii: a digit
+    // and a separator): counts the file cannot hold are refused.
+    const uint64_t body = size > header_bytes ? size - header_bytes : 0;
+    uint64_t least = 0;
+    for (const auto& e : elements) {
+        const uint64_t per = uint64_t(e.props.size()) * (ascii ? 2 : 1);
+        if (e.count > body / per + 1) throw Error(f + ": PLY header: element '" + e.name + "' claims " + std::to_string(e.count) +
+                                                      " entries, more than the file's " + std::to_string(body) + " bytes after the header hold");
+        least += e.count * per;
+    }
+    if (least > body + 1) throw Error(f + ": PLY header: the elements need at least " + std::to_string(least) + " bytes, the file has " + std::to_string(body) + " after the header");
+}
+
+namespace {
+void check_stl(const std::filesystem::path& file) {
+    const uint64_t size = regular_file_size(file);
+    std::ifstream in(file, std::ios::binary);
+    char head[84] = {};
+    in.read(head, 84);
+    const bool ascii = std::string(head, std::min<size_t>(size_t(in.gcount()), 5)) == "solid";
+    if (size < 84) {
+        if (!ascii) throw Error(file.string() + ": STL file of " + std::to_string(size) + " bytes: too short for a binary STL header");
+        return;
+    }
+    uint32_t n = 0;
+    std::memcpy(&n, head + 80, 4);
+    // A binary file says how many 50-byte triangles follow; ASCII files may start with "solid" too.
+    if (84 + 50ull * n == size) return;
+    if (!ascii) throw Error(file.string() + ": binary STL claims " + std::to_string(n) + " triangles (" + std::to_string(84 + 50ull * n) +
+                            " bytes), the file has " + std::to_string(size));
+}
 
 // Text OBJ and OFF are parsed here (not by CGAL) so that every error names
 // file:line, the vertex or face, and what was expected; CGAL's readers accept
@@ -314,11 +444,14 @@ Mesh read_mesh(const std::filesystem::path& file, MeshRepairReport* report) {
     std::vector<Point> points;
     std::vector<Polygon> polys;
     if (!std::filesystem::exists(file)) throw Error(file.string() + ": no such mesh file");
+    regular_file_size(file); // a device or FIFO never ends: refused before reading
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     if (ext == ".obj") read_obj(file, points, polys);
     else if (ext == ".off") read_off(file, points, polys);
     else {
+        if (ext == ".ply") detail::check_ply_header(file, true);
+        else if (ext == ".stl") check_stl(file);
         bool ok = false;
         try {
             ok = CGAL::IO::read_polygon_soup(file.string(), points, polys, CGAL::parameters::verbose(false));

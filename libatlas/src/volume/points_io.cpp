@@ -1,6 +1,7 @@
 // Point cloud reading: PLY through CGAL, XYZ text by hand.
 #include "atlas/core/error.h"
 #include "atlas/volume/splat.h"
+#include "ply_header.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Point_set_3.h>
@@ -86,9 +87,14 @@ Points read_ply(const std::filesystem::path& file) {
 
 Points read_points(const std::filesystem::path& file) {
     if (!std::filesystem::exists(file)) throw Error(file.string() + ": no such point file");
+    if (!std::filesystem::is_regular_file(file))
+        throw Error(file.string() + ": cannot read points: not a regular file (a directory, device, FIFO or socket)");
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext == ".ply") return read_ply(file);
+    if (ext == ".ply") {
+        detail::check_ply_header(file, false); // CGAL's reader trusts the header
+        return read_ply(file);
+    }
     if (ext == ".xyz" || ext == ".txt" || ext == ".pts") return read_xyz(file);
     throw Error(file.string() + ": unknown point file type (expected .ply or .xyz)");
 }

@@ -46,6 +46,13 @@ std::string output_format_for_path(const fs::path& path);
 // Error metrics a writer measured (e.g. a DDS encode's max error), name -> value.
 using OutputMetrics = std::map<std::string, double>;
 
+// Checks the option values of an output that do not depend on the value
+// itself (an option's type and range, contradicting options), for a port
+// producing `produced`: what a graph load can refuse before anything cooks.
+// Throws atlas::Error "output 'NAME': option 'key': expected ..., got '...'".
+// Option names are not checked here (the caller lists the known ones).
+void check_output_options(const std::string& format, const fs::path& path, const OutputOptions& options, PortType produced);
+
 std::vector<fs::path> write_value(const Value& value, const fs::path& path, const std::string& format, const OutputOptions& options,
                                   OutputMetrics* metrics = nullptr);
 
