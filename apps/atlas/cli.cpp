@@ -103,7 +103,7 @@ const std::vector<Command>& commands() {
           {"--edge", "wrap|clamp|empty", "2.5D: the map beyond its bounds (default: empty for a superstorm set, else wrap)"},
           {"--envelope", "on|off|auto", "2.5D: skip empty space with a cone map over the cloud tops (the graph's ndf/cone_map if it writes one); auto (default) = on above the lowest cloud base"},
           {"--artistic", "on|off", "off: the physical lighting a path tracer computes (no powder, octave multiple scattering; docs/render.md \"Reference: Cycles\")"},
-          {"--ms-octaves", "N", "with --artistic off: octaves of multiple scattering (0 = single scattering; default " + std::to_string(render::kPhysicalMsOctaves) + ")"},
+          {"--ms-octaves", "N[,A,B,C]", "with --artistic off: octaves of multiple scattering (0 = single scattering; default " + std::to_string(render::kPhysicalMsOctaves) + "), optionally their energy, extinction and anisotropy factors"},
           {"--light-grid", "NX,NY,NZ", "voxel light grid resolution (default 128,128,32, capped at the volume's)"},
           {"--export-scene", "DIR", "also write DIR/density.vdb and DIR/scene.json for scripts/cycles_reference.py (Blender Cycles)"},
           {"--quiet", "", "no progress bar or summary"}},

@@ -3,7 +3,6 @@
 // reference error and time per quality; --turntable writes N frames.
 #include "cli.h"
 #include "export_scene.h"
-#include "export_scene.h"
 #include "progress_bar.h"
 
 #include "atlas/core/error.h"
@@ -348,28 +347,6 @@ void apply_physics_options(const Args& a, render::RenderSettings& s) {
             s.ms_octaves = render::kPhysicalMsOctaves;
             s.multiple_scattering = 1;
             s.ambient_strength = 1;
-        }
-    }
-    if (a.has("--ms-octaves")) {
-        if (s.artistic) throw UsageError{"--ms-octaves sets the physical model's multiple scattering; it needs --artistic off", "preview"};
-        s.ms_octaves = static_cast<int>(numbers(a.get("--ms-octaves"), 1, "--ms-octaves")[0]);
-    }
-    if (a.has("--light-grid")) {
-        auto v = numbers(a.get("--light-grid"), 3, "--light-grid");
-        s.light_grid = {{int(v[0]), int(v[1]), int(v[2])}};
-    }
-}
-
-// --artistic on|off, --ms-octaves N, --light-grid NX,NY,NZ (docs/render.md, "Reference: Cycles").
-void apply_physics_options(const Args& a, render::RenderSettings& s) {
-    if (a.has("--artistic")) {
-        const std::string v = a.get("--artistic");
-        if (v != "on" && v != "off") throw UsageError{"--artistic expects on or off, got '" + v + "'", "preview"};
-        if (v == "off") {
-            s.artistic = false;
-            s.ms_octaves = render::kPhysicalMsOctaves;
-            s.multiple_scattering = 1;
-            s.ambient_strength = 1;
             // One Henyey-Greenstein lobe with the dual lobe's mean cosine
             // (0.33 for the defaults): what a path tracer's volume offers
             // (Cycles 3.4 does not weight two scatter closures by their
@@ -380,7 +357,11 @@ void apply_physics_options(const Args& a, render::RenderSettings& s) {
     }
     if (a.has("--ms-octaves")) {
         if (s.artistic) throw UsageError{"--ms-octaves sets the physical model's multiple scattering; it needs --artistic off", "preview"};
-        s.ms_octaves = static_cast<int>(numbers(a.get("--ms-octaves"), 1, "--ms-octaves")[0]);
+        const std::string t = a.get("--ms-octaves");
+        const bool four = std::count(t.begin(), t.end(), ',') == 3;
+        auto v = numbers(t, four ? 4 : 1, "--ms-octaves");
+        s.ms_octaves = static_cast<int>(v[0]);
+        if (four) s.ms_energy = v[1], s.ms_extinction = v[2], s.ms_anisotropy = v[3];
     }
     if (a.has("--light-grid")) {
         auto v = numbers(a.get("--light-grid"), 3, "--light-grid");
@@ -651,12 +632,6 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
     }
     for (const auto& l : a.all("--light")) s.lights.push_back(parse_light(l));
     const double exposure = a.has("--exposure") ? numbers(a.get("--exposure"), 1, "--exposure")[0] : 1.5;
-    apply_physics_options(a, s); // --artistic, --ms-octaves, --light-grid
-    if (a.has("--export-scene")) {
-        if (!have_voxel || have_layer) throw UsageError{"--export-scene exports a voxel scene; this preview has no (or not only a) volume/nvdf set", "preview"};
-        const std::string note = export_scene(a.get("--export-scene"), scene, s);
-        if (!quiet) std::fprintf(stderr, "%s\n", note.c_str());
-    }
     apply_physics_options(a, s); // --artistic, --ms-octaves, --light-grid
     if (a.has("--export-scene")) {
         if (!have_voxel || have_layer) throw UsageError{"--export-scene exports a voxel scene; this preview has no (or not only a) volume/nvdf set", "preview"};
