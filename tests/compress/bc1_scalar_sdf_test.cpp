@@ -10,6 +10,7 @@
 #include "test_blocks.h"
 
 #include <gtest/gtest.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -314,58 +315,65 @@ float measured_error(const uint8_t blk[8], const ScalarUnpack& u, const float sr
     return worst;
 }
 
-// Every block's error against the exhaustive optimum: at most twice it plus the
-// format's endpoint slack under the set (asserted on every block), and, on a sample,
-// how many blocks exceed twice the optimum outright (printed).
-void check_sdf_blocks(DecoderSet set, Quality q, int count, int sample_every) {
+// Every block's error against the exhaustive optimum (issue 14's criterion: at most
+// twice it). `strict`: asserted on every block, the search with stop = err / 2 proving
+// that no pair reaches half the encoder's error. Otherwise asserted with the set's
+// endpoint slack added (err <= 2 opt + slack) and the strict misses counted and bounded
+// by `max_strict_misses`. Blocks are checked in parallel (the search is read-only).
+void check_sdf_blocks(DecoderSet set, Quality q, int count, bool strict, int max_strict_misses = 0) {
     const ExhaustiveSearch search(set);
     const ScalarUnpack& u = search.unpack();
-    const float slack = search.endpoint_slack();
+    const float slack = strict ? 0.0f : search.endpoint_slack();
     BlockOptions o;
     o.one_sided_below = true;
     o.decoders = set;
     o.quality = q;
-    int worse = 0, sampled = 0, over_twice = 0;
-    double sum_err = 0, worst_err = 0, worst_excess = 0;
-    for (int k = 0; k < count; ++k) {
+    struct Outcome {
+        float err = 0, better = INFINITY;
+        uint16_t c0 = 0, c1 = 0, e0 = 0, e1 = 0;
+        float spread = 0, slack_better = INFINITY;
+        bool one_sided = false, bound_ok = false;
+    };
+    std::vector<Outcome> out(static_cast<size_t>(count));
+    tbb::parallel_for(0, count, [&](int k) {
         float src[16];
         sdf_block(uint64_t(k), src);
         uint8_t blk[8];
         const BlockResult r = encode_bc1_scalar_block(src, u, o, blk);
-        bool os = false;
-        const float err = measured_error(blk, u, src, os);
-        ASSERT_TRUE(os) << "block " << k << " is not one-sided";
-        ASSERT_TRUE(r.one_sided_ok);
-        ASSERT_LE(err, r.max_error) << "block " << k;
-        sum_err += err;
-        worst_err = std::max(worst_err, double(err));
-        // Any pair with an error below (err - slack) / 2 is a failure.
-        const float stop = 0.5f * (err - slack);
-        uint16_t c0 = 0, c1 = 0;
-        if (stop > 0) {
-            const float better = search.best_below(src, stop, &c0, &c1);
-            if (better < INFINITY) {
-                ++worse;
-                if (worse <= 5)
-                    ADD_FAILURE() << "block " << k << ": encoder " << err * (kHi - kLo) << " m, pair (" << c0 << ", " << c1 << ") reaches "
-                                  << better * (kHi - kLo) << " m (slack " << slack * (kHi - kLo) << " m); texels " << src[0] << " .. "
-                                  << src[15];
-            }
+        Outcome& oc = out[size_t(k)];
+        oc.err = measured_error(blk, u, src, oc.one_sided);
+        oc.e0 = uint16_t(blk[0] | (blk[1] << 8));
+        oc.e1 = uint16_t(blk[2] | (blk[3] << 8));
+        oc.spread = *std::max_element(src, src + 16) - *std::min_element(src, src + 16);
+        oc.one_sided = oc.one_sided && r.one_sided_ok;
+        oc.bound_ok = oc.err <= r.max_error;
+        oc.better = search.best_below(src, 0.5f * oc.err, &oc.c0, &oc.c1);
+        if (!strict && oc.better < INFINITY) oc.slack_better = search.best_below(src, 0.5f * (oc.err - slack));
+    });
+    int worse = 0, strict_misses = 0;
+    double sum_err = 0, worst_err = 0, worst_ratio = 0;
+    for (int k = 0; k < count; ++k) {
+        const Outcome& oc = out[size_t(k)];
+        ASSERT_TRUE(oc.one_sided) << "block " << k << " is not one-sided";
+        ASSERT_TRUE(oc.bound_ok) << "block " << k << ": measured error above the reported one";
+        sum_err += oc.err;
+        worst_err = std::max(worst_err, double(oc.err));
+        if (oc.better < INFINITY) {
+            ++strict_misses;
+            worst_ratio = std::max(worst_ratio, double(oc.err / oc.better));
         }
-        if (k % sample_every == 0) {
-            ++sampled;
-            const float opt = search.best_below(src, 0.5f * err);
-            if (opt < INFINITY) {
-                ++over_twice;
-                worst_excess = std::max(worst_excess, double(err - 2 * opt));
-            }
-        }
+        const bool fails = strict ? oc.better < INFINITY : oc.slack_better < INFINITY;
+        if (fails && ++worse <= 5)
+            ADD_FAILURE() << "block " << k << " (spread " << oc.spread * (kHi - kLo) << " m): encoder pair (" << oc.e0 << ", " << oc.e1 << ") "
+                          << oc.err * (kHi - kLo) << " m, pair (" << oc.c0 << ", " << oc.c1 << ") reaches " << oc.better * (kHi - kLo)
+                          << " m, less than half" << (strict ? "" : " (after the endpoint slack)");
     }
-    EXPECT_EQ(worse, 0);
-    std::printf("bc1-scalar one-sided SDF blocks (%s, %d, endpoint slack %.3f m): max error %.2f m, mean %.2f m; of %d sampled, %d exceed "
-                "twice the exhaustive optimum, by up to %.3f m\n",
-                quality_name(q), count, slack * (kHi - kLo), worst_err * (kHi - kLo), sum_err / count * (kHi - kLo), sampled, over_twice,
-                worst_excess * (kHi - kLo));
+    EXPECT_EQ(worse, 0) << "blocks above twice the exhaustive optimum" << (strict ? "" : " plus the endpoint slack");
+    EXPECT_LE(strict_misses, max_strict_misses) << "blocks above twice the exhaustive optimum";
+    std::printf("bc1-scalar one-sided SDF blocks (%s, %d): max error %.2f m, mean %.2f m; %d above twice the exhaustive optimum "
+                "(worst %.2fx; endpoint slack %.3f m)\n",
+                quality_name(q), count, worst_err * (kHi - kLo), sum_err / count * (kHi - kLo), strict_misses, worst_ratio,
+                search.endpoint_slack() * (kHi - kLo));
 }
 
 // The search itself: on random pairs' own palettes it finds an error no larger than
@@ -397,15 +405,28 @@ TEST(Bc1ScalarSdf, ExhaustiveSearchNeverMissesAKnownPair) {
 }
 
 // The decoder set graphs/cloudscape.yaml uses for its field data. Its 8-bit decoders
-// disagree on an endpoint by up to ~0.003 of the range (12.7 m here), which the slack
-// allows; the sample prints how often twice the optimum is missed outright.
-TEST(Bc1ScalarSdf, OneSidedWithinTwiceTheExhaustiveOptimumReferenceNvidiaAmd) {
-    check_sdf_blocks(kReferenceOnly | decoder_bit(Decoder::Nvidia) | decoder_bit(Decoder::Amd), Quality::Normal, kSdfBlocks, 50);
+// disagree on an endpoint by up to ~0.003 of the range (12.1 m here, the slack); Normal
+// stays within twice the optimum plus that on every block and misses twice the optimum
+// outright on about 0.1% (10 of 10^4 when written; the bound leaves room for 2x that).
+TEST(Bc1ScalarSdf, NormalWithinTwiceTheExhaustiveOptimumPlusSlackReferenceNvidiaAmd) {
+    check_sdf_blocks(kReferenceOnly | decoder_bit(Decoder::Nvidia) | decoder_bit(Decoder::Amd), Quality::Normal, kSdfBlocks, false,
+                     kSdfBlocks / 500);
 }
 
 // Reference only: the slack is one 16-bit endpoint step (0.07 m here).
-TEST(Bc1ScalarSdf, OneSidedWithinTwiceTheExhaustiveOptimumReferenceOnly) {
-    check_sdf_blocks(kReferenceOnly, Quality::Normal, kSdfBlocks / 5, 10);
+TEST(Bc1ScalarSdf, NormalWithinTwiceTheExhaustiveOptimumPlusSlackReferenceOnly) {
+    check_sdf_blocks(kReferenceOnly, Quality::Normal, kSdfBlocks / 5, false, kSdfBlocks / 5 / 100);
+}
+
+// Best: strictly within twice the optimum on every block (issue 14's criterion).
+TEST(Bc1ScalarSdf, BestStrictlyWithinTwiceTheExhaustiveOptimumReferenceNvidiaAmd) {
+    check_sdf_blocks(kReferenceOnly | decoder_bit(Decoder::Nvidia) | decoder_bit(Decoder::Amd), Quality::Best, kSdfBlocks / 5, true);
+}
+
+// Reference only, Best: a few blocks whose errors are centimetres (a fraction of one
+// 16-bit endpoint step) miss twice the optimum; the slack holds on every block.
+TEST(Bc1ScalarSdf, BestWithinTwiceTheExhaustiveOptimumPlusSlackReferenceOnly) {
+    check_sdf_blocks(kReferenceOnly, Quality::Best, kSdfBlocks / 5, false, kSdfBlocks / 5 / 200);
 }
 
 } // namespace

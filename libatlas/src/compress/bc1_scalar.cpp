@@ -88,6 +88,96 @@ uint16_t split_r(float v, int r, const ScalarUnpack& u, const detail::ScalarTabl
     return uint16_t(c);
 }
 
+// Candidates for a block one blend entry serves (see the caller). Coarse: for each mode,
+// blend entry and R digit pair whose R part is at most `smin` under every decoder and
+// within reach of G and B, the shared G, B digits of the largest split of the rest (a
+// blend of equal digits is the level itself), stepped down until the entry is <= smin.
+// Fine, for the four R pairs whose coarse entry came closest: G digits that differ
+// between the endpoints with the same blend (their decoders disagree differently), and
+// B digit pairs whose blend fills the rest.
+template <class Consider>
+void single_entry_candidates(const detail::ScalarTables& T, float smin, float below, Consider& consider) {
+    const ScalarUnpack& u = T.unpack;
+    const float w1 = u.weights[1], w2 = u.weights[2];
+    const float reach = T.hi6[63] * w1 + T.hi5[31] * w2;
+    struct Combo { float lo = -INFINITY; int f = 0, i = 0, r0 = 0, r1 = 0; float r_hi = 0; };
+    constexpr int kTop = 4;
+    Combo top[kTop];
+    auto entry_bounds = [&](uint16_t c0, uint16_t c1, int i, float& lo, float& hi) {
+        detail::Palette<1> p;
+        detail::scalar_interval_palette(T, c0, c1, p);
+        lo = p.lo[i][0];
+        hi = p.hi[i][0];
+    };
+    for (int f = 0; f < 2; ++f)
+        for (int i = 2; i < (f == 1 ? 4 : 3); ++i) // the blends: 2, 3 (four colours), 2 (three colours)
+            for (int r0 = 0; r0 < 32; ++r0)
+                for (int r1 = 0; r1 < 32; ++r1) {
+                    if (f == 1 ? !(r0 > r1) : !(r0 < r1)) continue; // the codes' order picks the mode
+                    float r_hi = -INFINITY;
+                    for (int di = 0; di < kDecoderCount; ++di)
+                        if (T.in_set[di]) r_hi = std::max(r_hi, T.r[di][f][r0][r1][i]);
+                    if (!(r_hi <= smin) || r_hi < smin - reach - below) continue;
+                    const float rest = smin - r_hi;
+                    const int g = floor_level(T.hi6, 64, w1, rest);
+                    const int b = floor_level(T.hi5, 32, w2, rest - T.hi6[g] * w1);
+                    for (int alt = 0; alt < 2; ++alt) {
+                        const int start = alt == 0 ? (g << 5) | b : g > 0 ? ((g - 1) << 5) | 31 : -1;
+                        for (int gb = start; gb >= 0 && gb >= start - 4; --gb) { // step down until <= smin
+                            const uint16_t c0 = uint16_t((r0 << 11) | gb), c1 = uint16_t((r1 << 11) | gb);
+                            float lo, hi;
+                            entry_bounds(c0, c1, i, lo, hi);
+                            if (!(hi <= smin)) continue;
+                            consider(c0, c1);
+                            // Keep the kTop best distinct combos (by the entry's lower bound), sorted.
+                            int at = 0;
+                            while (at < kTop && top[at].lo >= lo && !(top[at].f == f && top[at].i == i && top[at].r0 == r0 && top[at].r1 == r1)) ++at;
+                            if (at < kTop && !(top[at].f == f && top[at].i == i && top[at].r0 == r0 && top[at].r1 == r1)) {
+                                for (int k = kTop - 1; k > at; --k) top[k] = top[k - 1];
+                                top[at] = Combo{lo, f, i, r0, r1, r_hi};
+                            }
+                            break;
+                        }
+                    }
+                }
+    for (const Combo& c : top) {
+        if (!(c.lo > -INFINITY)) continue;
+        // The blend's weights of endpoint 0 and 1, times 6 (integers).
+        const int a0 = c.f == 0 ? 3 : c.i == 2 ? 4 : 2, a1 = 6 - a0;
+        const float rest = smin - c.r_hi;
+        const float g_level = rest / w1 * 63.0f; // the G level (Reference) the blend should reach
+        const int gc = int(g_level);
+        for (int g0 = std::max(0, gc - 8); g0 <= std::min(63, gc + 8); ++g0) {
+            // a0 g0 + a1 g1 ~ 6 gc: both roundings of g1.
+            const float g1f = (6.0f * float(gc) - float(a0 * g0)) / float(a1);
+            for (int g1 = int(std::floor(g1f)) - 1; g1 <= int(std::ceil(g1f)) + 1; ++g1) {
+                if (g1 < 0 || g1 > 63) continue;
+                // The entry with B digits 0 under every decoder at once (the channels'
+                // maxima can come from different decoders): what B must add.
+                float lo0, hi0;
+                const uint16_t z0 = uint16_t((c.r0 << 11) | (g0 << 5)), z1 = uint16_t((c.r1 << 11) | (g1 << 5));
+                entry_bounds(z0, z1, c.i, lo0, hi0);
+                const float rest_b = smin - hi0;
+                if (rest_b < 0) continue;
+                const float b_level = std::min(31.0f, rest_b / w2 * 31.0f);
+                for (int b0 = 0; b0 < 32; ++b0) {
+                    const float b1f = (6.0f * b_level - float(a0 * b0)) / float(a1);
+                    const int b1 = int(std::floor(b1f));
+                    for (int db = 1; db >= -1; --db) {
+                        const int bb = b1 + db;
+                        if (bb < 0 || bb > 31) continue;
+                        const uint16_t c0 = uint16_t((c.r0 << 11) | (g0 << 5) | b0), c1 = uint16_t((c.r1 << 11) | (g1 << 5) | bb);
+                        if (c.f == 1 ? !(c0 > c1) : !(c0 <= c1)) continue;
+                        float lo, hi;
+                        entry_bounds(c0, c1, c.i, lo, hi);
+                        if (hi <= smin && lo > c.lo) consider(c0, c1);
+                    }
+                }
+            }
+        }
+    }
+}
+
 // A small sorted set of endpoint codes without allocation.
 struct Codes {
     uint16_t v[64];
@@ -388,6 +478,15 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
             }
         }
     }
+    // Near-constant blocks (spread under half the error so far): one palette entry can
+    // serve every texel, and then the error is the spread plus that entry's decoder
+    // disagreement, which the R channel dominates (w_r = 1; the 8-bit decoders' R levels
+    // sit up to ~1/255 off Reference's). A blend of two R digits often lands where the
+    // decoders agree far better than on any single endpoint, so try every blend entry of
+    // every R pair just below the minimum, G and B shared by both endpoints (their blend
+    // is then the level itself) and split from the rest.
+    if (options.one_sided_below && options.quality != Quality::Fast && !T.conformant && have && smax - smin < 0.5f * best.max_err)
+        single_entry_candidates(T, smin, 0.5f * best.max_err, consider);
     // Normal retargets only blocks well above the exact-entry fit (twice it plus the
     // endpoint slack: the decoders' disagreement on an endpoint and one step), and not
     // under Conformant, whose tolerance (not the entries' positions) sets the error: most
@@ -396,19 +495,25 @@ BlockResult encode_bc1_scalar_block(const float src[16], const ScalarUnpack& u, 
                               (T.conformant || (options.one_sided_below && best.max_err <= 2.0f * fit_floor + T.endpoint_slack));
     if (!normal_skips) retarget(rounds, options.quality == Quality::Normal);
     const bool missed = !have || (options.max_error >= 0 && best.max_err > options.max_error);
-    if (options.quality == Quality::Best || missed) {
-        if (missed && rounds < 4) retarget(4, false);
-        // Nudge both endpoint codes by a few units (neighbouring codes are neighbouring values).
-        for (int round = 0; round < 4 && have; ++round) {
+    // Nudge both endpoint codes by a few units (neighbouring codes are neighbouring
+    // values, and the decoders round neighbours differently), until nothing improves.
+    auto nudge = [&](int radius, int nrounds) {
+        for (int round = 0; round < nrounds && have; ++round) {
             const uint16_t k0 = b0, k1 = b1;
-            for (int d0 = -3; d0 <= 3; ++d0)
-                for (int d1 = -3; d1 <= 3; ++d1) {
+            for (int d0 = -radius; d0 <= radius; ++d0)
+                for (int d1 = -radius; d1 <= radius; ++d1) {
                     const int a = int(k0) + d0, b = int(k1) + d1;
                     if (a < 0 || b < 0 || a > 65535 || b > 65535) continue;
                     both(uint16_t(a), uint16_t(b));
                 }
             if (k0 == b0 && k1 == b1) break;
         }
+    };
+    if (options.quality == Quality::Best || missed) {
+        if (missed && rounds < 4) retarget(4, false);
+        nudge(3, 4);
+    } else if (options.quality == Quality::Normal && options.one_sided_below && !T.conformant) {
+        nudge(2, 2);
     }
     if (!have) { // unreachable for sources >= 0: (0,0) gives the exact black entry
         both(0, 0);

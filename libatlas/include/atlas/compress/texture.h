@@ -30,7 +30,8 @@ namespace fs = std::filesystem;
 // cooked outputs and cached textures from an older encoder are not reused.
 // 2: DDS rows top-down; exact (double) one-sided and max-error bounds; bc1-scalar
 // one-sided search that never falls back to black.
-constexpr int kEncoderVersion = 2;
+// 3: bc1-scalar single-entry search for near-constant blocks and normal's nudges.
+constexpr int kEncoderVersion = 3;
 
 // The most mip levels a front end asks for by number (a 65536 texture has 17
 // levels; "full" asks for all of them).
