@@ -268,8 +268,22 @@ void check_vdb_structure(const fs::path& path) {
                 throw Error(where + "grid " + std::to_string(i) + " claims data up to byte " + std::to_string(o) + ", the file has " +
                             std::to_string(size) + " bytes (truncated?)");
         if (offs[0] > offs[1] || offs[1] > offs[2]) throw Error(where + "grid " + std::to_string(i) + " has inconsistent offsets");
-        in.seekg(std::streamoff(offs[2]));
-        pos = uint64_t(offs[2]);
+        const uint64_t next = uint64_t(offs[2]);
+        // The grid's own metadata (OpenVDB allocates what an unknown type's
+        // length field says): compression flags, then name/type/value triples.
+        in.seekg(std::streamoff(offs[0]));
+        pos = uint64_t(offs[0]);
+        u32("a grid's compression flags");
+        const uint32_t grid_metas = u32("a grid's metadata count");
+        need(uint64_t(grid_metas) * 12, "a grid's metadata");
+        for (uint32_t k = 0; k < grid_metas; ++k) {
+            skip_string("a grid metadata name");
+            skip_string("a grid metadata type");
+            skip_string("a grid metadata value");
+        }
+        if (pos > uint64_t(offs[1])) throw Error(where + "grid " + std::to_string(i) + "'s metadata runs into its data");
+        in.seekg(std::streamoff(next));
+        pos = next;
     }
 }
 } // namespace
