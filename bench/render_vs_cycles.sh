@@ -1,0 +1,139 @@
+#!/usr/bin/env bash
+# The voxel preview's luminance error against Blender's Cycles, and Cycles' own error against
+# its converged image per sample count (docs/render.md, "Reference: Cycles").
+#
+#   bench/render_vs_cycles.sh [--smoke] [--build DIR] [--out DIR] [--size WxH] [--ref-spp N]
+#
+# Per scene: atlas preview --artistic off --export-scene (the scene for Cycles), then
+#   - Cycles with --ref-spp samples (default 512) and 128 volume bounces: the reference;
+#   - the preview at its defaults (--artistic off and on), across --quality (march steps)
+#     and --light-grid (the sun's light grid) and single scattering (--ms-octaves 0);
+#   - Cycles at 1, 4, 16, 64 samples (another seed): its error and time.
+# Writes OUT/results.csv, OUT/table.md and docs/images/cycles_error_vs_time.png (matplotlib).
+# --smoke: one scene, 64x36, 8 reference samples, no plot (CI: checks the pipeline runs).
+set -euo pipefail
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=$ROOT/build
+OUT=$ROOT/build/render_vs_cycles
+SIZE=160x90
+REF_SPP=512
+SMOKE=0
+while [ $# -gt 0 ]; do
+  case $1 in
+    --smoke) SMOKE=1; shift ;;
+    --build) BUILD=$2; shift 2 ;;
+    --out) OUT=$2; shift 2 ;;
+    --size) SIZE=$2; shift 2 ;;
+    --ref-spp) REF_SPP=$2; shift 2 ;;
+    *) echo "unknown option $1" >&2; exit 2 ;;
+  esac
+done
+ATLAS=$BUILD/bin/atlas
+PY=/usr/bin/python3
+if ! command -v blender > /dev/null; then echo "render_vs_cycles: blender not found (scripts/setup.sh installs it)" >&2; exit 77; fi
+LADDER="1 4 16 64"
+# name|atlas preview arguments
+SCENES=(
+  "quickstart|$ROOT/examples/quickstart.yaml"
+  "cloudscape|$ROOT/graphs/cloudscape.yaml"
+  "quickstart_thin|$ROOT/examples/quickstart.yaml --extinction 0.008"
+)
+if [ $SMOKE = 1 ]; then SIZE=64x36; REF_SPP=8; LADDER="1"; SCENES=("${SCENES[0]}"); fi
+mkdir -p "$OUT"
+CSV=$OUT/results.csv
+echo "scene,renderer,setting,seconds,mean_rel,rmse,cloud_mean_rel,cloud_rmse,cloud_bias" > "$CSV"
+echo "render_vs_cycles: $(date -u), load $(cat /proc/loadavg)" >&2
+
+cycles() { # DIR OUT SPP SEED [extra] -> prints wall seconds
+  local d=$1 o=$2 n=$3 seed=$4; shift 4
+  blender -b --factory-startup --python-exit-code 1 --python "$ROOT/scripts/cycles_reference.py" -- "$d" "$o" \
+    --samples "$n" --bounces 128 --seed "$seed" --threads 2 --stats "$o.json" "$@" > "$o.log" 2>&1
+  $PY -c "import json; print('%.2f' % json.load(open('$o.json'))['seconds'])"
+}
+atlas() { # OUT args... -> prints render seconds (the CLI's summary line)
+  local o=$1; shift
+  "$ATLAS" preview "$@" --size "$SIZE" --cache "$OUT/cache" -o "$o" 2> "$o.log" > /dev/null
+  sed -n 's/.*rendered [0-9x]* (voxel) in \([0-9.]*\) s.*/\1/p' "$o.log" | tail -1
+}
+row() { # scene renderer setting seconds image reference
+  local m
+  m=$($PY "$ROOT/scripts/render_compare.py" "$5" "$6" --json)
+  $PY -c "import json,sys; m=json.loads(sys.argv[1]); print(','.join(['$1','$2','$3','$4']+['%.4f'%m.get(k,float('nan')) for k in ('mean_rel','rmse','cloud_mean_rel','cloud_rmse','cloud_bias')]))" "$m" >> "$CSV"
+}
+
+for entry in "${SCENES[@]}"; do
+  name=${entry%%|*}; args=${entry#*|}
+  d=$OUT/$name; mkdir -p "$d"
+  # shellcheck disable=SC2086
+  t=$(atlas "$d/physical_default.exr" $args --artistic off --export-scene "$d/scene")
+  ref=$d/cycles_ref.exr
+  tref=$(cycles "$d/scene" "$ref" "$REF_SPP" 0)
+  echo "$name: cycles reference $REF_SPP spp in $tref s" >&2
+  row "$name" cycles "$REF_SPP spp (reference)" "$tref" "$ref" "$ref"
+  row "$name" atlas "artistic off; defaults" "$t" "$d/physical_default.exr" "$ref"
+  # shellcheck disable=SC2086
+  t=$(atlas "$d/artistic_on.exr" $args --artistic on --export-scene "$d/scene_on")
+  row "$name" atlas "artistic on (the look); defaults" "$t" "$d/artistic_on.exr" "$ref"
+  if [ $SMOKE = 0 ]; then
+    for q in 0.5 2 4; do
+      # shellcheck disable=SC2086
+      t=$(atlas "$d/q$q.exr" $args --artistic off --quality $q --export-scene "$d/scene_q")
+      row "$name" atlas "artistic off; quality $q" "$t" "$d/q$q.exr" "$ref"
+    done
+    for g in 32,32,8 64,64,16; do
+      # shellcheck disable=SC2086
+      t=$(atlas "$d/g$g.exr" $args --artistic off --light-grid $g --export-scene "$d/scene_g")
+      row "$name" atlas "artistic off; light grid ${g//,/x}" "$t" "$d/g$g.exr" "$ref"
+    done
+    # shellcheck disable=SC2086
+    t=$(atlas "$d/ss.exr" $args --artistic off --ms-octaves 0 --export-scene "$d/scene_ss")
+    row "$name" atlas "artistic off; single scattering" "$t" "$d/ss.exr" "$ref"
+  fi
+  for n in $LADDER; do
+    t=$(cycles "$d/scene" "$d/cycles_$n.exr" "$n" 7)
+    # the Cycles image has no transmittance channel: the cloud mask is the preview's
+    $PY -c "
+import sys; sys.path.insert(0, '$ROOT/scripts')
+import render_compare as rc
+m = rc.metrics(rc.luminance('$d/cycles_$n.exr'), rc.luminance('$ref'), cloud=rc.cloud_mask('$d/physical_default.exr'))
+print(','.join(['$name', 'cycles', '$n spp', '$t'] + ['%.4f' % m.get(k, float('nan')) for k in ('mean_rel', 'rmse', 'cloud_mean_rel', 'cloud_rmse', 'cloud_bias')]))
+" >> "$CSV"
+  done
+  echo "$name: done" >&2
+done
+
+$PY - "$CSV" "$OUT/table.md" "$SMOKE" "$ROOT/docs/images/cycles_error_vs_time.png" <<'EOF'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+with open(sys.argv[2], "w") as f:
+    f.write("| scene | renderer | setting | s | mean rel. (Y > 5% mean) | RMSE | cloud mean rel. | cloud RMSE | cloud bias |\n")
+    f.write("|---|---|---|---|---|---|---|---|---|\n")
+    for r in rows:
+        f.write(f"| {r['scene']} | {r['renderer']} | {r['setting']} | {r['seconds']} | {r['mean_rel']} | {r['rmse']} | {r['cloud_mean_rel']} | {r['cloud_rmse']} | {r['cloud_bias']} |\n")
+print(open(sys.argv[2]).read())
+if sys.argv[3] == "1":
+    sys.exit(0)
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+scenes = sorted({r["scene"] for r in rows}, key=[r["scene"] for r in rows].index)
+fig, axes = plt.subplots(1, len(scenes), figsize=(4.2 * len(scenes), 3.6), squeeze=False)
+for ax, s in zip(axes[0], scenes):
+    cyc = [r for r in rows if r["scene"] == s and r["renderer"] == "cycles" and "reference" not in r["setting"]]
+    ax.loglog([float(r["seconds"]) for r in cyc], [float(r["cloud_mean_rel"]) for r in cyc], "o-", label="Cycles (1..64 spp)")
+    for r in cyc:
+        ax.annotate(r["setting"].split()[0], (float(r["seconds"]), float(r["cloud_mean_rel"])), fontsize=7)
+    at = [r for r in rows if r["scene"] == s and r["renderer"] == "atlas"]
+    for r in at:
+        mk = "s" if "artistic on" in r["setting"] else ("^" if "defaults" in r["setting"] else "x")
+        ax.loglog(float(r["seconds"]), float(r["cloud_mean_rel"]), mk, label="Atlas " + r["setting"].replace("artistic off; ", ""))
+    ax.axhline(0.10, color="grey", lw=0.8, ls="--")
+    ax.set_title(s)
+    ax.set_xlabel("wall seconds (2-core machine, shared)")
+    ax.set_ylabel("cloud mean relative luminance error")
+    ax.grid(True, which="both", lw=0.3)
+axes[0][-1].legend(fontsize=6, loc="best")
+fig.tight_layout()
+fig.savefig(sys.argv[4], dpi=90)
+print("wrote", sys.argv[4])
+EOF
