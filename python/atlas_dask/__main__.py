@@ -1,6 +1,8 @@
 """python3 -m atlas_dask GRAPH --tiles NX,NY --scheduler ADDRESS|local (see __init__.py)."""
 import sys
 
-from . import main
+from atlas_dask import main
 
-sys.exit(main())
+# Spawned LocalCluster workers import this module again as __mp_main__: no driver there.
+if __name__ == "__main__":
+    sys.exit(main())

@@ -151,3 +151,17 @@ outputs:
     r = subprocess.run([ATLAS, "cook", str(g), "--tiles", "2,2", "--out", str(tmp_path / "o"), "--quiet"], capture_output=True, text=True)
     assert r.returncode != 0
     assert "node 'w' (ndf/warp) cannot be cooked in tiles" in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("entry", [["python/atlas_dask/atlas-dask"], ["-m", "atlas_dask"]])
+def test_script_entry_points_with_a_local_cluster(single, tmp_path, entry):
+    # The script and `python -m` spawn LocalCluster workers, which import the main module
+    # again: without its __main__ guard each worker would start a driver of its own.
+    out = tmp_path / "out"
+    cmd = [sys.executable, *([str(SOURCE_DIR / entry[0])] if len(entry) == 1 else entry), str(WORLD), "--tiles", "2,2",
+           "--scheduler", "local", "--workers", "2", "--out", str(out), "--atlas", ATLAS]
+    env = dict(os.environ, PYTHONPATH=str(SOURCE_DIR / "python"))
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=180, env=env)
+    assert r.returncode == 0, r.stderr
+    assert "[4/4] tile" in r.stderr and "assembled 4 tiles" in r.stderr, r.stderr
+    assert_same_files(single, out)
