@@ -1,5 +1,6 @@
-// Atlas's BC1 / BC4 encoders side by side with libsquish on the same inputs, in one run:
-// single-thread time per image and the error of the decoded result (Reference decoder,
+// Atlas's BC1 / BC4 encoders side by side with libsquish (and rgbcx from bc7enc_rdo when
+// -DATLAS_PEERS_DIR holds rgbcx.h and a librgbcx.a built from it) on the same inputs, in one run:
+// single-thread CPU time per image and the error of the decoded result (Reference decoder,
 // in 8-bit steps). Built only when libsquish is found (Debian libsquish-dev).
 //
 // Inputs: a smooth field (gradient + value noise, 512x512) and natural images (PNG
@@ -17,6 +18,10 @@
 #include <OpenImageIO/imageio.h>
 #include <benchmark/benchmark.h>
 #include <squish.h>
+#if defined(ATLAS_BENCH_RGBCX)
+#include <rgbcx.h>
+#endif
+#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -24,7 +29,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <memory>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -122,7 +129,14 @@ struct Errors {
     double rmse() const { return n ? std::sqrt(sq / double(n)) : 0; }
 };
 
-enum class Codec { AtlasFast, AtlasNormal, AtlasBest, AtlasNormalAll, SquishRange, SquishCluster, SquishIterative };
+enum class Codec { AtlasFast, AtlasNormal, AtlasBest, AtlasNormalAll, SquishRange, SquishCluster, SquishIterative, RgbcxDefault, RgbcxHq };
+
+// Thread CPU seconds: the machine is shared, so wall time overstates every encoder's cost.
+double cpu_now() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 const char* codec_name(Codec c) {
     switch (c) {
@@ -133,6 +147,8 @@ const char* codec_name(Codec c) {
     case Codec::SquishRange: return "squish_fast_rangefit";
     case Codec::SquishCluster: return "squish_normal_clusterfit";
     case Codec::SquishIterative: return "squish_best_iterativeclusterfit";
+    case Codec::RgbcxDefault: return "rgbcx_default";
+    case Codec::RgbcxHq: return "rgbcx_best";
     }
     return "?";
 }
@@ -154,10 +170,23 @@ double run_bc1(const Image& im, Codec codec, Errors& err) {
     const int flags = squish::kDxt1 | (codec == Codec::SquishRange ? squish::kColourRangeFit
                                        : codec == Codec::SquishIterative ? squish::kColourIterativeClusterFit
                                                                          : squish::kColourClusterFit);
-    const auto t0 = std::chrono::steady_clock::now();
+    const double t0 = cpu_now();
     for (int by = 0; by < bh; ++by)
         for (int bx = 0; bx < bw; ++bx) {
             uint8_t* out = &blocks[(size_t(by) * size_t(bw) + size_t(bx)) * 8];
+#if defined(ATLAS_BENCH_RGBCX)
+            if (codec == Codec::RgbcxDefault || codec == Codec::RgbcxHq) {
+                uint8_t rgba[64];
+                for (int t = 0; t < 16; ++t) {
+                    for (int c = 0; c < 3; ++c)
+                        rgba[4 * t + c] = im.rgb[((size_t(by) * 4 + size_t(t / 4)) * size_t(im.w) + size_t(bx) * 4 + size_t(t % 4)) * 3 + size_t(c)];
+                    rgba[4 * t + 3] = 255;
+                }
+                // Levels as bc7enc's command line: default 10, best rgbcx::MAX_LEVEL (18); 3-colour blocks allowed.
+                rgbcx::encode_bc1(codec == Codec::RgbcxHq ? rgbcx::MAX_LEVEL : 10, out, rgba, true, false);
+                continue;
+            }
+#endif
             if (is_atlas(codec)) {
                 float src[48];
                 for (int t = 0; t < 16; ++t)
@@ -174,7 +203,7 @@ double run_bc1(const Image& im, Codec codec, Errors& err) {
                 squish::Compress(rgba, out, flags);
             }
         }
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double s = cpu_now() - t0;
     for (int by = 0; by < bh; ++by)
         for (int bx = 0; bx < bw; ++bx) {
             float rgb[48];
@@ -192,21 +221,35 @@ double run_bc4(const Image& im, Codec codec, Errors& err) {
     std::unique_ptr<Bc4Encoder> enc;
     if (is_atlas(codec)) enc = std::make_unique<Bc4Encoder>(false, atlas_options(codec)); // tables: once per texture
     auto grey = [&](int bx, int by, int t) { return im.grey((size_t(by) * 4 + size_t(t / 4)) * size_t(im.w) + size_t(bx) * 4 + size_t(t % 4)); };
-    const auto t0 = std::chrono::steady_clock::now();
+    // The blocks' texels, gathered before the clock starts (every encoder gets its own
+    // input type ready: 8-bit for the peers, float for Atlas).
+    std::vector<uint8_t> texels(size_t(bw) * size_t(bh) * 16);
+    for (int by = 0; by < bh; ++by)
+        for (int bx = 0; bx < bw; ++bx)
+            for (int t = 0; t < 16; ++t) texels[(size_t(by) * size_t(bw) + size_t(bx)) * 16 + size_t(t)] = grey(bx, by, t);
+    std::vector<float> texels_f(texels.size());
+    for (size_t i = 0; i < texels.size(); ++i) texels_f[i] = texels[i] / 255.0f;
+    const double t0 = cpu_now();
     for (int by = 0; by < bh; ++by)
         for (int bx = 0; bx < bw; ++bx) {
             uint8_t* out = &blocks[(size_t(by) * size_t(bw) + size_t(bx)) * 8];
+            const uint8_t* g8 = &texels[(size_t(by) * size_t(bw) + size_t(bx)) * 16];
+#if defined(ATLAS_BENCH_RGBCX)
+            if (codec == Codec::RgbcxDefault || codec == Codec::RgbcxHq) {
+                if (codec == Codec::RgbcxDefault) rgbcx::encode_bc4(out, g8, 1);
+                else rgbcx::encode_bc4_hq(out, g8, 1);
+                continue;
+            }
+#endif
             if (enc) {
-                float src[16];
-                for (int t = 0; t < 16; ++t) src[t] = grey(bx, by, t) / 255.0f;
-                enc->encode(src, out);
+                enc->encode(&texels_f[(size_t(by) * size_t(bw) + size_t(bx)) * 16], out);
             } else {
                 uint8_t rgba[64] = {};
-                for (int t = 0; t < 16; ++t) rgba[4 * t] = grey(bx, by, t); // squish's BC4 reads red
+                for (int t = 0; t < 16; ++t) rgba[4 * t] = g8[t]; // squish's BC4 reads red
                 squish::Compress(rgba, out, squish::kBc4);
             }
         }
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double s = cpu_now() - t0;
     for (int by = 0; by < bh; ++by)
         for (int bx = 0; bx < bw; ++bx) {
             float v[16];
@@ -277,6 +320,46 @@ int rmse_of(const std::string& dds, const std::string& png) {
     return 0;
 }
 
+// BC4 `best` (the exhaustive search) on the SDF volume of compress_bench (distance to 4
+// spheres, -256..4096 m, all 6 decoder models) at three sizes: encode_texture on all
+// threads; reports its encode time (wall) and the process CPU time of the call.
+atlas::Field3D sdf_volume(int nx, int ny, int nz) {
+    atlas::Field3D f(atlas::Vec3i{{nx, ny, nz}}, 1, atlas::Box3d{{{0, 0, 0}}, {{nx * 8.0, ny * 8.0, nz * 8.0}}}, {"distance"});
+    for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x) {
+                double d = 1e30;
+                for (int k = 0; k < 4; ++k) {
+                    const double cx = nx * (0.2 + 0.2 * k), cy = ny * (0.3 + 0.13 * k), cz = nz * 0.5;
+                    d = std::min(d, std::sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz)) * 8.0 - 120.0);
+                }
+                f.at(0, x, y, z) = float(std::clamp(d, -256.0, 4096.0));
+            }
+    return f;
+}
+
+void bc4_best_volume(benchmark::State& state) {
+    const int nx = int(state.range(0)), nz = int(state.range(1));
+    const atlas::Field3D f = sdf_volume(nx, nx, nz);
+    CompressOptions o;
+    o.format = Format::Bc4;
+    o.quality = Quality::Best;
+    o.decoders = kAllDecoders;
+    CompressReport last;
+    double cpu = 0;
+    for (auto _ : state) {
+        const std::clock_t c0 = std::clock();
+        EncodedTexture e = encode_texture(f, o);
+        cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
+        benchmark::DoNotOptimize(e.dds.data.data());
+        last = e.report;
+        state.SetIterationTime(e.report.encode_seconds);
+    }
+    state.counters["process_cpu_s_incl_verify"] = cpu;
+    state.counters["max_err_m"] = last.bound_max_error;
+    state.counters["rmse_m"] = last.rmse.empty() ? 0 : last.rmse[0];
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -284,9 +367,15 @@ int main(int argc, char** argv) {
     if (argc == 4 && std::strcmp(argv[1], "--rmse") == 0) {
         try { return rmse_of(argv[2], argv[3]); } catch (const std::exception& e) { std::fprintf(stderr, "%s\n", e.what()); return 1; }
     }
-    const Codec bc1[] = {Codec::AtlasFast, Codec::AtlasNormal, Codec::AtlasBest, Codec::AtlasNormalAll,
-                         Codec::SquishRange, Codec::SquishCluster, Codec::SquishIterative};
-    const Codec bc4[] = {Codec::AtlasFast, Codec::AtlasNormal, Codec::AtlasBest, Codec::AtlasNormalAll, Codec::SquishCluster};
+#if defined(ATLAS_BENCH_RGBCX)
+    rgbcx::init();
+#endif
+    std::vector<Codec> bc1 = {Codec::AtlasFast, Codec::AtlasNormal, Codec::AtlasBest, Codec::AtlasNormalAll,
+                              Codec::SquishRange, Codec::SquishCluster, Codec::SquishIterative};
+    std::vector<Codec> bc4 = {Codec::AtlasFast, Codec::AtlasNormal, Codec::AtlasBest, Codec::AtlasNormalAll, Codec::SquishCluster};
+#if defined(ATLAS_BENCH_RGBCX)
+    for (auto* v : {&bc1, &bc4}) { v->push_back(Codec::RgbcxDefault); v->push_back(Codec::RgbcxHq); }
+#endif
     for (int i = 0; i < int(images().size()); ++i) {
         const std::string tag = "[" + images()[size_t(i)].name + "]";
         for (Codec c : bc1)
@@ -297,6 +386,10 @@ int main(int argc, char** argv) {
                                          peer, i, true, c)
                 ->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
     }
+    for (auto [nx, nz] : {std::pair{128, 16}, std::pair{256, 32}, std::pair{512, 64}})
+        benchmark::RegisterBenchmark(("BC4Volume/atlas_best_sdf_" + std::to_string(nx) + "x" + std::to_string(nx) + "x" + std::to_string(nz)).c_str(),
+                                     bc4_best_volume)
+            ->Args({nx, nz})->UseManualTime()->Iterations(1)->Unit(benchmark::kSecond);
     // A tiny case for the ctest smoke run (the filter "Smoke").
     benchmark::RegisterBenchmark("Smoke_PeersBc4Squish", [](benchmark::State& s) {
         uint8_t rgba[64] = {}, out[8];
