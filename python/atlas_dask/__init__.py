@@ -129,16 +129,15 @@ def run(graph: str, tiles: tuple[int, int], scheduler: str = "local", out: str =
             try:
                 r = f.result()
             except Exception as e:  # the tile failed after its retries, or its worker kept dying
-                failure = failure or e
+                if failure is None:
+                    failure = e if isinstance(e, TileError) else TileError(f"tile {i},{j}: {type(e).__name__}: {e}")
                 print(f"[{k}/{total}] tile {i},{j} FAILED: {e}", file=log, flush=True)
                 continue
             results.append(r)
             print(f"[{k}/{total}] tile {i},{j} done on {r['host']} pid {r['pid']} in {r['seconds']:.2f} s, "
                   f"peak {r['peak_rss_bytes'] / 2**20:.0f} MiB", file=log, flush=True)
         if failure is not None:
-            if isinstance(failure, TileError):
-                raise failure
-            raise TileError(f"a tile failed: {failure}") from failure
+            raise failure
     finally:
         client.close()
         if cluster is not None:

@@ -165,3 +165,21 @@ def test_script_entry_points_with_a_local_cluster(single, tmp_path, entry):
     assert r.returncode == 0, r.stderr
     assert "[4/4] tile" in r.stderr and "assembled 4 tiles" in r.stderr, r.stderr
     assert_same_files(single, out)
+
+
+def test_worker_that_keeps_dying_names_the_tile(tmp_path):
+    # Every attempt at tile 1,0 kills its worker: the scheduler gives up (allowed-failures 1).
+    import dask
+
+    atlas = wrapper(tmp_path, """
+if tile == '1,0':
+    os.kill(os.getppid(), signal.SIGKILL)
+    sys.exit('worker killed')
+""")
+    out = tmp_path / "out"
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+        with pytest.raises(atlas_dask.TileError, match=r"^tile 1,0: KilledWorker"):
+            atlas_dask.run(str(WORLD), (2, 1), "local", str(out), atlas=atlas, workers=2, retries=0)
+    assert not (out / "tiles" / "index.json").exists()
+    assert not (out / "tiles" / "1_0.json").exists()
+    assert not (out / "density.exr").exists()
