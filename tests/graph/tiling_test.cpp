@@ -23,9 +23,20 @@ namespace {
 
 const fs::path kWorld = fs::path(ATLAS_SOURCE_DIR) / "tests/graph/tiling/world.yaml";
 
+fs::path scratch_root() { return fs::temp_directory_path() / ("atlas_tiling_" + std::to_string(::getpid())); }
+
+// Removes this process's scratch directories at the end.
+struct ScratchCleanup : ::testing::Environment {
+    void TearDown() override {
+        std::error_code ec;
+        fs::remove_all(scratch_root(), ec);
+    }
+};
+const auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
+
 fs::path scratch(const std::string& name) {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    fs::path d = fs::temp_directory_path() / ("atlas_tiling_" + std::to_string(::getpid())) / (std::string(info->name()) + "_" + name);
+    fs::path d = scratch_root() / (std::string(info->name()) + "_" + name);
     fs::remove_all(d);
     fs::create_directories(d);
     return d;
