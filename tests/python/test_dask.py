@@ -7,6 +7,8 @@ leaves no index and no assembled output. Also the CLI's tile flags' errors.
 Run by ctest as `dask_driver` (tests/CMakeLists.txt), with ATLAS_BIN and
 ATLAS_SOURCE_DIR set; PYTHONPATH holds python/ of the source tree.
 """
+import hashlib
+import json
 import os
 import pathlib
 import stat
@@ -68,6 +70,18 @@ def test_local_cluster_matches_single_cook(single, tmp_path):
     assert sorted(tuple(r["tile"]) for r in summary["tile_results"]) == [(i, j) for i in range(3) for j in range(2)]
     assert (out / "tiles" / "index.json").exists()
     assert_same_files(single, out)
+    # The index's sha256 of every tile file, against hashlib.
+    index = json.loads((out / "tiles" / "index.json").read_text())
+    checked = 0
+    for o in index["outputs"]:
+        assert len(o["tiles"]) == 6
+        for t in o["tiles"]:
+            for f in t["files"] + [t["raw"]]:
+                data = (out / f["path"]).read_bytes()
+                assert len(data) == f["bytes"]
+                assert hashlib.sha256(data).hexdigest() == f["sha256"], f["path"]
+                checked += 1
+    assert checked > 6 * 7
 
 
 def test_failed_tile_is_retried(single, tmp_path):
