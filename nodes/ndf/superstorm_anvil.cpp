@@ -1,5 +1,6 @@
 // ndf/superstorm_anvil: the anvil-spread map of a superstorm stencil.
 #include "atlas/ndf/superstorm.h"
+#include "atlas/graph/option_params.h"
 #include "ndf/ndf_params.h"
 
 namespace {
@@ -16,20 +17,13 @@ void declare(NodeDeclaration& d) {
     d.input("anvil_in", PortType::Field2D, "optional anvil map of the previous stencil (same grid)").optional = true;
     d.output("out", PortType::Field2D, "anvil map: channel anvil_bias in [0, 1]");
     d.param_float2("center", {{30000, 30000}}).with_unit("m").describe("stencil centre");
-    d.param_float("radius", 8000).with_unit("m").describe("stencil radius (> 0)");
-    d.param_float("core", 0.3).range(0, 0.999).describe("fraction of the radius at full strength");
-    d.param_float("blend", 1.0).range(0, 1).describe("strength of the stencil");
-    d.param_float("anvil", 1.0).range(0, 1).describe("anvil spread at the centre");
+    declare_options(d, ndf::superstorm_options(), {"radius", "core", "blend", "anvil"}); // the library's schema
 }
 
 void cook(CookContext& ctx) {
     ndf::SuperstormStencil s;
     s.center = ctx.get_float2("center");
-    s.radius = ctx.get_float("radius");
-    s.core = ctx.get_float("core");
-    s.blend = ctx.get_float("blend");
-    s.anvil = ctx.get_float("anvil");
-    if (!(s.radius > 0)) ctx.fail("'radius' must be > 0");
+    read_options(ctx, ndf::superstorm_options(), s, {"radius", "core", "blend", "anvil"});
     auto in = ctx.input_field2d("in");
     if (!ndf::stencil_touches(s, in->bounds())) ctx.warn("the stencil lies entirely outside the map: it changes nothing");
     Field2DPtr previous = ctx.has_input("anvil_in") ? ctx.input_field2d("anvil_in") : nullptr;

@@ -8,28 +8,34 @@
 #include <tbb/parallel_for.h>
 
 #include <cmath>
+#include <limits>
 
 namespace atlas::ndf {
 
-namespace {
-void in_unit(double v, const char* name) {
-    if (!(v >= 0 && v <= 1)) throw Error(std::string("superstorm: '") + name + "' must be in [0, 1]");
+std::span<const NumberOption<SuperstormStencil>> superstorm_options() {
+    using S = SuperstormStencil;
+    static const NumberOption<S> options[] = {
+        {"radius", &S::radius, 1e-6, std::numeric_limits<double>::infinity(), "m", "stencil radius (> 0)"},
+        {"core", &S::core, 0, 0.999, "", "fraction of the radius at full strength"},
+        {"coverage", &S::coverage, 0, 1, "", "coverage at the centre (never lowers the map's)"},
+        {"blend", &S::blend, 0, 1, "", "strength of the stencil"},
+        {"storm_type", &S::storm_type, 0, 1, "", "type and top type at the centre"},
+        {"bottom_type", &S::bottom_type, 0, 1, "", "bottom type at the centre (1: ragged underside)"},
+        {"min_height", &S::min_height, -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(), "m",
+         "storm base at the centre"},
+        {"max_height", &S::max_height, -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(), "m",
+         "storm top at the centre (>= min_height)"},
+        {"distortion", &S::distortion, 0, 0.999, "", "radial wobble of the height gradients"},
+        {"noise_scale", &S::noise_scale, 1e-6, 1e6, "", "noise cells across the radius"},
+        {"anvil", &S::anvil, 0, 1, "", "anvil spread at the centre (the anvil map only)"},
+    };
+    return options;
 }
-} // namespace
 
 void validate(const SuperstormStencil& s) {
     if (!std::isfinite(s.center[0]) || !std::isfinite(s.center[1])) throw Error("superstorm: 'center' must be finite");
-    if (!(s.radius > 0) || !std::isfinite(s.radius)) throw Error("superstorm: 'radius' must be > 0 and finite");
-    if (!(s.core >= 0 && s.core < 1)) throw Error("superstorm: 'core' must be in [0, 1)");
-    in_unit(s.coverage, "coverage");
-    in_unit(s.blend, "blend");
-    in_unit(s.storm_type, "storm_type");
-    in_unit(s.bottom_type, "bottom_type");
-    in_unit(s.anvil, "anvil");
-    if (!std::isfinite(s.min_height) || !std::isfinite(s.max_height)) throw Error("superstorm: 'min_height' and 'max_height' must be finite");
+    check_options(s, superstorm_options(), "superstorm");
     if (s.min_height > s.max_height) throw Error("superstorm: 'min_height' must not be above 'max_height'");
-    if (!(s.distortion >= 0 && s.distortion < 1)) throw Error("superstorm: 'distortion' must be in [0, 1)");
-    if (!(s.noise_scale > 0) || !std::isfinite(s.noise_scale)) throw Error("superstorm: 'noise_scale' must be > 0");
 }
 
 bool stencil_touches(const SuperstormStencil& s, const Box2d& b) {

@@ -18,7 +18,10 @@
 #include "atlas/core/field.h"
 #include "atlas/core/memory.h"
 
+#include "atlas/core/option_schema.h"
+
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -26,7 +29,7 @@ namespace atlas::ndf {
 
 struct SuperstormStencil {
     Vec2d center{{0, 0}};     // metres
-    double radius = 4000;     // metres, > 0
+    double radius = 8000;     // metres, > 0
     double core = 0.3;        // fraction of the radius at full strength, [0,1)
     double coverage = 1.0;    // [0,1]
     double blend = 1.0;       // [0,1]
@@ -39,11 +42,16 @@ struct SuperstormStencil {
     uint32_t seed = 0;
     // Anvil: how far the storm's top spreads out ([0,1]); written to the
     // separate anvil map (superstorm_anvil), not to the 8-channel set.
-    double anvil = 0;
+    double anvil = 1.0;
 };
 
-// Throws atlas::Error naming the parameter: radius <= 0, min_height >
-// max_height, values out of range, not finite.
+// The numeric options' schema (ranges, units, docs; defaults are the struct's):
+// validate(), the ndf/superstorm and ndf/superstorm_anvil nodes and docs/nodes.md are
+// built from it. center and seed are not numeric options.
+std::span<const NumberOption<SuperstormStencil>> superstorm_options();
+
+// Throws atlas::Error naming the parameter: an option outside its schema range or not
+// finite, center not finite, min_height > max_height.
 void validate(const SuperstormStencil& s);
 // True when the stencil's disc overlaps the map's bounds at all.
 bool stencil_touches(const SuperstormStencil& s, const Box2d& bounds);
