@@ -323,7 +323,7 @@ void search_block(uint64_t k, bool snorm, float out[16]) {
 // two- and one-sided.
 TEST(Bc4, BestEqualsBruteForceOnRandomSmoothAndSdfBlocks) {
     constexpr float kWidening = 2.5e-7f;
-    const int blocks = std::max(3, 45 / test::kExhaustiveDivisor);
+    const int blocks = std::max(3, 150 / test::kExhaustiveDivisor);
     for (bool snorm : {false, true})
         for (DecoderSet set : {kReferenceOnly, kAllDecoders}) {
             const BruteBc4 brute(snorm, set);

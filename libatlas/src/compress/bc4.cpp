@@ -180,10 +180,11 @@ struct PairTables {
     float row_imin[256][2], row_imax[256][2];
     float c_lo = 0, c_hi = 1; // the 6-value mode's constants
     // Spacing bound (search_all_pairs): the exact value of each endpoint byte, and the
-    // largest distance of any entry's interval end from the exact, evenly spaced value
-    // x_j = lower + j (upper - lower) / steps of its mode, over every pair and decoder.
+    // largest |c - x_j| - h of any entry (interval centre c, half-width h over the
+    // decoder set) against the exact, evenly spaced value x_j = lower + j (upper -
+    // lower) / steps of its mode, over every pair.
     float val[256];
-    double slack[2] = {0, 0}; // [0]: 8-value mode, [1]: 6-value mode
+    double slack[2] = {-1, -1}; // [0]: 8-value mode, [1]: 6-value mode (may be < 0)
 };
 } // namespace
 
@@ -221,7 +222,10 @@ Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
                 double x;
                 if (eight) x = i == 0 ? e0 : i == 1 ? e1 : e1 + double(8 - i) * (e0 - e1) / 7.0;
                 else x = i == 0 ? e0 : i == 1 ? e1 : e0 + double(i - 1) * (e1 - e0) / 5.0;
-                sl = std::max({sl, std::fabs(double(p.lo[i][0]) - x), std::fabs(double(p.hi[i][0]) - x)});
+                // error = max(hi - s, s - lo) = |s - c| + h (centre c, half-width h), so an
+                // entry serving s within E has |s - x| <= E - h + |c - x|.
+                const double c = 0.5 * (double(p.lo[i][0]) + double(p.hi[i][0])), h = 0.5 * (double(p.hi[i][0]) - double(p.lo[i][0]));
+                sl = std::max(sl, std::fabs(c - x) - h);
             }
         }
         const int interp = eight ? 8 : 6;
@@ -255,6 +259,17 @@ namespace {
 //     that span (float subtraction is monotone, so this bounds the computed error).
 //   * For the 8-value mode every texel counts; rows are skipped by their extremes.
 int search_all_pairs(const PairTables& T, const float src[16], bool os, detail::Selection& best, int best_k) {
+    // An exact incumbent (max error 0, squared error 0: constant blocks on a level or a
+    // constant, e.g. an SDF clamped at its range) can only tie: the answer is the lowest
+    // index with an exact palette, found by a scan in index order (every 6-value pair
+    // serves a block at 0 or 1 exactly, and none of them is pruned by the bounds below).
+    if (best_k >= 0 && best.max_err == 0.0f && best.sum_sq == 0.0) {
+        for (int k = 0; k < best_k; ++k) {
+            const detail::Selection s = detail::select_indices(T.pal[size_t(k)], src, os, 0.0f);
+            if (s.max_err == 0.0f && s.sum_sq == 0.0) { best = s; return k; }
+        }
+        return best_k;
+    }
     float smin = src[0], smax = src[0];
     for (int t = 1; t < 16; ++t) { smin = std::min(smin, src[t]); smax = std::max(smax, src[t]); }
     // Error of a constant entry c for texel s, as select_indices computes it.
