@@ -5,8 +5,8 @@
 // MacCormack (Selle et al. 2008): a forward and a backward semi-Lagrangian
 // step estimate the error, half of which is removed; the result is clamped
 // to the min/max of the source cells the forward step read (so it can never
-// create new extrema), and samples whose trace ends within one cell of the
-// domain edge keep the plain semi-Lagrangian value.
+// create new extrema), and samples whose trace ends within one cell of an open
+// face keep the plain semi-Lagrangian value.
 // Back-traces are clamped into the domain (walls and open faces alike read
 // the edge value: zero-gradient inflow); along a periodic axis they wrap
 // around instead, and the reads too. Traces along a periodic axis are made
