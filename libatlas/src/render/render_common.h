@@ -109,7 +109,11 @@ inline void shade(const RenderSettings& s, const SunTerms& st, double tau, doubl
             b *= s.ms_extinction;
             ms += a * std::exp(-b * tau) * st.ms_phase[size_t(n - 1)];
         }
-        sun_w = direct + s.multiple_scattering * ms;
+        // Light scatters again only where there is medium around the sample:
+        // the octaves are weighted by the probability of a further scattering
+        // event along the two paths we know, toward the sun and the zenith.
+        const double again = -std::expm1(-(tau + sky_tau));
+        sun_w = direct + s.multiple_scattering * ms * again;
         sky_w = s.ambient_strength * (s.ms_octaves > 0 ? 1.0 : std::exp(-sky_tau));
         return;
     }
