@@ -266,6 +266,53 @@ TEST(SimNodes, PeriodicBoundariesMatchTheLibraryRunByHand) {
     EXPECT_NE(e.find("even"), std::string::npos) << e;
 }
 
+// Periodic x: an emitter field reaching over the x- face (bounds x in [-320,
+// 320] m) and a bubble centred on it (x = 0) wrap around to the x+ side; the
+// node equals the library run with the wrapped sources and the bubble computed
+// by hand from the nearest image of its centre.
+TEST(SimNodes, PeriodicEmitterAndBubbleWrapAcrossTheSeam) {
+    Session s(builtin_nodes());
+    s.load_text(kGraph, "sim.yaml", fs::temp_directory_path());
+    s.set("cloud", "boundary_x", std::string("periodic"));
+    s.set("patch", "bounds_min", std::vector<double>{-320, 0, 0});
+    s.set("patch", "bounds_max", std::vector<double>{320, 640, 160});
+    s.set("patch", "center", std::vector<double>{0, 320});
+    s.set("cloud", "bubble_center", std::vector<double>{0, 320, 150});
+    const auto patch = as<Field3D>(s.get("patch", "out", values_only()));
+    const auto density = as<Field3D>(s.get("cloud", "out", values_only()));
+    const auto temperature = as<Field3D>(s.get("cloud", "temperature", values_only()));
+
+    sim::GridSpec spec;
+    spec.nx = spec.ny = spec.nz = 16;
+    spec.dx = 40;
+    spec.boundary[0] = spec.boundary[1] = sim::Boundary::Periodic;
+    sim::SimOptions o;
+    o.projection.tolerance = 1e-7;
+    sim::Simulation sim(spec, graph_sounding(), o);
+    std::vector<float> heat(spec.cells(), 0.f), vap(spec.cells(), 0.f), bubble(spec.cells(), 0.f);
+    for (int k = 0; k < 16; ++k)
+        for (int j = 0; j < 16; ++j)
+            for (int i = 0; i < 16; ++i) {
+                const size_t n = (size_t(k) * 16 + j) * 16 + i;
+                const int e = (i + 8) % 16; // emitter cell e is at x = -300 + 40 e; grid cell i at 20 + 40 i (mod 640)
+                if (k < 4) {
+                    heat[n] = patch->at(0, e, j, k);
+                    vap[n] = patch->at(1, e, j, k);
+                }
+                const double x = std::min((i + 0.5) * 40, 640 - (i + 0.5) * 40); // distance to x = 0 across the seam
+                const double l = std::sqrt(x * x + std::pow((j + 0.5) * 40 - 320, 2) + std::pow((k + 0.5) * 40 - 150, 2)) / 150;
+                if (l < 1) bubble[n] = float(2 * std::pow(std::cos(0.5 * M_PI * l), 2));
+            }
+    double wrapped = 0;
+    for (int i = 8; i < 16; ++i) wrapped += heat[size_t(8) * 16 + i];
+    EXPECT_GT(wrapped, 0.0) << "half of the patch lies beyond x- and must reach the x+ cells";
+    sim.set_sources(heat, vap);
+    sim.add_theta(bubble);
+    for (int step = 0; step < 4; ++step) sim.step(10);
+    expect_same(*density, sim.cloud_water(), "qc");
+    expect_same(*temperature, sim.temperature(), "temperature");
+}
+
 // The options the node passes through (rain with no threshold and k1 = 1/s so rain
 // forms within 40 s, the cubic scheme, advection-reflection, reversible
 // theta_e): the node equals the library run bit for bit, and rain is >= 0.
