@@ -240,7 +240,12 @@ void check_vdb_structure(const fs::path& path) {
     read(&magic, 8, "the header");
     if (magic != 0x56444220) throw Error(where + "no VDB magic number at the start");
     const uint32_t version = u32("the header");
-    if (version < 222) return; // an old layout: left to OpenVDB
+    // Files older than 222 (OpenVDB before 3.0, 2014) have another header layout that
+    // cannot be checked here, and OpenVDB trusts their lengths (a fuzzed version-0
+    // header made it allocate 3.4 GB): refused by name.
+    if (version < 222 || version > 255)
+        throw Error(where + "file format version " + std::to_string(version) +
+                    " is not supported (expected 222..224, written by OpenVDB 3 or later)");
     u32("the header"); // library major
     u32("the header"); // library minor
     char offsets = 0;
