@@ -82,7 +82,9 @@ struct Kernels {
 
     static void gradient3(const LatticeView& L, const double* const* u, size_t n, double scale, float* out) {
         const F one = I::fset(1.0f), six = I::fset(6.0f), fifteen = I::fset(15.0f), ten = I::fset(10.0f);
-        const V px = I::iset(L.px), pxy = I::iset(L.px * L.py), fifteen_i = I::iset(15);
+        // px * py is used only with a table (small periods); hashed lattices can have periods
+        // whose product overflows int, so it is formed with wrapping unsigned arithmetic.
+        const V px = I::iset(L.px), pxy = I::iset(int(uint32_t(L.px) * uint32_t(L.py))), fifteen_i = I::iset(15);
         for (size_t i0 = 0; i0 < n; i0 += size_t(W)) {
             const Batch b(u, i0, n);
             V c[3][2], prev;
