@@ -2,6 +2,7 @@
 // serve from cache, cook the rest level by level in parallel, write outputs
 // atomically.
 #include "atlas/graph/evaluator.h"
+#include "graph_walk.h"
 
 #include "atlas/core/files.h"
 #include "atlas/io/writers.h"
@@ -111,24 +112,8 @@ void Session::set_text(const std::string& node, const std::string& param, const 
 
 namespace {
 
-// Topological order (inputs first) of every node, following file order.
-std::vector<const GraphNode*> topological_order(const Graph& g) {
-    std::vector<const GraphNode*> order;
-    std::set<std::string> done;
-    std::function<void(const GraphNode&)> visit = [&](const GraphNode& n) {
-        if (done.count(n.name)) return;
-        done.insert(n.name);
-        for (const auto& [port, b] : n.inputs) visit(*g.find(b.node));
-        order.push_back(&n);
-    };
-    for (const auto& n : g.nodes) visit(n);
-    return order;
-}
-
-std::string source_port(const Graph& g, const NodeRegistry& reg, const InputBinding& b) {
-    if (!b.port.empty()) return b.port;
-    return reg.find(g.find(b.node)->type)->decl.outputs().front().name;
-}
+using detail::source_port;
+using detail::topological_order;
 
 Hash128 node_hash(const Graph& g, const NodeRegistry& reg, const GraphNode& n, const NodeType& type,
                   const std::map<std::string, Hash128>& input_hashes) {

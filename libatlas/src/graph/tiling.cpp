@@ -1,6 +1,7 @@
 // Tiled cooking (atlas/graph/tiling.h, docs/scale.md): regions per node,
 // crops, tile files, fragments, the tile index and assembly.
 #include "atlas/graph/tiling.h"
+#include "graph_walk.h"
 
 #include "atlas/core/files.h"
 #include "atlas/core/hash.h"
@@ -24,23 +25,8 @@ namespace fs = std::filesystem;
 
 std::string tile_name(Vec2i t) { return std::to_string(t[0]) + "," + std::to_string(t[1]); }
 
-std::vector<const GraphNode*> topological_order(const Graph& g) {
-    std::vector<const GraphNode*> order;
-    std::set<std::string> done;
-    std::function<void(const GraphNode&)> visit = [&](const GraphNode& n) {
-        if (done.count(n.name)) return;
-        done.insert(n.name);
-        for (const auto& [port, b] : n.inputs) visit(*g.find(b.node));
-        order.push_back(&n);
-    };
-    for (const auto& n : g.nodes) visit(n);
-    return order;
-}
-
-std::string source_port(const Graph& g, const NodeRegistry& reg, const InputBinding& b) {
-    if (!b.port.empty()) return b.port;
-    return reg.find(g.find(b.node)->type)->decl.outputs().front().name;
-}
+using detail::source_port;
+using detail::topological_order;
 
 // What the requested outputs need: the outputs and the nodes, inputs first.
 struct Plan {
