@@ -369,7 +369,8 @@ void check_sdf_blocks(DecoderSet set, Quality q, int count, bool strict, int max
                           << " m, less than half" << (strict ? "" : " (after the endpoint slack)");
     }
     EXPECT_EQ(worse, 0) << "blocks above twice the exhaustive optimum" << (strict ? "" : " plus the endpoint slack");
-    EXPECT_LE(strict_misses, max_strict_misses) << "blocks above twice the exhaustive optimum";
+    // The allowance is a fraction of the blocks, at least 2 (sanitizer builds check 600).
+    EXPECT_LE(strict_misses, std::max(max_strict_misses, strict ? 0 : 2)) << "blocks above twice the exhaustive optimum";
     std::printf("bc1-scalar one-sided SDF blocks (%s, %d): max error %.2f m, mean %.2f m; %d above twice the exhaustive optimum "
                 "(worst %.2fx; endpoint slack %.3f m)\n",
                 quality_name(q), count, worst_err * (kHi - kLo), sum_err / count * (kHi - kLo), strict_misses, worst_ratio,
