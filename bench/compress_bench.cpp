@@ -1,6 +1,7 @@
 // Compression throughput (texels/s) per format and quality, with the error reached.
 // Large cases use the design's 512x512x64 volume (16.8 M texels) of SDF-like data;
 // "Smoke" cases are tiny (ctest runs them).
+#include "sdf_volume.h"
 #include "atlas/compress/texture.h"
 
 #include <benchmark/benchmark.h>
@@ -12,21 +13,7 @@ namespace {
 using namespace atlas;
 using namespace atlas::compress;
 
-// SDF-like field: distance (metres) to a few spheres, -256..4096 m like Nubis's.
-Field3D sdf_volume(int nx, int ny, int nz) {
-    Field3D f(Vec3i{{nx, ny, nz}}, 1, Box3d{{{0, 0, 0}}, {{nx * 8.0, ny * 8.0, nz * 8.0}}}, {"distance"});
-    for (int z = 0; z < nz; ++z)
-        for (int y = 0; y < ny; ++y)
-            for (int x = 0; x < nx; ++x) {
-                double d = 1e30;
-                for (int k = 0; k < 4; ++k) {
-                    const double cx = nx * (0.2 + 0.2 * k), cy = ny * (0.3 + 0.13 * k), cz = nz * 0.5;
-                    d = std::min(d, std::sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz)) * 8.0 - 120.0);
-                }
-                f.at(0, x, y, z) = float(std::clamp(d, -256.0, 4096.0));
-            }
-    return f;
-}
+using atlas::bench::sdf_volume;
 
 Field3D rgb_volume(int nx, int ny, int nz) {
     Field3D f(Vec3i{{nx, ny, nz}}, 3, Box3d{{{0, 0, 0}}, {{1, 1, 1}}});

@@ -11,6 +11,7 @@
 // Extra modes used by bench/compare_nvcompress.sh:
 //   compress_peers_bench --write-inputs DIR   writes the inputs as PNG (RGB and grey)
 //   compress_peers_bench --rmse FILE.dds SOURCE.png   RMSE / max error of a DDS (our decoder)
+#include "sdf_volume.h"
 #include "atlas/compress/bc1.h"
 #include "atlas/compress/bc4.h"
 #include "atlas/compress/texture.h"
@@ -323,20 +324,7 @@ int rmse_of(const std::string& dds, const std::string& png) {
 // BC4 `best` (the exhaustive search) on the SDF volume of compress_bench (distance to 4
 // spheres, -256..4096 m, all 6 decoder models) at three sizes: encode_texture on all
 // threads; reports its encode time (wall) and the process CPU time of the call.
-atlas::Field3D sdf_volume(int nx, int ny, int nz) {
-    atlas::Field3D f(atlas::Vec3i{{nx, ny, nz}}, 1, atlas::Box3d{{{0, 0, 0}}, {{nx * 8.0, ny * 8.0, nz * 8.0}}}, {"distance"});
-    for (int z = 0; z < nz; ++z)
-        for (int y = 0; y < ny; ++y)
-            for (int x = 0; x < nx; ++x) {
-                double d = 1e30;
-                for (int k = 0; k < 4; ++k) {
-                    const double cx = nx * (0.2 + 0.2 * k), cy = ny * (0.3 + 0.13 * k), cz = nz * 0.5;
-                    d = std::min(d, std::sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz)) * 8.0 - 120.0);
-                }
-                f.at(0, x, y, z) = float(std::clamp(d, -256.0, 4096.0));
-            }
-    return f;
-}
+using atlas::bench::sdf_volume;
 
 void bc4_best_volume(benchmark::State& state) {
     const int nx = int(state.range(0)), nz = int(state.range(1));
