@@ -13,6 +13,8 @@
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
 
+#include "random_velocity.h"
+
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
@@ -63,16 +65,7 @@ double max_divergence(const MacVelocity& v, const std::vector<double>& rc, const
     return m;
 }
 
-MacVelocity random_velocity(const GridSpec& s, uint32_t seed) {
-    MacVelocity v(s);
-    auto fill = [&](std::vector<float>& a, uint32_t salt) {
-        for (size_t n = 0; n < a.size(); ++n) a[n] = 2.f * hash_to_unit(hash_coords(seed + salt, int32_t(n))) - 1.f;
-    };
-    fill(v.u, 1);
-    fill(v.v, 2);
-    fill(v.w, 3);
-    return v;
-}
+using test::random_velocity;
 
 // A cell-lattice field shifted by (sx, sy) cells with wrap: out(i + sx, j + sy) = in(i, j).
 std::vector<float> shifted(const std::vector<float>& in, int nx, int ny, int nz, int sx, int sy, int extra_x = 0, int extra_y = 0) {

@@ -3,6 +3,8 @@
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
 
+#include "random_velocity.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,16 +14,7 @@ using namespace atlas;
 using namespace atlas::sim;
 
 namespace {
-MacVelocity random_velocity(const GridSpec& s, uint32_t seed) {
-    MacVelocity v(s);
-    auto fill = [&](std::vector<float>& a, uint32_t salt) {
-        for (size_t n = 0; n < a.size(); ++n) a[n] = 2.f * hash_to_unit(hash_coords(seed + salt, int32_t(n))) - 1.f;
-    };
-    fill(v.u, 1);
-    fill(v.v, 2);
-    fill(v.w, 3);
-    return v;
-}
+using test::random_velocity;
 GridSpec cube(int n, BoundarySet b) {
     GridSpec s;
     s.nx = s.ny = s.nz = n;
