@@ -31,7 +31,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-$ROOT/build}
 ATLAS=$BUILD/bin/atlas
-command -v vdb_render >/dev/null || { echo "vdb_render not found (apt install libopenvdb-tools)" >&2; exit 1; }
+command -v vdb_render >/dev/null || { echo "vdb_render not found (scripts/setup.sh --bench installs libopenvdb-tools)" >&2; exit 1; }
 command -v oiiotool >/dev/null || { echo "oiiotool not found (apt install openimageio-tools)" >&2; exit 1; }
 [ -x "$ATLAS" ] || { echo "$ATLAS not found: build the atlas target first" >&2; exit 1; }
 

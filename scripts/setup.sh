@@ -2,6 +2,7 @@
 # Installs every build and test dependency of Atlas from Debian 12 packages.
 # Idempotent: packages already present are not reinstalled, and apt is not
 # touched at all when nothing is missing. Must run as root (or via sudo).
+# Usage: scripts/setup.sh [--bench]
 set -euo pipefail
 
 PACKAGES=(
@@ -25,6 +26,11 @@ PACKAGES=(
   # The Cycles reference (scripts/cycles_reference.py, bench/render_vs_cycles.sh): its error plots.
   python3-matplotlib
 )
+# `scripts/setup.sh --bench`: also the peers the benchmarks compare against (not needed by CI):
+# OpenVDB's vdb_tool and vdb_render (mesh SDF, voxel preview) and nvcompress (BC encoders).
+if [ "${1:-}" = "--bench" ]; then
+  PACKAGES+=(libopenvdb-tools libnvtt-bin)
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
