@@ -79,8 +79,7 @@ Vec2i parse_pair(const Args& a, const std::string& flag, int min) {
 int run_cook_tiled(const Args& a, CookOptions o) {
     if (a.positional.size() != 1) throw UsageError{"--tiles cooks one graph file, got " + std::to_string(a.positional.size()), "cook"};
     if (!a.has("--tiles")) throw UsageError{"--tile and --assemble need --tiles NX,NY", "cook"};
-    for (const char* f : {"--report", "--depfile"})
-        if (a.has(f)) throw UsageError{std::string(f) + " is not supported with --tiles (the tile index lists every file)", "cook"};
+    if (a.has("--depfile")) throw UsageError{"--depfile is not supported with --tiles (the tile index lists every file)", "cook"};
     TileOptions t;
     t.tiles = parse_pair(a, "--tiles", 1);
     if (a.has("--tile")) t.only = parse_pair(a, "--tile", 0);
@@ -95,12 +94,18 @@ int run_cook_tiled(const Args& a, CookOptions o) {
     o.progress = bar.sink();
     TiledCookResult r;
     try {
-        r = cook_tiled(session, o, t);
-    } catch (...) {
+        cook_tiled(session, o, t, r);
+    } catch (const std::exception& e) {
         bar.finish();
+        // A failed tile's report: the tiles before it, and it with its error.
+        if (a.has("--report"))
+            write_text_atomic(a.get("--report"),
+                              tiled_report_json(r, a.positional[0], dynamic_cast<const CancelledError*>(&e) ? "cancelled" : "failed", e.what()),
+                              "the report");
         throw;
     }
     bar.finish();
+    if (a.has("--report")) write_text_atomic(a.get("--report"), tiled_report_json(r, a.positional[0], "ok", ""), "the report");
     size_t cooked = 0;
     for (const auto& tr : r.tiles_done) cooked += tr.status == "cooked";
     std::cout << "cooked " << cooked << " of " << r.tiles_done.size() << " tiles (" << r.tiles[0] << " x " << r.tiles[1] << " over " << r.grid[0]

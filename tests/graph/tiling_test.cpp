@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <unistd.h>
@@ -224,11 +225,7 @@ TEST(Tiling, NodesThatCannotTileAreRefusedByName) {
         }
         EXPECT_TRUE(files_under(out).empty());
     }
-    // The SDF: an exact distance transform is refused, not approximated.
-    const NodeRegistry reg = builtin_nodes();
-    const TileRule& sdf = reg.find("volume/sdf")->decl.tiling();
-    EXPECT_EQ(sdf.kind, TileRule::Kind::None);
-    EXPECT_NE(sdf.why_not.find("exact distance transform"), std::string::npos);
+    // An unclipped SDF: Tiling.UnclippedSdfIsRefusedByName.
 }
 
 TEST(Tiling, BadTileCountsAndIndicesAreRefused) {
@@ -382,4 +379,303 @@ outputs:
                 for (int y = 0; y < 32; ++y)
                     for (int x = 0; x < 32; ++x) ASSERT_EQ(f->at(0, x, y, z), ref->at(0, 32 * i + x, 32 * j + y, z)) << p;
         }
+}
+
+// ------------------------------------------------------------ clipped SDFs
+
+namespace {
+
+const fs::path kSdfWorld = fs::path(ATLAS_SOURCE_DIR) / "tests/graph/tiling/sdf_world.yaml";
+
+// Brute force, independent of the EDT: the distance (metres) from voxel
+// (x, y, z)'s centre to the nearest linear iso crossing on any grid edge (and
+// to the grid faces half a voxel beyond the border voxels, when `faces`),
+// clipped to `clip`, negative inside (density > iso).
+double brute_sdf(const Field3D& d, double iso, double clip, bool faces, int x, int y, int z) {
+    const Vec3d h = d.voxel_size();
+    const Vec3i res = d.resolution();
+    double best = clip * clip;
+    auto consider = [&](double px, double py, double pz) {
+        const double dx = (px - x) * h[0], dy = (py - y) * h[1], dz = (pz - z) * h[2];
+        best = std::min(best, dx * dx + dy * dy + dz * dz);
+    };
+    for (int k = 0; k < res[2]; ++k)
+        for (int j = 0; j < res[1]; ++j)
+            for (int i = 0; i < res[0]; ++i) {
+                const float a = d.at(0, i, j, k);
+                const bool in = a > iso;
+                const int c[3] = {i, j, k};
+                for (int axis = 0; axis < 3; ++axis) {
+                    double p[3] = {double(i), double(j), double(k)};
+                    if (faces && in && c[axis] == 0) {
+                        p[axis] -= 0.5;
+                        consider(p[0], p[1], p[2]);
+                        p[axis] += 0.5;
+                    }
+                    if (faces && in && c[axis] == res[axis] - 1) {
+                        p[axis] += 0.5;
+                        consider(p[0], p[1], p[2]);
+                        p[axis] -= 0.5;
+                    }
+                    if (c[axis] + 1 >= res[axis]) continue;
+                    const int n[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
+                    const float b = d.at(0, n[0], n[1], n[2]);
+                    if ((b > iso) == in) continue;
+                    p[axis] += (iso - double(a)) / (double(b) - double(a));
+                    consider(p[0], p[1], p[2]);
+                }
+            }
+    const double dist = std::sqrt(best);
+    return d.at(0, x, y, z) > iso ? -dist : dist;
+}
+
+} // namespace
+
+class TiledSdf : public ::testing::TestWithParam<std::pair<int, int>> {};
+
+// A clipped SDF tiles: the assembled EXR, VDB, TGA slices and BC4 DDS are the
+// untiled cook's bytes, for a clip below and above the tile size; and the
+// assembled distances are the brute-force distances of the density.
+TEST_P(TiledSdf, AssembledClippedSdfIsByteIdenticalToTheUntiledCook) {
+    const auto [nx, ny] = GetParam();
+    const fs::path single = scratch("single"), tiled = scratch("tiled");
+    Session a = load(kSdfWorld);
+    a.cook(options(single));
+    Session b = load(kSdfWorld);
+    TileOptions t;
+    t.tiles = {{nx, ny}};
+    t.assemble = true;
+    const TiledCookResult rb = cook_tiled(b, options(tiled), t);
+    EXPECT_EQ(rb.tiles_done.size(), size_t(nx * ny));
+    const auto files = files_under(single);
+    std::set<std::string> exts;
+    for (const auto& f : files) exts.insert(f.extension().string());
+    for (const char* e : {".exr", ".vdb", ".dds", ".tga"}) EXPECT_TRUE(exts.count(e)) << e;
+    ASSERT_GE(files.size(), size_t(14));
+    for (const auto& f : files) {
+        ASSERT_TRUE(fs::exists(tiled / f)) << f;
+        EXPECT_TRUE(bytes_of(single / f) == bytes_of(tiled / f)) << f << " differs between the untiled and the " << nx << "x" << ny << " cook";
+    }
+
+    // The assembled distances against brute force, at voxels near the tile
+    // seams and corners and elsewhere (both clips reach across seams).
+    const Field3DPtr dens = std::get<Field3DPtr>(a.get("dens", "out"));
+    const Field3DPtr near = io::as_field3d(io::read_field_file(tiled / "near.vdb"));
+    const Field3DPtr far = io::as_field3d(io::read_field_file(tiled / "far.vdb"));
+    ASSERT_EQ(near->resolution(), dens->resolution());
+    int surface = 0, clipped = 0;
+    for (int x : {0, 7, 15, 16, 23, 24, 31, 32, 47})
+        for (int y : {0, 9, 15, 16, 31})
+            for (int z : {0, 3, 7}) {
+                const double bn = brute_sdf(*dens, 0.5, 350, false, x, y, z);
+                const double bf = brute_sdf(*dens, 0.6, 2500, true, x, y, z);
+                EXPECT_NEAR(near->at(0, x, y, z), bn, 1e-3) << x << "," << y << "," << z;
+                EXPECT_NEAR(far->at(0, x, y, z), bf, 1e-2) << x << "," << y << "," << z;
+                surface += std::abs(bn) < 350;
+                clipped += std::abs(bn) == 350;
+            }
+    // The sample sees both distances within the clip and clipped ones.
+    EXPECT_GT(surface, 20);
+    EXPECT_GT(clipped, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Tiles, TiledSdf, ::testing::Values(std::pair{1, 1}, std::pair{2, 2}, std::pair{3, 2}));
+
+// An unclipped SDF (and fast sweeping) is refused for tiling, naming the node
+// and saying what to set; a clip on the same graph is accepted.
+TEST(Tiling, UnclippedSdfIsRefusedByName) {
+    const fs::path out = scratch("out");
+    const std::string head = R"(atlas: 1
+nodes:
+  vol: { type: noise/perlin_worley, params: { resolution: [32, 32, 4], bounds_max: [3200, 3200, 400], seed: 5 } }
+)";
+    struct Case {
+        std::string sdf, expect;
+    };
+    const std::vector<Case> cases = {
+        {"{}", "node 'dist' (volume/sdf) cannot be cooked in tiles: an exact distance transform of unclipped distances reads the whole grid"},
+        {"{ method: fast_sweeping, max_distance: 300 }", "node 'dist' (volume/sdf) cannot be cooked in tiles: method 'fast_sweeping'"},
+    };
+    for (const auto& c : cases) {
+        Session s = load_text(head + "  dist: { type: volume/sdf, inputs: { in: vol }, params: " + c.sdf + " }\noutputs:\n  - { node: dist, file: d.exr }\n", out);
+        TileOptions t;
+        t.tiles = {{2, 2}};
+        try {
+            cook_tiled(s, options(out), t);
+            ADD_FAILURE() << "no error for " << c.sdf;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("inline.yaml:"), std::string::npos) << e.what();
+            if (c.sdf == "{}") {
+                EXPECT_NE(std::string(e.what()).find("set 'max_distance'"), std::string::npos) << e.what();
+            }
+        }
+        EXPECT_TRUE(files_under(out).empty());
+    }
+    Session ok = load_text(head + "  dist: { type: volume/sdf, inputs: { in: vol }, params: { max_distance: 300 } }\noutputs:\n  - { node: dist, file: d.exr }\n", out);
+    EXPECT_NO_THROW(check_tileable(ok, {}));
+}
+
+// The halo is what makes the tiles exact: the same clipped SDF with its halo
+// forced to 0 (a test node wrapping volume/sdf) gives other bytes at the
+// seams, so the comparison above can fail.
+TEST(Tiling, ClippedSdfWithoutItsHaloDiffersAtTheSeams) {
+    const std::string text = R"(atlas: 1
+nodes:
+  vol:  { type: noise/perlin_worley, params: { resolution: [32, 32, 4], bounds_max: [3200, 3200, 400], seed: 5 } }
+  dens: { type: math/remap, inputs: { in: vol }, params: { in_min: 0.2, in_max: 0.9 } }
+  dist: { type: volume/sdf, inputs: { in: dens }, params: { max_distance: 400 } }
+outputs:
+  - { node: dist, file: d.vdb }
+)";
+    const fs::path single = scratch("single"), tiled = scratch("tiled"), zero = scratch("zero");
+    Session a = load_text(text, single);
+    a.cook(options(single));
+    TileOptions t;
+    t.tiles = {{2, 2}};
+    t.assemble = true;
+    Session b = load_text(text, tiled);
+    cook_tiled(b, options(tiled), t);
+    EXPECT_TRUE(bytes_of(single / "d.vdb") == bytes_of(tiled / "d.vdb"));
+    // volume/sdf re-declared with a zero halo (keeping the window, so only the halo differs).
+    NodeRegistry r = builtin_nodes();
+    const NodeType* sdf = r.find("volume/sdf");
+    r.add({.name = "test/sdf_no_halo", .version = 1,
+           .declare =
+               [declare = sdf->declare](NodeDeclaration& d) {
+                   declare(d);
+                   d.tiling(TileRule::with_halo([](const NodeParams&) { return 0; }).with_window());
+               },
+           .cook = sdf->cook});
+    Session c(std::move(r));
+    std::string text0 = text;
+    text0.replace(text0.find("type: volume/sdf"), 16, "type: test/sdf_no_halo");
+    c.load_text(text0, "inline.yaml", zero);
+    cook_tiled(c, options(zero), t);
+    EXPECT_FALSE(bytes_of(single / "d.vdb") == bytes_of(zero / "d.vdb"));
+}
+
+// The tiled cook's report (docs/report.md, "Tiled cooks"): per tile its
+// status, times, memory and files, whose sizes and hashes are those on disk;
+// after a failure it still lists the tiles done and the failed tile.
+TEST(Tiling, ReportListsEveryTileAndTheFailedOne) {
+    const fs::path out = scratch("out");
+    {
+        Session s = load(kWorld);
+        TileOptions t;
+        t.tiles = {{3, 2}};
+        t.assemble = true;
+        TiledCookResult r;
+        cook_tiled(s, options(out), t, r);
+        const auto doc = nlohmann::json::parse(tiled_report_json(r, "world.yaml", "ok", ""));
+        EXPECT_EQ(doc["status"], "ok");
+        EXPECT_EQ(doc["tiled"]["tiles"], nlohmann::json::array({3, 2}));
+        EXPECT_EQ(doc["tiled"]["grid"], nlohmann::json::array({48, 32}));
+        ASSERT_EQ(doc["tiles"].size(), size_t(6));
+        EXPECT_EQ(doc["tiles"][1]["tile"], nlohmann::json::array({1, 0})); // row by row
+        EXPECT_EQ(doc["summary"]["cooked"], 6);
+        EXPECT_EQ(doc["assembled"].size(), files_under(out).size() - files_under(out / "tiles").size());
+        for (const auto& tile : doc["tiles"]) {
+            EXPECT_EQ(tile["status"], "cooked");
+            EXPECT_GT(tile["value_bytes_peak"].get<uint64_t>(), uint64_t(48 / 3 * 32 / 2 * 8 * 4)); // at least the tile's density
+            EXPECT_GE(tile["rss_peak_bytes"].get<uint64_t>(), tile["value_bytes_peak"].get<uint64_t>());
+            EXPECT_GE(tile["files"].size(), size_t(7 + 1));
+            for (const auto& f : tile["files"]) {
+                const fs::path p = out / f["path"].get<std::string>();
+                ASSERT_TRUE(fs::exists(p)) << p;
+                EXPECT_EQ(fs::file_size(p), f["bytes"].get<uint64_t>()) << p;
+                EXPECT_EQ(file_content_hash(p).hex(), f["hash"].get<std::string>()) << p;
+            }
+        }
+        // A second call finds every tile up to date.
+        Session s2 = load(kWorld);
+        TiledCookResult r2;
+        cook_tiled(s2, options(out), t, r2);
+        const auto doc2 = nlohmann::json::parse(tiled_report_json(r2, "world.yaml", "ok", ""));
+        EXPECT_EQ(doc2["summary"]["up to date"], 6);
+        EXPECT_EQ(doc2["tiles"][0]["files"], doc["tiles"][0]["files"]);
+    }
+    const fs::path bad = scratch("bad");
+    Session s = load_text(std::string(kMapHead) + "  x: { type: test/fail_right, inputs: { in: base } }\noutputs:\n  - { node: x, file: x.exr }\n", bad);
+    TileOptions t;
+    t.tiles = {{2, 1}};
+    TiledCookResult r;
+    std::string error;
+    try {
+        cook_tiled(s, options(bad), t, r);
+    } catch (const Error& e) {
+        error = e.what();
+    }
+    ASSERT_FALSE(error.empty());
+    const auto doc = nlohmann::json::parse(tiled_report_json(r, "inline.yaml", "failed", error));
+    EXPECT_EQ(doc["status"], "failed");
+    EXPECT_EQ(doc["error"]["tile"], nlohmann::json::array({1, 0}));
+    ASSERT_EQ(doc["tiles"].size(), size_t(2));
+    EXPECT_EQ(doc["tiles"][0]["status"], "cooked");
+    EXPECT_EQ(doc["tiles"][1]["status"], "failed");
+    EXPECT_NE(doc["tiles"][1]["error"].get<std::string>().find("fails on purpose"), std::string::npos);
+    EXPECT_TRUE(doc["tiles"][1]["files"].empty());
+    EXPECT_EQ(doc["summary"]["failed"], 1);
+    EXPECT_FALSE(doc.contains("index"));
+}
+
+// ndf/warp (tileable: false) tiles with a halo of its largest offset: the
+// assembled EXR and BC4 DDS are the untiled bytes, for an offset below and
+// above the tile size; a warp value outside [0, 1] (an offset beyond the
+// halo) is refused in a tiled cook, naming the node.
+TEST(Tiling, WarpTilesWithTheHaloOfItsLargestOffset) {
+    const std::string text = R"(atlas: 1
+nodes:
+  base: { type: ndf/noise, params: { resolution: [48, 32], bounds_min: [0, 0], bounds_max: [4800, 3200], octaves: 3, seed: 1 } }
+  push: { type: ndf/noise, params: { resolution: [48, 32], bounds_min: [0, 0], bounds_max: [4800, 3200], period: [3, 3], octaves: 2, seed: 4 } }
+  near: { type: ndf/warp, inputs: { in: base, warp: push }, params: { amount: 280, tileable: false } }
+  far:  { type: ndf/warp, inputs: { in: base, warp: push }, params: { amount: 2100, tileable: false } }
+outputs:
+  - { node: near, file: near.exr }
+  - { node: near, file: near_bc4.dds, options: { encoding: bc4 } }
+  - { node: far, file: far.exr }
+)";
+    const fs::path single = scratch("single");
+    Session a = load_text(text, single);
+    a.cook(options(single));
+    // The untiled node is the library's domain warp.
+    const Field2D ref = ndf::domain_warp(*std::get<Field2DPtr>(a.get("base", "out")), *std::get<Field2DPtr>(a.get("push", "out")), 280,
+                                         WrapMode::Clamp, nullptr);
+    const Field2DPtr near = std::get<Field2DPtr>(a.get("near", "out"));
+    ASSERT_EQ(near->resolution(), ref.resolution());
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 48; ++x) ASSERT_EQ(near->at(0, x, y), ref.at(0, x, y));
+    for (auto [nx, ny] : {std::pair{1, 1}, std::pair{2, 2}, std::pair{3, 2}}) {
+        const fs::path tiled = scratch("tiled" + std::to_string(nx) + std::to_string(ny));
+        Session b = load_text(text, tiled);
+        TileOptions t;
+        t.tiles = {{nx, ny}};
+        t.assemble = true;
+        cook_tiled(b, options(tiled), t);
+        const auto files = files_under(single);
+        ASSERT_EQ(files.size(), size_t(4));
+        for (const auto& f : files) EXPECT_TRUE(bytes_of(single / f) == bytes_of(tiled / f)) << f << " " << nx << "x" << ny;
+    }
+    // Offsets beyond the halo: a warp value of 1.5.
+    const fs::path bad = scratch("bad");
+    Session c = load_text(R"(atlas: 1
+nodes:
+  base: { type: ndf/noise, params: { resolution: [32, 32], bounds_min: [0, 0], bounds_max: [3200, 3200], seed: 1 } }
+  push: { type: ndf/constant, params: { resolution: [32, 32], bounds_max: [3200, 3200], value: 1.5 } }
+  x: { type: ndf/warp, inputs: { in: base, warp: push }, params: { amount: 200, tileable: false } }
+outputs:
+  - { node: x, file: x.exr }
+)",
+                          bad);
+    TileOptions t;
+    t.tiles = {{2, 2}};
+    try {
+        cook_tiled(c, options(bad), t);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("tile 0,0: "), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("node 'x' (ndf/warp)"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("outside [0, 1]"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(files_under(bad).empty());
 }

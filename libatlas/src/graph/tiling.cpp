@@ -16,6 +16,8 @@
 #include <functional>
 #include <set>
 
+#include <sys/resource.h>
+
 namespace atlas {
 
 namespace {
@@ -33,6 +35,8 @@ struct Plan {
     std::vector<const GraphOutput*> outputs;
     std::vector<const GraphNode*> order;
     std::map<std::string, int> halo; // per node
+    std::set<std::string> grid_halo;  // nodes whose halo needs the grid (computed once it is known)
+    std::set<std::string> reads_window; // nodes that get their input window (CookContext::window())
     std::map<std::string, TileGrid> windowed; // generators that cook each tile's window themselves
     std::map<std::string, std::string> last_use; // node -> the last node (in order) that reads it
     std::set<std::string> output_nodes;
@@ -87,7 +91,11 @@ Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::s
         if (rule.refuse)
             if (std::string why = rule.refuse(params); !why.empty()) throw Error(node_label(*n) + " cannot be cooked in tiles: " + why);
         int h = 0;
-        if (rule.kind == TileRule::Kind::Halo && !n->inputs.empty()) h = rule.halo(params);
+        if (rule.kind == TileRule::Kind::Halo && !n->inputs.empty()) {
+            if (rule.grid_halo) p.grid_halo.insert(n->name);
+            else h = rule.halo(params);
+        }
+        if (rule.reads_window && !n->inputs.empty()) p.reads_window.insert(n->name);
         if (h < 0) throw Error(node_label(*n) + ": internal: negative tiling halo");
         p.halo[n->name] = h;
         if (n->inputs.empty() && rule.window_grid)
@@ -278,7 +286,115 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+double cpu_seconds() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+uint64_t peak_rss_bytes() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return uint64_t(u.ru_maxrss) * 1024; // Linux: kilobytes
+}
+
+// Bytes of the values, each field counted once (crops that are the whole value share it).
+uint64_t distinct_bytes(const std::vector<Value>& values) {
+    std::set<const void*> seen;
+    uint64_t total = 0;
+    for (const Value& v : values) {
+        const void* p = nullptr;
+        if (auto f2 = std::get_if<Field2DPtr>(&v)) p = f2->get();
+        else if (auto f3 = std::get_if<Field3DPtr>(&v)) p = f3->get();
+        if (p && !seen.insert(p).second) continue;
+        total += value_bytes(v);
+    }
+    return total;
+}
+
+// A tile's report: its files are those its fragment lists, and the fragment.
+TileReport tile_report(Vec2i t, TileRect texels, std::string status, double seconds, double cpu, uint64_t value_peak, const json* frag,
+                       const fs::path& root) {
+    TileReport r;
+    r.tile = t;
+    r.texels = texels;
+    r.status = std::move(status);
+    r.seconds = seconds;
+    r.cpu_seconds = cpu;
+    r.value_bytes_peak = value_peak;
+    r.rss_peak_bytes = peak_rss_bytes();
+    if (!frag) return r;
+    auto add = [&](const json& f) {
+        r.files.push_back({f.at("path").get<std::string>(), f.at("bytes").get<uint64_t>(), f.at("hash").get<std::string>(),
+                           f.value("sha256", std::string())});
+    };
+    std::set<std::string> seen;
+    for (const auto& o : frag->at("outputs")) {
+        for (const auto& f : o.at("files"))
+            if (seen.insert(f.at("path").get<std::string>()).second) add(f);
+        if (seen.insert(o.at("raw").at("path").get<std::string>()).second) add(o.at("raw"));
+    }
+    const fs::path fp = root / fragment_rel(t);
+    std::error_code ec;
+    if (fs::exists(fp, ec)) add(file_entry(root, fp, fp));
+    return r;
+}
+
 } // namespace
+
+std::string tiled_report_json(const TiledCookResult& r, const std::string& graph_file, const std::string& status, const std::string& error) {
+    json doc;
+    doc["atlas_report_version"] = 1;
+    doc["graph"] = graph_file;
+    doc["status"] = status;
+    if (status != "ok") {
+        json e{{"message", error}};
+        for (const auto& t : r.tiles_done)
+            if (t.status == "failed" || t.status == "cancelled") e["tile"] = {t.tile[0], t.tile[1]};
+        doc["error"] = e;
+    }
+    doc["seconds"] = r.seconds;
+    doc["jobs"] = r.jobs;
+    doc["tiled"] = {{"tiles", {r.tiles[0], r.tiles[1]}}, {"grid", {r.grid[0], r.grid[1]}}};
+    std::vector<const TileReport*> order;
+    for (const auto& t : r.tiles_done) order.push_back(&t);
+    std::stable_sort(order.begin(), order.end(), [](const TileReport* a, const TileReport* b) {
+        return std::pair(a->tile[1], a->tile[0]) < std::pair(b->tile[1], b->tile[0]);
+    });
+    json tiles = json::array();
+    json summary = {{"cooked", 0}, {"up to date", 0}, {"failed", 0}};
+    double cpu = 0;
+    uint64_t value_peak = 0, rss_peak = 0;
+    for (const TileReport* t : order) {
+        json jt = {{"tile", {t->tile[0], t->tile[1]}},
+                   {"texels", {t->texels.x0, t->texels.y0, t->texels.x1, t->texels.y1}},
+                   {"status", t->status},
+                   {"seconds", t->seconds},
+                   {"cpu_seconds", t->cpu_seconds},
+                   {"value_bytes_peak", t->value_bytes_peak},
+                   {"rss_peak_bytes", t->rss_peak_bytes}};
+        if (!t->error.empty()) jt["error"] = t->error;
+        json files = json::array();
+        for (const auto& f : t->files) files.push_back({{"path", f.path}, {"bytes", f.bytes}, {"hash", f.hash}, {"sha256", f.sha256}});
+        jt["files"] = files;
+        tiles.push_back(jt);
+        const std::string k = t->status == "cancelled" ? "failed" : t->status;
+        if (summary.contains(k)) summary[k] = summary[k].get<int>() + 1;
+        cpu += t->cpu_seconds;
+        value_peak = std::max(value_peak, t->value_bytes_peak);
+        rss_peak = std::max(rss_peak, t->rss_peak_bytes);
+    }
+    doc["tiles"] = tiles;
+    if (!r.index.empty()) doc["index"] = r.index.generic_string();
+    json assembled = json::array();
+    for (const auto& p : r.assembled) assembled.push_back(p.generic_string());
+    doc["assembled"] = assembled;
+    summary["cpu_seconds"] = cpu;
+    summary["value_bytes_peak"] = value_peak;
+    summary["rss_peak_bytes"] = rss_peak;
+    doc["summary"] = summary;
+    return doc.dump(2) + "\n";
+}
 
 TileRect tile_rect(Vec2i grid, Vec2i tiles, Vec2i t) {
     const int w = grid[0] / tiles[0], h = grid[1] / tiles[1];
@@ -290,6 +406,12 @@ void check_tileable(const Session& session, const std::vector<std::string>& outp
 }
 
 TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileOptions& topt) {
+    TiledCookResult result;
+    cook_tiled(session, opt, topt, result);
+    return result;
+}
+
+void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& topt, TiledCookResult& result) {
     const auto t_start = std::chrono::steady_clock::now();
     const Graph& g = session.graph();
     const NodeRegistry& reg = session.registry();
@@ -300,13 +422,14 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
         throw Error("--tile " + tile_name(*topt.only) + " is out of range: --tiles " + tile_name(tiles) + " has tiles 0.." +
                     std::to_string(tiles[0] - 1) + ", 0.." + std::to_string(tiles[1] - 1));
     if (topt.only && topt.assemble) throw Error("--assemble needs every tile: it cannot be combined with --tile");
-    const Plan plan = make_plan(g, reg, opt.outputs);
+    Plan plan = make_plan(g, reg, opt.outputs);
     const MemoryBudget budget(opt.memory_budget);
     const fs::path root = opt.out_dir;
     remove_stale_staging(root);
 
-    TiledCookResult result;
+    result = TiledCookResult{};
     result.tiles = tiles;
+    result.jobs = opt.jobs > 0 ? opt.jobs : int(tbb::info::default_concurrency());
     const auto hashes = session.node_hashes();
 
     std::vector<Vec2i> selection;
@@ -390,6 +513,15 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
                         std::to_string(tiles[a]) + " tiles along " + (a ? "y" : "x") + " (" + std::to_string(grid.res[a]) + " is not a multiple of " +
                         std::to_string(tiles[a]) + ")");
     const Vec2i tile_size{{grid.res[0] / tiles[0], grid.res[1] / tiles[1]}};
+    // Halos in world units (e.g. a clipped SDF's max_distance) become texels of this grid.
+    for (const std::string& name : plan.grid_halo) {
+        const GraphNode& n = *g.find(name);
+        const NodeType* t = reg.find(n.type);
+        NodeParams params(&t->decl, resolved_params(n, *t), g.base_dir);
+        const int h = t->decl.tiling().grid_halo(params, TileGrid{grid.res, {grid.lo, grid.hi}});
+        if (h < 0) throw Error(node_label(n) + ": internal: negative tiling halo");
+        plan.halo[name] = h;
+    }
     for (const GraphOutput* o : plan.outputs)
         if (o->format == "dds" && (tile_size[0] % 4 || tile_size[1] % 4))
             throw Error(o->where.str() + ": --tiles " + tile_name(tiles) + ": output '" + o->file +
@@ -414,6 +546,8 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
             for (const auto& [port, b] : n.inputs) region[b.node] = unite(region[b.node], need);
         }
         std::map<std::pair<std::string, std::string>, Held> held;
+        const double cpu0 = cpu_seconds();
+        uint64_t value_peak = 0;
         try {
             for (const GraphNode* n : plan.order) {
                 const TileRect r = region.at(n->name);
@@ -435,7 +569,16 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
                 ProgressSink node_progress;
                 node_progress.is_cancelled = opt.progress.is_cancelled;
                 CookContext ctx(n->name, n->type, type.decl, params, std::move(inputs), budget, node_progress);
+                const TileWindow in_window = window_of(grid, in_rect);
                 if (windowed) ctx.set_window(&window);
+                else if (plan.reads_window.count(n->name)) ctx.set_window(&in_window);
+                {
+                    // Memory: what is held for later nodes, this node's inputs and (below) its outputs.
+                    std::vector<Value> alive;
+                    for (const auto& [key, h] : held) alive.push_back(h.v);
+                    for (const auto& [port, v] : inputs) alive.push_back(v);
+                    value_peak = std::max(value_peak, distinct_bytes(alive));
+                }
                 try {
                     arena.execute([&] { type.cook(ctx); });
                 } catch (const CancelledError&) {
@@ -443,6 +586,12 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
                 } catch (const std::exception& e) {
                     const std::string msg = e.what();
                     throw Error(node_label(*n) + ": " + msg);
+                }
+                {
+                    std::vector<Value> alive;
+                    for (const auto& [key, h] : held) alive.push_back(h.v);
+                    for (const auto& [port, v] : ctx.outputs()) alive.push_back(v);
+                    value_peak = std::max(value_peak, distinct_bytes(alive));
                 }
                 const Box2d want = rect_bounds(grid, in_rect);
                 for (const auto& out : type.decl.outputs()) {
@@ -499,24 +648,29 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
             write_file_checked(st.stage(fragment_rel(t)), text.data(), text.size());
             for (const auto& p : st.commit()) result.written.push_back(p);
             fragments[{t[0], t[1]}] = std::move(frag);
-        } catch (const CancelledError&) {
-            throw;
         } catch (const std::exception& e) {
+            TileReport failed = tile_report(t, tr, dynamic_cast<const CancelledError*>(&e) ? "cancelled" : "failed", seconds_since(t0),
+                                            cpu_seconds() - cpu0, value_peak, nullptr, root);
+            failed.error = e.what();
+            result.tiles_done.push_back(std::move(failed));
+            result.seconds = seconds_since(t_start);
+            if (dynamic_cast<const CancelledError*>(&e)) throw;
             const std::string msg = e.what();
             if (dynamic_cast<const MemoryBudgetError*>(&e)) throw MemoryBudgetError(tname + ": " + msg);
             throw Error(tname + ": " + msg);
         }
-        result.tiles_done.push_back({t, tr, "cooked", seconds_since(t0)});
+        result.tiles_done.push_back(
+            tile_report(t, tr, "cooked", seconds_since(t0), cpu_seconds() - cpu0, value_peak, &fragments.at({t[0], t[1]}), root));
         ++tiles_finished;
         if (opt.progress.on_progress) opt.progress.on_progress({tname, double(tiles_finished) / total_tiles, tiles_finished, total_tiles});
     }
     for (Vec2i t : selection)
         if (std::none_of(to_cook.begin(), to_cook.end(), [&](Vec2i c) { return c == t; }))
-            result.tiles_done.push_back({t, tile_rect(grid.res, tiles, t), "up to date", 0.0});
+            result.tiles_done.push_back(tile_report(t, tile_rect(grid.res, tiles, t), "up to date", 0, 0, 0, &fragments.at({t[0], t[1]}), root));
 
     if (topt.only) {
         result.seconds = seconds_since(t_start);
-        return result;
+        return;
     }
 
     // Every tile is present: the tile index, then (optionally) the untiled outputs.
@@ -601,7 +755,8 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
                 auto& st = staging[out_root];
                 if (!st) st = std::make_unique<StagedOutputs>(out_root);
                 const Value full = full2 ? Value(Field2DPtr(full2)) : Value(Field3DPtr(full3));
-                io::write_value(full, st->stage(rel), o->format, o->options, nullptr);
+                for (const auto& f : io::write_value(full, st->stage(rel), o->format, o->options, nullptr))
+                    result.assembled.push_back(st->final_path(f));
             } catch (const CancelledError&) {
                 throw;
             } catch (const std::exception& e) {
@@ -612,7 +767,6 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
             for (const auto& p : st->commit()) result.written.push_back(p);
     }
     result.seconds = seconds_since(t_start);
-    return result;
 }
 
 } // namespace atlas

@@ -15,7 +15,9 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <limits>
 #include <vector>
@@ -109,6 +111,8 @@ Field3D sdf_from_density_edt(const Field3D& density, const SdfOptions& o, const 
                              const ProgressSink* progress) {
     const auto t0 = std::chrono::steady_clock::now();
     detail::check_density(density, o, "sdf (edt)");
+    if (!std::isfinite(o.max_distance) || o.max_distance < 0)
+        throw Error("sdf (edt): max_distance must be finite and >= 0, got " + std::to_string(o.max_distance));
     const Vec3i res = density.resolution();
     const size_t count = density.voxel_count();
     if (budget) budget->check(field_bytes(count, 3), "sdf (edt): output and two scratch grids");
@@ -121,24 +125,30 @@ Field3D sdf_from_density_edt(const Field3D& density, const SdfOptions& o, const 
     auto seeds = [&](int a, size_t base, int n, std::vector<double>& out_seeds) {
         const size_t st = stride[a];
         auto d = [&](int i) { return dens[base + size_t(i) * st]; };
-        if (border && detail::is_inside(d(0), iso)) out_seeds.push_back(-0.5);
+        // The grid's faces only: a crop's inner faces have the rest of the grid beyond them.
+        if (border && o.grid_faces[size_t(2 * a)] && detail::is_inside(d(0), iso)) out_seeds.push_back(-0.5);
         bool prev = detail::is_inside(d(0), iso);
         for (int i = 0; i + 1 < n; ++i) {
             const bool next = detail::is_inside(d(i + 1), iso);
             if (prev != next) out_seeds.push_back(i + detail::crossing_t(d(i), d(i + 1), iso));
             prev = next;
         }
-        if (border && detail::is_inside(d(n - 1), iso)) out_seeds.push_back(n - 0.5);
+        if (border && o.grid_faces[size_t(2 * a + 1)] && detail::is_inside(d(n - 1), iso)) out_seeds.push_back(n - 0.5);
     };
     unsigned long long crossings = 0;
-    std::vector<float> best = detail::squared_distance_to_line_seeds(res, density.voxel_size(), seeds, &crossings);
+    // A crop of a larger grid uses the whole grid's voxel edge: its own bounds
+    // (TileWindow::edge) may differ from the grid's arithmetic in the last bit.
+    const Vec3d h = o.grid_voxel_size[0] > 0 ? o.grid_voxel_size : density.voxel_size();
+    std::vector<float> best = detail::squared_distance_to_line_seeds(res, h, seeds, &crossings);
     if (progress) progress->poll();
-    const float far = float(detail::far_value(density, o));
+    const bool clip = o.max_distance > 0;
+    const float far = clip ? float(o.max_distance) : float(detail::far_value(density, o));
     auto sdf = out.channel(0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
             const bool in = detail::is_inside(dens[i], iso);
-            const float d = best[i] == kInf ? far : std::sqrt(best[i]);
+            float d = best[i] == kInf ? far : std::sqrt(best[i]);
+            if (clip) d = std::min(d, far);
             sdf[i] = in ? -d : d;
         }
     });

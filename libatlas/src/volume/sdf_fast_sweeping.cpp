@@ -7,6 +7,7 @@
 #include <openvdb/tools/Dense.h>
 #include <openvdb/tools/FastSweeping.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -16,6 +17,8 @@ Field3D sdf_from_density_fast_sweeping(const Field3D& density, const SdfOptions&
                                        SdfStats* stats) {
     const auto t0 = std::chrono::steady_clock::now();
     detail::check_density(density, o, "sdf (fast sweeping)");
+    if (!std::isfinite(o.max_distance) || o.max_distance < 0)
+        throw Error("sdf (fast sweeping): max_distance must be finite and >= 0, got " + std::to_string(o.max_distance));
     if (sweeps < 1) throw Error("sdf (fast sweeping): sweeps must be >= 1, got " + std::to_string(sweeps));
     const Vec3d h = density.voxel_size();
     if (std::abs(h[0] - h[1]) > 1e-9 * h[0] || std::abs(h[0] - h[2]) > 1e-9 * h[0])
@@ -42,7 +45,7 @@ Field3D sdf_from_density_fast_sweeping(const Field3D& density, const SdfOptions&
     }
     if (!any_inside) {
         // No surface: fogToSdf has nothing to sweep from; same answer as the EDT.
-        const float far = float(detail::far_value(density, o));
+        const float far = o.max_distance > 0 ? float(o.max_distance) : float(detail::far_value(density, o));
         std::fill(out.channel(0).begin(), out.channel(0).end(), far);
     } else {
         const openvdb::CoordBBox box(openvdb::Coord(0, 0, 0), openvdb::Coord(res[0] - 1, res[1] - 1, res[2] - 1));
@@ -75,7 +78,8 @@ Field3D sdf_from_density_fast_sweeping(const Field3D& density, const SdfOptions&
                 throw Error("sdf (fast sweeping): OpenVDB left voxel (" + std::to_string(i % size_t(res[0])) + ", " +
                             std::to_string((i / size_t(res[0])) % size_t(res[1])) + ", " + std::to_string(i / (size_t(res[0]) * size_t(res[1]))) +
                             ") without a distance (use the edt method)");
-            const float m = float(double(std::abs(s[i])) * to_metres);
+            float m = float(double(std::abs(s[i])) * to_metres);
+            if (o.max_distance > 0) m = std::min(m, float(o.max_distance));
             s[i] = inside ? -m : m;
         }
         for (int z = 0; z < res[2]; ++z)

@@ -90,6 +90,14 @@ struct TileRule {
     // (nullopt: it is cooked whole and cropped). Only such generators keep a
     // tile's memory to the tile: the others are cooked whole once per process.
     std::function<std::optional<TileGrid>(const NodeParams&)> window_grid;
+    // Optional, for Halo: a halo that depends on the tiled grid's texel size
+    // as well (e.g. a distance in metres); used instead of `halo` when set.
+    std::function<int(const NodeParams&, const TileGrid&)> grid_halo;
+    // The node's cook reads CookContext::window() in a tiled cook: the window
+    // of the whole grid its inputs cover (the region grown by the halo), so it
+    // can use the whole grid's texel size and tell the grid's own faces from a
+    // crop's (null in an untiled cook).
+    bool reads_window = false;
 
     TileRule& windowed(std::function<std::optional<TileGrid>(const NodeParams&)> grid) {
         window_grid = std::move(grid);
@@ -97,12 +105,35 @@ struct TileRule {
     }
 
     static TileRule pointwise(std::function<std::string(const NodeParams&)> refuse = {}) {
-        return {Kind::Pointwise, {}, std::move(refuse), {}, {}};
+        TileRule r;
+        r.kind = Kind::Pointwise;
+        r.refuse = std::move(refuse);
+        return r;
     }
     static TileRule with_halo(std::function<int(const NodeParams&)> halo, std::function<std::string(const NodeParams&)> refuse = {}) {
-        return {Kind::Halo, std::move(halo), std::move(refuse), {}, {}};
+        TileRule r;
+        r.kind = Kind::Halo;
+        r.halo = std::move(halo);
+        r.refuse = std::move(refuse);
+        return r;
     }
-    static TileRule none(std::string why) { return {Kind::None, {}, {}, std::move(why), {}}; }
+    static TileRule with_grid_halo(std::function<int(const NodeParams&, const TileGrid&)> halo,
+                                   std::function<std::string(const NodeParams&)> refuse = {}) {
+        TileRule r;
+        r.kind = Kind::Halo;
+        r.grid_halo = std::move(halo);
+        r.refuse = std::move(refuse);
+        return r;
+    }
+    TileRule& with_window() {
+        reads_window = true;
+        return *this;
+    }
+    static TileRule none(std::string why) {
+        TileRule r;
+        r.why_not = std::move(why);
+        return r;
+    }
 };
 
 class NodeDeclaration {
@@ -221,7 +252,8 @@ public:
     [[noreturn]] void fail(const std::string& message) const;
 
     // In a tiled cook, the window of its grid a generator whose TileRule is
-    // windowed() is asked for (null otherwise: make the whole grid).
+    // windowed() is asked for, or for a node whose TileRule reads_window the
+    // window its inputs cover (null otherwise, and in an untiled cook).
     const TileWindow* window() const { return window_; }
     void set_window(const TileWindow* w) { window_ = w; }
 

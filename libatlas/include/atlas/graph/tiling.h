@@ -45,11 +45,25 @@ struct TileOptions {
     std::string graph_name;    // recorded in the index
 };
 
+struct TileFileReport {
+    std::string path;   // relative to the output directory
+    uint64_t bytes = 0;
+    std::string hash;   // file_content_hash, hex
+    std::string sha256;
+};
+
 struct TileReport {
     Vec2i tile{{0, 0}};
     TileRect texels;
-    std::string status; // "cooked" or "up to date" (its fragment and files were current)
-    double seconds = 0;
+    // "cooked", "up to date" (its fragment and files were current) or
+    // "failed" (`error` says why; nothing of the tile was written).
+    std::string status;
+    std::string error;
+    double seconds = 0;          // wall time of the tile (0 when up to date)
+    double cpu_seconds = 0;      // process CPU time (user + system) spent on it
+    uint64_t value_bytes_peak = 0; // most bytes of node values held at once on the tile
+    uint64_t rss_peak_bytes = 0;   // the process's peak resident set when the tile ended
+    std::vector<TileFileReport> files; // the tile's files (outputs, exact values, fragment)
 };
 
 struct TiledCookResult {
@@ -58,6 +72,8 @@ struct TiledCookResult {
     std::vector<TileReport> tiles_done;
     std::vector<std::filesystem::path> written; // every file this call wrote
     std::filesystem::path index;                // the tile index, when written
+    std::vector<std::filesystem::path> assembled; // the untiled outputs written by assembling
+    int jobs = 0;
     double seconds = 0;
 };
 
@@ -69,5 +85,15 @@ void check_tileable(const Session& session, const std::vector<std::string>& outp
 // Cooks the tiles (one or all) and writes them; see the top of this file.
 // Errors name the tile ("tile 1,0: node 'blur' (ndf/blur): ...").
 TiledCookResult cook_tiled(Session& session, const CookOptions& options, const TileOptions& tiles);
+
+// The same, filling `result` as it goes, so that after an error it holds
+// the tiles done before and the failed tile (status "failed", its error)
+// for a report; then the error is rethrown.
+void cook_tiled(Session& session, const CookOptions& options, const TileOptions& tiles, TiledCookResult& result);
+
+// The --report document of a tiled cook (docs/report.md, "Tiled cooks").
+// `status` is "ok", "failed" or "cancelled"; `error` the message when not ok.
+std::string tiled_report_json(const TiledCookResult& result, const std::string& graph_file, const std::string& status,
+                              const std::string& error);
 
 } // namespace atlas

@@ -21,6 +21,7 @@
 
 #include "atlas/core/field.h"
 
+#include <array>
 #include <cstdint>
 #include <functional>
 
@@ -48,6 +49,19 @@ struct SdfOptions {
     // Treat everything outside the grid as empty: inside voxels on the border
     // then see a surface on the grid face (half a voxel beyond their centre).
     bool border_is_outside = false;
+    // > 0: distances are clipped to +-max_distance metres. A voxel whose
+    // nearest crossing is farther, and every voxel of a grid without a
+    // surface, gets +-max_distance (far_distance is then not used). A clipped
+    // SDF depends only on the density within max_distance (plus one voxel) of
+    // each voxel, so it tiles byte for byte (docs/scale.md). 0: unclipped.
+    double max_distance = 0;
+    // For a crop of a larger grid (a tiled cook's region grown by the halo):
+    // the whole grid's voxel edge (all zero: the density's own voxel size),
+    // and which faces of the density are faces of the whole grid, in the
+    // order -x, +x, -y, +y, -z, +z (border_is_outside puts a surface only on
+    // those). The defaults are the untiled cook's.
+    Vec3d grid_voxel_size{{0, 0, 0}};
+    std::array<bool, 6> grid_faces{{true, true, true, true, true, true}};
 };
 
 // Measured cost and the surface found, filled by the functions below.
