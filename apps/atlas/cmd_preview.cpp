@@ -12,6 +12,7 @@
 #include "atlas/ndf/cone_map.h"
 #include "atlas/render/image_out.h"
 #include "atlas/render/layer.h"
+#include "atlas/render/preview.h"
 #include "atlas/render/renderer.h"
 #include "atlas/render/sweep.h"
 
@@ -89,23 +90,6 @@ bool has_channels(const Field2D& f, std::initializer_list<const char*> names) {
     return true;
 }
 
-// A weather map (coverage [, type, precipitation]) as a layer set with the
-// FC6 presets' default heights.
-Field2DPtr weather_map_as_set(const Field2D& m) {
-    std::vector<std::string> names{"coverage", "type", "precipitation", "min_height", "max_height"};
-    Field2D f(m.resolution(), int(names.size()), m.bounds(), names);
-    const int ct = m.find_channel("type"), cp = m.find_channel("precipitation"), cc = m.find_channel("coverage");
-    for (int y = 0; y < m.height(); ++y)
-        for (int x = 0; x < m.width(); ++x) {
-            f.at(0, x, y) = m.at(cc, x, y);
-            f.at(1, x, y) = ct >= 0 ? m.at(ct, x, y) : 0.5f;
-            f.at(2, x, y) = cp >= 0 ? m.at(cp, x, y) : 0.0f;
-            f.at(3, x, y) = 1500;
-            f.at(4, x, y) = 4000;
-        }
-    return std::make_shared<const Field2D>(std::move(f));
-}
-
 GraphContent cook_graph(Session& session, const std::string& file, int jobs, ProgressSink progress,
                         const std::optional<std::filesystem::path>& cache_dir, bool quiet) {
     GraphContent g;
@@ -161,12 +145,9 @@ GraphContent cook_graph(Session& session, const std::string& file, int jobs, Pro
             auto* f2 = std::get_if<Field2DPtr>(&v);
             if (!f2 || !*f2) continue;
             const Field2D& f = **f2;
-            if (has_channels(f, {"coverage", "min_height", "max_height"})) {
+            if (render::is_ndf_set(f) || render::is_weather_map(f)) {
                 render::check_finite(f, what);
-                if (!g.ndf) g.ndf = *f2, g.ndf_node = w.node;
-            } else if (has_channels(f, {"coverage"}) && !has_channels(f, {"cumulus"})) {
-                render::check_finite(f, what);
-                if (!g.ndf) g.ndf = weather_map_as_set(f), g.ndf_node = w.node;
+                if (!g.ndf) g.ndf = *f2, g.ndf_node = w.node; // a weather map becomes a set in render::layer_preview_scene
             } else if (has_channels(f, {"inner", "outer", "speed", "overlap_end"})) {
                 render::check_finite(f, what);
                 if (!g.vortex) g.vortex = *f2;
@@ -254,54 +235,6 @@ Field3DPtr cook_voxel_noise(int jobs, const std::optional<std::filesystem::path>
     return std::get<Field3DPtr>(s.get("nubis_noise", "out", o));
 }
 
-// A sky layer's opacity ramp from the texture's statistics: clear below the
-// mean, opaque two standard deviations above it.
-render::SkyLayer sky_layer_from(Field2DPtr tex, int channel, double altitude, double tile, double opacity) {
-    render::SkyLayer l;
-    l.texture = tex;
-    l.channel = channel;
-    l.altitude = altitude;
-    l.tile = tile;
-    l.opacity = opacity;
-    auto ch = tex->channel(channel);
-    double sum = 0, sq = 0;
-    for (float v : ch) sum += v, sq += double(v) * v;
-    const double n = double(ch.size()), mean = sum / n, sd = std::sqrt(std::max(0.0, sq / n - mean * mean));
-    l.value_min = mean;
-    l.value_max = mean + 2 * std::max(sd, 1e-6);
-    l.wind = {{3, 1}};
-    return l;
-}
-
-// The envelope's cone-step map over the cloud tops (ndf::cone_map, robust
-// for bilinear lookups): heights = max_height where coverage > 0, 0 (the
-// ground) elsewhere, max-pooled to at most 128 texels a side (a pooled top is
-// >= every top it covers, so its cones stay free) and dilated by one pooled
-// texel (the set is read bilinearly).
-Field2DPtr cloud_top_cone_map(const Field2D& set) {
-    const int cc = set.find_channel("coverage"), cm = set.find_channel("max_height");
-    const int w = set.width(), h = set.height();
-    const int k = std::max(1, (std::max(w, h) + 127) / 128);
-    const int pw = (w + k - 1) / k, ph = (h + k - 1) / k;
-    Field2D pooled({{pw, ph}}, 1, set.bounds(), {"top"});
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-            if (set.at(cc, x, y) > 0) pooled.at(0, x / k, y / k) = std::max(pooled.at(0, x / k, y / k), set.at(cm, x, y));
-    Field2D tops({{pw, ph}}, 1, set.bounds(), {"top"});
-    for (int y = 0; y < ph; ++y)
-        for (int x = 0; x < pw; ++x) {
-            float top = 0;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx)
-                    top = std::max(top, pooled.at(0, std::clamp(x + dx, 0, pw - 1), std::clamp(y + dy, 0, ph - 1)));
-            tops.at(0, x, y) = top;
-        }
-    ndf::ConeMapOptions o;
-    o.robust = true;
-    o.texel_size = std::min((set.bounds().max[0] - set.bounds().min[0]) / pw, (set.bounds().max[1] - set.bounds().min[1]) / ph);
-    return std::make_shared<const Field2D>(ndf::cone_map(tops, 0, o, nullptr));
-}
-
 // The box around the voxels that hold cloud (SDF < 0), or the whole bounds.
 Box3d cloud_bounds(const render::CloudScene& scene) {
     const Field3D& sdf = *scene.sdf;
@@ -367,18 +300,6 @@ void apply_physics_options(const Args& a, render::RenderSettings& s) {
         auto v = numbers(a.get("--light-grid"), 3, "--light-grid");
         s.light_grid = {{int(v[0]), int(v[1]), int(v[2])}};
     }
-}
-
-render::PointLight parse_light(const std::string& text) {
-    const size_t n = std::count(text.begin(), text.end(), ',') + 1;
-    if (n != 7 && n != 8) throw UsageError{"--light expects X,Y,Z,R,G,B,INTENSITY[,RADIUS], got '" + text + "'", "preview"};
-    auto v = numbers(text, n, "--light");
-    render::PointLight l;
-    l.position = {{v[0], v[1], v[2]}};
-    l.colour = {{float(v[3]), float(v[4]), float(v[5])}};
-    l.intensity = v[6];
-    l.radius = n == 8 ? v[7] : 0.0;
-    return l;
 }
 
 } // namespace
@@ -481,7 +402,7 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
             slice0 = a.has("--slice") ? static_cast<int>(numbers(a.get("--slice"), 1, "--slice")[0]) : 0;
             if (slice0 < 0 || slice0 >= forecast->nz())
                 throw UsageError{"--slice expects 0.." + std::to_string(forecast->nz() - 1) + " (the forecast's time slices)", "preview"};
-            g.ndf = weather_map_as_set(forecast_slice(*forecast, slice0));
+            g.ndf = std::make_shared<const Field2D>(forecast_slice(*forecast, slice0));
         }
         const bool layerish = g.ndf || g.cirrus || g.sky2d;
         if (!g.nvdf && !layerish) {
@@ -497,28 +418,20 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
         if (have_voxel) scene = render::scene_from_nvdf_set(g.nvdf);
         if (have_layer) {
             LayerInputs in = cook_layer_inputs(jobs, cache_dir, sink, quiet);
-            layer.ndf = g.ndf;
-            if (!layer.ndf) {
-                // Only 2D layers: an empty cloud layer under them.
-                Field2D empty({{2, 2}}, 3, Box2d{{{0, 0}}, {{40000, 40000}}}, {"coverage", "min_height", "max_height"});
-                for (int y = 0; y < 2; ++y)
-                    for (int x = 0; x < 2; ++x) empty.at(1, x, y) = 1500, empty.at(2, x, y) = 4000;
-                layer.ndf = std::make_shared<const Field2D>(std::move(empty));
-            }
-            layer.profile_lut = g.lut ? g.lut : in.lut;
-            layer.base_noise = in.low;
-            layer.detail_noise = in.high;
-            layer.curl = in.curl;
-            layer.envelope.cone_map = g.cone;
-            layer.anvil = g.anvil;
-            layer.vortex_table = g.vortex;
-            layer.envelope.distance_map = g.distance;
-            auto tile_of = [](const Field2D& f) {
-                const double sx = f.bounds().max[0] - f.bounds().min[0];
-                return sx > 100 ? sx : 20000.0; // unit-box textures: 20 km per tile
-            };
-            if (g.cirrus) layer.sky_layers.push_back(sky_layer_from(g.cirrus, g.cirrus->find_channel("cirrus"), 8000, tile_of(*g.cirrus), 0.8));
-            if (g.sky2d) layer.sky_layers.push_back(sky_layer_from(g.sky2d, 0, 6000, tile_of(*g.sky2d), 0.9));
+            // The library assembles the scene (the render/preview node calls the same).
+            render::LayerPreviewInputs li;
+            li.ndf = g.ndf;
+            li.profile_lut = g.lut ? g.lut : in.lut;
+            li.base_noise = in.low;
+            li.detail_noise = in.high;
+            li.curl = in.curl;
+            li.cone_map = g.cone;
+            li.anvil = g.anvil;
+            li.vortex_table = g.vortex;
+            li.distance_map = g.distance;
+            li.cirrus = g.cirrus;
+            li.sky_texture = g.sky2d;
+            layer = render::layer_preview_scene(li);
         }
     } else {
         if (mode == "layer") throw UsageError{"--mode layer needs a graph that writes an NDF set", "preview"};
@@ -541,12 +454,7 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
             auto v = numbers(a.get("--wind"), 2, "--wind");
             layer.wind = {{v[0], v[1]}};
         }
-        // A storm is one feature: no copies of it beyond the map. Weather maps tile.
-        const int cs = layer.ndf->find_channel("superstorm_coverage");
-        bool storm = false;
-        if (cs >= 0)
-            for (float v : layer.ndf->channel(cs)) storm = storm || v > 0;
-        layer.edge = storm ? render::MapEdge::Empty : render::MapEdge::Wrap;
+        // (edge: layer_preview_scene's choice, Empty for a storm, else Wrap)
         if (a.has("--edge")) {
             const std::string e = a.get("--edge");
             if (e == "wrap") layer.edge = render::MapEdge::Wrap;
@@ -559,39 +467,19 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
 
     const Box3d bounds = have_voxel ? scene.modeling->bounds() : Box3d{{{0, 0, 0}}, {{1, 1, 1}}};
     render::RenderSettings s = render::preview_settings(bounds, w, h);
-    s.threads = jobs;
     const double aspect = double(w) / h;
     if (have_layer) {
         const auto kind = view.kind == "aerial" ? render::LayerView::Aerial
                           : view.kind == "orbit" ? render::LayerView::Orbit
                                                  : render::LayerView::Ground;
-        s.camera = render::layer_camera(layer, kind, aspect, view.az, view.el);
-        // A daylight sky gradient unless --sky says otherwise.
-        s.sky_colour = {{0.07f, 0.17f, 0.50f}};
-        s.sky_horizon = Vec3f{{0.45f, 0.55f, 0.70f}};
-        s.sun_direction = render::sun_direction(230, 20);
-        // Kilometre-sized clouds are optically thick: a brighter sun over the
-        // same sky keeps their lit sides brighter than the sky, as in photographs.
-        s.sun_colour = {{2.6f, 2.45f, 2.25f}};
-        s.multiple_scattering = 0.8;
+        // The library's 2.5D daylight look and camera preset (the node's too).
+        s = render::layer_preview_settings(layer, w, h, kind, view.az, view.el);
     } else if (have_voxel && (view.kind != "auto" || (a.positional.size() == 1 && is_graph(a.positional[0])))) {
         s.camera = voxel_camera(scene, view, aspect);
     }
-    if (have_voxel && !have_layer && a.positional.size() == 1 && is_graph(a.positional[0])) {
-        // A graph's voxel clouds get the 2.5D mode's daylight: the sky gradient,
-        // a sun bright enough that lit flanks stand out against the sky and
-        // shadowed bases fall below it, low in the south-west (side and back
-        // light show the billows; a sun behind the camera flattens them).
-        s.sky_colour = {{0.07f, 0.17f, 0.50f}};
-        s.sky_horizon = Vec3f{{0.45f, 0.55f, 0.70f}};
-        s.sun_direction = render::sun_direction(230, 25);
-        s.sun_colour = {{2.6f, 2.45f, 2.25f}};
-        // Less multiple scattering and sky ambient than the library defaults
-        // (0.5, 1): shadowed bases fall to grey under the lit tops, as in the
-        // photographs the talks compare with (GPU Pro 7 fig. 4.15).
-        s.multiple_scattering = 0.3;
-        s.ambient_strength = 0.7;
-    }
+    s.threads = jobs;
+    // A graph's voxel clouds get the 2.5D mode's daylight (render::apply_voxel_daylight).
+    if (have_voxel && !have_layer && a.positional.size() == 1 && is_graph(a.positional[0])) render::apply_voxel_daylight(s);
     if (a.has("--camera")) {
         auto v = numbers(a.get("--camera"), 6, "--camera");
         s.camera.position = {{v[0], v[1], v[2]}};
@@ -612,7 +500,7 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
         if (env == "off") layer.envelope = {};
         if (env == "on" && !layer.envelope.cone_map && layer.ndf->width() > 2) {
             const auto t = std::chrono::steady_clock::now();
-            layer.envelope.cone_map = cloud_top_cone_map(*layer.ndf);
+            layer.envelope.cone_map = render::cloud_top_cone_map(*layer.ndf);
             if (!quiet)
                 std::fprintf(stderr, "envelope: cone map over the cloud tops (%dx%d) in %.2f s\n", layer.ndf->width(), layer.ndf->height(),
                              std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count());
@@ -635,7 +523,13 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
         s.sky_colour = {{float(v[0]), float(v[1]), float(v[2])}};
         s.sky_horizon = Vec3f{{float(v[3]), float(v[4]), float(v[5])}};
     }
-    for (const auto& l : a.all("--light")) s.lights.push_back(parse_light(l));
+    for (const auto& l : a.all("--light")) {
+        try {
+            for (const auto& p : render::parse_point_lights(l)) s.lights.push_back(p);
+        } catch (const Error& e) {
+            throw UsageError{std::string("--light: ") + e.what(), "preview"};
+        }
+    }
     const double exposure = a.has("--exposure") ? numbers(a.get("--exposure"), 1, "--exposure")[0] : 1.5;
     apply_physics_options(a, s); // --artistic, --ms-octaves, --light-grid
     if (a.has("--export-scene")) {
@@ -739,8 +633,8 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
                 // and a forecast its next time slice (the envelope follows the slice).
                 layer.time = time0 + i * time_step;
                 if (forecast) {
-                    layer.ndf = weather_map_as_set(forecast_slice(*forecast, (slice0 + i) % forecast->nz()));
-                    if (layer.envelope.cone_map) layer.envelope.cone_map = cloud_top_cone_map(*layer.ndf);
+                    layer.ndf = render::weather_map_as_set(forecast_slice(*forecast, (slice0 + i) % forecast->nz()));
+                    if (layer.envelope.cone_map) layer.envelope.cone_map = render::cloud_top_cone_map(*layer.ndf);
                 }
                 for (auto& f : s.light_fields) f.flash = flash0 + i;
             } else if (have_layer) {

@@ -315,6 +315,9 @@ TEST(LayerAnvil, AnvilMapIsTheStencilsFalloffAndChainsByMax) {
             const double gb = rb < b.radius ? 1 - ndf::smoothstep(b.core * b.radius, b.radius, rb) : 0.0;
             EXPECT_NEAR(first.at(0, x, y), a.anvil * a.blend * ga, 1e-6);
             EXPECT_NEAR(both.at(0, x, y), std::max(a.anvil * a.blend * ga, b.anvil * b.blend * gb), 1e-6);
+            // The lift channel: anvil_lift x the stencil's bias, chained by max.
+            EXPECT_NEAR(first.at(1, x, y), a.anvil_lift * a.anvil * a.blend * ga, 1e-3);
+            EXPECT_NEAR(both.at(1, x, y), std::max(a.anvil_lift * a.anvil * a.blend * ga, b.anvil_lift * b.anvil * b.blend * gb), 1e-3);
             if (rb >= b.radius) {
                 EXPECT_EQ(both.at(0, x, y), first.at(0, x, y)); // beyond the radius: the previous value exactly
             }
@@ -427,4 +430,119 @@ TEST(LayerVortex, RingsTurnTheStormAndAFullTurnIsTheStart) {
     EXPECT_GT(d_half, 0.2);
     const auto f = full.report.active_features();
     EXPECT_NE(std::find(f.begin(), f.end(), "vortex_rings"), f.end());
+}
+
+TEST(LayerAnvil, TheAnvilRisesAboveMaxHeightOnlyWhereTheBiasIsPositiveAndAtMostItsLift) {
+    // Uniform cumulonimbus 1500..4000 m, no noise; an anvil map with bias 1
+    // and lift L on the west half (x < 8 km), 0 on the east. Analytic
+    // expectation: above 4000 m there is density only where the bilinear bias
+    // is > 0, never at or above 4000 + lift(x) there, and the lower part of
+    // the raised band (f = 0.75 of the raised column) is cloudy in the west.
+    LayerScene s = scene_with(0.8, false, 1.0);
+    s.wind = {{0, 0}};
+    s.cloud_top_offset = 0;
+    const double L = 1500;
+    Field2D anvil({{20, 20}}, 2, s.ndf->bounds(), {"anvil_bias", "anvil_lift"});
+    for (int y = 0; y < 20; ++y)
+        for (int x = 0; x < 20; ++x) {
+            const bool west = x < 8;
+            anvil.at(0, x, y) = west ? 1.0f : 0.0f;
+            anvil.at(1, x, y) = west ? float(L) : 0.0f;
+        }
+    const LayerScene plain = s;
+    s.anvil = std::make_shared<const Field2D>(anvil);
+    EXPECT_NEAR(layer_shell(plain).top, 4000, 1e-9);
+    EXPECT_NEAR(layer_shell(s).top, 4000 + L, 1e-9);
+    std::vector<Vec3d> pts;
+    for (int i = 0; i < 40; ++i)
+        for (int k = 0; k < 40; ++k) pts.push_back({{250.0 + 500.0 * i, 10000.0, 4000.0 + 50.0 * k}});
+    // Points given at altitude: |p - C| - R = z at the map centre only, so
+    // place them on the sphere: radial from the Earth's centre.
+    const Vec3d C{{10000, 10000, -kR}};
+    for (Vec3d& p : pts) {
+        const double h = p[2];
+        Vec3d d{{p[0] - C[0], p[1] - C[1], 0 - C[2]}};
+        const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int a = 0; a < 3; ++a) p[a] = C[a] + d[a] / n * (kR + h);
+    }
+    const std::vector<double> d = layer_density(s, pts), d0 = layer_density(plain, pts);
+    int west_cloudy = 0;
+    for (size_t j = 0; j < pts.size(); ++j) {
+        const double x = pts[j][0], h = 4000.0 + 50.0 * double(j % 40);
+        EXPECT_EQ(d0[j], 0.0) << "no anvil: nothing at or above max_height";
+        // Bias of the 20-texel map (1 km texels, centres at 500 + 1000 i), bilinear, clamped.
+        const double u = std::clamp(x / 1000.0 - 0.5, 0.0, 19.0);
+        const int i0 = int(u);
+        const double t = u - i0;
+        const double bias = (i0 < 8 ? 1.0 : 0.0) * (1 - t) + (std::min(i0 + 1, 19) < 8 ? 1.0 : 0.0) * t;
+        if (bias <= 0) {
+            EXPECT_EQ(d[j], 0.0) << "x " << x << " h " << h;
+        }
+        if (h >= 4000 + L * bias) {
+            EXPECT_EQ(d[j], 0.0) << "x " << x << " h " << h;
+        }
+        if (x < 7000 && h > 4000 && h < 4000 + 0.7 * L && d[j] > 0) ++west_cloudy;
+    }
+    EXPECT_GT(west_cloudy, 100);
+    // A map without the lift channel lifts nothing (the old maps' meaning).
+    Field2D bias_only({{20, 20}}, 1, s.ndf->bounds(), {"anvil_bias"});
+    for (float& v : bias_only.channel(0)) v = 1.0f;
+    s.anvil = std::make_shared<const Field2D>(std::move(bias_only));
+    for (double v : layer_density(s, pts)) EXPECT_EQ(v, 0.0);
+}
+
+TEST(LayerVortex, SkewTurnsTheRingPatternByItsAngleTimesTheHeightFraction) {
+    // At time 0 one ring with skew k over the whole map: the layer at
+    // altitude h equals the layer without rings turned by k * phi about the
+    // ring centre, phi = (h - 1500) / (4000 - 1500). Checked at points by
+    // rotating them by hand.
+    LayerScene s = scene_with(0.0);
+    Field2D set = *s.ndf;
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) set.at(ndf::Coverage, x, y) = x < 8 ? 0.9f : 0.15f;
+    s.ndf = std::make_shared<const Field2D>(std::move(set));
+    s.wind = {{0, 0}};
+    s.cloud_top_offset = 0;
+    const LayerScene plain = s;
+    const double k = 1.2;
+    Field2D table({{1, 1}}, 5, Box2d{{{0, 0}}, {{20000, 20000}}}, {"inner", "outer", "speed", "skew", "overlap_end"});
+    table.at(0, 0, 0) = 0;
+    table.at(1, 0, 0) = 5e5;
+    table.at(2, 0, 0) = 0.01f; // no effect at time 0
+    table.at(3, 0, 0) = float(k);
+    table.at(4, 0, 0) = 6e5;
+    s.vortex_table = std::make_shared<const Field2D>(std::move(table));
+    const Vec3d C{{10000, 10000, -kR}};
+    auto on_sphere = [&](double x, double y, double h) {
+        const Vec3d d{{x - C[0], y - C[1], -C[2]}};
+        const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        return Vec3d{{C[0] + d[0] / n * (kR + h), C[1] + d[1] / n * (kR + h), C[2] + d[2] / n * (kR + h)}};
+    };
+    std::vector<Vec3d> pts, turned;
+    for (int a = 0; a < 24; ++a)
+        for (int r = 1; r <= 4; ++r)
+            for (double h : {1700.0, 2500.0, 3300.0}) {
+                const double ang = a * std::numbers::pi / 12, rad = 1500.0 * r;
+                const Vec3d p = on_sphere(10000 + rad * std::cos(ang), 10000 + rad * std::sin(ang), h);
+                pts.push_back(p);
+                // Read where the pattern came from: turned by -k phi about the centre (x, y only).
+                const double phi = (h - 1500) / 2500, c = std::cos(-k * phi), sn = std::sin(-k * phi);
+                const double dx = p[0] - 10000, dy = p[1] - 10000;
+                turned.push_back({{10000 + c * dx - sn * dy, 10000 + sn * dx + c * dy, p[2]}});
+            }
+    const std::vector<double> got = layer_density(s, pts), want = layer_density(plain, turned), unturned = layer_density(plain, pts);
+    double diff = 0, moved = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {
+        EXPECT_NEAR(got[i], want[i], 1e-6) << i;
+        diff = std::max(diff, std::fabs(got[i] - want[i]));
+        moved = std::max(moved, std::fabs(got[i] - unturned[i]));
+    }
+    EXPECT_GT(moved, 0.1) << "the skew must change the layer";
+    // The picture shows it too, and reports the rings.
+    RenderSettings st = small_settings(32, 18);
+    st.camera.position = {{10000, -4000, 9000}};
+    st.camera.look_at = {{10000, 10000, 2000}};
+    const LayerResult r = render_layer(s, st, nullptr);
+    EXPECT_TRUE(r.report.vortex);
+    EXPECT_FALSE(same_bytes(r.image, render_layer(plain, st, nullptr).image));
 }

@@ -1,11 +1,15 @@
 // The render/preview node: cooks through the registry like the evaluator
 // does, on a small NVDF set, and agrees with the library call.
 #include "atlas/graph/node.h"
+#include "atlas/ndf/ndf_set.h"
 #include "atlas/render/image_out.h"
+#include "atlas/render/preview.h"
 #include "atlas/render/renderer.h"
 #include "render_scenes.h"
 
 #include <gtest/gtest.h>
+
+#include <numbers>
 
 using namespace atlas;
 
@@ -47,10 +51,9 @@ TEST(RenderPreviewNode, MatchesLibraryRender) {
     ASSERT_EQ(image->height(), 12);
     ASSERT_EQ(image->channels(), 4);
     ASSERT_EQ(preview->channels(), 3);
-    // Same as the library with the node's defaults (auto camera, sun 60/35).
+    // Same as the library with the node's defaults (auto camera, the preview sun of preview_settings).
     auto scene = render::scene_from_nvdf_set(set);
     auto s = render::preview_settings(set->bounds(), 20, 12);
-    s.sun_direction = render::sun_direction(60, 35);
     auto r = render::render_clouds(scene, s);
     EXPECT_TRUE(r.image == *image);
     EXPECT_TRUE(render::tone_map(r.image, 1.5) == *preview);
@@ -77,7 +80,6 @@ TEST(RenderPreviewNode, LightsSkyAndFlashParamsReachTheRenderer) {
     // The same through the library.
     auto scene = render::scene_from_nvdf_set(set);
     auto s = render::preview_settings(set->bounds(), 20, 12);
-    s.sun_direction = render::sun_direction(60, 35);
     s.sky_horizon = Vec3f{{0.9f, 0.8f, 0.6f}};
     s.lights = {{{{50, 50, 50}}, {{1, 0.5f, 0.2f}}, 2e4, 0}, {{{10, 20, 30}}, {{0, 0, 1}}, 1e3, 40}};
     auto r = render::render_clouds(scene, s);
@@ -91,4 +93,60 @@ TEST(RenderPreviewNode, LightsSkyAndFlashParamsReachTheRenderer) {
     auto plain = std::get<Field2DPtr>(cook({{"size", size}}, {{"nvdf", set}}).at("image"));
     EXPECT_FALSE(*flash == *plain);
     EXPECT_THROW(cook({{"lights", std::string("1 2 3")}}, {{"nvdf", set}}), Error);
+}
+
+TEST(RenderPreviewNode, TheSunDefaultIsThePreviewSunOfTheLibrary) {
+    NodeRegistry reg = builtin_nodes();
+    NodeDeclaration d;
+    reg.find("render/preview")->declare(d);
+    EXPECT_EQ(std::get<double>(d.find_param("sun_azimuth")->default_value), render::kPreviewSunAzimuthDeg);
+    EXPECT_EQ(std::get<double>(d.find_param("sun_elevation")->default_value), render::kPreviewSunElevationDeg);
+    // preview_settings' sun is sun_direction(azimuth, elevation): north-east of
+    // the south-west azimuth 230 means x < 0, y > 0 (0 = from -y, counter-clockwise).
+    const Vec3d sun = render::preview_settings(Box3d{{{0, 0, 0}}, {{1, 1, 1}}}, 4, 4).sun_direction;
+    const double a = render::kPreviewSunAzimuthDeg * std::numbers::pi / 180, e = render::kPreviewSunElevationDeg * std::numbers::pi / 180;
+    EXPECT_NEAR(sun[0], std::cos(e) * std::sin(a), 1e-12);
+    EXPECT_NEAR(sun[1], -std::cos(e) * std::cos(a), 1e-12);
+    EXPECT_NEAR(sun[2], std::sin(e), 1e-12);
+}
+
+TEST(RenderPreviewNode, RendersAnNdfSetIn25DAsTheLibraryEntryDoes) {
+    // A weather map (coverage only) through the node: the library entry
+    // (layer_preview_scene: 1500..4000 m, default LUT; layer_preview_settings)
+    // gives the same bytes, clouds are seen, and a bad map is refused.
+    Field2D map({{8, 8}}, 1, Box2d{{{0, 0}}, {{20000, 20000}}}, {"coverage"});
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) map.at(0, x, y) = (x + y) % 3 == 0 ? 0.9f : 0.4f;
+    auto m = std::make_shared<const Field2D>(map);
+    const std::vector<double> size{24, 14};
+    auto out = cook({{"size", size}, {"view", std::string("orbit")}}, {{"ndf", Field2DPtr(m)}});
+    auto image = std::get<Field2DPtr>(out.at("image"));
+    render::LayerPreviewInputs in;
+    in.ndf = m;
+    const render::LayerScene layer = render::layer_preview_scene(in);
+    render::RenderSettings s = render::layer_preview_settings(layer, 24, 14, render::LayerView::Orbit, 30, 20);
+    auto r = render::render_layer(layer, s);
+    EXPECT_TRUE(r.image == *image);
+    float min_t = 1;
+    for (float v : image->channel(3)) min_t = std::min(min_t, v);
+    EXPECT_LT(min_t, 0.5f);
+    // The set the library made from the map: heights 1500..4000, coverage kept.
+    EXPECT_EQ(layer.ndf->at(layer.ndf->find_channel("max_height"), 3, 3), 4000.0f);
+    EXPECT_EQ(layer.ndf->at(layer.ndf->find_channel("coverage"), 3, 0), map.at(0, 3, 0));
+    Field2D wrong({{4, 4}}, 1, map.bounds(), {"density"});
+    EXPECT_THROW(cook({}, {{"ndf", Field2DPtr(std::make_shared<Field2D>(wrong))}}), Error);
+}
+
+TEST(PointLightSyntax, CommasOrSpacesSemicolonsBetweenLights) {
+    const auto a = render::parse_point_lights("1,2,3,0.5,0.25,1,100; 4 5 6 1 1 1 2e3 50;;");
+    ASSERT_EQ(a.size(), 2u);
+    EXPECT_EQ(a[0].position[2], 3);
+    EXPECT_EQ(a[0].colour[1], 0.25f);
+    EXPECT_EQ(a[0].intensity, 100);
+    EXPECT_EQ(a[0].radius, 0);
+    EXPECT_EQ(a[1].position[0], 4);
+    EXPECT_EQ(a[1].radius, 50);
+    EXPECT_TRUE(render::parse_point_lights("").empty());
+    for (const char* bad : {"1,2,3", "1,2,3,4,5,6,7,8,9", "a,2,3,4,5,6,7", "1,,2,3,4,5,6,7", "1,2,3,4,5,6,nan"})
+        EXPECT_THROW(render::parse_point_lights(bad), Error) << bad;
 }

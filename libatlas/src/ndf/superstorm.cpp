@@ -28,6 +28,7 @@ std::span<const NumberOption<SuperstormStencil>> superstorm_options() {
         {"distortion", &S::distortion, 0, 0.999, "", "radial wobble of the height gradients"},
         {"noise_scale", &S::noise_scale, 1e-6, 1e6, "", "noise cells across the radius"},
         {"anvil", &S::anvil, 0, 1, "", "anvil spread at the centre (the anvil map only)"},
+        {"anvil_lift", &S::anvil_lift, 0, 20000, "m", "how far the anvil rises above max_height at bias 1 (the anvil map only)"},
     };
     return options;
 }
@@ -86,16 +87,23 @@ Field2D superstorm_anvil(const Field2D& set, const SuperstormStencil& s, const F
     if (previous && (previous->resolution() != set.resolution() || previous->channels() < 1))
         throw Error("superstorm: the previous anvil map must have the set's resolution (" + std::to_string(set.width()) + "x" +
                     std::to_string(set.height()) + ") and one channel");
-    Field2D out(set.resolution(), 1, set.bounds(), {"anvil_bias"}, budget);
-    if (previous) std::copy(previous->channel(0).begin(), previous->channel(0).end(), out.channel(0).begin());
+    Field2D out(set.resolution(), 2, set.bounds(), {"anvil_bias", "anvil_lift"}, budget);
+    if (previous) {
+        const int cb = std::max(0, previous->find_channel("anvil_bias")), cl = previous->find_channel("anvil_lift");
+        std::copy(previous->channel(cb).begin(), previous->channel(cb).end(), out.channel(0).begin());
+        if (cl >= 0) std::copy(previous->channel(cl).begin(), previous->channel(cl).end(), out.channel(1).begin());
+    }
     if (s.blend == 0 || s.anvil == 0) return out;
     tbb::parallel_for(0, set.height(), [&](int y) {
         for (int x = 0; x < set.width(); ++x) {
             const double r = length(set.texel_center(x, y) - s.center);
             if (!(r < s.radius)) continue;
             const double w = s.anvil * s.blend * (1.0 - smoothstep(s.core * s.radius, s.radius, r));
-            float& v = out.channel(0)[set.index(x, y)];
+            const size_t i = set.index(x, y);
+            float& v = out.channel(0)[i];
             v = float(std::max(double(v), w));
+            float& l = out.channel(1)[i];
+            l = float(std::max(double(l), s.anvil_lift * w));
         }
     });
     return out;

@@ -457,6 +457,20 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
     return {std::move(image), report};
 }
 
+std::vector<double> layer_density(const LayerScene& scene, const std::vector<Vec3d>& points) {
+    validate_layer_scene(scene);
+    const LayerModel m(scene);
+    std::vector<double> d(points.size(), 0.0);
+    for (size_t i = 0; i < points.size(); ++i) d[i] = m.density(points[i], m.altitude(points[i]), true);
+    return d;
+}
+
+LayerShell layer_shell(const LayerScene& scene) {
+    validate_layer_scene(scene);
+    const LayerModel m(scene);
+    return {m.bottom(), m.top()};
+}
+
 Camera layer_camera(const LayerScene& scene, LayerView view, double aspect, double azimuth_deg, double elevation_deg) {
     validate_layer_scene(scene);
     LayerModel m(scene);

@@ -149,6 +149,7 @@ public:
             any_cloud_ = true;
         }
         if (!any_cloud_) bottom_ = top_ = 0;
+        set_top_ = top_;
         if (ch_precip_) {
             auto p = ndf_.channel(cp);
             precipitation_ = std::any_of(p.begin(), p.end(), [](float v) { return v > 0; });
@@ -171,11 +172,19 @@ public:
             cone_ratio_ = cone_->channel(cr).data();
         }
         if (s.envelope.distance_map) dist_ = s.envelope.distance_map.get();
-        if (s.vortex_table && s.time != 0) {
+        if (s.vortex_table) {
             const Field2D& t = *s.vortex_table;
             const int ci = t.find_channel("inner"), co = t.find_channel("outer"), cs = t.find_channel("speed"), ce = t.find_channel("overlap_end");
-            for (int i = 0; i < t.width(); ++i)
-                rings_.push_back({t.at(ci, i, 0), t.at(co, i, 0), t.at(cs, i, 0), t.at(ce, i, 0)});
+            const int ck = t.find_channel("skew");
+            bool skewed = false;
+            std::vector<Ring> rings;
+            for (int i = 0; i < t.width(); ++i) {
+                const double k = ck >= 0 ? double(t.at(ck, i, 0)) : 0.0;
+                skewed = skewed || k != 0;
+                rings.push_back({t.at(ci, i, 0), t.at(co, i, 0), t.at(cs, i, 0), t.at(ce, i, 0), k});
+            }
+            // At time 0 without skew the rings turn nothing: no rings (same bytes as none).
+            if (s.time != 0 || skewed) rings_ = std::move(rings);
             const Box2d& tb = t.bounds();
             vortex_centre_ = {{0.5 * (tb.min[0] + tb.max[0]), 0.5 * (tb.min[1] + tb.max[1])}};
         }
@@ -189,25 +198,39 @@ public:
                 const Box2d& ab = a.bounds();
                 anvil_origin_ = {{ab.min[0], ab.min[1]}};
                 anvil_inv_ = {{a.width() / (ab.max[0] - ab.min[0]), a.height() / (ab.max[1] - ab.min[1])}};
+                const int cl = a.find_channel("anvil_lift");
+                if (cl >= 0) {
+                    auto lift = a.channel(cl);
+                    double most = 0;
+                    for (size_t i = 0; i < lift.size(); ++i)
+                        if (ch[i] > 0) most = std::max(most, double(lift[i]));
+                    if (most > 0) {
+                        anvil_lift_ch_ = lift.data();
+                        max_lift_ = most;
+                        if (any_cloud_) top_ += most; // the anvil rises above the set's tops, at most this far
+                    }
+                }
             }
         }
     }
     bool has_anvil() const { return anvil_ != nullptr; }
     bool has_vortex() const { return !rings_.empty(); }
 
-    // Vortex rings: the angle (radians) the map turns by at radius r.
-    double vortex_angle(double r) const {
+    // Vortex rings: the angle (radians) the map turns by at radius r and
+    // height fraction phi of the set's shell (skew tilts the tendrils).
+    double vortex_angle(double r, double phi) const {
         const size_t n = rings_.size();
         for (size_t i = 0; i < n; ++i) {
             const Ring& g = rings_[i];
             if (r < g.inner) break;
-            const double a = g.speed * s_.time;
+            const double a = g.speed * s_.time + g.skew * phi;
             if (r < g.outer) {
                 // Inside ring i: the previous ring's overlap band reaches in.
                 if (i > 0 && r < rings_[i - 1].overlap_end) {
                     const Ring& pr = rings_[i - 1];
                     const double w = (r - pr.outer) / std::max(1e-9, pr.overlap_end - pr.outer);
-                    return pr.speed * s_.time + (a - pr.speed * s_.time) * w;
+                    const double ap = pr.speed * s_.time + pr.skew * phi;
+                    return ap + (a - ap) * w;
                 }
                 return a;
             }
@@ -215,10 +238,11 @@ public:
         }
         return 0;
     }
-    // p with its x, y turned about the vortex centre by -angle(r).
-    Vec3d unrotate(const Vec3d& p) const {
+    // p (altitude h) with its x, y turned about the vortex centre by -angle(r, phi).
+    Vec3d unrotate(const Vec3d& p, double h) const {
         const double dx = p[0] - vortex_centre_[0], dy = p[1] - vortex_centre_[1];
-        const double a = -vortex_angle(std::hypot(dx, dy));
+        const double phi = set_top_ > bottom_ ? detail::saturate((h - bottom_) / (set_top_ - bottom_)) : 0.0;
+        const double a = -vortex_angle(std::hypot(dx, dy), phi);
         if (a == 0) return p;
         const double c = std::cos(a), sn = std::sin(a);
         return {{vortex_centre_[0] + c * dx - sn * dy, vortex_centre_[1] + sn * dx + c * dy, p[2]}};
@@ -233,7 +257,7 @@ public:
     bool has_detail() const { return detail_.ok(); }
     bool has_curl() const { return curl_ != nullptr; }
     bool has_cone() const { return cone_ != nullptr; }
-    bool has_distance() const { return dist_ != nullptr; }
+    bool has_distance() const { return dist_ != nullptr && max_lift_ == 0; } // a lifted anvil is not in the distance map
 
     double altitude(const Vec3d& p) const { return length(p - centre_) - s_.earth_radius; }
 
@@ -304,17 +328,23 @@ public:
     // (HZD's "cheap" sample). shape_out: the base shape with coverage (the
     // sample's profile for ambient and multiple scattering).
     double density(const Vec3d& p_in, double h, bool full, Column* col_out = nullptr, double* shape_out = nullptr) const {
-        const Vec3d p = rings_.empty() ? p_in : unrotate(p_in);
+        const Vec3d p = rings_.empty() ? p_in : unrotate(p_in, h);
         Column c;
         if (!column(p[0], p[1], c)) return 0;
-        if (h <= c.min_h || h >= c.max_h) return 0;
-        const double f = (h - c.min_h) / (c.max_h - c.min_h);
-        if (anvil_ && f > 0.7) {
-            // HZD's anvil bias: the top of the column spreads.
+        if (h <= c.min_h) return 0;
+        double bias = 0;
+        if (anvil_ && (h > c.min_h + 0.7 * (c.max_h - c.min_h) || h >= c.max_h)) {
             Bilinear b;
             axis_clamp((p[0] - map_shift_[0] - anvil_origin_[0]) * anvil_inv_[0], anvil_->width(), b.x0, b.x1, b.tx);
             axis_clamp((p[1] - map_shift_[1] - anvil_origin_[1]) * anvil_inv_[1], anvil_->height(), b.y0, b.y1, b.ty);
-            const double bias = detail::saturate(lerp2(anvil_ch_, anvil_->width(), b));
+            bias = detail::saturate(lerp2(anvil_ch_, anvil_->width(), b));
+            // The anvil rises: where bias > 0 the column's top is max_height + lift.
+            if (anvil_lift_ch_ && bias > 0) c.max_h += std::max(0.0f, lerp2(anvil_lift_ch_, anvil_->width(), b));
+        }
+        if (h >= c.max_h) return 0;
+        const double f = (h - c.min_h) / (c.max_h - c.min_h);
+        if (bias > 0 && f > 0.7) {
+            // HZD's anvil bias: the top of the column spreads.
             c.coverage = std::pow(c.coverage, detail::remap(f, 0.7, 0.8, 1.0, 1.0 - 0.5 * bias));
         }
         const double profile = profile_split(lut_, lut_bottom_, lut_top_, c.bottom_type, c.top_type, f);
@@ -380,7 +410,8 @@ public:
             Bilinear b;
             axis_clamp(u * cone_->width(), cone_->width(), b.x0, b.x1, b.tx);
             axis_clamp(v * cone_->height(), cone_->height(), b.y0, b.y1, b.ty);
-            const double apex = lerp2(cone_apex_, cone_->width(), b), c = lerp2(cone_ratio_, cone_->width(), b);
+            // A lifted anvil raises every top by at most max_lift_: so are the apexes.
+            const double apex = lerp2(cone_apex_, cone_->width(), b) + max_lift_, c = lerp2(cone_ratio_, cone_->width(), b);
             if (h > apex && c > 0) {
                 const double hl = std::hypot(d[0], d[1]);
                 const double denom = hl - c * d[2];
@@ -423,7 +454,7 @@ private:
     std::vector<std::array<float, 8>> texels_;
     Vec2d origin_, size_, inv_texel_;
     Vec3d centre_;
-    double bottom_ = 0, top_ = 0;
+    double bottom_ = 0, top_ = 0, set_top_ = 0; // set_top_: without the anvil's lift
     bool any_cloud_ = false, precipitation_ = false;
     Noise3 base_, detail_;
     const Field2D* curl_ = nullptr;
@@ -437,12 +468,14 @@ private:
     bool equalised_ = false;
     double base_max_ = 1; // largest dilated base value (1 without noise)
     struct Ring {
-        double inner, outer, speed, overlap_end;
+        double inner, outer, speed, overlap_end, skew;
     };
     std::vector<Ring> rings_;
     Vec2d vortex_centre_{{0, 0}};
     const Field2D* anvil_ = nullptr;
     const float* anvil_ch_ = nullptr;
+    const float* anvil_lift_ch_ = nullptr;
+    double max_lift_ = 0;
     Vec2d anvil_origin_{{0, 0}}, anvil_inv_{{1, 1}};
 };
 

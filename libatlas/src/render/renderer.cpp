@@ -308,6 +308,7 @@ RenderSettings preview_settings(const Box3d& bounds, int width, int height) {
     s.width = width;
     s.height = height;
     s.camera = framing_camera(bounds, double(width) / double(height));
+    s.sun_direction = sun_direction(kPreviewSunAzimuthDeg, kPreviewSunElevationDeg); // the preview's sun (renderer.h)
     return s;
 }
 

@@ -43,6 +43,10 @@ struct SuperstormStencil {
     // Anvil: how far the storm's top spreads out ([0,1]); written to the
     // separate anvil map (superstorm_anvil), not to the 8-channel set.
     double anvil = 1.0;
+    // Anvil lift: metres the anvil may rise above the set's max_height where
+    // the anvil map's bias is 1 (lift = anvil_lift * bias, so 0 where the
+    // bias is 0); [0, 20000] m. The anvil map only.
+    double anvil_lift = 1500;
 };
 
 // The numeric options' schema (ranges, units, docs; defaults are the struct's):
@@ -58,20 +62,25 @@ bool stencil_touches(const SuperstormStencil& s, const Box2d& bounds);
 // The stencil applied to an NDF set (see the formulas above).
 Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const MemoryBudget* budget);
 
-// The anvil map of a stencil: one channel "anvil_bias" over the set's grid,
-// max(previous, anvil * blend * g(r)) (previous: `previous`'s value, or 0
-// when null; it must match the set's resolution). A renderer spreads the
-// cloud top with it, as Horizon Zero Dawn's anvil bias does: in the upper
-// part of a column the coverage becomes coverage^e, e = remap(f, 0.7, 0.8,
-// 1, lerp(1, 0.5, anvil_bias)) (f the height fraction; atlas/render/layer.h).
-// Beyond the radius the previous value is kept exactly.
+// The anvil map of a stencil: channels "anvil_bias" and "anvil_lift" (m)
+// over the set's grid, bias = max(previous, anvil * blend * g(r)) and lift =
+// max(previous lift, anvil_lift * anvil * blend * g(r)) (previous:
+// `previous`'s values, or 0 when null or when it lacks the lift channel; it
+// must match the set's resolution). A renderer spreads the cloud top with
+// it, as Horizon Zero Dawn's anvil bias does: the column's top rises to
+// max_height + lift, and in the upper part of the column the coverage becomes
+// coverage^e, e = remap(f, 0.7, 0.8, 1, lerp(1, 0.5, anvil_bias)) (f the
+// height fraction; atlas/render/layer.h). Beyond the radius the previous
+// values are kept exactly.
 Field2D superstorm_anvil(const Field2D& set, const SuperstormStencil& s, const Field2D* previous, const MemoryBudget* budget);
 
 // One vortex ring: an annulus [inner, outer] metres around the centre.
 struct VortexRing {
     double inner, outer;  // metres, 0 <= inner < outer
     double speed;         // rotation, radians per second (falls outward)
-    double skew;          // radians: tilt of the ring's spiral tendrils
+    double skew;          // radians: tilt of the ring's spiral tendrils: the 2.5D
+                          // renderer turns the ring's pattern by a further skew * phi at
+                          // height fraction phi of the layer (0 base, 1 top; layer.h)
 };
 // N rings over [0, radius] (outer radii `radii`, strictly increasing, or
 // evenly spaced when empty), each extended by `overlap` * its width into the

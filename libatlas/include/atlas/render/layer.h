@@ -107,19 +107,42 @@ struct LayerScene {
     double haze_distance = 90000;
     LayerEnvelope envelope;
     std::vector<SkyLayer> sky_layers;
-    // Optional anvil map (ndf/superstorm's `anvil` output): channel
-    // "anvil_bias" (else 0) in [0, 1] over its own bounds (read bilinearly,
-    // clamped, with the map's wind scroll). HZD's anvil: in the top of a column
-    // coverage becomes coverage^e, e = remap(f, 0.7, 0.8, 1, lerp(1, 0.5, bias)).
+    // Optional anvil map (ndf/superstorm_anvil's output): channel
+    // "anvil_bias" (else 0) in [0, 1] and optional "anvil_lift" (metres, >= 0)
+    // over its own bounds (read bilinearly, clamped, with the map's wind
+    // scroll). The anvil rises above the set: where bias > 0 a column's top is
+    // max_height + lift (f is measured over the raised column, and the shell's
+    // top is the set's highest top plus the map's largest lift), so cloud
+    // exists above the set's max_height only where bias > 0 and at most `lift`
+    // metres above it. HZD's anvil: in the top of a column coverage becomes
+    // coverage^e, e = remap(f, 0.7, 0.8, 1, lerp(1, 0.5, bias)). With a lift,
+    // the distance map is not used (it describes the unraised columns); the
+    // cone map's apexes are raised by the largest lift.
     Field2DPtr anvil;
     // Optional vortex rings (ndf/vortex_rings' `table`: N x 1 texels with
-    // channels inner, outer (m), speed (rad/s), overlap_end (m); bounds =
-    // centre +- radius). At `time` the map and the noise are read rotated by
-    // -speed_i * time about the centre inside ring i; in ring i's overlap band
-    // [outer_i, overlap_end_i] the angle blends linearly to ring i+1's (past
-    // the last ring, to 0), so the storm turns, faster inside.
+    // channels inner, outer (m), speed (rad/s), overlap_end (m), optional skew
+    // (rad); bounds = centre +- radius). At `time` and altitude h the map and
+    // the noise are read rotated by -(speed_i * time + skew_i * phi) about the
+    // centre inside ring i, phi = saturate((h - bottom) / (top - bottom)) over
+    // the shell of the set (anvil lift not counted): the ring's tendrils tilt,
+    // its pattern turning by skew_i from the layer's base to its top. In ring
+    // i's overlap band [outer_i, overlap_end_i] the angle blends linearly to
+    // ring i+1's (past the last ring, to 0), so the storm turns, faster inside.
     Field2DPtr vortex_table;
 };
+
+// The layer's density model at world points: what render_layer marches (full
+// samples: profile, coverage, base noise, detail erosion, wind, anvil, vortex
+// rings), for tests and tools. Validates the scene (throws as
+// validate_layer_scene). Thread-safe, deterministic.
+std::vector<double> layer_density(const LayerScene& scene, const std::vector<Vec3d>& points);
+// The altitude range [bottom, top] (metres) of the cloud shell render_layer
+// marches: the lowest min_height and highest max_height over texels with
+// coverage > 0 and max > min, the top raised by the anvil map's largest lift.
+struct LayerShell {
+    double bottom = 0, top = 0;
+};
+LayerShell layer_shell(const LayerScene& scene);
 
 // Throws atlas::Error naming the problem (null fields, missing channels,
 // non-finite values: "channel 'coverage' holds NaN at texel (x, y)", bad
@@ -139,7 +162,7 @@ struct LayerReport {
     bool wind = false;            // non-zero wind or top offset
     bool precipitation = false;   // some precipitation > 0
     bool anvil = false;           // an anvil map with some bias > 0
-    bool vortex = false;          // vortex rings turn the storm (table given and time != 0)
+    bool vortex = false;          // vortex rings turn the storm (table given, time != 0 or some skew != 0)
     int sky_layers = 0;
     int point_lights = 0;         // lights integrated (given + flashes)
     bool sky_gradient = false;

@@ -133,9 +133,19 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
 
 namespace atlas::render {
 
+// The preview's sun (degrees, sun_direction's convention: azimuth 0 = from
+// -y, counter-clockwise; elevation above the horizon): low in the south-west,
+// so side and back light show the billows. preview_settings(), the preview
+// looks of atlas/render/preview.h (the CLI) and the render/preview node's
+// sun_azimuth / sun_elevation defaults all use it (docs/DECISIONS.md,
+// 2026-12-02). RenderSettings' own default direction is unchanged.
+inline constexpr double kPreviewSunAzimuthDeg = 230;
+inline constexpr double kPreviewSunElevationDeg = 25;
+
 // Settings for a w x h preview of a volume with these bounds: the default
-// framing camera (framing_camera with its defaults), the default sun and
-// sky, fast mode. Throws atlas::Error on a non-positive size.
+// framing camera (framing_camera with its defaults), the preview sun
+// (kPreviewSun*), the default sky, fast mode. Throws atlas::Error on a
+// non-positive size.
 RenderSettings preview_settings(const Box3d& bounds, int width, int height);
 
 // The density the voxel renderer sees (after the noise up-rez, without the

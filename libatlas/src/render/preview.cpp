@@ -1,0 +1,171 @@
+// One preview for any graph (atlas/render/preview.h): the 2.5D scene, the
+// daylight looks and the point-light syntax shared by the CLI and the node.
+#include "atlas/render/preview.h"
+
+#include "atlas/core/error.h"
+#include "atlas/ndf/cone_map.h"
+#include "atlas/ndf/vertical_profile.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+namespace atlas::render {
+
+bool is_ndf_set(const Field2D& f) {
+    return f.find_channel("coverage") >= 0 && f.find_channel("min_height") >= 0 && f.find_channel("max_height") >= 0;
+}
+
+bool is_weather_map(const Field2D& f) { return f.find_channel("coverage") >= 0 && !is_ndf_set(f) && f.find_channel("cumulus") < 0; }
+
+Field2DPtr weather_map_as_set(const Field2D& m) {
+    std::vector<std::string> names{"coverage", "type", "precipitation", "min_height", "max_height"};
+    Field2D f(m.resolution(), int(names.size()), m.bounds(), names);
+    const int ct = m.find_channel("type"), cp = m.find_channel("precipitation"), cc = m.find_channel("coverage");
+    if (cc < 0) throw Error("render (2.5D): a weather map needs a 'coverage' channel");
+    for (int y = 0; y < m.height(); ++y)
+        for (int x = 0; x < m.width(); ++x) {
+            f.at(0, x, y) = m.at(cc, x, y);
+            f.at(1, x, y) = ct >= 0 ? m.at(ct, x, y) : 0.5f;
+            f.at(2, x, y) = cp >= 0 ? m.at(cp, x, y) : 0.0f;
+            f.at(3, x, y) = 1500;
+            f.at(4, x, y) = 4000;
+        }
+    return std::make_shared<const Field2D>(std::move(f));
+}
+
+SkyLayer sky_layer_from(Field2DPtr tex, int channel, double altitude, double tile, double opacity) {
+    if (!tex || channel < 0 || channel >= tex->channels()) throw Error("render (2.5D): sky layer texture missing or channel out of range");
+    SkyLayer l;
+    l.texture = tex;
+    l.channel = channel;
+    l.altitude = altitude;
+    l.tile = tile;
+    l.opacity = opacity;
+    auto ch = tex->channel(channel);
+    double sum = 0, sq = 0;
+    for (float v : ch) sum += v, sq += double(v) * v;
+    const double n = double(ch.size()), mean = sum / n, sd = std::sqrt(std::max(0.0, sq / n - mean * mean));
+    l.value_min = mean;
+    l.value_max = mean + 2 * std::max(sd, 1e-6);
+    l.wind = {{3, 1}};
+    return l;
+}
+
+LayerScene layer_preview_scene(const LayerPreviewInputs& in) {
+    LayerScene layer;
+    if (in.ndf) layer.ndf = is_ndf_set(*in.ndf) ? in.ndf : weather_map_as_set(*in.ndf);
+    else {
+        // Only 2D layers: an empty cloud layer under them.
+        Field2D empty({{2, 2}}, 3, Box2d{{{0, 0}}, {{40000, 40000}}}, {"coverage", "min_height", "max_height"});
+        for (int y = 0; y < 2; ++y)
+            for (int x = 0; x < 2; ++x) empty.at(1, x, y) = 1500, empty.at(2, x, y) = 4000;
+        layer.ndf = std::make_shared<const Field2D>(std::move(empty));
+    }
+    layer.profile_lut = in.profile_lut ? in.profile_lut
+                                       : std::make_shared<const Field2D>(ndf::build_profile_lut(ndf::VerticalProfile{}, 97, 128, nullptr));
+    layer.base_noise = in.base_noise;
+    layer.detail_noise = in.detail_noise;
+    layer.curl = in.curl;
+    layer.envelope.cone_map = in.cone_map;
+    layer.envelope.distance_map = in.distance_map;
+    layer.anvil = in.anvil;
+    layer.vortex_table = in.vortex_table;
+    auto tile_of = [](const Field2D& f) {
+        const double sx = f.bounds().max[0] - f.bounds().min[0];
+        return sx > 100 ? sx : 20000.0; // unit-box textures: 20 km per tile
+    };
+    if (in.cirrus) {
+        const int c = in.cirrus->find_channel("cirrus");
+        layer.sky_layers.push_back(sky_layer_from(in.cirrus, c >= 0 ? c : 0, 8000, tile_of(*in.cirrus), 0.8));
+    }
+    if (in.sky_texture) layer.sky_layers.push_back(sky_layer_from(in.sky_texture, 0, 6000, tile_of(*in.sky_texture), 0.9));
+    // A storm is one feature: no copies of it beyond the map. Weather maps tile.
+    const int cs = layer.ndf->find_channel("superstorm_coverage");
+    bool storm = false;
+    if (cs >= 0)
+        for (float v : layer.ndf->channel(cs)) storm = storm || v > 0;
+    layer.edge = storm ? MapEdge::Empty : MapEdge::Wrap;
+    validate_layer_scene(layer);
+    return layer;
+}
+
+Field2DPtr cloud_top_cone_map(const Field2D& set) {
+    const int cc = set.find_channel("coverage"), cm = set.find_channel("max_height");
+    if (cc < 0 || cm < 0) throw Error("render (2.5D): the cone map needs an NDF set with coverage and max_height");
+    const int w = set.width(), h = set.height();
+    const int k = std::max(1, (std::max(w, h) + 127) / 128);
+    const int pw = (w + k - 1) / k, ph = (h + k - 1) / k;
+    Field2D pooled({{pw, ph}}, 1, set.bounds(), {"top"});
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            if (set.at(cc, x, y) > 0) pooled.at(0, x / k, y / k) = std::max(pooled.at(0, x / k, y / k), set.at(cm, x, y));
+    Field2D tops({{pw, ph}}, 1, set.bounds(), {"top"});
+    for (int y = 0; y < ph; ++y)
+        for (int x = 0; x < pw; ++x) {
+            float top = 0;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) top = std::max(top, pooled.at(0, std::clamp(x + dx, 0, pw - 1), std::clamp(y + dy, 0, ph - 1)));
+            tops.at(0, x, y) = top;
+        }
+    ndf::ConeMapOptions o;
+    o.robust = true;
+    o.texel_size = std::min((set.bounds().max[0] - set.bounds().min[0]) / pw, (set.bounds().max[1] - set.bounds().min[1]) / ph);
+    return std::make_shared<const Field2D>(ndf::cone_map(tops, 0, o, nullptr));
+}
+
+namespace {
+void daylight(RenderSettings& s) {
+    s.sky_colour = {{0.07f, 0.17f, 0.50f}};
+    s.sky_horizon = Vec3f{{0.45f, 0.55f, 0.70f}};
+    s.sun_direction = sun_direction(kPreviewSunAzimuthDeg, kPreviewSunElevationDeg);
+    s.sun_colour = {{2.6f, 2.45f, 2.25f}};
+}
+} // namespace
+
+RenderSettings layer_preview_settings(const LayerScene& scene, int width, int height, LayerView view, double azimuth_deg, double elevation_deg) {
+    RenderSettings s = preview_settings(Box3d{{{0, 0, 0}}, {{1, 1, 1}}}, width, height);
+    s.camera = layer_camera(scene, view, double(width) / height, azimuth_deg, elevation_deg);
+    daylight(s);
+    s.multiple_scattering = 0.8;
+    return s;
+}
+
+void apply_voxel_daylight(RenderSettings& s) {
+    daylight(s);
+    s.multiple_scattering = 0.3;
+    s.ambient_strength = 0.7;
+}
+
+std::vector<PointLight> parse_point_lights(const std::string& text) {
+    std::vector<PointLight> lights;
+    std::stringstream all(text);
+    for (std::string item; std::getline(all, item, ';');) {
+        std::string spaced = item;
+        std::replace(spaced.begin(), spaced.end(), ',', ' ');
+        std::stringstream one(spaced);
+        std::vector<double> v;
+        bool ok = true;
+        for (std::string t; one >> t;) {
+            char* end = nullptr;
+            v.push_back(std::strtod(t.c_str(), &end));
+            ok = ok && end != t.c_str() && *end == '\0' && std::isfinite(v.back());
+        }
+        // Two commas in a row leave an empty number: not a light.
+        ok = ok && item.find(",,") == std::string::npos;
+        if (v.empty() && ok) continue;
+        if (!ok || (v.size() != 7 && v.size() != 8))
+            throw Error("lights: expected 'X,Y,Z,R,G,B,INTENSITY[,RADIUS]' (7 or 8 finite numbers, commas or spaces) per light, lights separated by ';', got '" +
+                        item + "'");
+        PointLight l;
+        l.position = {{v[0], v[1], v[2]}};
+        l.colour = {{float(v[3]), float(v[4]), float(v[5])}};
+        l.intensity = v[6];
+        l.radius = v.size() == 8 ? v[7] : 0.0;
+        lights.push_back(l);
+    }
+    return lights;
+}
+
+} // namespace atlas::render
