@@ -197,3 +197,47 @@ if tile == '1,0':
     assert not (out / "tiles" / "index.json").exists()
     assert not (out / "tiles" / "1_0.json").exists()
     assert not (out / "density.exr").exists()
+
+
+def test_cli_tiled_report(tmp_path):
+    # `atlas cook --tiles --report`: every tile with its status, times, memory and
+    # files, whose sizes and SHA-256 (hashlib, not atlas) are those on disk.
+    out = tmp_path / "out"
+    r = subprocess.run([ATLAS, "cook", str(WORLD), "--tiles", "2,2", "--assemble", "--out", str(out), "--quiet",
+                        "--report", str(tmp_path / "r.json")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    doc = json.loads((tmp_path / "r.json").read_text())
+    assert doc["status"] == "ok" and doc["tiled"]["tiles"] == [2, 2] and doc["tiled"]["grid"] == [48, 32]
+    assert [t["tile"] for t in doc["tiles"]] == [[0, 0], [1, 0], [0, 1], [1, 1]]
+    assert doc["summary"]["cooked"] == 4 and doc["index"].endswith("tiles/index.json")
+    assert len(doc["assembled"]) >= 16
+    for t in doc["tiles"]:
+        assert t["status"] == "cooked" and t["seconds"] > 0 and t["value_bytes_peak"] > 0
+        assert t["rss_peak_bytes"] >= t["value_bytes_peak"]
+        for f in t["files"]:
+            data = (out / f["path"]).read_bytes()
+            assert len(data) == f["bytes"] and hashlib.sha256(data).hexdigest() == f["sha256"], f["path"]
+
+    # Tile 1,0 fails (warp values above 1 on the right of the map, beyond the halo):
+    # exit 1, and the report has tile 0,0 cooked and tile 1,0 failed with the reason.
+    g = tmp_path / "fails.yaml"
+    g.write_text("""atlas: 1
+nodes:
+  a: { type: ndf/noise, params: { resolution: [64, 16], bounds_max: [6400, 1600] } }
+  ramp: { type: ndf/gradient, params: { resolution: [64, 16], bounds_max: [6400, 1600], start: [0, 0], end: [6400, 0] } }
+  push: { type: math/remap, inputs: { in: ramp }, params: { out_max: 1.2, clamp: false } }
+  w: { type: ndf/warp, inputs: { in: a, warp: push }, params: { amount: 100, tileable: false } }
+outputs:
+  - { node: w, file: w.exr }
+""")
+    bad = tmp_path / "bad"
+    r = subprocess.run([ATLAS, "cook", str(g), "--tiles", "2,1", "--out", str(bad), "--quiet", "--report", str(tmp_path / "f.json")],
+                       capture_output=True, text=True)
+    assert r.returncode == 1, r.stderr
+    assert "tile 1,0: " in r.stderr and "outside [0, 1]" in r.stderr, r.stderr
+    doc = json.loads((tmp_path / "f.json").read_text())
+    assert doc["status"] == "failed" and doc["error"]["tile"] == [1, 0]
+    assert [(t["tile"], t["status"]) for t in doc["tiles"]] == [([0, 0], "cooked"), ([1, 0], "failed")]
+    assert "node 'w' (ndf/warp)" in doc["tiles"][1]["error"] and doc["tiles"][1]["files"] == []
+    assert doc["summary"]["failed"] == 1 and "index" not in doc
+    assert not (bad / "tiles" / "1_0.json").exists() and (bad / "tiles" / "0_0.json").exists()

@@ -584,7 +584,10 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
                 } catch (const CancelledError&) {
                     throw;
                 } catch (const std::exception& e) {
-                    const std::string msg = e.what();
+                    std::string msg = e.what();
+                    // CookContext::fail already names the node: name it once, with its place.
+                    const std::string own = "node '" + n->name + "' (" + n->type + "): ";
+                    if (msg.rfind(own, 0) == 0) msg.erase(0, own.size());
                     throw Error(node_label(*n) + ": " + msg);
                 }
                 {
