@@ -2,6 +2,7 @@
 #include "atlas/compress/bc4.h"
 
 #include "test_blocks.h"
+#include "../../libatlas/src/compress/bc4_eval.h" // internal: the fast / normal evaluation paths
 
 #include <gtest/gtest.h>
 
@@ -61,6 +62,100 @@ void run_random(bool snorm, bool one_sided, Quality q, DecoderSet set, int block
         under += r.sum_sq;
     }
     (void)under;
+}
+
+// fast / normal assemble each candidate palette from per-entry tables (a few KB) instead
+// of the 65,536-pair table: the same floats for every pair, mode, decoder set, UNORM / SNORM.
+TEST(Bc4Eval, EntryTablesEqualPairTables) {
+    for (bool snorm : {false, true})
+        for (DecoderSet set : {kReferenceOnly, kAllDecoders, decoder_bit(Decoder::Tool8) | decoder_bit(Decoder::Tool8Round),
+                               decoder_bit(Decoder::Conformant)})
+            EXPECT_EQ(detail::bc4_entry_table_mismatches(snorm, set), 0) << "snorm " << snorm << " set " << set;
+}
+
+// A palette of 8 random intervals (lo <= ref <= hi), sorted or not, wide or a few ulps.
+void random_palette(uint64_t k, detail::Palette<1>& p) {
+    p.n = 8;
+    const bool narrow = k % 3 != 0, sorted = k % 2 == 0;
+    for (int i = 0; i < 8; ++i) {
+        float c = float(test::unit(k, 100 + uint64_t(i)));
+        if (sorted) c = float((i + test::unit(k, 100 + uint64_t(i))) / 8.0);
+        const float w = narrow ? c * 1e-7f * float(i % 3) : float(test::unit(k, 200 + uint64_t(i))) * (2.0f / 255.0f);
+        p.lo[i][0] = c - w;
+        p.hi[i][0] = c + w;
+        p.ref[i][0] = c;
+    }
+    if (k % 5 == 0) { p.lo[6][0] = p.hi[6][0] = p.ref[6][0] = 0.0f; p.lo[7][0] = p.hi[7][0] = p.ref[7][0] = 1.0f; }
+}
+
+template <bool OS>
+void expect_paths_equal(const detail::Palette<1>& p, const float* src, float stop, uint64_t k) {
+    detail::Bc4Keys a, b;
+    const bool ra = detail::bc4_keys_portable<OS>(p, src, stop, a);
+#if defined(__SSE2__)
+    const bool rb = detail::bc4_keys_sse2<OS>(p, src, stop, b);
+#else
+    const bool rb = detail::bc4_keys_portable<OS>(p, src, stop, b);
+#endif
+    ASSERT_EQ(ra, rb) << "case " << k;
+#if defined(ATLAS_BC4_AVX2)
+    if (detail::bc4_cpu_has_avx2()) {
+        detail::Bc4Keys c;
+        ASSERT_EQ(detail::bc4_keys_avx2<OS>(p, src, stop, c), ra) << "case " << k;
+        if (ra) {
+            ASSERT_EQ(std::memcmp(&a.max_err, &c.max_err, 4), 0) << "case " << k;
+            ASSERT_EQ(std::memcmp(&a.sum, &c.sum, 4), 0) << "case " << k;
+            ASSERT_EQ(std::memcmp(a.key, c.key, sizeof a.key), 0) << "case " << k;
+            float m0, m1;
+            double q0, q1;
+            uint8_t i0[16], i1[16];
+            detail::bc4_exact_portable<OS>(p, src, a, m0, q0, i0);
+            detail::bc4_exact_avx2(p, src, a, m1, q1, i1);
+            ASSERT_EQ(std::memcmp(&m0, &m1, 4), 0) << "case " << k;
+            ASSERT_EQ(std::memcmp(&q0, &q1, 8), 0) << "case " << k;
+            ASSERT_EQ(std::memcmp(i0, i1, 16), 0) << "case " << k;
+        }
+    }
+#endif
+    bool all_same = true;
+    for (int t = 1; t < 16; ++t) all_same = all_same && std::memcmp(&src[t], &src[0], 4) == 0;
+    if (all_same) {
+        detail::Bc4Keys f;
+        ASSERT_EQ(detail::bc4_keys_flat<OS>(p, src, stop, f), ra) << "case " << k;
+        if (ra) {
+            ASSERT_EQ(std::memcmp(&a.max_err, &f.max_err, 4), 0) << "case " << k;
+            ASSERT_EQ(std::memcmp(&a.sum, &f.sum, 4), 0) << "case " << k;
+            ASSERT_EQ(std::memcmp(a.key, f.key, sizeof a.key), 0) << "case " << k;
+        }
+    }
+    if (!ra) return;
+    ASSERT_EQ(std::memcmp(&a.max_err, &b.max_err, 4), 0) << "case " << k;
+    ASSERT_EQ(std::memcmp(&a.sum, &b.sum, 4), 0) << "case " << k;
+    ASSERT_EQ(std::memcmp(a.key, b.key, sizeof a.key), 0) << "case " << k;
+    // Each texel's key is its least error (to the 3 dropped bits) and names its entry.
+    for (int t = 0; t < 16; ++t) {
+        float best = INFINITY;
+        for (int i = 0; i < 8; ++i) best = std::min(best, detail::entry_error_t<1, OS>(p, i, src + t));
+        const int i = int(a.key[t] & 7u);
+        const float e = detail::entry_error_t<1, OS>(p, i, src + t);
+        ASSERT_LE(detail::bc4_key_error(a.key[t]), e) << "case " << k;
+        ASSERT_LE(e, best * (1.0f + 1e-6f)) << "case " << k << " texel " << t;
+    }
+}
+
+// The SSE2, AVX2 (where the CPU has it) and flat-block (16 equal texels) key evaluations
+// return the same keys, maxima and sums as the portable one, and the AVX2 exact pass the
+// same errors, squared errors and indices.
+TEST(Bc4Eval, Sse2EqualsPortable) {
+    for (uint64_t k = 0; k < uint64_t(test::kRandomBlocks / 10); ++k) {
+        detail::Palette<1> p;
+        random_palette(k, p);
+        float src[16];
+        test::scalar_block(k, 0.0f, 1.0f, src);
+        const float stop = k % 4 == 0 ? float(test::unit(k, 7)) * 0.05f : detail::kBc4Infeasible;
+        expect_paths_equal<false>(p, src, stop, k);
+        expect_paths_equal<true>(p, src, stop, k);
+    }
 }
 
 TEST(Bc4, RandomBlocksUnormAllDecoders) { run_random(false, false, Quality::Normal, kAllDecoders, kRandomBlocks); }

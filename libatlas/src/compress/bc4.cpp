@@ -1,6 +1,7 @@
 // BC4 decoding under each decoder model, and the endpoint search.
 #include "atlas/compress/bc4.h"
 
+#include "bc4_eval.h"
 #include "palette_search.h"
 
 #include <algorithm>
@@ -185,15 +186,22 @@ struct PairTables {
     // lower) / steps of its mode, over every pair.
     float val[256];
     double slack[2] = {-1, -1}; // [0]: 8-value mode, [1]: 6-value mode (may be < 0)
+    // Every palette entry's interval depends only on its numerator: an endpoint on its
+    // byte, an interpolated entry of mode m (0: 8 values, steps 7; 1: 6 values, steps 5)
+    // on num = (steps - 1 - k) e0 + (k + 1) e1. These tables (a few KB, cache resident)
+    // hold the same floats as `pal` and build fast/normal's candidate palettes, which
+    // would otherwise be an L3 or memory miss per candidate.
+    float end_lo[256], end_hi[256], end_ref[256];
+    std::vector<float> num_lo[2], num_hi[2], num_ref[2];
+    int num_base[2] = {0, 0}; // index = num - num_base
+    bool avx2 = false;        // fast / normal evaluate with AVX2 (same results, bc4_eval.h)
 };
 } // namespace
 
 struct Bc4Encoder::Tables : PairTables {};
 
-Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
-    : snorm_(snorm), options_(options), tables_(std::make_unique<Tables>()) {
-    if (options_.decoders == 0) options_.decoders = kReferenceOnly;
-    Tables& T = *tables_;
+namespace {
+void build_tables(PairTables& T, bool snorm, DecoderSet decoders) {
     T.pal.resize(65536);
     T.pal_min.resize(65536);
     T.imin.resize(65536);
@@ -201,21 +209,30 @@ Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
     T.six.resize(65536);
     T.six_mask.resize(65536);
     for (int i = 0; i < 8; ++i) { T.ent_lo[i].resize(65536); T.ent_hi[i].resize(65536); }
-    T.c_lo = snorm_ ? -1.0f : 0.0f;
+    T.c_lo = snorm ? -1.0f : 0.0f;
     for (int r = 0; r < 256; ++r)
         for (int m = 0; m < 2; ++m) { T.row_imin[r][m] = INFINITY; T.row_imax[r][m] = -INFINITY; }
-    const double vscale = snorm_ ? 127.0 : 255.0;
-    for (int b = 0; b < 256; ++b) T.val[b] = float(level(uint8_t(b), snorm_) / vscale);
+    const double vscale = snorm ? 127.0 : 255.0;
+    for (int b = 0; b < 256; ++b) T.val[b] = float(level(uint8_t(b), snorm) / vscale);
+    const int lmin = snorm ? -127 : 0, lmax = snorm ? 127 : 255;
+    for (int m = 0; m < 2; ++m) {
+        const int steps = m == 0 ? 7 : 5;
+        T.num_base[m] = steps * lmin;
+        const size_t n = size_t(steps * (lmax - lmin) + 1);
+        T.num_lo[m].assign(n, NAN);
+        T.num_hi[m].assign(n, NAN);
+        T.num_ref[m].assign(n, NAN);
+    }
     for (int k = 0; k < 65536; ++k) {
         const uint8_t b0 = uint8_t(k >> 8), b1 = uint8_t(k & 255);
         auto& p = T.pal[size_t(k)];
-        interval_palette(b0, b1, snorm_, options_.decoders, p, true);
-        const bool eight = snorm_ ? (static_cast<int8_t>(b0) > static_cast<int8_t>(b1)) : (b0 > b1);
+        interval_palette(b0, b1, snorm, decoders, p, true);
+        const bool eight = snorm ? (static_cast<int8_t>(b0) > static_cast<int8_t>(b1)) : (b0 > b1);
         {
             // Entry i's place j on the exact grid: 8-value mode e1 + j (e0 - e1) / 7 with
             // entries 1, 7, 6, .., 2, 0 at j = 0..7; 6-value mode e0 + j (e1 - e0) / 5
             // with entries 0, 2, .., 5, 1.
-            const double e0 = level(b0, snorm_) / vscale, e1 = level(b1, snorm_) / vscale;
+            const double e0 = level(b0, snorm) / vscale, e1 = level(b1, snorm) / vscale;
             const int interp = eight ? 8 : 6;
             double& sl = T.slack[eight ? 0 : 1];
             for (int i = 0; i < interp; ++i) {
@@ -233,6 +250,14 @@ Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
         for (int i = 1; i < 8; ++i) mn = std::min(mn, p.lo[i][0]);
         float imn = p.lo[0][0];
         for (int i = 1; i < interp; ++i) { imn = std::min(imn, p.lo[i][0]); imx = std::max(imx, p.hi[i][0]); }
+        {
+            const int e0 = level(b0, snorm), e1 = level(b1, snorm), m = eight ? 0 : 1, steps = eight ? 7 : 5;
+            T.end_lo[b0] = p.lo[0][0]; T.end_hi[b0] = p.hi[0][0]; T.end_ref[b0] = p.ref[0][0];
+            for (int i = 2; i < interp; ++i) {
+                const size_t at = size_t((steps - 1 - (i - 2)) * e0 + (i - 1) * e1 - T.num_base[m]);
+                T.num_lo[m][at] = p.lo[i][0]; T.num_hi[m][at] = p.hi[i][0]; T.num_ref[m][at] = p.ref[i][0];
+            }
+        }
         T.pal_min[size_t(k)] = mn;
         T.imin[size_t(k)] = imn;
         T.imax[size_t(k)] = imx;
@@ -244,6 +269,55 @@ Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
         T.row_imin[b0][m] = std::min(T.row_imin[b0][m], imn);
         T.row_imax[b0][m] = std::max(T.row_imax[b0][m], imx);
     }
+}
+
+// fast / normal's candidate palette of pair k from the per-entry tables: the same
+// floats as T.pal[k] (test Bc4Eval.EntryTablesEqualPairTables).
+void entry_palette(const PairTables& T, int k, bool snorm, detail::Palette<1>& p) {
+    const uint8_t b0 = uint8_t(k >> 8), b1 = uint8_t(k & 255);
+    const int e0 = level(b0, snorm), e1 = level(b1, snorm);
+    const bool eight = snorm ? (static_cast<int8_t>(b0) > static_cast<int8_t>(b1)) : (b0 > b1);
+    p.n = 8;
+    p.lo[0][0] = T.end_lo[b0]; p.hi[0][0] = T.end_hi[b0]; p.ref[0][0] = T.end_ref[b0];
+    p.lo[1][0] = T.end_lo[b1]; p.hi[1][0] = T.end_hi[b1]; p.ref[1][0] = T.end_ref[b1];
+    const int m = eight ? 0 : 1, steps = eight ? 7 : 5, interp = eight ? 8 : 6;
+    const float* lo = T.num_lo[m].data() - T.num_base[m];
+    const float* hi = T.num_hi[m].data() - T.num_base[m];
+    const float* ref = T.num_ref[m].data() - T.num_base[m];
+    for (int i = 2; i < interp; ++i) {
+        const int num = (steps - i + 1) * e0 + (i - 1) * e1;
+        p.lo[i][0] = lo[num]; p.hi[i][0] = hi[num]; p.ref[i][0] = ref[num];
+    }
+    if (!eight) {
+        p.lo[6][0] = p.hi[6][0] = p.ref[6][0] = T.c_lo;
+        p.lo[7][0] = p.hi[7][0] = p.ref[7][0] = 1.0f;
+    }
+}
+} // namespace
+
+namespace detail {
+long bc4_entry_table_mismatches(bool snorm, DecoderSet set) {
+    auto T = std::make_unique<PairTables>();
+    build_tables(*T, snorm, set == 0 ? kReferenceOnly : set);
+    long bad = 0;
+    for (int k = 0; k < 65536; ++k) {
+        Palette<1> p;
+        entry_palette(*T, k, snorm, p);
+        const Palette<1>& q = T->pal[size_t(k)];
+        bad += p.n != q.n;
+        for (int i = 0; i < 8; ++i)
+            bad += std::memcmp(&p.lo[i][0], &q.lo[i][0], 4) != 0 || std::memcmp(&p.hi[i][0], &q.hi[i][0], 4) != 0 ||
+                   std::memcmp(&p.ref[i][0], &q.ref[i][0], 4) != 0;
+    }
+    return bad;
+}
+} // namespace detail
+
+Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
+    : snorm_(snorm), options_(options), tables_(std::make_unique<Tables>()) {
+    if (options_.decoders == 0) options_.decoders = kReferenceOnly;
+    build_tables(*tables_, snorm_, options_.decoders);
+    tables_->avx2 = detail::bc4_cpu_has_avx2();
 }
 
 Bc4Encoder::~Bc4Encoder() = default;
@@ -427,55 +501,131 @@ BlockResult Bc4Encoder::encode_exhaustive(const float src[16], uint8_t out[8]) c
     return {best.max_err, best.sum_sq, true};
 }
 
+namespace {
+// The exact result of the indices a key evaluation chose, written into `s` in place
+// (a returned copy read the fresh stores back as one 16-byte load: a forwarding stall).
+template <bool OneSided>
+void exact_selection(const PairTables& T, const detail::Palette<1>& p, const float src[16], const detail::Bc4Keys& k, detail::Selection& s) {
+#if defined(ATLAS_BC4_AVX2)
+    if (T.avx2) {
+        detail::bc4_exact_avx2(p, src, k, s.max_err, s.sum_sq, s.idx);
+        return;
+    }
+#else
+    (void)T;
+#endif
+    detail::bc4_exact_portable<OneSided>(p, src, k, s.max_err, s.sum_sq, s.idx);
+}
+
+template <bool OneSided>
+bool keys_of(const PairTables& T, const detail::Palette<1>& p, const float src[16], float stop, detail::Bc4Keys& k) {
+#if defined(ATLAS_BC4_AVX2)
+    if (T.avx2) return detail::bc4_keys_avx2<OneSided>(p, src, stop, k);
+#else
+    (void)T;
+#endif
+    return detail::bc4_keys<OneSided>(p, src, stop, k);
+}
+} // namespace
+
 BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
-    float smin = src[0], smax = src[0];
-    for (int t = 1; t < 16; ++t) { smin = std::min(smin, src[t]); smax = std::max(smax, src[t]); }
+    float smin, smax;
+    bool finite, flat; // flat: all 16 texels have the same bits
+#if defined(__SSE2__)
+    {
+        const __m128 a = _mm_loadu_ps(src), b = _mm_loadu_ps(src + 4), c = _mm_loadu_ps(src + 8), d = _mm_loadu_ps(src + 12);
+        __m128 mn = _mm_min_ps(_mm_min_ps(a, b), _mm_min_ps(c, d)), mx = _mm_max_ps(_mm_max_ps(a, b), _mm_max_ps(c, d));
+        mn = _mm_min_ps(mn, _mm_movehl_ps(mn, mn));
+        mx = _mm_max_ps(mx, _mm_movehl_ps(mx, mx));
+        smin = _mm_cvtss_f32(_mm_min_ss(mn, _mm_shuffle_ps(mn, mn, 1)));
+        smax = _mm_cvtss_f32(_mm_max_ss(mx, _mm_shuffle_ps(mx, mx, 1)));
+        const __m128 nan = _mm_or_ps(_mm_or_ps(_mm_cmpunord_ps(a, b), _mm_cmpunord_ps(c, d)), _mm_cmpunord_ps(a, c));
+        finite = !_mm_movemask_ps(nan) && smin >= -1e30f && smax <= 1e30f;
+        const __m128i v0 = _mm_castps_si128(_mm_set1_ps(src[0]));
+        const __m128i eq = _mm_and_si128(_mm_and_si128(_mm_cmpeq_epi32(_mm_castps_si128(a), v0), _mm_cmpeq_epi32(_mm_castps_si128(b), v0)),
+                                         _mm_and_si128(_mm_cmpeq_epi32(_mm_castps_si128(c), v0), _mm_cmpeq_epi32(_mm_castps_si128(d), v0)));
+        flat = _mm_movemask_epi8(eq) == 0xffff;
+    }
+#else
+    smin = src[0];
+    smax = src[0];
+    bool nan = std::isnan(src[0]);
+    for (int t = 1; t < 16; ++t) { smin = std::min(smin, src[t]); smax = std::max(smax, src[t]); nan = nan || std::isnan(src[t]); }
+    finite = !nan && smin >= -1e30f && smax <= 1e30f;
+    flat = true;
+    for (int t = 1; t < 16; ++t) flat = flat && std::memcmp(&src[t], &src[0], 4) == 0;
+#endif
     const float scale = snorm_ ? 127.0f : 255.0f;
     const int lo_lim = snorm_ ? -127 : 0, hi_lim = snorm_ ? 127 : 255;
     auto clampi = [&](int v) { return std::clamp(v, lo_lim, hi_lim); };
-    const int qlo0 = clampi(int(std::floor(smin * scale))), qlo1 = clampi(int(std::ceil(smin * scale)));
-    const int qhi0 = clampi(int(std::floor(smax * scale))), qhi1 = clampi(int(std::ceil(smax * scale)));
+    // floor / ceil of a scaled extreme, in integers (clamped first: the levels are within +-255).
+    auto in_range = [](float x) { return x > -1024.0f ? (x < 1024.0f ? x : 1024.0f) : -1024.0f; }; // NaN -> -1024
+    auto floor_i = [&](float x) { x = in_range(x); const int i = int(x); return i - (float(i) > x ? 1 : 0); };
+    auto ceil_i = [&](float x) { x = in_range(x); const int i = int(x); return i + (float(i) < x ? 1 : 0); };
+    const int qlo0 = clampi(floor_i(smin * scale)), qlo1 = clampi(ceil_i(smin * scale));
+    const int qhi0 = clampi(floor_i(smax * scale)), qhi1 = clampi(ceil_i(smax * scale));
     auto byte_of = [&](int v) { return uint8_t(snorm_ ? uint8_t(int8_t(v)) : uint8_t(v)); };
-    detail::Selection best;
-    int best_k = -1;
     const bool os = options_.one_sided_below;
-    // The candidate pairs are gathered first and their palettes prefetched: the table
-    // (6.5 MB) lives in L3, and loading the candidates one after the other cost a
-    // third of the encode. The evaluation order (and so the result) is unchanged.
+    // Candidate pairs (each once), evaluated in order; ties keep the earlier one.
     int cands[32];
     int ncand = 0;
     auto consider = [&](int a, int b) {
         const int k = int(byte_of(a)) * 256 + int(byte_of(b));
+        for (int c = 0; c < ncand; ++c)
+            if (cands[c] == k) return;
         cands[ncand++] = k;
-#if defined(__SSE2__)
-        const char* line = reinterpret_cast<const char*>(&tables_->pal[size_t(k)]);
-        _mm_prefetch(line, _MM_HINT_T0);
-        _mm_prefetch(line + 64, _MM_HINT_T0);
-        _mm_prefetch(line + sizeof(detail::Palette<1>) - 1, _MM_HINT_T0);
-#endif
     };
-    // Floor / ceil of the extremes (Best and blocks missing the bound start the
-    // exhaustive search from this incumbent: the result is the same, found sooner).
+    // Floor / ceil of the extremes, the 8-value mode first (Best and blocks missing the
+    // bound start the exhaustive search from this incumbent: the result is the same,
+    // found sooner). One-sided: also the level below the floor. The bounds are exact
+    // (widened), so a minimum that sits on a level's float value can be an ulp below the
+    // level itself, and without a lower endpoint such a texel would be left with the
+    // constant 0.
     const int hstep = options_.quality == Quality::Fast ? std::max(1, qhi1 - qhi0) : 1;
-    for (int h = os && qhi0 > lo_lim ? qhi0 - hstep : qhi0; h <= qhi1; h += hstep)
-        // One-sided: also the level below the floor. The bounds are exact (widened), so a
-        // minimum that sits on a level's float value can be an ulp below the level itself,
-        // and without a lower endpoint such a texel would be left with the constant 0.
-        for (int l = os ? clampi(qlo0 - 1) : qlo0; l <= qlo1; ++l) {
-            int a = clampi(h), b = clampi(l);
-            if (a > b) consider(a, b);  // 8 interpolated values
-            // Fast skips the 6-value mode, except for flat blocks (a == b) where the
-            // 8-value mode has no pair (else they would fall to the exhaustive search).
-            if (options_.quality != Quality::Fast || options_.one_sided_below || a == b)
-                consider(std::min(a, b), std::max(a, b)); // 6 values plus exact extremes
+    const int h0 = os && qhi0 > lo_lim ? qhi0 - hstep : qhi0, l0 = os ? clampi(qlo0 - 1) : qlo0;
+    for (int h = h0; h <= qhi1; h += hstep)
+        for (int l = l0; l <= qlo1; ++l)
+            if (clampi(h) > clampi(l)) consider(clampi(h), clampi(l)); // 8 interpolated values
+    // The 6-value mode (plus exact extremes). Fast skips it, except for flat blocks
+    // (a == b) where the 8-value mode has no pair (else they would fall to the
+    // exhaustive search).
+    for (int h = h0; h <= qhi1; h += hstep)
+        for (int l = l0; l <= qlo1; ++l) {
+            const int a = clampi(h), b = clampi(l);
+            if (options_.quality != Quality::Fast || os || a == b) consider(std::min(a, b), std::max(a, b));
         }
-    for (int c = 0; c < ncand; ++c) {
-        const int k = cands[c];
-        detail::Selection s = detail::select_indices(tables_->pal[size_t(k)], src, os, best.max_err);
-        if (best_k < 0 ? std::isfinite(s.max_err) : detail::better(s, best)) { best = s; best_k = k; }
+    detail::Bc4Keys keys[2];
+    detail::Palette<1> pal[2];
+    int cur = 0, best_k = -1;
+    detail::Selection best;
+    if (!finite) { // NaN or huge texels: select_indices' comparisons, no keys
+        for (int c = 0; c < ncand; ++c) {
+            const int k = cands[c];
+            detail::Selection s = detail::select_indices(tables_->pal[size_t(k)], src, os, best.max_err);
+            if (best_k < 0 ? std::isfinite(s.max_err) : detail::better(s, best)) { best = s; best_k = k; }
+        }
+    } else {
+        for (int c = 0; c < ncand; ++c) {
+            const int k = cands[c];
+            entry_palette(*tables_, k, snorm_, pal[cur]);
+            const auto& p = pal[cur];
+            const float stop = best_k < 0 ? detail::kBc4Infeasible : keys[1 - cur].max_err;
+            // A flat block is evaluated on one texel (the same keys and sums, bc4_eval.h).
+            const bool ok = flat ? (os ? detail::bc4_keys_flat<true>(p, src, stop, keys[cur]) : detail::bc4_keys_flat<false>(p, src, stop, keys[cur]))
+                                 : (os ? keys_of<true>(*tables_, p, src, stop, keys[cur]) : keys_of<false>(*tables_, p, src, stop, keys[cur]));
+            if (ok && (best_k < 0 || detail::bc4_keys_better(keys[cur], keys[1 - cur]))) { best_k = k; cur = 1 - cur; }
+        }
+    }
+    if (finite && best_k >= 0) {
+        const auto& p = pal[1 - cur];
+        if (os) exact_selection<true>(*tables_, p, src, keys[1 - cur], best);
+        else exact_selection<false>(*tables_, p, src, keys[1 - cur], best);
     }
     const bool missed = best_k < 0 || (options_.max_error >= 0 && best.max_err > options_.max_error);
     if (missed || options_.quality == Quality::Best) {
+        // The exhaustive search's incumbent is select_indices' result for the pair (its
+        // result, the lexicographic minimum over all pairs, does not depend on it).
+        if (best_k >= 0) best = detail::select_indices(tables_->pal[size_t(best_k)], src, os);
         best_k = search_all_pairs(*tables_, src, os, best, best_k);
         if (best_k < 0) { // cannot happen for UNORM/SNORM (0 / -1 entry), kept for safety
             std::memset(out, 0, 8);

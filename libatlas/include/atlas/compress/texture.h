@@ -31,7 +31,8 @@ namespace fs = std::filesystem;
 // 2: DDS rows top-down; exact (double) one-sided and max-error bounds; bc1-scalar
 // one-sided search that never falls back to black.
 // 3: bc1-scalar single-entry search for near-constant blocks and normal's nudges.
-constexpr int kEncoderVersion = 3;
+// 4: BC4 fast / normal one-pass key evaluation (ties within 8 ulps may pick differently).
+constexpr int kEncoderVersion = 4;
 
 // The most mip levels a front end asks for by number (a 65536 texture has 17
 // levels; "full" asks for all of them).

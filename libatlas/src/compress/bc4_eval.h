@@ -1,0 +1,277 @@
+// Internal: BC4 `fast` / `normal` candidate evaluation in one pass over the palette.
+//
+// Each texel takes the entry of least worst-case error over the decoder set, found as the
+// minimum of a key: the error's float bits with the 3 low bits replaced by the entry index
+// (errors are >= 0, so their bits order like the floats; the 3 bits break ties by index
+// and cost at most 7 ulps of precision in the comparison). A candidate is ranked by the
+// largest key error, then by the float sum of the squared key errors; the winner's exact
+// errors are recomputed from its indices (bc4.cpp). One pass replaces select_indices'
+// two (minimum, then the squared-error choice), which is what `best` keeps.
+//
+// The SSE2 path and the portable path perform the same IEEE operations in the same order
+// (MAXPS(a, b) is `a > b ? a : b`, MINPS likewise; the sum of squares per lane over the 4
+// groups of 4 texels, then (lane 0 + lane 1) + (lane 2 + lane 3)), so they return the same
+// keys and sums (test Bc4Eval.Sse2EqualsPortable).
+#pragma once
+
+#include "atlas/compress/decoder_model.h"
+#include "palette_search.h"
+
+#include <bit>
+#include <cstdint>
+#include <cstring>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define ATLAS_BC4_AVX2 1 // functions compiled for AVX2 by attribute, run after a CPU check
+#endif
+
+namespace atlas::compress::detail {
+
+// Left uninitialised (the evaluations write every field they return true for): zeroing
+// two of them per block cost a tenth of the encode.
+struct Bc4Keys {
+    float max_err; // largest key error (the error with its 3 low bits cleared)
+    float sum;     // sum of squared key errors (float, fixed order)
+    uint32_t key[16];
+};
+
+// The error of an infeasible entry (one-sided: above the source), 2^127; larger errors
+// (and NaN) are clamped to it. Its 3 low bits are 0, so a key error equal to it marks
+// the texel infeasible.
+inline constexpr float kBc4Infeasible = 1.7014118346046923e38f;
+inline constexpr uint32_t kBc4KeyMask = ~uint32_t(7);
+static_assert(std::bit_cast<uint32_t>(kBc4Infeasible) == 0x7f000000u);
+
+inline float bc4_key_error(uint32_t key) {
+    const uint32_t b = key & kBc4KeyMask;
+    float f;
+    std::memcpy(&f, &b, 4);
+    return f;
+}
+
+inline bool bc4_keys_better(const Bc4Keys& a, const Bc4Keys& b) {
+    return a.max_err < b.max_err || (a.max_err == b.max_err && a.sum < b.sum);
+}
+
+// src: 16 finite texels within +-1e30. Returns false when some texel has no feasible entry or a key error exceeds `stop`.
+template <bool OneSided>
+inline bool bc4_keys_portable(const Palette<1>& p, const float* src, float stop, Bc4Keys& out) {
+    float acc[4] = {0, 0, 0, 0}, mx = 0;
+    for (int q = 0; q < 4; ++q) {
+        float qmax = 0;
+        for (int j = 0; j < 4; ++j) {
+            const int t = 4 * q + j;
+            const float s = src[t];
+            uint32_t best = 0xffffffffu;
+            float best_f = 0;
+            for (int i = 0; i < p.n; ++i) {
+                const float a = p.hi[i][0] - s, b = s - p.lo[i][0];
+                float e = a > b ? a : b;
+                if constexpr (OneSided)
+                    if (p.hi[i][0] > s) e = kBc4Infeasible;
+                uint32_t bits;
+                std::memcpy(&bits, &e, 4);
+                const uint32_t key = (bits & kBc4KeyMask) | uint32_t(i);
+                float kf;
+                std::memcpy(&kf, &key, 4);
+                if (i == 0 || kf < best_f) { best = key; best_f = kf; }
+            }
+            out.key[t] = best;
+            const float ek = bc4_key_error(best);
+            qmax = ek > qmax ? ek : qmax;
+            acc[j] = acc[j] + ek * ek;
+        }
+        if (qmax > stop || !(qmax < kBc4Infeasible)) return false;
+        mx = qmax > mx ? qmax : mx;
+    }
+    out.max_err = mx;
+    out.sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    return true;
+}
+
+#if defined(__SSE2__)
+template <bool OneSided>
+inline bool bc4_keys_sse2(const Palette<1>& p, const float* src, float stop, Bc4Keys& out) {
+    const __m128 zero = _mm_setzero_ps(), vstop = _mm_set1_ps(stop), vinf = _mm_set1_ps(kBc4Infeasible);
+    const __m128 clear = _mm_castsi128_ps(_mm_set1_epi32(int(kBc4KeyMask)));
+    __m128 acc = zero, mx = zero;
+    for (int q = 0; q < 4; ++q) {
+        const __m128 s = _mm_loadu_ps(src + 4 * q);
+        __m128 best = zero;
+        for (int i = 0; i < p.n; ++i) {
+            const __m128 vlo = _mm_set1_ps(p.lo[i][0]), vhi = _mm_set1_ps(p.hi[i][0]);
+            __m128 e = _mm_max_ps(_mm_sub_ps(vhi, s), _mm_sub_ps(s, vlo));
+            if constexpr (OneSided) {
+                const __m128 above = _mm_cmpgt_ps(vhi, s);
+                e = _mm_or_ps(_mm_and_ps(above, vinf), _mm_andnot_ps(above, e));
+            }
+            const __m128 key = _mm_or_ps(_mm_and_ps(e, clear), _mm_castsi128_ps(_mm_set1_epi32(i)));
+            best = i == 0 ? key : _mm_min_ps(key, best);
+        }
+        _mm_storeu_ps(reinterpret_cast<float*>(out.key + 4 * q), best);
+        const __m128 ek = _mm_and_ps(best, clear);
+        // Per-lane running max of the groups so far, as the portable code's max over texels.
+        if (_mm_movemask_ps(_mm_or_ps(_mm_cmpgt_ps(ek, vstop), _mm_cmpge_ps(ek, vinf)))) return false;
+        mx = _mm_max_ps(ek, mx);
+        acc = _mm_add_ps(acc, _mm_mul_ps(ek, ek));
+    }
+    float a[4], m[4];
+    _mm_storeu_ps(a, acc);
+    _mm_storeu_ps(m, mx);
+    float r = m[0];
+    for (int j = 1; j < 4; ++j) r = m[j] > r ? m[j] : r;
+    out.max_err = r;
+    out.sum = (a[0] + a[1]) + (a[2] + a[3]);
+    return true;
+}
+#endif
+
+// A flat block (16 equal texels): one texel's evaluation, with the sums formed as above,
+// so the same keys, maxima and sums as the 16-texel paths.
+template <bool OneSided>
+inline bool bc4_keys_flat(const Palette<1>& p, const float* src, float stop, Bc4Keys& out) {
+    const float s = src[0];
+    uint32_t best = 0;
+    float best_f = 0;
+    for (int i = 0; i < p.n; ++i) {
+        const float a = p.hi[i][0] - s, b = s - p.lo[i][0];
+        float e = a > b ? a : b;
+        if constexpr (OneSided)
+            if (p.hi[i][0] > s) e = kBc4Infeasible;
+        uint32_t bits;
+        std::memcpy(&bits, &e, 4);
+        const uint32_t key = (bits & kBc4KeyMask) | uint32_t(i);
+        float kf;
+        std::memcpy(&kf, &key, 4);
+        if (i == 0 || kf < best_f) { best = key; best_f = kf; }
+    }
+    const float ek = bc4_key_error(best);
+    if (ek > stop || !(ek < kBc4Infeasible)) return false;
+    for (int t = 0; t < 16; ++t) out.key[t] = best;
+    const float sq = ek * ek, lane = ((sq + sq) + sq) + sq;
+    out.max_err = ek > 0.0f ? ek : 0.0f;
+    out.sum = (lane + lane) + (lane + lane);
+    return true;
+}
+
+// The exact result of the chosen indices: each texel's entry_error_t (only texels whose
+// key error equals the block's largest can hold the block's maximum: a texel's exact
+// error has the bits of its key error plus 0..7) and the squared Reference error in
+// double, in 4 partial sums (texel t into t % 4), then (0 + 1) + (2 + 3).
+template <bool OneSided>
+inline void bc4_exact_portable(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err, double& sum_sq, uint8_t idx[16]) {
+    float mx = 0;
+    double sq[4] = {0, 0, 0, 0};
+    for (int t = 0; t < 16; ++t) {
+        const int i = int(k.key[t] & 7u);
+        idx[t] = uint8_t(i);
+        if (bc4_key_error(k.key[t]) == k.max_err) {
+            const float e = entry_error_t<1, OneSided>(p, i, src + t);
+            mx = e > mx ? e : mx;
+        }
+        const double d = double(p.ref[i][0]) - src[t];
+        sq[t & 3] += d * d;
+    }
+    max_err = mx;
+    sum_sq = (sq[0] + sq[1]) + (sq[2] + sq[3]);
+}
+
+#if defined(ATLAS_BC4_AVX2)
+// AVX2: 8 texels at a time, the same operations per texel; the sums are formed in the
+// portable order (lanes of texels j, 4 + j, 8 + j, 12 + j, then (0 + 1) + (2 + 3)).
+template <bool OneSided>
+__attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, const float* src, float stop, Bc4Keys& out) {
+    const __m256 vstop = _mm256_set1_ps(stop), vinf = _mm256_set1_ps(kBc4Infeasible);
+    const __m256 clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask)));
+    __m256 ek[2];
+    for (int h = 0; h < 2; ++h) {
+        const __m256 s = _mm256_loadu_ps(src + 8 * h);
+        __m256 best = _mm256_setzero_ps();
+        for (int i = 0; i < p.n; ++i) {
+            const __m256 vlo = _mm256_set1_ps(p.lo[i][0]), vhi = _mm256_set1_ps(p.hi[i][0]);
+            __m256 e = _mm256_max_ps(_mm256_sub_ps(vhi, s), _mm256_sub_ps(s, vlo));
+            if constexpr (OneSided) {
+                const __m256 above = _mm256_cmp_ps(vhi, s, _CMP_GT_OQ);
+                e = _mm256_blendv_ps(e, vinf, above);
+            }
+            const __m256 key = _mm256_or_ps(_mm256_and_ps(e, clear), _mm256_castsi256_ps(_mm256_set1_epi32(i)));
+            best = i == 0 ? key : _mm256_min_ps(key, best);
+        }
+        _mm256_storeu_ps(reinterpret_cast<float*>(out.key + 8 * h), best);
+        ek[h] = _mm256_and_ps(best, clear);
+        if (_mm256_movemask_ps(_mm256_or_ps(_mm256_cmp_ps(ek[h], vstop, _CMP_GT_OQ), _mm256_cmp_ps(ek[h], vinf, _CMP_GE_OQ)))) return false;
+    }
+    const __m256 sq0 = _mm256_mul_ps(ek[0], ek[0]), sq1 = _mm256_mul_ps(ek[1], ek[1]);
+    const __m128 acc = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm256_castps256_ps128(sq0), _mm256_extractf128_ps(sq0, 1)), _mm256_castps256_ps128(sq1)),
+                                  _mm256_extractf128_ps(sq1, 1));
+    const __m256 m8 = _mm256_max_ps(ek[1], _mm256_max_ps(ek[0], _mm256_setzero_ps()));
+    float a[4], m[8];
+    _mm_storeu_ps(a, acc);
+    _mm256_storeu_ps(m, m8);
+    float r = m[0];
+    for (int j = 1; j < 8; ++j) r = m[j] > r ? m[j] : r;
+    out.max_err = r;
+    out.sum = (a[0] + a[1]) + (a[2] + a[3]);
+    return true;
+}
+
+// The exact errors of the chosen entries (entry_error_t's terms; every chosen entry is
+// feasible) and the squared Reference error in double, summed in exact_selection's
+// order (lanes of texels j, 4 + j, 8 + j, 12 + j, then (0 + 1) + (2 + 3)); the block's
+// max error is the max over all texels, which equals the max over the texels whose key
+// error is the largest (bc4.cpp).
+__attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err,
+                                                           double& sum_sq, uint8_t idx[16]) {
+    static_assert(sizeof(p.lo) == 8 * sizeof(float), "one channel: 8 contiguous entries");
+    const __m256 lo = _mm256_loadu_ps(&p.lo[0][0]), hi = _mm256_loadu_ps(&p.hi[0][0]), ref = _mm256_loadu_ps(&p.ref[0][0]);
+    const __m256 zero = _mm256_setzero_ps();
+    __m256 mx = zero;
+    __m256d acc = _mm256_setzero_pd();
+    alignas(32) int32_t ii[16];
+    for (int h = 0; h < 2; ++h) {
+        const __m256i sel = _mm256_and_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(k.key + 8 * h)), _mm256_set1_epi32(7));
+        _mm256_store_si256(reinterpret_cast<__m256i*>(ii + 8 * h), sel);
+        const __m256 s = _mm256_loadu_ps(src + 8 * h);
+        const __m256 l = _mm256_permutevar8x32_ps(lo, sel), u = _mm256_permutevar8x32_ps(hi, sel), r = _mm256_permutevar8x32_ps(ref, sel);
+        const __m256 e = _mm256_max_ps(_mm256_max_ps(_mm256_sub_ps(u, s), _mm256_sub_ps(s, l)), zero);
+        mx = _mm256_max_ps(e, mx);
+        const __m256d d0 = _mm256_sub_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(r)), _mm256_cvtps_pd(_mm256_castps256_ps128(s)));
+        const __m256d d1 = _mm256_sub_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(r, 1)), _mm256_cvtps_pd(_mm256_extractf128_ps(s, 1)));
+        acc = _mm256_add_pd(acc, _mm256_mul_pd(d0, d0));
+        acc = _mm256_add_pd(acc, _mm256_mul_pd(d1, d1));
+    }
+    float m[8];
+    double a[4];
+    _mm256_storeu_ps(m, mx);
+    _mm256_storeu_pd(a, acc);
+    float r = m[0];
+    for (int j = 1; j < 8; ++j) r = m[j] > r ? m[j] : r;
+    max_err = r;
+    sum_sq = (a[0] + a[1]) + (a[2] + a[3]);
+    for (int t = 0; t < 16; ++t) idx[t] = uint8_t(ii[t]);
+}
+
+inline bool bc4_cpu_has_avx2() { return __builtin_cpu_supports("avx2") != 0; }
+#else
+inline bool bc4_cpu_has_avx2() { return false; }
+#endif
+
+template <bool OneSided>
+inline bool bc4_keys(const Palette<1>& p, const float* src, float stop, Bc4Keys& out) {
+#if defined(__SSE2__)
+    return bc4_keys_sse2<OneSided>(p, src, stop, out);
+#else
+    return bc4_keys_portable<OneSided>(p, src, stop, out);
+#endif
+}
+
+// Test hook (bc4.cpp): builds an encoder's tables for (snorm, set) and returns how many
+// entries of the 65,536 pair palettes differ (bitwise) from the palettes fast / normal
+// assemble from the per-entry tables; 0 when they are the same floats.
+long bc4_entry_table_mismatches(bool snorm, DecoderSet set);
+
+} // namespace atlas::compress::detail
