@@ -137,12 +137,16 @@ void interval_palette(uint8_t b0, uint8_t b1, bool snorm, DecoderSet set, detail
         }
 }
 
-void write_block(uint8_t b0, uint8_t b1, const uint8_t idx[16], uint8_t out[8]) {
+void write_block_bits(uint8_t b0, uint8_t b1, uint64_t bits, uint8_t out[8]) {
     out[0] = b0;
     out[1] = b1;
+    for (int i = 0; i < 6; ++i) out[2 + i] = uint8_t(bits >> (8 * i));
+}
+
+void write_block(uint8_t b0, uint8_t b1, const uint8_t idx[16], uint8_t out[8]) {
     uint64_t bits = 0;
     for (int t = 0; t < 16; ++t) bits |= uint64_t(idx[t] & 7) << (3 * t);
-    for (int i = 0; i < 6; ++i) out[2 + i] = uint8_t(bits >> (8 * i));
+    write_block_bits(b0, b1, bits, out);
 }
 
 } // namespace
@@ -505,16 +509,17 @@ namespace {
 // The exact result of the indices a key evaluation chose, written into `s` in place
 // (a returned copy read the fresh stores back as one 16-byte load: a forwarding stall).
 template <bool OneSided>
-void exact_selection(const PairTables& T, const detail::Palette<1>& p, const float src[16], const detail::Bc4Keys& k, detail::Selection& s) {
+void exact_selection(const PairTables& T, const detail::Palette<1>& p, const float src[16], const detail::Bc4Keys& k, detail::Selection& s,
+                     uint64_t& bits) {
 #if defined(ATLAS_BC4_AVX2)
     if (T.avx2) {
-        detail::bc4_exact_avx2(p, src, k, s.max_err, s.sum_sq, s.idx);
+        detail::bc4_exact_avx2(p, src, k, s.max_err, s.sum_sq, bits);
         return;
     }
 #else
     (void)T;
 #endif
-    detail::bc4_exact_portable<OneSided>(p, src, k, s.max_err, s.sum_sq, s.idx);
+    detail::bc4_exact_portable<OneSided>(p, src, k, s.max_err, s.sum_sq, bits);
 }
 
 template <bool OneSided>
@@ -598,6 +603,8 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     detail::Palette<1> pal[2];
     int cur = 0, best_k = -1;
     detail::Selection best;
+    uint64_t bits = 0;  // the winner's index field when `keyed`
+    bool keyed = false; // else best.idx (select_indices)
     if (!finite) { // NaN or huge texels: select_indices' comparisons, no keys
         for (int c = 0; c < ncand; ++c) {
             const int k = cands[c];
@@ -618,21 +625,24 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     }
     if (finite && best_k >= 0) {
         const auto& p = pal[1 - cur];
-        if (os) exact_selection<true>(*tables_, p, src, keys[1 - cur], best);
-        else exact_selection<false>(*tables_, p, src, keys[1 - cur], best);
+        if (os) exact_selection<true>(*tables_, p, src, keys[1 - cur], best, bits);
+        else exact_selection<false>(*tables_, p, src, keys[1 - cur], best, bits);
+        keyed = true;
     }
     const bool missed = best_k < 0 || (options_.max_error >= 0 && best.max_err > options_.max_error);
     if (missed || options_.quality == Quality::Best) {
         // The exhaustive search's incumbent is select_indices' result for the pair (its
         // result, the lexicographic minimum over all pairs, does not depend on it).
         if (best_k >= 0) best = detail::select_indices(tables_->pal[size_t(best_k)], src, os);
+        keyed = false;
         best_k = search_all_pairs(*tables_, src, os, best, best_k);
         if (best_k < 0) { // cannot happen for UNORM/SNORM (0 / -1 entry), kept for safety
             std::memset(out, 0, 8);
             return {std::numeric_limits<float>::infinity(), 0, false};
         }
     }
-    write_block(uint8_t(best_k >> 8), uint8_t(best_k & 255), best.idx, out);
+    if (keyed) write_block_bits(uint8_t(best_k >> 8), uint8_t(best_k & 255), bits, out);
+    else write_block(uint8_t(best_k >> 8), uint8_t(best_k & 255), best.idx, out);
     return {best.max_err, best.sum_sq, true};
 }
 

@@ -161,14 +161,16 @@ inline bool bc4_keys_flat(const Palette<1>& p, const float* src, float stop, Bc4
 // The exact result of the chosen indices: each texel's entry_error_t (only texels whose
 // key error equals the block's largest can hold the block's maximum: a texel's exact
 // error has the bits of its key error plus 0..7) and the squared Reference error in
-// double, in 4 partial sums (texel t into t % 4), then (0 + 1) + (2 + 3).
+// double, in 4 partial sums (texel t into t % 4), then (0 + 1) + (2 + 3); `bits`: the
+// 16 3-bit indices, texel 0 lowest (the block's index field).
 template <bool OneSided>
-inline void bc4_exact_portable(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err, double& sum_sq, uint8_t idx[16]) {
+inline void bc4_exact_portable(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err, double& sum_sq, uint64_t& bits) {
     float mx = 0;
     double sq[4] = {0, 0, 0, 0};
+    bits = 0;
     for (int t = 0; t < 16; ++t) {
         const int i = int(k.key[t] & 7u);
-        idx[t] = uint8_t(i);
+        bits |= uint64_t(i) << (3 * t);
         if (bc4_key_error(k.key[t]) == k.max_err) {
             const float e = entry_error_t<1, OneSided>(p, i, src + t);
             mx = e > mx ? e : mx;
@@ -225,16 +227,21 @@ __attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, c
 // max error is the max over all texels, which equals the max over the texels whose key
 // error is the largest (bc4.cpp).
 __attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err,
-                                                           double& sum_sq, uint8_t idx[16]) {
+                                                           double& sum_sq, uint64_t& bits) {
     static_assert(sizeof(p.lo) == 8 * sizeof(float), "one channel: 8 contiguous entries");
     const __m256 lo = _mm256_loadu_ps(&p.lo[0][0]), hi = _mm256_loadu_ps(&p.hi[0][0]), ref = _mm256_loadu_ps(&p.ref[0][0]);
     const __m256 zero = _mm256_setzero_ps();
     __m256 mx = zero;
     __m256d acc = _mm256_setzero_pd();
-    alignas(32) int32_t ii[16];
+    uint32_t half[2];
+    const __m256i shifts = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
     for (int h = 0; h < 2; ++h) {
         const __m256i sel = _mm256_and_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(k.key + 8 * h)), _mm256_set1_epi32(7));
-        _mm256_store_si256(reinterpret_cast<__m256i*>(ii + 8 * h), sel);
+        // The 8 indices at 3-bit offsets, OR-reduced to 24 bits.
+        __m256i b = _mm256_sllv_epi32(sel, shifts);
+        b = _mm256_or_si256(b, _mm256_shuffle_epi32(b, 0x4E));
+        b = _mm256_or_si256(b, _mm256_shuffle_epi32(b, 0xB1));
+        half[h] = uint32_t(_mm_cvtsi128_si32(_mm_or_si128(_mm256_castsi256_si128(b), _mm256_extracti128_si256(b, 1))));
         const __m256 s = _mm256_loadu_ps(src + 8 * h);
         const __m256 l = _mm256_permutevar8x32_ps(lo, sel), u = _mm256_permutevar8x32_ps(hi, sel), r = _mm256_permutevar8x32_ps(ref, sel);
         const __m256 e = _mm256_max_ps(_mm256_max_ps(_mm256_sub_ps(u, s), _mm256_sub_ps(s, l)), zero);
@@ -252,7 +259,7 @@ __attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, 
     for (int j = 1; j < 8; ++j) r = m[j] > r ? m[j] : r;
     max_err = r;
     sum_sq = (a[0] + a[1]) + (a[2] + a[3]);
-    for (int t = 0; t < 16; ++t) idx[t] = uint8_t(ii[t]);
+    bits = uint64_t(half[0]) | (uint64_t(half[1]) << 24);
 }
 
 inline bool bc4_cpu_has_avx2() { return __builtin_cpu_supports("avx2") != 0; }
