@@ -3,7 +3,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
 #include "atlas/core/memory.h"
-#include "parallel_blocks.h"
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,7 +21,7 @@ std::vector<std::string> default_channel_names(int channels) {
 namespace detail {
 
 namespace {
-// Channels are zeroed and copied in fixed 1 Mi-float blocks (parallel_blocks.h).
+// Channels are zeroed and copied in fixed 1 Mi-float blocks (atlas/core/parallel.h).
 constexpr size_t kFillBlock = size_t(1) << 20;
 
 ChannelData zeroed_channel(size_t count) {

@@ -1,10 +1,9 @@
 #include "atlas/core/field_math.h"
 
 #include "atlas/core/error.h"
-#include "parallel_blocks.h"
+#include "atlas/core/parallel.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -85,7 +84,7 @@ Value apply_per_voxel(const Value& a, const Value& x, double xc, const char* x_n
         auto pa = sa.channel(c);
         auto po = o.channel(c);
         const Operand ox = operand(x, step_x, c, xc), oy = operand(y, step_y, c, yc);
-        detail::parallel_blocks(pa.size(), kBlock, [&](size_t i0, size_t i1) {
+        parallel_blocks(pa.size(), kBlock, [&](size_t i0, size_t i1) {
             for (size_t i = i0; i < i1; ++i) po[i] = op(pa[i], ox.at(i), oy.at(i));
         });
     }
@@ -146,30 +145,28 @@ Value field_clamp(const Value& a, double lo, double hi, const MemoryBudget* budg
 Field3D resample_field(const Field3D& src, Vec3i res, Box3d bounds, WrapMode wrap, const MemoryBudget* budget) {
     Field3D out(res, src.channels(), bounds, src.channel_names(), budget);
     const Vec3d svs = src.voxel_size();
-    tbb::parallel_for(tbb::blocked_range<int>(0, res[2], 1), [&](const tbb::blocked_range<int>& r) {
-        for (int z = r.begin(); z < r.end(); ++z)
-            for (int y = 0; y < res[1]; ++y)
-                for (int x = 0; x < res[0]; ++x) {
-                    Vec3d p = out.voxel_center(x, y, z);
-                    double u = (p[0] - src.bounds().min[0]) / svs[0], v = (p[1] - src.bounds().min[1]) / svs[1],
-                           w = (p[2] - src.bounds().min[2]) / svs[2];
-                    for (int c = 0; c < src.channels(); ++c) out.at(c, x, y, z) = src.sample_voxel(c, u, v, w, wrap);
-                }
-    }, tbb::simple_partitioner());
+    parallel_for_index(res[2], [&](int z) {
+        for (int y = 0; y < res[1]; ++y)
+            for (int x = 0; x < res[0]; ++x) {
+                Vec3d p = out.voxel_center(x, y, z);
+                double u = (p[0] - src.bounds().min[0]) / svs[0], v = (p[1] - src.bounds().min[1]) / svs[1],
+                       w = (p[2] - src.bounds().min[2]) / svs[2];
+                for (int c = 0; c < src.channels(); ++c) out.at(c, x, y, z) = src.sample_voxel(c, u, v, w, wrap);
+            }
+    });
     return out;
 }
 
 Field2D resample_field(const Field2D& src, Vec2i res, Box2d bounds, WrapMode wrap, const MemoryBudget* budget) {
     Field2D out(res, src.channels(), bounds, src.channel_names(), budget);
     const Vec2d svs = src.voxel_size();
-    tbb::parallel_for(tbb::blocked_range<int>(0, res[1], 1), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y < r.end(); ++y)
-            for (int x = 0; x < res[0]; ++x) {
-                Vec2d p = out.texel_center(x, y);
-                double u = (p[0] - src.bounds().min[0]) / svs[0], v = (p[1] - src.bounds().min[1]) / svs[1];
-                for (int c = 0; c < src.channels(); ++c) out.at(c, x, y) = src.sample_texel(c, u, v, wrap);
-            }
-    }, tbb::simple_partitioner());
+    parallel_for_index(res[1], [&](int y) {
+        for (int x = 0; x < res[0]; ++x) {
+            Vec2d p = out.texel_center(x, y);
+            double u = (p[0] - src.bounds().min[0]) / svs[0], v = (p[1] - src.bounds().min[1]) / svs[1];
+            for (int c = 0; c < src.channels(); ++c) out.at(c, x, y) = src.sample_texel(c, u, v, wrap);
+        }
+    });
     return out;
 }
 

@@ -4,7 +4,7 @@
 
 #include "atlas/core/error.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <cmath>
 
@@ -27,7 +27,7 @@ Field3D bake_ndf_set(const Field2D& set, BakeFormula formula, const VerticalProf
     if (!bounds.valid()) throw Error("ndf bake: bounds must be finite with max > min");
     Field3D out(res, 1, bounds, {"dimensional_profile"}, budget);
     auto dst = out.channel(0);
-    tbb::parallel_for(0, res[1], [&](int y) {
+    parallel_for_index(res[1], [&](int y) {
         for (int x = 0; x < res[0]; ++x) {
             const Vec3d c = out.voxel_center(x, y, 0);
             const Vec2d p{{c[0], c[1]}};

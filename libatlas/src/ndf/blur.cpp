@@ -3,7 +3,7 @@
 
 #include "atlas/core/error.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <cmath>
 
@@ -35,7 +35,7 @@ Field2D blur(const Field2D& in, double sigma, WrapMode wrap, const MemoryBudget*
         auto src = in.channel(c);
         auto mid = tmp.channel(0);
         auto dst = out.channel(c);
-        tbb::parallel_for(0, h, [&](int y) {
+        parallel_for_index(h, [&](int y) {
             std::vector<float> pad(size_t(w + 2 * rad));
             const float* row = src.data() + in.index(0, y);
             for (int x = -rad; x < w + rad; ++x) pad[size_t(x + rad)] = row[wrap_index(x, w, wrap)];
@@ -47,7 +47,7 @@ Field2D blur(const Field2D& in, double sigma, WrapMode wrap, const MemoryBudget*
                 m[x] = acc;
             }
         });
-        tbb::parallel_for(0, h, [&](int y) {
+        parallel_for_index(h, [&](int y) {
             float* d = dst.data() + in.index(0, y);
             std::fill(d, d + w, 0.0f);
             for (int i = -rad; i <= rad; ++i) {

@@ -5,7 +5,7 @@
 #include "atlas/ndf/ndf_set.h"
 #include "atlas/noise/fill.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -72,7 +72,7 @@ Field2D cirrus_texture(const CirrusSpec& spec, const MemoryBudget* budget) {
     if (!spec.bounds.valid() || !std::isfinite(spec.bounds.min[0] + spec.bounds.min[1] + spec.bounds.max[0] + spec.bounds.max[1]))
         throw Error("cirrus: 'bounds' must be finite with max > min in x and y");
     Field2D out(spec.resolution, 3, spec.bounds, cirrus_channels(), budget);
-    tbb::parallel_for(0, H, [&](int y) {
+    parallel_for_index(H, [&](int y) {
         std::vector<Vec2d> p(static_cast<size_t>(W)), q(static_cast<size_t>(W));
         for (int x = 0; x < W; ++x) p[size_t(x)] = Vec2d{{(x + 0.5) / W, (y + 0.5) / H}};
         const std::vector<float> curl = noise::sample_noise(warp, std::span<const Vec2d>(p));
@@ -121,7 +121,7 @@ Field2D cirrus_horizon(const CirrusHorizonSpec& spec, const MemoryBudget* budget
     const NoiseSpec warp =
         make_spec(noise::Kernel::Gradient, {{std::max(1, spec.cells_along / 4), kYPeriod}}, 2, noise::Combinator::Fbm, spec.seed + 13);
     Field2D out(spec.resolution, 1, Box2d{{{0, 0}}, {{1, 1}}}, {"cirrus_horizon"}, budget);
-    tbb::parallel_for(0, H, [&](int y) {
+    parallel_for_index(H, [&](int y) {
         const double v = (y + 0.5) / H;
         std::vector<Vec2d> p(static_cast<size_t>(W)), q(static_cast<size_t>(W));
         for (int x = 0; x < W; ++x) p[size_t(x)] = Vec2d{{(x + 0.5) / W, v * y_scale}};

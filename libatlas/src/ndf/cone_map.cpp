@@ -3,7 +3,7 @@
 
 #include "atlas/core/error.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <cmath>
 
@@ -131,7 +131,7 @@ Field2D cone_map(const Field2D& heights, int channel, const ConeMapOptions& opt,
     }
     const int top = int(levels.size()) - 1;
 
-    tbb::parallel_for(0, p.h, [&](int y) {
+    parallel_for_index(p.h, [&](int y) {
         if (progress) progress->poll();
         struct Node {
             int k, i, j;

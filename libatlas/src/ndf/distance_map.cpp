@@ -3,7 +3,7 @@
 
 #include "atlas/core/error.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <cmath>
 
@@ -77,7 +77,7 @@ Field3D distance_map(const Field2D& heights, int channel, int layers, double z0,
     std::vector<double> g(size_t(nx) * size_t(ny) * size_t(nz));
     auto idx = [&](int x, int y, int k) { return (size_t(k) * size_t(ny) + size_t(y)) * size_t(nx) + size_t(x); };
     // Along z first: the solid is a column, so the 1D result is exact per column.
-    tbb::parallel_for(0, ny, [&](int y) {
+    parallel_for_index(ny, [&](int y) {
         const size_t n = size_t(nz);
         std::vector<double> f(n), d(n);
         std::vector<int> v(n);
@@ -90,7 +90,7 @@ Field3D distance_map(const Field2D& heights, int channel, int layers, double z0,
         }
     });
     // Along y, then x.
-    tbb::parallel_for(0, nz, [&](int k) {
+    parallel_for_index(nz, [&](int k) {
         const size_t n = size_t(std::max(nx, ny));
         std::vector<double> f(n), d(n);
         std::vector<int> v(f.size());

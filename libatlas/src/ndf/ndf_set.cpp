@@ -4,7 +4,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/memory.h"
 
-#include "parallel.h"
+#include "atlas/core/parallel.h"
 
 #include <tbb/parallel_for.h>
 
@@ -54,7 +54,7 @@ Field2D apply_precipitation_rule(const Field2D& set, const PrecipitationRule& ru
     auto type = out.channel(Type);
     auto top = out.channel(TopType);
     auto rain = set.channel(Precipitation);
-    for_each_index(cov.size(), [&](size_t i) {
+    parallel_for_each(cov.size(), 4096, [&](size_t i) {
         const double w = smoothstep(rule.rain_start, rule.rain_full, rain[i]);
         if (w <= 0) return;
         type[i] = float(lerp(double(type[i]), rule.storm_type, w));

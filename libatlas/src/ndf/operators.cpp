@@ -4,10 +4,7 @@
 
 #include "atlas/core/error.h"
 #include "atlas/core/field_math.h"
-
-#include "parallel.h"
-
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <cmath>
 #include <sstream>
@@ -54,7 +51,7 @@ Field2D domain_warp(const Field2D& in, const Field2D& warp, double amount, WrapM
     const Vec2d s = in.voxel_size();
     const Vec2d lo = in.bounds().min;
     const auto wx = warp.channel(0), wy = warp.channel(cy);
-    tbb::parallel_for(0, h, [&](int y) {
+    parallel_for_index(h, [&](int y) {
         const double py = lo[1] + (y + 0.5) * s[1];
         for (int x = 0; x < w; ++x) {
             const size_t i = in.index(x, y);
@@ -132,7 +129,7 @@ Field2D apply_curve(const Field2D& in, const Curve& curve, const MemoryBudget* b
     for (int c = 0; c < in.channels(); ++c) {
         auto src = in.channel(c);
         auto dst = out.channel(c);
-        for_each_index(src.size(), [&](size_t i) { dst[i] = float(curve(src[i])); });
+        parallel_for_each(src.size(), 4096, [&](size_t i) { dst[i] = float(curve(src[i])); });
     }
     return out;
 }
@@ -144,7 +141,7 @@ Field2D threshold(const Field2D& in, double level, double width, const MemoryBud
     for (int c = 0; c < in.channels(); ++c) {
         auto src = in.channel(c);
         auto dst = out.channel(c);
-        for_each_index(src.size(), [&](size_t i) {
+        parallel_for_each(src.size(), 4096, [&](size_t i) {
             const double v = src[i];
             dst[i] = width > 0 ? float(smoothstep(level - 0.5 * width, level + 0.5 * width, v)) : (v >= level ? 1.0f : 0.0f);
         });
@@ -173,7 +170,7 @@ Field2D composite(const Field2D& a, const Field2D& b, const Field2D* mask, Compo
         auto sa = a.channel(c);
         auto sb = b.channel(b.channels() == 1 ? 0 : c);
         auto dst = out.channel(c);
-        for_each_index(sa.size(), [&](size_t i) {
+        parallel_for_each(sa.size(), 4096, [&](size_t i) {
             const float x = sa[i], y = sb[i];
             float r = y;
             switch (op) {

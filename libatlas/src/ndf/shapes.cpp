@@ -4,7 +4,7 @@
 
 #include "atlas/core/error.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <cmath>
 #include <sstream>
@@ -150,7 +150,7 @@ Field2D paint_shapes(Vec2i res, Box2d bounds, const std::vector<Shape>& shapes, 
         }
         boxes.push_back(b);
     }
-    tbb::parallel_for(0, res[1], [&](int y) {
+    parallel_for_index(res[1], [&](int y) {
         for (int x = 0; x < res[0]; ++x) {
             const Vec2d p = f.texel_center(x, y);
             double v = 0;

@@ -4,7 +4,7 @@
 
 #include "atlas/core/error.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <cmath>
 #include <numbers>
@@ -36,7 +36,7 @@ Field2D unity_cloud_layer(const Field2D& set, const Field2D* cirrus, int cirrus_
         if (!o.tileable && !(p[0] >= b.min[0] && p[0] <= b.max[0] && p[1] >= b.min[1] && p[1] <= b.max[1])) return 0.0f;
         return f.sample_world(c, p, o.tileable ? WrapMode::Wrap : WrapMode::Clamp);
     };
-    tbb::parallel_for(0, H, [&](int y) {
+    parallel_for_index(H, [&](int y) {
         const double theta = o.upper_hemisphere_only ? 0.5 * pi * (y + 0.5) / H : -0.5 * pi + pi * (y + 0.5) / H;
         if (!(theta > 0)) return; // below the horizon: the cloud plane is not seen (zero-filled)
         const double d = o.altitude / std::tan(theta);

@@ -4,7 +4,7 @@
 
 #include "atlas/core/error.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -69,7 +69,7 @@ Field2D unity_cloud_lut(const VerticalProfile& profile, const UnityCloudLutOptio
     Field2D lut({{W, H}}, 3, Box2d{{{0, 0}}, {{1, 1}}}, {"density", "erosion", "ambient"}, budget);
     std::vector<double> fs(static_cast<size_t>(H));
     for (int j = 0; j < H; ++j) fs[size_t(j)] = (j + 0.5) / H;
-    tbb::parallel_for(0, W, [&](int i) {
+    parallel_for_index(W, [&](int i) {
         const double t = (i + 0.5) / W;
         const std::vector<double> m = mass_above(profile, t, fs, 32);
         for (int j = 0; j < H; ++j) {
@@ -88,7 +88,7 @@ double unity_cloud_lut_max_error(const Field2D& lut, const VerticalProfile& prof
     std::vector<double> worst(size_t(nu + 1), 0.0);
     std::vector<double> fs(static_cast<size_t>(nv + 1));
     for (int b = 0; b <= nv; ++b) fs[size_t(b)] = double(b) / nv;
-    tbb::parallel_for(0, nu + 1, [&](int a) {
+    parallel_for_index(nu + 1, [&](int a) {
         const double t = double(a) / nu;
         const std::vector<double> m = mass_above(profile, t, fs, 8);
         for (int b = 0; b <= nv; ++b) {

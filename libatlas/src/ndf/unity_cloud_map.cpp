@@ -3,7 +3,7 @@
 #include "atlas/ndf/ndf_set.h"
 
 #include "exporters_common.h"
-#include "parallel.h"
+#include "atlas/core/parallel.h"
 
 namespace atlas::ndf {
 
@@ -15,7 +15,7 @@ Field2D unity_cloud_map(const Field2D& set, CloudLayer layer, const MemoryBudget
     for (int c = 0; c < 3; ++c) std::copy(set.channel(src[c]).begin(), set.channel(src[c]).end(), out.channel(c).begin());
     auto mh = set.channel(MaxHeight);
     auto a = out.channel(3);
-    for_each_index(mh.size(), [&](size_t i) { a[i] = detail::in_layer(mh[i], layer); });
+    parallel_for_each(mh.size(), 4096, [&](size_t i) { a[i] = detail::in_layer(mh[i], layer); });
     return out;
 }
 

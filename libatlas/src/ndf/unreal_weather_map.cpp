@@ -3,7 +3,7 @@
 #include "atlas/ndf/ndf_set.h"
 
 #include "exporters_common.h"
-#include "parallel.h"
+#include "atlas/core/parallel.h"
 
 namespace atlas::ndf {
 
@@ -15,7 +15,7 @@ Field2D unreal_weather_map(const Field2D& set, CloudLayer layer, const MemoryBud
     std::copy(set.channel(Type).begin(), set.channel(Type).end(), out.channel(1).begin());
     auto lo = set.channel(MinHeight), hi = set.channel(MaxHeight);
     auto b = out.channel(2), a = out.channel(3);
-    for_each_index(lo.size(), [&](size_t i) {
+    parallel_for_each(lo.size(), 4096, [&](size_t i) {
         b[i] = detail::in_layer(lo[i], layer);
         a[i] = detail::in_layer(hi[i], layer);
     });

@@ -1,10 +1,8 @@
 #include "atlas/noise/fill.h"
 
 #include "atlas/core/error.h"
+#include "atlas/core/parallel.h"
 #include "engine.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
@@ -36,11 +34,9 @@ void normalize_channel(std::span<float> v, const OutputParams& o) {
     const auto [mn, mx] = std::minmax_element(v.begin(), v.end());
     const double lo = *mn, hi = *mx;
     const double span = hi - lo;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, v.size(), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-            const double t = span > 0 ? (double(v[i]) - lo) / span : 0.0;
-            v[i] = float(o.out_min + t * (o.out_max - o.out_min));
-        }
+    parallel_for_each(v.size(), size_t(1) << 16, [&](size_t i) {
+        const double t = span > 0 ? (double(v[i]) - lo) / span : 0.0;
+        v[i] = float(o.out_min + t * (o.out_max - o.out_min));
     });
 }
 
@@ -72,10 +68,10 @@ void fill_noise(Field3D& out, int channel, const NoiseSpec& spec, const Progress
     for (int i = 0; i < nx; ++i) xs[size_t(i)] = voxel_coord(spec, 0, w.x0 + i, w.full_nx);
     std::atomic<int> done{0};
     // One z-slice per task: fixed work units, results independent of the split.
-    tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
+    parallel_blocks(size_t(nz), 1, [&](size_t z0, size_t z1) {
         Scratch sc;
         std::vector<double> ys(static_cast<size_t>(nx), 0.0), zs(static_cast<size_t>(nx), 0.0);
-        for (int z = r.begin(); z != r.end(); ++z) {
+        for (int z = int(z0); z != int(z1); ++z) {
             if (progress) progress->poll();
             std::fill(zs.begin(), zs.end(), voxel_coord(spec, 2, z, nz));
             for (int y = 0; y < ny; ++y) {
@@ -102,10 +98,10 @@ void fill_noise(Field2D& out, int channel, const NoiseSpec& spec, const Progress
     std::vector<double> xs(size_t(nx), 0.0);
     for (int i = 0; i < nx; ++i) xs[size_t(i)] = voxel_coord(spec, 0, w.x0 + i, w.full_nx);
     std::atomic<int> done{0};
-    tbb::parallel_for(tbb::blocked_range<int>(0, ny, 1), [&](const tbb::blocked_range<int>& r) {
+    parallel_blocks(size_t(ny), 1, [&](size_t y0, size_t y1) {
         Scratch sc;
         std::vector<double> ys(static_cast<size_t>(nx), 0.0);
-        for (int y = r.begin(); y != r.end(); ++y) {
+        for (int y = int(y0); y != int(y1); ++y) {
             if (progress) progress->poll();
             std::fill(ys.begin(), ys.end(), voxel_coord(spec, 1, w.y0 + y, w.full_ny));
             float* dst[2];

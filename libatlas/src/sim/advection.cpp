@@ -3,8 +3,7 @@
 
 #include "atlas/core/error.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -259,19 +258,18 @@ void trace_from(const MacVelocity& vel, const Pos& p, const double v0[3], double
 // Calls f(id, pos) for every lattice node; pos is node-relative along periodic axes.
 template <class F>
 void for_lattice(const Lattice& l, F&& f) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, l.n[2], 1), [&](const tbb::blocked_range<int>& r) {
-        for (int k = r.begin(); k < r.end(); ++k)
-            for (int j = 0; j < l.n[1]; ++j)
-                for (int i = 0; i < l.n[0]; ++i) {
-                    const int idx[3] = {i, j, k};
-                    Pos p;
-                    for (int a = 0; a < 3; ++a) {
-                        const bool wrap = l.period[a] > 0;
-                        p.sh[a] = wrap ? idx[a] : 0;
-                        p.p[a] = wrap ? l.offset[a] : idx[a] + l.offset[a];
-                    }
-                    f((size_t(k) * l.n[1] + j) * l.n[0] + i, p);
+    parallel_for_index(l.n[2], [&](int k) {
+        for (int j = 0; j < l.n[1]; ++j)
+            for (int i = 0; i < l.n[0]; ++i) {
+                const int idx[3] = {i, j, k};
+                Pos p;
+                for (int a = 0; a < 3; ++a) {
+                    const bool wrap = l.period[a] > 0;
+                    p.sh[a] = wrap ? idx[a] : 0;
+                    p.p[a] = wrap ? l.offset[a] : idx[a] + l.offset[a];
                 }
+                f((size_t(k) * l.n[1] + j) * l.n[0] + i, p);
+            }
     });
 }
 

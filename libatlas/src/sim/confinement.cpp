@@ -1,21 +1,12 @@
 // Vorticity confinement (see confinement.h).
 #include "atlas/sim/confinement.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
 
 namespace atlas::sim {
-namespace {
-template <class F>
-void for_slices(int nz, F&& f) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
-        for (int k = r.begin(); k < r.end(); ++k) f(k);
-    });
-}
-} // namespace
 
 void confinement_force(const MacVelocity& vel, double eps, std::vector<float>& fx, std::vector<float>& fy,
                        std::vector<float>& fz) {
@@ -25,7 +16,7 @@ void confinement_force(const MacVelocity& vel, double eps, std::vector<float>& f
     const size_t n = s.cells();
     std::vector<float> cu(n), cv(n), cw(n), ox(n), oy(n), oz(n), mag(n);
     fx.assign(n, 0.f), fy.assign(n, 0.f), fz.assign(n, 0.f);
-    for_slices(nz, [&](int k) {
+    parallel_for_index(nz, [&](int k) {
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i) {
                 size_t c = vel.ic(i, j, k);
@@ -51,7 +42,7 @@ void confinement_force(const MacVelocity& vel, double eps, std::vector<float>& f
         if (span == 0) return 0.0;
         return (double(a[vel.ic(hi[0], hi[1], hi[2])]) - a[vel.ic(lo[0], lo[1], lo[2])]) / (span * h);
     };
-    for_slices(nz, [&](int k) {
+    parallel_for_index(nz, [&](int k) {
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i) {
                 size_t c = vel.ic(i, j, k);
@@ -61,7 +52,7 @@ void confinement_force(const MacVelocity& vel, double eps, std::vector<float>& f
                 mag[c] = std::sqrt(ox[c] * ox[c] + oy[c] * oy[c] + oz[c] * oz[c]);
             }
     });
-    for_slices(nz, [&](int k) {
+    parallel_for_index(nz, [&](int k) {
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i) {
                 size_t c = vel.ic(i, j, k);
@@ -84,7 +75,7 @@ void add_confinement(MacVelocity& vel, double eps, double dt) {
     const GridSpec& s = vel.spec;
     // Periodic axes: face 0 (= face n) lies between the last and the first cell.
     const bool wx = s.periodic(0), wy = s.periodic(1);
-    for_slices(s.nz, [&](int k) {
+    parallel_for_index(s.nz, [&](int k) {
         for (int j = 0; j < s.ny; ++j) {
             for (int i = 1; i < s.nx; ++i)
                 vel.u[vel.iu(i, j, k)] += float(dt * 0.5 * (fx[vel.ic(i - 1, j, k)] + fx[vel.ic(i, j, k)]));

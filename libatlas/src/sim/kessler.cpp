@@ -3,9 +3,7 @@
 
 #include "atlas/core/error.h"
 #include "atlas/sim/thermo.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,13 +12,6 @@
 
 namespace atlas::sim {
 namespace {
-
-template <class F>
-void for_range(int n, F&& f) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, n, 1), [&](const tbb::blocked_range<int>& r) {
-        for (int k = r.begin(); k < r.end(); ++k) f(k);
-    });
-}
 
 void check(double v, double lo, double hi, const char* what) {
     if (!(v >= lo && v <= hi)) {
@@ -79,7 +70,7 @@ KesslerReport kessler_conversions(const GridSpec& s, std::span<float> theta, std
     check_finite(qr, "qr");
     const size_t plane = size_t(s.nx) * s.ny;
     std::vector<double> au(size_t(s.nz)), ac(size_t(s.nz)), ev(size_t(s.nz));
-    for_range(s.nz, [&](int k) {
+    parallel_for_index(s.nz, [&](int k) {
         const double p = pressure[size_t(k)], pi = exner[size_t(k)], r = rho[size_t(k)];
         double sa = 0, sc = 0, se = 0;
         for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
@@ -138,7 +129,7 @@ KesslerReport rain_sedimentation(const GridSpec& s, std::span<float> qr, const s
     std::vector<double> vmax(static_cast<size_t>(nz)), out(static_cast<size_t>(ny));
     double remaining = dt;
     while (remaining > 1e-12 * dt && dt > 0) {
-        for_range(nz, [&](int k) {
+        parallel_for_index(nz, [&](int k) {
             double m = 0;
             for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
                 m = std::max(m, rain_fall_speed(qr[c], rho[size_t(k)], rs));
@@ -151,7 +142,7 @@ KesslerReport rain_sedimentation(const GridSpec& s, std::span<float> qr, const s
         if (++rep.sedimentation_substeps > 100000) throw Error("sim kessler: sedimentation needs more than 100000 substeps");
         // Rows of x are independent columns: parallel over y rows, each
         // column swept bottom-up so every cell reads the pre-step flux above it.
-        for_range(ny, [&](int j) {
+        parallel_for_index(ny, [&](int j) {
             double lost = 0;
             for (int i = 0; i < nx; ++i) {
                 size_t c0 = size_t(j) * nx + i;

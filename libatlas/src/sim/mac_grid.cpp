@@ -1,9 +1,7 @@
 #include "atlas/sim/mac_grid.h"
 
 #include "atlas/core/error.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -86,21 +84,18 @@ double MacVelocity::max_abs() const {
     constexpr size_t kBlock = 1 << 16;
     double m = 0;
     for (const auto* a : arrays) {
-        const size_t nb = (a->size() + kBlock - 1) / kBlock;
-        std::vector<double> part(nb, 0.0);
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, nb, 1), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t b = r.begin(); b < r.end(); ++b) {
-                double bm = 0;
-                for (size_t n = b * kBlock, e = std::min(a->size(), n + kBlock); n < e; ++n) {
-                    const float x = (*a)[n];
-                    if (std::isnan(x)) {
-                        bm = std::numeric_limits<double>::quiet_NaN();
-                        break;
-                    }
-                    bm = std::max(bm, double(std::fabs(x)));
+        std::vector<double> part(block_count(a->size(), kBlock), 0.0);
+        parallel_blocks(a->size(), kBlock, [&](size_t n0, size_t n1) {
+            double bm = 0;
+            for (size_t n = n0; n < n1; ++n) {
+                const float x = (*a)[n];
+                if (std::isnan(x)) {
+                    bm = std::numeric_limits<double>::quiet_NaN();
+                    break;
                 }
-                part[b] = bm;
+                bm = std::max(bm, double(std::fabs(x)));
             }
+            part[n0 / kBlock] = bm;
         });
         for (double x : part) {
             if (std::isnan(x)) return x;
@@ -115,23 +110,21 @@ DivergenceStats divergence_stats(const MacVelocity& vel, const std::vector<doubl
     const auto& s = vel.spec;
     // Per-slice partial sums added in slice order: same bytes for any thread count.
     std::vector<double> part2(static_cast<size_t>(s.nz)), partmax(static_cast<size_t>(s.nz));
-    tbb::parallel_for(tbb::blocked_range<int>(0, s.nz, 1), [&](const tbb::blocked_range<int>& r) {
-        for (int k = r.begin(); k < r.end(); ++k) {
-            const double rc = rho_cell.empty() ? 1.0 : rho_cell[size_t(k)];
-            const double rlo = rho_face.empty() ? 1.0 : rho_face[size_t(k)], rhi = rho_face.empty() ? 1.0 : rho_face[size_t(k + 1)];
-            double sum2 = 0, mx = 0;
-            for (int j = 0; j < s.ny; ++j)
-                for (int i = 0; i < s.nx; ++i) {
-                    double d = rc * (double(vel.u[vel.iu(i + 1, j, k)]) - vel.u[vel.iu(i, j, k)]) +
-                               rc * (double(vel.v[vel.iv(i, j + 1, k)]) - vel.v[vel.iv(i, j, k)]) +
-                               (rhi * vel.w[vel.iw(i, j, k + 1)] - rlo * double(vel.w[vel.iw(i, j, k)]));
-                    d /= rc * s.dx;
-                    sum2 += d * d;
-                    mx = std::max(mx, std::fabs(d));
-                }
-            part2[size_t(k)] = sum2;
-            partmax[size_t(k)] = mx;
-        }
+    parallel_for_index(s.nz, [&](int k) {
+        const double rc = rho_cell.empty() ? 1.0 : rho_cell[size_t(k)];
+        const double rlo = rho_face.empty() ? 1.0 : rho_face[size_t(k)], rhi = rho_face.empty() ? 1.0 : rho_face[size_t(k + 1)];
+        double sum2 = 0, mx = 0;
+        for (int j = 0; j < s.ny; ++j)
+            for (int i = 0; i < s.nx; ++i) {
+                double d = rc * (double(vel.u[vel.iu(i + 1, j, k)]) - vel.u[vel.iu(i, j, k)]) +
+                           rc * (double(vel.v[vel.iv(i, j + 1, k)]) - vel.v[vel.iv(i, j, k)]) +
+                           (rhi * vel.w[vel.iw(i, j, k + 1)] - rlo * double(vel.w[vel.iw(i, j, k)]));
+                d /= rc * s.dx;
+                sum2 += d * d;
+                mx = std::max(mx, std::fabs(d));
+            }
+        part2[size_t(k)] = sum2;
+        partmax[size_t(k)] = mx;
     });
     double sum2 = 0, mx = 0;
     for (int k = 0; k < s.nz; ++k) sum2 += part2[size_t(k)], mx = std::max(mx, partmax[size_t(k)]);

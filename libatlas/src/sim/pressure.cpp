@@ -3,8 +3,7 @@
 
 #include "atlas/core/error.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,19 +11,12 @@
 namespace atlas::sim {
 namespace {
 
-template <class F>
-void for_slices(int nz, F&& f) {
-    // One task per z-slice: work split is fixed, results do not depend on threads.
-    tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
-        for (int k = r.begin(); k < r.end(); ++k) f(k);
-    });
-}
 
 // Sum of per-slice partial sums, added in slice order (deterministic).
 template <class F>
 double reduce_slices(int nz, std::vector<double>& partial, F&& f) {
     partial.assign(size_t(nz), 0.0);
-    for_slices(nz, [&](int k) { partial[size_t(k)] = f(k); });
+    parallel_for_index(nz, [&](int k) { partial[size_t(k)] = f(k); });
     double s = 0;
     for (double p : partial) s += p;
     return s;
@@ -76,7 +68,7 @@ struct Level {
                 }
     }
     void apply(const std::vector<double>& v, std::vector<double>& out) const {
-        for_slices(nz, [&](int k) {
+        parallel_for_index(nz, [&](int k) {
             for (int j = 0; j < ny; ++j) {
                 const Row rw = row(v, j, k);
                 const size_t c0 = id(0, j, k);
@@ -120,7 +112,7 @@ struct Level {
     }
     // One red-black Gauss-Seidel half sweep over cells with (i+j+k)%2 == color.
     void gs(int color) {
-        for_slices(nz, [&](int k) {
+        parallel_for_index(nz, [&](int k) {
             for (int j = 0; j < ny; ++j) {
                 const Row rw = row(x, j, k);
                 double* xr = &x[id(0, j, k)];
@@ -131,7 +123,7 @@ struct Level {
         });
     }
     void residual() {
-        for_slices(nz, [&](int k) {
+        parallel_for_index(nz, [&](int k) {
             for (int j = 0; j < ny; ++j) {
                 const Row rw = row(x, j, k);
                 const size_t c0 = id(0, j, k);
@@ -254,14 +246,14 @@ struct PressureSolver::Impl {
         f.residual();
         Level& c = levels[l + 1];
         // Restriction: each coarse slice sums its own fine slices (disjoint writes).
-        for_slices(c.nz, [&](int K) {
+        parallel_for_index(c.nz, [&](int K) {
             std::fill(c.b.begin() + long(c.id(0, 0, K)), c.b.begin() + long(c.id(0, 0, K) + size_t(c.nx) * c.ny), 0.0);
             for (int k = K * f.fz; k < (K + 1) * f.fz; ++k)
                 for (int j = 0; j < f.ny; ++j)
                     for (int i = 0; i < f.nx; ++i) c.b[c.id(i / f.fx, j / f.fy, K)] += f.r[f.id(i, j, k)];
         });
         vcycle(l + 1);
-        for_slices(f.nz, [&](int k) {
+        parallel_for_index(f.nz, [&](int k) {
             for (int j = 0; j < f.ny; ++j)
                 for (int i = 0; i < f.nx; ++i) f.x[f.id(i, j, k)] += kOvercorrect * c.x[c.id(i / f.fx, j / f.fy, k / f.fz)];
         });
@@ -276,7 +268,7 @@ struct PressureSolver::Impl {
                        return s;
                    }) /
                    double(f.cells());
-        for_slices(f.nz, [&](int k) {
+        parallel_for_index(f.nz, [&](int k) {
             for (size_t c = f.id(0, 0, k), e = c + size_t(f.nx) * f.ny; c < e; ++c) v[c] -= m;
         });
     }
@@ -363,7 +355,7 @@ ProjectionReport PressureSolver::project(MacVelocity& vel, const ProjectionOptio
     std::vector<double>& b = L.b;
     std::vector<double>& rhs = m.rhs;
     rhs.resize(s.cells());
-    for_slices(nz, [&](int k) {
+    parallel_for_index(nz, [&](int k) {
         double rc = rho_cell_[size_t(k)], rlo = rho_face_[size_t(k)], rhi = rho_face_[size_t(k + 1)];
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i) {
@@ -389,7 +381,7 @@ ProjectionReport PressureSolver::project(MacVelocity& vel, const ProjectionOptio
             double dq = m.dot(m.d, m.q);
             if (!(dq > 0)) break;
             double alpha = rz / dq;
-            for_slices(nz, [&](int k) {
+            parallel_for_index(nz, [&](int k) {
                 for (size_t c = L.id(0, 0, k), e = c + size_t(nx) * ny; c < e; ++c) {
                     m.phi[c] += alpha * m.d[c];
                     m.res[c] -= alpha * m.q[c];
@@ -402,7 +394,7 @@ ProjectionReport PressureSolver::project(MacVelocity& vel, const ProjectionOptio
             double rz2 = m.dot(m.res, m.z);
             double beta = rz2 / rz;
             rz = rz2;
-            for_slices(nz, [&](int k) {
+            parallel_for_index(nz, [&](int k) {
                 for (size_t c = L.id(0, 0, k), e = c + size_t(nx) * ny; c < e; ++c) m.d[c] = m.z[c] + beta * m.d[c];
             });
         }
@@ -425,7 +417,7 @@ ProjectionReport PressureSolver::project(MacVelocity& vel, const ProjectionOptio
     };
     const bool keep_x0 = L.open[0] || L.wrap[0], keep_x1 = L.open[1] || L.wrap[0];
     const bool keep_y0 = L.open[2] || L.wrap[1], keep_y1 = L.open[3] || L.wrap[1];
-    for_slices(nz, [&](int k) {
+    parallel_for_index(nz, [&](int k) {
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i <= nx; ++i) {
                 if ((i == 0 && !keep_x0) || (i == nx && !keep_x1)) continue;
@@ -437,7 +429,7 @@ ProjectionReport PressureSolver::project(MacVelocity& vel, const ProjectionOptio
                 vel.v[vel.iv(i, j, k)] -= float(P(i, j, k) - P(i, j - 1, k));
             }
     });
-    for_slices(nz + 1, [&](int k) {
+    parallel_for_index(nz + 1, [&](int k) {
         if ((k == 0 && !L.open[4]) || (k == nz && !L.open[5])) return;
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i) vel.w[vel.iw(i, j, k)] -= float(P(i, j, k) - P(i, j, k - 1));

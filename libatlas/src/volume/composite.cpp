@@ -3,7 +3,7 @@
 #include "atlas/core/memory.h"
 #include "atlas/volume/edit.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -37,7 +37,7 @@ Field3D composite(const Field3D& world, const Field3D& cloud, CompositeOp op, do
     Field3D out = world;
     const bool same = aligned(world, cloud);
     const float op_f = float(opacity);
-    tbb::parallel_for(0, world.nz(), [&](int z) {
+    parallel_for_index(world.nz(), [&](int z) {
         for (int y = 0; y < world.ny(); ++y)
             for (int x = 0; x < world.nx(); ++x) {
                 const float c = op_f * (same ? cloud.at(cc, x, y, z) : sample_or(cloud, cc, world.voxel_center(x, y, z)));
@@ -58,7 +58,7 @@ Field3D cutout_density(const Field3D& density, const Shape& shape, double edge, 
     if (!(edge >= 0) || !std::isfinite(edge)) throw Error("cutout: edge must be finite and >= 0");
     if (budget) budget->check(density.byte_size(), "cutout: the density copy");
     Field3D out = density;
-    tbb::parallel_for(0, density.nz(), [&](int z) {
+    parallel_for_index(density.nz(), [&](int z) {
         for (int y = 0; y < density.ny(); ++y)
             for (int x = 0; x < density.nx(); ++x) {
                 const double d = shape_distance(shape, density.voxel_center(x, y, z));
@@ -75,7 +75,7 @@ Field3D subtract_shape_sdf(const Field3D& sdf, const Shape& shape, int channel, 
     check_channel(sdf, channel, "subtract_shape_sdf");
     if (budget) budget->check(sdf.byte_size(), "subtract_shape_sdf: the SDF copy");
     Field3D out = sdf;
-    tbb::parallel_for(0, sdf.nz(), [&](int z) {
+    parallel_for_index(sdf.nz(), [&](int z) {
         for (int y = 0; y < sdf.ny(); ++y)
             for (int x = 0; x < sdf.nx(); ++x) {
                 float& d = out.at(channel, x, y, z);
@@ -90,7 +90,7 @@ Field3D cutout_density_by_sdf(const Field3D& density, const Field3D& cutter, dou
     if (budget) budget->check(density.byte_size(), "cutout: the density copy");
     Field3D out = density;
     const bool same = aligned(density, cutter);
-    tbb::parallel_for(0, density.nz(), [&](int z) {
+    parallel_for_index(density.nz(), [&](int z) {
         for (int y = 0; y < density.ny(); ++y)
             for (int x = 0; x < density.nx(); ++x) {
                 const double d = same ? cutter.at(0, x, y, z) : sample_or(cutter, 0, density.voxel_center(x, y, z), 1e30f);

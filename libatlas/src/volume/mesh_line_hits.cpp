@@ -1,6 +1,7 @@
 // Mesh/grid-line crossings and the six-ray winding vote.
 #include "mesh_line_hits.h"
 
+#include "atlas/core/parallel.h"
 #include "atlas/core/error.h"
 #include "atlas/volume/mesh_io.h"
 #include "atlas/volume/mesh_voxelize.h"
@@ -141,7 +142,7 @@ std::vector<float> ray_winding_vote(const MeshLineHits& hits, Vec3i res, const M
         other_axes(a, b, c);
         const AxisHits& ah = hits.axis[a];
         // Parallel over c: lines with different c touch disjoint voxels.
-        tbb::parallel_for(0, res[c], [&](int j) {
+        parallel_for_index(res[c], [&](int j) {
             for (int i = 0; i < res[b]; ++i) {
                 const uint32_t l = uint32_t(i) + uint32_t(j) * uint32_t(res[b]);
                 const uint32_t k0 = ah.offsets[l], k1 = ah.offsets[l + 1];

@@ -2,7 +2,7 @@
 #include "atlas/volume/sdf.h"
 #include "surface_crossings.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -51,7 +51,7 @@ Field3D sdf_brute_force(const Field3D& density, const SdfOptions& o) {
     Field3D out(res, 1, density.bounds(), {"sdf"});
     const double far = detail::far_value(density, o);
     auto sdf = out.channel(0);
-    tbb::parallel_for(0, res[2], [&](int z) {
+    parallel_for_index(res[2], [&](int z) {
         for (int y = 0; y < res[1]; ++y)
             for (int x = 0; x < res[0]; ++x) {
                 double best = std::numeric_limits<double>::infinity();

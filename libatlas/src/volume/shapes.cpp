@@ -4,7 +4,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/memory.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -53,7 +53,7 @@ double shape_distance(const Shape& s, Vec3d p) {
 Field3D shape_sdf(const Shape& s, Vec3i res, Box3d bounds, const MemoryBudget* budget) {
     validate_shape(s);
     Field3D out(res, 1, bounds, {"sdf"}, budget);
-    tbb::parallel_for(0, res[2], [&](int z) {
+    parallel_for_index(res[2], [&](int z) {
         for (int y = 0; y < res[1]; ++y)
             for (int x = 0; x < res[0]; ++x) out.at(0, x, y, z) = float(shape_distance(s, out.voxel_center(x, y, z)));
     });

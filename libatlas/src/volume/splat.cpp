@@ -4,7 +4,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/memory.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -66,7 +66,7 @@ Field3D splat_points(const Points& pts, Vec3i res, Box3d bounds, const SplatOpti
         return 0;
     };
     // Parallel over z slices; each voxel visits points in input order.
-    tbb::parallel_for(0, res[2], [&](int z) {
+    parallel_for_index(res[2], [&](int z) {
         const double zc = bounds.min[2] + (z + 0.5) * h[2];
         for (const Splat& s : splats) {
             const double dz = zc - s.c[2];

@@ -3,7 +3,7 @@
 #include "atlas/core/memory.h"
 #include "atlas/volume/edit.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <cmath>
 #include <numbers>
@@ -36,7 +36,7 @@ Field3D transform_field(const Field3D& src, const CloudTransform& t, Vec3i res, 
     const double sq_xy = 1 / std::sqrt(t.squash);
     const Vec3d S{{t.scale[0] * sq_xy, t.scale[1] * sq_xy, t.scale[2] * t.squash}};
     Field3D out(res, src.channels(), bounds, src.channel_names(), budget);
-    tbb::parallel_for(0, res[2], [&](int z) {
+    parallel_for_index(res[2], [&](int z) {
         for (int y = 0; y < res[1]; ++y)
             for (int x = 0; x < res[0]; ++x) {
                 const Vec3d q = out.voxel_center(x, y, z) - t.pivot - t.translate;
