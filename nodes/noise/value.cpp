@@ -1,8 +1,6 @@
 // noise/value: tileable value-noise FBM filling a 3D field.
 #include "atlas/graph/node.h"
-#include "atlas/noise/value_noise.h"
-
-#include <tbb/parallel_for.h>
+#include "atlas/noise/value_fbm.h"
 
 namespace {
 using namespace atlas;
@@ -25,29 +23,9 @@ void cook(CookContext& ctx) {
     if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in every axis");
     const Vec3i res = ctx.get_int3("resolution");
     const Vec3i period = ctx.get_int3("period");
-    const int octaves = int(ctx.get_int("octaves"));
-    const double gain = ctx.get_float("gain");
-    const uint32_t seed = uint32_t(ctx.get_int("seed"));
+    const noise::ValueFbm fbm{.octaves = int(ctx.get_int("octaves")), .gain = ctx.get_float("gain"), .seed = uint32_t(ctx.get_int("seed"))};
     auto f = ctx.make_field3d(res, 1, box, {"density"});
-    auto out = f->channel(0);
-    double norm = 0, amp = 1;
-    for (int o = 0; o < octaves; ++o, amp *= gain) norm += amp;
-    tbb::parallel_for(0, res[2], [&](int z) {
-        std::vector<float> row(static_cast<size_t>(res[0]));
-        for (int y = 0; y < res[1]; ++y) {
-            float* dst = out.data() + f->index(0, y, z);
-            std::fill(dst, dst + res[0], 0.0f);
-            double a = 1.0;
-            for (int o = 0; o < octaves; ++o, a *= gain) {
-                const int scale = 1 << o;
-                const Vec3i p{{period[0] * scale, period[1] * scale, period[2] * scale}};
-                // Voxel centres in lattice units: (i + 0.5) / res * period.
-                const double dx = double(p[0]) / res[0];
-                noise::value_noise_row(row, 0.5 * dx, dx, (y + 0.5) * p[1] / res[1], (z + 0.5) * p[2] / res[2], p, seed + uint32_t(o) * 1013u);
-                for (int x = 0; x < res[0]; ++x) dst[x] += float(a / norm) * row[size_t(x)];
-            }
-        }
-    });
+    noise::fill_value_fbm(*f, 0, period, fbm);
     ctx.set_output("out", Field3DPtr(f));
 }
 } // namespace

@@ -1,6 +1,6 @@
 // sim/emitter: heat and vapour source rates for sim/cloud_growth, from a
 // noise-modulated ground patch or from any Field3D mask (shapes, meshes, noise).
-#include "atlas/core/hash.h"
+#include "atlas/noise/value_fbm.h"
 #include "sim_params.h"
 #include "volume/grid_params.h"
 
@@ -9,23 +9,6 @@
 
 namespace {
 using namespace atlas;
-
-// Smooth value noise in [0, 1] on a unit lattice: hashed corner values,
-// smoothstep-weighted trilinear blend. Deterministic and resolution-independent
-// (it is evaluated at world positions divided by the feature size).
-double value_noise(uint32_t seed, double x, double y, double z) {
-    const double fx = std::floor(x), fy = std::floor(y), fz = std::floor(z);
-    const int ix = int(fx), iy = int(fy), iz = int(fz);
-    auto s = [](double t) { return t * t * (3 - 2 * t); };
-    const double tx = s(x - fx), ty = s(y - fy), tz = s(z - fz);
-    double acc = 0;
-    for (int c = 0; c < 8; ++c) {
-        const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
-        const double w = (dx ? tx : 1 - tx) * (dy ? ty : 1 - ty) * (dz ? tz : 1 - tz);
-        acc += w * hash_to_unit(hash_coords(seed, ix + dx, iy + dy, iz + dz));
-    }
-    return acc;
-}
 
 void declare(NodeDeclaration& d) {
     d.doc("Heat (K/s) and vapour (kg/kg/s) source rates for sim/cloud_growth's 'emitter' input. 'ground_patch': a disc of "
@@ -85,11 +68,11 @@ void cook(CookContext& ctx) {
                     const double h = p[2] - box.min[2];
                     if (r >= 1 || h > depth) continue;
                     shape = std::pow(std::cos(0.5 * M_PI * r), 2) * (1 - h / depth);
-                    n = value_noise(seed, p[0] / scale, p[1] / scale, 0.0);
+                    n = noise::smooth_value_noise(seed, p[0] / scale, p[1] / scale, 0.0);
                 } else {
                     shape = std::max(0.0f, mask->at(ch, x, y, z));
                     if (shape == 0) continue;
-                    n = value_noise(seed, p[0] / scale, p[1] / scale, p[2] / scale);
+                    n = noise::smooth_value_noise(seed, p[0] / scale, p[1] / scale, p[2] / scale);
                 }
                 const double m = shape * ((1 - amount) + amount * 2 * n);
                 out->at(0, x, y, z) = float(heat * m);

@@ -6,8 +6,8 @@
 #include "atlas/sim/confinement.h"
 #include "atlas/sim/thermo.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
+#include "atlas/noise/value_fbm.h"
 
 #include <algorithm>
 #include <chrono>
@@ -19,13 +19,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-template <class F>
-void for_slices(int nz, F&& f) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
-        for (int k = r.begin(); k < r.end(); ++k) f(k);
-    });
-}
 
 void check_range(double v, double lo, double hi, const char* what) {
     if (!(v >= lo && v <= hi)) {
@@ -45,21 +38,6 @@ void check_nonnegative(const std::vector<float>& a, const char* what) {
 void check_finite(const std::vector<float>& a, const std::string& what) {
     for (size_t n = 0; n < a.size(); ++n)
         if (!std::isfinite(a[n])) throw Error("sim: " + what + " holds NaN/Inf at cell " + std::to_string(n));
-}
-
-// Smooth value noise in [0, 1] from hash_coords: deterministic, any resolution.
-double value_noise(uint32_t seed, double x, double y, double z) {
-    int xi = int(std::floor(x)), yi = int(std::floor(y)), zi = int(std::floor(z));
-    double fx = x - xi, fy = y - yi, fz = z - zi;
-    auto s = [](double t) { return t * t * (3 - 2 * t); };
-    fx = s(fx), fy = s(fy), fz = s(fz);
-    double v = 0;
-    for (int c = 0; c < 8; ++c) {
-        int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
-        double w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
-        v += w * hash_to_unit(hash_coords(seed, xi + dx, yi + dy, zi + dz));
-    }
-    return v;
 }
 
 } // namespace
@@ -326,7 +304,7 @@ void Simulation::add_ground_patch(const GroundPatch& g) {
                 double r = std::hypot(ddx, ddy) / g.radius;
                 if (r >= 1 || z > g.depth) continue;
                 double shape = std::pow(std::cos(0.5 * M_PI * r), 2) * (1 - z / g.depth);
-                double nse = value_noise(g.seed, x / g.noise_scale, y / g.noise_scale, 0.0);
+                double nse = noise::smooth_value_noise(g.seed, x / g.noise_scale, y / g.noise_scale, 0.0);
                 double m = shape * ((1 - g.noise_amount) + g.noise_amount * 2 * nse);
                 size_t c = vel_.ic(i, j, k);
                 heat_src_[c] += float(g.heat_rate * m);
@@ -349,7 +327,7 @@ double Simulation::max_buoyancy() const {
 void Simulation::buoyancy_into(MacVelocity& v, double dt) {
     const int nx = spec_.nx, ny = spec_.ny, nz = spec_.nz;
     std::vector<float>& b = tmp_;
-    for_slices(nz, [&](int k) {
+    parallel_for_index(nz, [&](int k) {
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i) {
                 size_t c = vel_.ic(i, j, k);
@@ -357,7 +335,7 @@ void Simulation::buoyancy_into(MacVelocity& v, double dt) {
                 b[c] = float(kGravity * (tv - thetav0_[size_t(k)]) / thetav0_[size_t(k)]);
             }
     });
-    for_slices(nz + 1, [&](int k) {
+    parallel_for_index(nz + 1, [&](int k) {
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i) {
                 double bb = k == 0 ? b[vel_.ic(i, j, 0)] : k == nz ? b[vel_.ic(i, j, nz - 1)]
@@ -384,7 +362,7 @@ void lap_accumulate(const Lattice& l, const std::vector<float>& in, std::vector<
         double v = in[(size_t(k) * l.n[1] + j) * l.n[0] + i];
         return ref_by_k ? v - (*ref_by_k)[size_t(k)] : v;
     };
-    for_slices(l.n[2], [&](int k) {
+    parallel_for_index(l.n[2], [&](int k) {
         for (int j = 0; j < l.n[1]; ++j)
             for (int i = 0; i < l.n[0]; ++i) {
                 double c = at(i, j, k);
@@ -417,7 +395,7 @@ void diffuse_heun(const Lattice& l, std::vector<float>& q, double coef_dt_h2, co
 double redistribute_negatives(std::vector<float>& q, int nz, size_t plane) {
     if (q.empty()) return 0;
     std::vector<double> moved(size_t(nz), 0.0);
-    for_slices(nz, [&](int k) {
+    parallel_for_index(nz, [&](int k) {
         double neg = 0, pos = 0;
         for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
             if (q[c] < 0) neg -= q[c];
@@ -453,7 +431,7 @@ void Simulation::diffuse(double dt) {
 void Simulation::add_sources(double dt, StepReport& rep) {
     const size_t plane = size_t(spec_.nx) * spec_.ny;
     std::vector<double> deficit(size_t(spec_.nz), 0.0);
-    for_slices(spec_.nz, [&](int k) {
+    parallel_for_index(spec_.nz, [&](int k) {
         double d = 0;
         for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
             theta_[c] += float(dt * heat_src_[c]);
@@ -474,7 +452,7 @@ void Simulation::thermodynamics(double dt, StepReport& rep) {
         const double relax = opt_.condensation_rate > 0 ? 1 - std::exp(-opt_.condensation_rate * dt) : 1.0;
         const size_t nzs = size_t(nz);
         std::vector<double> before(nzs), after(nzs), drift(nzs), cond(nzs);
-        for_slices(nz, [&](int k) {
+        parallel_for_index(nz, [&](int k) {
             const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)], lk = kLv / (kCp * pi);
             double wb = 0, wa = 0, dr = 0, cd = 0;
             for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c) {
@@ -536,7 +514,7 @@ void Simulation::advect_scalars(const MacVelocity& vel, const Lattice& cl, doubl
     const int nz = spec_.nz;
     const size_t plane = size_t(spec_.nx) * spec_.ny;
     if (opt_.reversible_theta_e && opt_.moist) {
-        for_slices(nz, [&](int k) {
+        parallel_for_index(nz, [&](int k) {
             const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
             for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
                 theta_[c] = float(equivalent_potential_temperature(theta_[c] * pi, p, qv_[c], double(qv_[c]) + qc_[c]));
@@ -557,7 +535,7 @@ void Simulation::advect_scalars(const MacVelocity& vel, const Lattice& cl, doubl
         qr_.swap(c);
     }
     if (opt_.reversible_theta_e && opt_.moist) {
-        for_slices(nz, [&](int k) {
+        parallel_for_index(nz, [&](int k) {
             const double pi = ref_.exner[size_t(k)], p = ref_.pressure[size_t(k)];
             for (size_t c = size_t(k) * plane; c < size_t(k + 1) * plane; ++c)
                 theta_[c] = float(temperature_from_theta_e(theta_[c], p, qv_[c], double(qv_[c]) + qc_[c]) / pi);

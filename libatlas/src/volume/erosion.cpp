@@ -1,10 +1,10 @@
 // Value erosion by fractal value noise (the Nubis remap erosion).
 #include "atlas/core/error.h"
 #include "atlas/core/memory.h"
-#include "atlas/noise/value_noise.h"
+#include "atlas/noise/value_fbm.h"
 #include "atlas/volume/edit.h"
 
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,23 +25,25 @@ Field3D erode_by_noise(const Field3D& density, const ErosionOptions& o, const Me
         if (ext[a] * o.frequency * std::ldexp(1.0, o.octaves - 1) > 1e7)
             throw Error("erode_by_noise: frequency x extent is too large (over 1e7 noise cells per axis)");
     Field3D out = density;
-    double norm = 0;
-    for (int k = 0; k < o.octaves; ++k) norm += std::ldexp(1.0, -k);
-    tbb::parallel_for(0, density.nz(), [&](int z) {
-        std::vector<float> row(size_t(density.nx())), acc(size_t(density.nx()));
+    // Gain 0.5 (octave weights 2^-k / sum); octave k at frequency 2^k.
+    const noise::ValueFbm fbm{.octaves = o.octaves, .gain = 0.5, .seed = o.seed, .seed_step = 0x9E3779B9u};
+    const std::vector<float> weights = noise::fbm_weights(fbm);
+    parallel_for_index(density.nz(), [&](int z) {
+        std::vector<float> acc(size_t(density.nx())), scratch;
         for (int y = 0; y < density.ny(); ++y) {
-            std::fill(acc.begin(), acc.end(), 0.0f);
-            for (int k = 0; k < o.octaves; ++k) {
+            noise::value_fbm_row(acc, fbm, weights, [&](int k) {
                 const double f = o.frequency * std::ldexp(1.0, k);
                 // Period in cells: the extent, so the noise tiles on the bounds
                 // when frequency * extent is an integer.
-                const Vec3i period{{std::max(1, int(std::lround(ext[0] * f))), std::max(1, int(std::lround(ext[1] * f))),
-                                    std::max(1, int(std::lround(ext[2] * f)))}};
-                noise::value_noise_row(row, 0.5 * h[0] * f, h[0] * f, (y + 0.5) * h[1] * f, (z + 0.5) * h[2] * f, period,
-                                       o.seed + uint32_t(k) * 0x9E3779B9u);
-                const float w = float(std::ldexp(1.0, -k) / norm);
-                for (size_t i = 0; i < row.size(); ++i) acc[i] += w * row[i];
-            }
+                noise::FbmRow r;
+                r.period = {{std::max(1, int(std::lround(ext[0] * f))), std::max(1, int(std::lround(ext[1] * f))),
+                             std::max(1, int(std::lround(ext[2] * f)))}};
+                r.x0 = 0.5 * h[0] * f;
+                r.dx = h[0] * f;
+                r.y = (y + 0.5) * h[1] * f;
+                r.z = (z + 0.5) * h[2] * f;
+                return r;
+            }, scratch);
             for (int x = 0; x < density.nx(); ++x) {
                 const double e = o.amount * std::clamp(double(acc[size_t(x)]), 0.0, 1.0);
                 float& d = out.at(o.channel, x, y, z);
