@@ -3,6 +3,7 @@
 
 #include "atlas/core/files.h"
 #include "atlas/io/writers.h"
+#include "atlas/io/yaml_document.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -18,11 +19,7 @@ namespace {
 struct Parser {
     std::string filename;
 
-    SourceLocation at(const YAML::Node& n) const {
-        YAML::Mark m = n.Mark();
-        if (m.is_null()) return {filename, 0, 0};
-        return {filename, m.line + 1, m.column + 1};
-    }
+    SourceLocation at(const YAML::Node& n) const { return io::yaml_location(filename, n); }
     [[noreturn]] void fail(const YAML::Node& n, const std::string& msg) const { throw ParseError(at(n), msg); }
 
     std::string scalar(const YAML::Node& n, const std::string& what) const {
@@ -252,13 +249,7 @@ GraphNode* Graph::find(const std::string& name) {
 Graph parse_graph(const std::string& text, const std::string& filename, const std::filesystem::path& base_dir,
                   const NodeRegistry& registry) {
     Parser p{filename};
-    YAML::Node root;
-    try {
-        root = YAML::Load(text);
-    } catch (const YAML::Exception& e) {
-        throw ParseError({filename, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1},
-                         "invalid YAML: " + e.msg);
-    }
+    const YAML::Node root = io::load_yaml(text, filename, "invalid YAML: ");
     if (!root || root.IsNull()) throw ParseError({filename, 1, 1}, "empty graph file: expected 'atlas: 1', 'nodes' and 'outputs'");
     if (!root.IsMap()) p.fail(root, "a graph file is a map with 'atlas', 'nodes' and 'outputs'");
     p.check_keys(root, {"atlas", "description", "nodes", "outputs"}, "graph");

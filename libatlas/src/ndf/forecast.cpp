@@ -7,8 +7,8 @@
 #include "atlas/ndf/ndf_set.h"
 
 #include <nlohmann/json.hpp>
-#include <tbb/parallel_for.h>
-#include <yaml-cpp/yaml.h>
+#include "atlas/core/parallel.h"
+#include "atlas/io/yaml_document.h"
 
 #include <algorithm>
 #include <cmath>
@@ -23,18 +23,12 @@ std::string num(double v) {
     return s.str();
 }
 
-SourceLocation where(const std::string& file, const YAML::Node& n) {
-    const YAML::Mark m = n.Mark();
-    if (m.is_null()) return {file, 0, 0};
-    return {file, m.line + 1, m.column + 1};
-}
-
 double as_number(const std::string& file, const YAML::Node& n, const std::string& what) {
     try {
         if (n.IsScalar()) return n.as<double>();
     } catch (const YAML::Exception&) {
     }
-    throw ParseError(where(file, n), what + " must be a number");
+    throw ParseError(io::yaml_location(file, n), what + " must be a number");
 }
 
 // The key segment containing `hour` (already in [0, period)), as the
@@ -134,70 +128,54 @@ void validate_forecast(const Forecast& f) {
 }
 
 Forecast parse_forecast(const std::string& text, const std::string& filename, std::vector<WeatherPreset> presets) {
-    YAML::Node root;
-    try {
-        root = YAML::Load(text);
-    } catch (const YAML::Exception& e) {
-        throw ParseError({filename, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1}, e.msg);
-    }
-    if (!root || !root.IsMap()) throw ParseError({filename, 1, 1}, "expected a map with 'atlas_forecast: 1', 'presets' and 'regions'");
-    const YAML::Node version = root["atlas_forecast"];
-    if (!version || !version.IsScalar() || version.Scalar() != "1")
-        throw ParseError(version ? where(filename, version) : SourceLocation{filename, 1, 1},
-                         "expected 'atlas_forecast: 1' (the forecast file version)");
-    for (const auto& kv : root) {
-        const std::string key = kv.first.Scalar();
-        if (key != "atlas_forecast" && key != "presets" && key != "period_hours" && key != "transition_hours" && key != "regions")
-            throw ParseError(where(filename, kv.first),
-                             "unknown key '" + key + "' (expected atlas_forecast, presets, period_hours, transition_hours, regions)");
-    }
+    const YAML::Node root = io::load_yaml(text, filename);
+    io::require_versioned_map(root, filename, "atlas_forecast", "1", "expected a map with 'atlas_forecast: 1', 'presets' and 'regions'",
+                              "expected 'atlas_forecast: 1' (the forecast file version)");
+    io::reject_unknown_keys(root, filename, {"atlas_forecast", "presets", "period_hours", "transition_hours", "regions"},
+                            "atlas_forecast, presets, period_hours, transition_hours, regions");
     Forecast f;
     f.presets = std::move(presets);
     if (f.presets.empty()) throw ParseError({filename, 1, 1}, "no presets to key the forecast with");
     if (const YAML::Node n = root["period_hours"]) {
         f.period_hours = as_number(filename, n, "period_hours");
         if (!(f.period_hours > 0 && f.period_hours <= 10000))
-            throw ParseError(where(filename, n), "period_hours = " + num(f.period_hours) + " is out of range (0, 10000]");
+            throw ParseError(io::yaml_location(filename, n), "period_hours = " + num(f.period_hours) + " is out of range (0, 10000]");
     }
     if (const YAML::Node n = root["transition_hours"]) {
         f.transition_hours = as_number(filename, n, "transition_hours");
         if (!(f.transition_hours >= 0 && std::isfinite(f.transition_hours)))
-            throw ParseError(where(filename, n), "transition_hours = " + num(f.transition_hours) + " must be >= 0");
+            throw ParseError(io::yaml_location(filename, n), "transition_hours = " + num(f.transition_hours) + " must be >= 0");
     }
     const YAML::Node regions = root["regions"];
     if (!regions || !regions.IsSequence() || regions.size() == 0)
-        throw ParseError(regions ? where(filename, regions) : SourceLocation{filename, 1, 1}, "'regions' must be a non-empty list");
+        throw ParseError(regions ? io::yaml_location(filename, regions) : SourceLocation{filename, 1, 1}, "'regions' must be a non-empty list");
     for (size_t r = 0; r < regions.size(); ++r) {
         const YAML::Node& rn = regions[r];
-        if (!rn.IsMap()) throw ParseError(where(filename, rn), "a region is a map with name, keys (and rect, blend)");
+        if (!rn.IsMap()) throw ParseError(io::yaml_location(filename, rn), "a region is a map with name, keys (and rect, blend)");
         ForecastRegion reg;
         reg.name = rn["name"] && rn["name"].IsScalar() ? rn["name"].Scalar() : "region" + std::to_string(r);
         const std::string who = "region '" + reg.name + "'";
-        for (const auto& kv : rn) {
-            const std::string key = kv.first.Scalar();
-            if (key != "name" && key != "rect" && key != "blend" && key != "keys")
-                throw ParseError(where(filename, kv.first), who + ": unknown key '" + key + "' (expected name, rect, blend, keys)");
-        }
+        io::reject_unknown_keys(rn, filename, {"name", "rect", "blend", "keys"}, "name, rect, blend, keys", who + ": ");
         if (const YAML::Node n = rn["rect"]) {
-            if (r == 0) throw ParseError(where(filename, n), who + ": the first region covers the whole map and takes no rect");
+            if (r == 0) throw ParseError(io::yaml_location(filename, n), who + ": the first region covers the whole map and takes no rect");
             if (!n.IsSequence() || n.size() != 4)
-                throw ParseError(where(filename, n), who + ": rect must be [xmin, ymin, xmax, ymax] in metres");
+                throw ParseError(io::yaml_location(filename, n), who + ": rect must be [xmin, ymin, xmax, ymax] in metres");
             double v[4];
             for (size_t i = 0; i < 4; ++i) v[i] = as_number(filename, n[i], who + ": rect");
             reg.whole_map = false;
             reg.rect = Box2d{{{v[0], v[1]}}, {{v[2], v[3]}}};
             if (!reg.rect.valid() || !std::isfinite(v[0] + v[1] + v[2] + v[3]))
-                throw ParseError(where(filename, n), who + ": rect must have xmin < xmax and ymin < ymax");
+                throw ParseError(io::yaml_location(filename, n), who + ": rect must have xmin < xmax and ymin < ymax");
         } else if (r > 0) {
-            throw ParseError(where(filename, rn), who + ": regions after the first need a rect [xmin, ymin, xmax, ymax]");
+            throw ParseError(io::yaml_location(filename, rn), who + ": regions after the first need a rect [xmin, ymin, xmax, ymax]");
         }
         if (const YAML::Node n = rn["blend"]) {
             reg.blend = as_number(filename, n, who + ": blend");
-            if (!(reg.blend >= 0 && std::isfinite(reg.blend))) throw ParseError(where(filename, n), who + ": blend must be >= 0 metres");
+            if (!(reg.blend >= 0 && std::isfinite(reg.blend))) throw ParseError(io::yaml_location(filename, n), who + ": blend must be >= 0 metres");
         }
         const YAML::Node keys = rn["keys"];
         if (!keys || !keys.IsSequence() || keys.size() == 0)
-            throw ParseError(keys ? where(filename, keys) : where(filename, rn),
+            throw ParseError(keys ? io::yaml_location(filename, keys) : io::yaml_location(filename, rn),
                              who + ": 'keys' must be a non-empty list of [hour, preset]");
         for (const auto& kn : keys) {
             YAML::Node hn, pn;
@@ -208,21 +186,21 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
                 hn = kn["hour"];
                 pn = kn["preset"];
             } else {
-                throw ParseError(where(filename, kn), who + ": a key is [hour, preset] or {hour: H, preset: NAME}");
+                throw ParseError(io::yaml_location(filename, kn), who + ": a key is [hour, preset] or {hour: H, preset: NAME}");
             }
             ForecastKey k;
             k.hour = as_number(filename, hn, who + ": key hour");
             if (!(k.hour >= 0 && k.hour < f.period_hours))
-                throw ParseError(where(filename, hn),
+                throw ParseError(io::yaml_location(filename, hn),
                                  who + ": key hour " + num(k.hour) + " is out of range [0, " + num(f.period_hours) + ")");
             if (!reg.keys.empty() && !(k.hour > reg.keys.back().hour))
-                throw ParseError(where(filename, hn), who + ": key hour " + num(k.hour) + " is not after the previous key (" +
+                throw ParseError(io::yaml_location(filename, hn), who + ": key hour " + num(k.hour) + " is not after the previous key (" +
                                                           num(reg.keys.back().hour) + "); keys must be in increasing hour order");
-            if (!pn.IsScalar()) throw ParseError(where(filename, pn), who + ": key preset must be a preset name");
+            if (!pn.IsScalar()) throw ParseError(io::yaml_location(filename, pn), who + ": key preset must be a preset name");
             try {
                 k.preset = find_preset(f.presets, pn.Scalar());
             } catch (const Error& e) {
-                throw ParseError(where(filename, pn), who + ": " + e.what());
+                throw ParseError(io::yaml_location(filename, pn), who + ": " + e.what());
             }
             reg.keys.push_back(k);
         }
@@ -234,15 +212,10 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
 
 std::filesystem::path forecast_presets_path(const std::filesystem::path& file) {
     const std::string text = read_file_bytes(file);
-    YAML::Node root;
-    try {
-        root = YAML::Load(text);
-    } catch (const YAML::Exception& e) {
-        throw ParseError({file.string(), e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1}, e.msg);
-    }
+    const YAML::Node root = io::load_yaml(text, file.string());
     const YAML::Node n = root.IsMap() ? root["presets"] : YAML::Node();
     if (!n || !n.IsScalar() || n.Scalar().empty())
-        throw ParseError(n ? where(file.string(), n) : SourceLocation{file.string(), 1, 1}, "'presets' must name the presets file");
+        throw ParseError(n ? io::yaml_location(file.string(), n) : SourceLocation{file.string(), 1, 1}, "'presets' must name the presets file");
     return file.parent_path() / n.Scalar();
 }
 
@@ -367,7 +340,7 @@ Field2D preset_weather_map(const WeatherPreset& p, const Field2D& noise, Vec2d d
     drift = Vec2d{{wrap_metres(drift[0], size[0]), wrap_metres(drift[1], size[1])}};
     Field2D out(noise.resolution(), 4, noise.bounds(), weather_map_channels(), budget);
     const Scroll s = scroll_of(noise, drift);
-    tbb::parallel_for(0, noise.height(), [&](int y) {
+    parallel_for_index(noise.height(), [&](int y) {
         for (int x = 0; x < noise.width(); ++x) {
             const double u = x + 0.5 - s.du, v = y + 0.5 - s.dv;
             float t[4];
@@ -389,7 +362,7 @@ Field2D forecast_weather_map(const Forecast& f, const Field2D& noise, double hou
         scrolls.push_back(scroll_of(noise, forecast_drift(f, int(r), hour, noise.bounds().size())));
     }
     Field2D out(noise.resolution(), 4, noise.bounds(), weather_map_channels(), budget);
-    tbb::parallel_for(0, noise.height(), [&](int y) {
+    parallel_for_index(noise.height(), [&](int y) {
         std::vector<double> w(nr);
         for (int x = 0; x < noise.width(); ++x) {
             region_weights(f, noise.texel_center(x, y), w);

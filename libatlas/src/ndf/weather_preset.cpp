@@ -3,8 +3,7 @@
 
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
-
-#include <yaml-cpp/yaml.h>
+#include "atlas/io/yaml_document.h"
 
 #include <algorithm>
 #include <cmath>
@@ -65,11 +64,6 @@ size_t edit_distance(const std::string& a, const std::string& b) {
     return row[b.size()];
 }
 
-SourceLocation where(const std::string& file, const YAML::Node& n) {
-    const YAML::Mark m = n.Mark();
-    if (m.is_null()) return {file, 0, 0};
-    return {file, m.line + 1, m.column + 1};
-}
 } // namespace
 
 void validate_preset(const WeatherPreset& p) {
@@ -82,25 +76,13 @@ void validate_preset(const WeatherPreset& p) {
 }
 
 std::vector<WeatherPreset> parse_presets(const std::string& text, const std::string& filename) {
-    YAML::Node root;
-    try {
-        root = YAML::Load(text);
-    } catch (const YAML::Exception& e) {
-        throw ParseError({filename, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1}, e.msg);
-    }
-    if (!root || !root.IsMap()) throw ParseError({filename, 1, 1}, "expected a map with 'atlas_presets: 1' and 'presets'");
-    const YAML::Node version = root["atlas_presets"];
-    if (!version || !version.IsScalar() || version.Scalar() != "1")
-        throw ParseError(version ? where(filename, version) : SourceLocation{filename, 1, 1},
-                         "expected 'atlas_presets: 1' (the presets file version)");
-    for (const auto& kv : root) {
-        const std::string key = kv.first.Scalar();
-        if (key != "atlas_presets" && key != "presets")
-            throw ParseError(where(filename, kv.first), "unknown key '" + key + "' (expected 'atlas_presets' and 'presets')");
-    }
+    const YAML::Node root = io::load_yaml(text, filename);
+    io::require_versioned_map(root, filename, "atlas_presets", "1", "expected a map with 'atlas_presets: 1' and 'presets'",
+                              "expected 'atlas_presets: 1' (the presets file version)");
+    io::reject_unknown_keys(root, filename, {"atlas_presets", "presets"}, "'atlas_presets' and 'presets'");
     const YAML::Node list = root["presets"];
     if (!list || !list.IsMap() || list.size() == 0)
-        throw ParseError(list ? where(filename, list) : SourceLocation{filename, 1, 1},
+        throw ParseError(list ? io::yaml_location(filename, list) : SourceLocation{filename, 1, 1},
                          "'presets' must be a non-empty map of name -> fields");
 
     std::vector<WeatherPreset> out;
@@ -108,10 +90,10 @@ std::vector<WeatherPreset> parse_presets(const std::string& text, const std::str
     for (const auto& entry : list) {
         WeatherPreset p;
         p.name = entry.first.Scalar();
-        if (p.name.empty()) throw ParseError(where(filename, entry.first), "a preset needs a name");
-        if (!names.insert(p.name).second) throw ParseError(where(filename, entry.first), "duplicate preset '" + p.name + "'");
+        if (p.name.empty()) throw ParseError(io::yaml_location(filename, entry.first), "a preset needs a name");
+        if (!names.insert(p.name).second) throw ParseError(io::yaml_location(filename, entry.first), "duplicate preset '" + p.name + "'");
         const YAML::Node& body = entry.second;
-        if (!body.IsMap()) throw ParseError(where(filename, body), "preset '" + p.name + "': expected a map of field: value");
+        if (!body.IsMap()) throw ParseError(io::yaml_location(filename, body), "preset '" + p.name + "': expected a map of field: value");
         for (const auto& kv : body) {
             const std::string field = kv.first.Scalar();
             const auto& fields = preset_fields();
@@ -121,7 +103,7 @@ std::vector<WeatherPreset> parse_presets(const std::string& text, const std::str
                 size_t best_d = 4;
                 for (const auto& f : fields)
                     if (size_t d = edit_distance(field, f.name); d < best_d) best_d = d, best = f.name;
-                throw ParseError(where(filename, kv.first), "preset '" + p.name + "': unknown field '" + field + "'" +
+                throw ParseError(io::yaml_location(filename, kv.first), "preset '" + p.name + "': unknown field '" + field + "'" +
                                                                 (best.empty() ? "" : " (did you mean '" + best + "'?)"));
             }
             double v = 0;
@@ -129,14 +111,14 @@ std::vector<WeatherPreset> parse_presets(const std::string& text, const std::str
                 if (!kv.second.IsScalar()) throw YAML::Exception(kv.second.Mark(), "not a scalar");
                 v = kv.second.as<double>();
             } catch (const YAML::Exception&) {
-                throw ParseError(where(filename, kv.second), "preset '" + p.name + "': " + field + " must be a number");
+                throw ParseError(io::yaml_location(filename, kv.second), "preset '" + p.name + "': " + field + " must be a number");
             }
             if (const std::string why = check_field(*it, v); !why.empty())
-                throw ParseError(where(filename, kv.second), "preset '" + p.name + "': " + why);
+                throw ParseError(io::yaml_location(filename, kv.second), "preset '" + p.name + "': " + why);
             p.*(it->member) = v;
         }
         if (p.min_height > p.max_height)
-            throw ParseError(where(filename, entry.first),
+            throw ParseError(io::yaml_location(filename, entry.first),
                              "preset '" + p.name + "': min_height = " + num(p.min_height) + " is above max_height = " + num(p.max_height));
         out.push_back(std::move(p));
     }
