@@ -3,11 +3,13 @@
 #include "atlas/compress/bc1_scalar.h"
 
 #include "test_blocks.h"
+#include "../../libatlas/src/compress/bc1_eval.h" // internal: the AVX2 selection and channel-major palettes
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace atlas::compress {
 namespace {
@@ -46,6 +48,62 @@ void rgb_block(uint64_t k, float out[48]) {
     scalar_block(k + 2000003, 0, 1, b);
     for (int t = 0; t < 16; ++t) { out[3 * t] = r[t]; out[3 * t + 1] = g[t]; out[3 * t + 2] = b[t]; }
 }
+
+// The channel-major palettes the encoder's AVX2 path uses hold the same floats as
+// bc1_interval_palette, for random pairs (both modes) under several decoder sets.
+TEST(Bc1Eval, ChannelMajorPaletteEqualsIntervalPalette) {
+    const DecoderSet sets[] = {kReferenceOnly, kAllDecoders, decoder_bit(Decoder::Nvidia), decoder_bit(Decoder::Conformant),
+                               decoder_bit(Decoder::Amd) | decoder_bit(Decoder::Tool8Round), 0};
+    for (uint64_t k = 0; k < 20000; ++k) {
+        const uint16_t c0 = uint16_t(unit(k, 1) * 65536), c1 = uint16_t(k % 7 == 0 ? c0 : uint16_t(unit(k, 2) * 65536));
+        for (DecoderSet set : sets) {
+            detail::Palette<3> p;
+            detail::Bc1PaletteCm q;
+            detail::bc1_interval_palette(c0, c1, set, p);
+            detail::bc1_interval_palette_cm(c0, c1, set, q);
+            for (int i = 0; i < 4; ++i)
+                for (int c = 0; c < 3; ++c) {
+                    ASSERT_EQ(std::memcmp(&p.lo[i][c], &q.lo[c][i], 4), 0) << c0 << " " << c1 << " set " << set;
+                    ASSERT_EQ(std::memcmp(&p.hi[i][c], &q.hi[c][i], 4), 0) << c0 << " " << c1 << " set " << set;
+                    ASSERT_EQ(std::memcmp(&p.ref[i][c], &q.ref[c][i], 4), 0) << c0 << " " << c1 << " set " << set;
+                }
+        }
+    }
+}
+
+#if defined(ATLAS_BC1_AVX2)
+// The AVX2 selection returns select_indices<3>'s result bit for bit (max error, squared
+// error, indices, early exit), two- and one-sided, on random and smooth blocks with random
+// pairs and incumbent bounds.
+TEST(Bc1Eval, Avx2EqualsSelectIndices) {
+    if (!detail::bc1_cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this CPU";
+    for (uint64_t k = 0; k < uint64_t(kRandomBlocks / 5); ++k) {
+        float src[48];
+        for (int c = 0; c < 3; ++c) {
+            float ch[16];
+            scalar_block(k * 3 + uint64_t(c), 0.0f, 1.0f, ch);
+            for (int t = 0; t < 16; ++t) src[3 * t + c] = ch[t];
+        }
+        const detail::Bc1Planes planes(src);
+        // Equal endpoints (every entry but black ties) and near pairs as well as random ones.
+        const uint16_t c0 = uint16_t(unit(k, 1) * 65536);
+        const uint16_t c1 = k % 5 == 0 ? c0 : k % 5 == 1 ? uint16_t(c0 ^ (1u << (k % 16))) : uint16_t(unit(k, 2) * 65536);
+        const DecoderSet set = k % 3 == 0 ? kAllDecoders : kReferenceOnly;
+        detail::Palette<3> p;
+        detail::Bc1PaletteCm q;
+        detail::bc1_interval_palette(c0, c1, set, p);
+        detail::bc1_interval_palette_cm(c0, c1, set, q);
+        const float stop = k % 4 == 0 ? float(unit(k, 3)) * 0.2f : INFINITY;
+        for (bool os : {false, true}) {
+            const detail::Selection a = detail::select_indices(p, src, os, stop);
+            const detail::Selection b = os ? detail::bc1_select_avx2<true>(q, planes, stop) : detail::bc1_select_avx2<false>(q, planes, stop);
+            ASSERT_EQ(std::memcmp(&a.max_err, &b.max_err, 4), 0) << "case " << k << " os " << os;
+            ASSERT_EQ(std::memcmp(&a.sum_sq, &b.sum_sq, 8), 0) << "case " << k << " os " << os;
+            ASSERT_EQ(std::memcmp(a.idx, b.idx, 16), 0) << "case " << k << " os " << os;
+        }
+    }
+}
+#endif
 
 TEST(Bc1, RandomBlocksReportedErrorBoundsEveryDecoder) {
     BlockOptions o;

@@ -2,6 +2,7 @@
 // endpoints under the decoder-set objective (max error, then squared error).
 #include "atlas/compress/bc1.h"
 
+#include "bc1_eval.h"
 #include "bc1_palette.h"
 
 #include <algorithm>
@@ -29,15 +30,32 @@ struct Candidate {
     bool valid = false;
 };
 
+// select_indices<3> with AVX2 where the CPU has it (bc1_eval.h: the same result).
+bool use_avx2() {
+    static const bool yes = detail::bc1_cpu_has_avx2();
+    return yes;
+}
+
 class Search {
 public:
-    Search(const float* src, const BlockOptions& o) : src_(src), o_(o) {}
+    Search(const float* src, const BlockOptions& o) : src_(src), o_(o), planes_(src), avx2_(use_avx2()) {}
 
     // Evaluates the ordered pair (c0, c1); keeps it when better.
     void try_pair(uint16_t c0, uint16_t c1) {
-        detail::Palette<3> p;
-        detail::bc1_interval_palette(c0, c1, o_.decoders, p);
-        detail::Selection s = detail::select_indices(p, src_, o_.one_sided_below, best.valid ? best.sel.max_err : INFINITY);
+        const float stop = best.valid ? best.sel.max_err : INFINITY;
+        detail::Selection s;
+#if defined(ATLAS_BC1_AVX2)
+        if (avx2_) {
+            detail::Bc1PaletteCm p;
+            detail::bc1_interval_palette_cm(c0, c1, o_.decoders, p);
+            s = o_.one_sided_below ? detail::bc1_select_avx2<true>(p, planes_, stop) : detail::bc1_select_avx2<false>(p, planes_, stop);
+        } else
+#endif
+        {
+            detail::Palette<3> p;
+            detail::bc1_interval_palette(c0, c1, o_.decoders, p);
+            s = detail::select_indices(p, src_, o_.one_sided_below, stop);
+        }
         if (!std::isfinite(s.max_err)) return;
         if (!best.valid || detail::better(s, best.sel)) { best.c0 = c0; best.c1 = c1; best.sel = s; best.valid = true; }
     }
@@ -71,6 +89,8 @@ public:
 private:
     const float* src_;
     const BlockOptions& o_;
+    detail::Bc1Planes planes_;
+    bool avx2_;
 };
 
 } // namespace

@@ -7,6 +7,7 @@
 #include "bc1_palette.h"
 
 #include <algorithm>
+#include <cstring>
 #include <memory>
 
 namespace atlas::compress {
@@ -164,6 +165,55 @@ void bc1_interval_palette(uint16_t c0, uint16_t c1, DecoderSet set, Palette<3>& 
         for (int i = 0; i < 4; ++i)
             for (int c = 0; c < 3; ++c) merge(i, c, v[i][c], v[i][c]);
         any = true;
+    }
+}
+
+void bc1_interval_palette_cm(uint16_t c0, uint16_t c1, DecoderSet set, Bc1PaletteCm& p) {
+    const ChannelTables& T = channel_tables();
+    const int f = c0 > c1 ? 1 : 0;
+    const bool four = f == 1;
+    const DecoderSet use = set == 0 ? kReferenceOnly : set;
+    const int a[3] = {(c0 >> 11) & 31, (c0 >> 5) & 63, c0 & 31}, b[3] = {(c1 >> 11) & 31, (c1 >> 5) & 63, c1 & 31};
+    if (use == kReferenceOnly) { // one model: lo = hi = ref
+        const int d = int(Decoder::Reference);
+        const float* v[3] = {T.t5[d][f][a[0]][b[0]], T.t6[d][f][a[1]][b[1]], T.t5[d][f][a[2]][b[2]]};
+        for (int ch = 0; ch < 3; ++ch) {
+            std::memcpy(p.ref[ch], v[ch], sizeof p.ref[ch]);
+            std::memcpy(p.lo[ch], v[ch], sizeof p.lo[ch]);
+            std::memcpy(p.hi[ch], v[ch], sizeof p.hi[ch]);
+        }
+        return;
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+        auto table = [&](int d) { return ch == 1 ? T.t6[d][f][a[ch]][b[ch]] : T.t5[d][f][a[ch]][b[ch]]; };
+        const float* ref = table(int(Decoder::Reference));
+        float lo[4], hi[4];
+        for (int i = 0; i < 4; ++i) { p.ref[ch][i] = ref[i]; lo[i] = hi[i] = ref[i]; }
+        bool any = false;
+        // bc1_interval_palette's merge, entry by entry: the first model sets the interval,
+        // the others widen it (std::min / std::max in the same order).
+        for (int di = 0; di < kDecoderCount; ++di) {
+            if (!(use & (DecoderSet(1) << di))) continue;
+            const Decoder d = static_cast<Decoder>(di);
+            float vlo[4], vhi[4];
+            if (d == Decoder::Conformant) {
+                const float t = bc1_conformant_tolerance(ref[0], ref[1]);
+                for (int i = 0; i < 4; ++i) {
+                    const float ti = (!four && i == 3) ? 0.0f : t; // black is exact
+                    vlo[i] = ref[i] - ti;
+                    vhi[i] = ref[i] + ti;
+                }
+            } else {
+                const float* v = table(di);
+                for (int i = 0; i < 4; ++i) vlo[i] = vhi[i] = v[i];
+            }
+            for (int i = 0; i < 4; ++i) {
+                if (!any) { lo[i] = vlo[i]; hi[i] = vhi[i]; }
+                else { lo[i] = std::min(lo[i], vlo[i]); hi[i] = std::max(hi[i], vhi[i]); }
+            }
+            any = true;
+        }
+        for (int i = 0; i < 4; ++i) { p.lo[ch][i] = lo[i]; p.hi[ch][i] = hi[i]; }
     }
 }
 

@@ -18,6 +18,16 @@ const float* bc1_channel_palette(Decoder d, bool four, bool six, int a, int b);
 // Per-channel interval palette of (c0, c1) over a decoder set.
 void bc1_interval_palette(uint16_t c0, uint16_t c1, DecoderSet set, Palette<3>& p);
 
+// The same intervals channel-major (lo[c][i]: channel c of entry i, i < 4), built 4 entries
+// at a time from the channel tables: the same floats as bc1_interval_palette (test
+// Bc1Eval.ChannelMajorPaletteEqualsIntervalPalette).
+struct Bc1PaletteCm {
+    alignas(16) float lo[3][4];
+    alignas(16) float hi[3][4];
+    alignas(16) float ref[3][4];
+};
+void bc1_interval_palette_cm(uint16_t c0, uint16_t c1, DecoderSet set, Bc1PaletteCm& p);
+
 inline void write_bc1_block(uint16_t c0, uint16_t c1, const uint8_t idx[16], uint8_t out[8]) {
     out[0] = uint8_t(c0); out[1] = uint8_t(c0 >> 8);
     out[2] = uint8_t(c1); out[3] = uint8_t(c1 >> 8);

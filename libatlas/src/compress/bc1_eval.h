@@ -1,0 +1,97 @@
+// Internal: BC1 index selection (select_indices<3>, palette_search.h) with AVX2 on a
+// channel-major palette (bc1_interval_palette_cm), the same result bit for bit: the block's max error and every texel's entry through the same float
+// operations (MAXPS(a, b) is `a > b ? a : b`, MINPS likewise, as written there), the
+// squared Reference error of each entry in double in the same order ((d0^2 + d1^2) + d2^2),
+// the first minimum per texel, and the texels' squares summed in texel order. Run after a
+// CPU check (bc1_encode.cpp); elsewhere the encoder calls select_indices itself. Tested
+// against select_indices: Bc1Eval.Avx2EqualsSelectIndices.
+#pragma once
+
+#include "bc1_palette.h"
+#include "palette_search.h"
+
+#include <cstdint>
+#include <limits>
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define ATLAS_BC1_AVX2 1
+#endif
+
+namespace atlas::compress::detail {
+
+// The 16 texels of a block as channel planes (r[t], g[t], b[t]).
+struct Bc1Planes {
+    alignas(32) float c[3][16];
+    explicit Bc1Planes(const float* rgb) {
+        for (int t = 0; t < 16; ++t)
+            for (int ch = 0; ch < 3; ++ch) c[ch][t] = rgb[3 * t + ch];
+    }
+};
+
+#if defined(ATLAS_BC1_AVX2)
+inline bool bc1_cpu_has_avx2() { return __builtin_cpu_supports("avx2") != 0; }
+
+template <bool OneSided>
+__attribute__((target("avx2"))) inline Selection bc1_select_avx2(const Bc1PaletteCm& p, const Bc1Planes& s, float stop_above) {
+    Selection out;
+    const __m256 zero = _mm256_setzero_ps(), vinf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+    const __m256 vstop = _mm256_set1_ps(stop_above);
+    __m256 err[4][2], block = zero;
+    for (int h = 0; h < 2; ++h) {
+        const __m256 sr = _mm256_load_ps(s.c[0] + 8 * h), sg = _mm256_load_ps(s.c[1] + 8 * h), sb = _mm256_load_ps(s.c[2] + 8 * h);
+        const __m256 sv[3] = {sr, sg, sb};
+        __m256 best = vinf;
+        for (int i = 0; i < 4; ++i) {
+            __m256 e = zero, above = zero;
+            for (int ch = 0; ch < 3; ++ch) {
+                const __m256 lo = _mm256_set1_ps(p.lo[ch][i]), hi = _mm256_set1_ps(p.hi[ch][i]);
+                const __m256 m = _mm256_max_ps(_mm256_sub_ps(hi, sv[ch]), _mm256_sub_ps(sv[ch], lo));
+                e = _mm256_max_ps(m, e); // std::max(e, m) = e < m ? m : e
+                if constexpr (OneSided) above = _mm256_or_ps(above, _mm256_cmp_ps(hi, sv[ch], _CMP_GT_OQ));
+            }
+            if constexpr (OneSided) e = _mm256_blendv_ps(e, vinf, above);
+            err[i][h] = e;
+            best = _mm256_min_ps(e, best); // std::min(best, e) = e < best ? e : best
+        }
+        // !(best <= stop) for any texel: infeasible or worse than the incumbent.
+        if (_mm256_movemask_ps(_mm256_cmp_ps(best, vstop, _CMP_LE_OQ)) != 0xff) return out;
+        block = _mm256_max_ps(best, block);
+    }
+    float bm[8];
+    _mm256_storeu_ps(bm, block);
+    float block_max = 0;
+    for (int j = 0; j < 8; ++j) block_max = std::max(block_max, bm[j]);
+    out.max_err = block_max;
+    const __m256d vmax = _mm256_set1_pd(double(block_max));
+    // Texels in groups of 4 (double lanes): group g holds texels 4g .. 4g + 3.
+    __m256d best_sq[4], best_i[4];
+    for (int g = 0; g < 4; ++g) { best_sq[g] = _mm256_set1_pd(std::numeric_limits<double>::infinity()); best_i[g] = _mm256_setzero_pd(); }
+    __m256d sd[3][4];
+    for (int ch = 0; ch < 3; ++ch)
+        for (int g = 0; g < 4; ++g) sd[ch][g] = _mm256_cvtps_pd(_mm_load_ps(s.c[ch] + 4 * g));
+    for (int i = 0; i < 4; ++i) {
+        const __m256d r0 = _mm256_set1_pd(double(p.ref[0][i])), r1 = _mm256_set1_pd(double(p.ref[1][i])), r2 = _mm256_set1_pd(double(p.ref[2][i]));
+        const __m256d vi = _mm256_set1_pd(double(i));
+        for (int g = 0; g < 4; ++g) {
+            const __m128 e4 = (g & 1) ? _mm256_extractf128_ps(err[i][g >> 1], 1) : _mm256_castps256_ps128(err[i][g >> 1]);
+            const __m256d allowed = _mm256_cmp_pd(_mm256_cvtps_pd(e4), vmax, _CMP_LE_OQ); // exact widening: the same comparison
+            const __m256d d0 = _mm256_sub_pd(r0, sd[0][g]), d1 = _mm256_sub_pd(r1, sd[1][g]), d2 = _mm256_sub_pd(r2, sd[2][g]);
+            const __m256d sq = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
+            const __m256d take = _mm256_and_pd(allowed, _mm256_cmp_pd(sq, best_sq[g], _CMP_LT_OQ)); // first minimum wins
+            best_sq[g] = _mm256_blendv_pd(best_sq[g], sq, take);
+            best_i[g] = _mm256_blendv_pd(best_i[g], vi, take);
+        }
+    }
+    double sq[16], bi[16];
+    for (int g = 0; g < 4; ++g) { _mm256_storeu_pd(sq + 4 * g, best_sq[g]); _mm256_storeu_pd(bi + 4 * g, best_i[g]); }
+    double total = 0;
+    for (int t = 0; t < 16; ++t) { out.idx[t] = uint8_t(bi[t]); total += sq[t]; }
+    out.sum_sq = total;
+    return out;
+}
+#else
+inline bool bc1_cpu_has_avx2() { return false; }
+#endif
+
+} // namespace atlas::compress::detail
