@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include "atlas/compress/compress_options.h"
 #include "atlas/compress/texture.h"
 #include "atlas/graph/graph.h"
 #include "atlas/render/renderer.h"
@@ -7,6 +8,22 @@
 #include <sstream>
 
 namespace atlas::cli {
+
+namespace {
+// `head`, then one flag per schema option that has one (in the schema's order), then `tail`.
+template <class T>
+std::vector<OptionDecl> with_schema_flags(std::vector<OptionDecl> head, std::span<const TextOption<T>> schema, std::vector<OptionDecl> tail) {
+    for (const TextOption<T>& o : schema)
+        if (o.cli_flag) head.push_back({o.cli_flag, o.metavar, schema_flag_doc(o)});
+    head.insert(head.end(), tail.begin(), tail.end());
+    return head;
+}
+} // namespace
+
+std::string schema_flag_doc(const TextOptionSpec& o) {
+    const bool names = o.kind == OptionKind::Choice || o.kind == OptionKind::List;
+    return o.doc + (names && !o.words.empty() ? ": " + o.expected() : "");
+}
 
 const std::vector<Command>& commands() {
     static const std::vector<Command> table = {
@@ -39,26 +56,19 @@ const std::vector<Command>& commands() {
         {"nodes", "[TYPE] [--markdown]", "list node types, or show one node's ports and parameters",
          {{"--markdown", "", "print the whole reference as Markdown (docs/nodes.md)"}},
          run_nodes},
+        {"options", "[--markdown]", "list every output format's options and the compress options (atlas compress flags = dds options)",
+         {{"--markdown", "", "print the reference as Markdown (docs/options.md)"}},
+         run_options},
         {"compress", "IN -o OUT.dds --format FORMAT [options]",
          "encode a field file (EXR, PNG, TGA, VDB, a slice stack STEM.001.tga or STEM(0).tga) as a DDS texture with a guaranteed error bound",
-         {{"--out", "OUT.dds", "output texture (also -o); OUT.dds.json (the manifest) is written beside it"},
-          {"--format", "FORMAT", compress::format_names()},
-          {"--quality", "LEVEL", "fast, normal (default) or best (bc4: exhaustive, provably optimal)"},
-          {"--max-error", "E", "guarantee |decoded - source| <= E (source units) for every texel, or fail listing the blocks"},
-          {"--one-sided", "below", "guarantee decoded <= source (SDFs for sphere tracing); mips are min-reduced"},
-          {"--allow-over-bound", "", "write the texture even when some blocks miss --max-error (they are listed)"},
-          {"--decoders", "LIST", "comma-separated decoder models the bounds hold for: " + compress::decoder_names() + " (default all)"},
-          {"--mips", "N|full", "mip levels: 1.." + std::to_string(compress::kMaxMipLevels) + " or full (default 1, as the dds output's 'mips')"},
-          {"--range", "LO,HI", "source values mapped to the format's 0..1 (default: the data's min and max)"},
-          {"--channels", "NAMES", "comma-separated input channels to store"},
-          {"--array", "", "store a 3D input as a 2D texture array instead of a volume"},
+         with_schema_flags({{"--out", "OUT.dds", "output texture (also -o); OUT.dds.json (the manifest) is written beside it"}}, compress::compress_options(), {
           {"--verify", "", "decode the written file with every decoder model and print the errors (default after a bounded encode)"},
           {"--no-verify", "", "skip the verification after a bounded encode"},
           {"--sweep", "", "encode at every quality level and print error against time as CSV (no texture written)"},
           {"--csv", "FILE", "with --sweep: also write the table to FILE"},
           {"--report", "FILE.json", "write the compression report"},
           {"--memory-budget", "SIZE", "refuse inputs past this size (default 8GiB)"},
-          {"--quiet", "", "no progress bar"}},
+          {"--quiet", "", "no progress bar"}}),
          run_compress},
         {"decompress", "IN.dds -o OUT.exr [--decoder MODEL]", "decode a DDS texture to float (EXR, PNG, VDB, ...)",
          {{"--out", "OUT", "output file; the format follows the extension"},

@@ -2,8 +2,11 @@
 // help and "did you mean" come from one table (in the manner of vdb_tool).
 #pragma once
 
+#include "atlas/core/option_schema.h"
+
 #include <functional>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -51,11 +54,27 @@ Args parse_args(const Command& cmd, const std::vector<std::string>& argv);
 std::string command_help(const Command& cmd);
 std::string general_help();
 
+// A schema option's flag doc in help: its doc, and for names the accepted ones.
+std::string schema_flag_doc(const TextOptionSpec& o);
+
+// Sets `out` from the flags of `cmd` that schema options declare (a Flag option's
+// flag takes no value and means true); throws UsageError
+// "--flag expects <expected>, got '<text>'". Other flags are left to the caller.
+template <class T>
+void read_schema_flags(const Args& a, std::span<const TextOption<T>> schema, T& out, const std::string& cmd) {
+    for (const TextOption<T>& o : schema) {
+        if (!o.cli_flag || !a.has(o.cli_flag)) continue;
+        const std::string text = o.kind == OptionKind::Flag ? "true" : a.get(o.cli_flag);
+        if (!set_text_option(o, text, out)) throw UsageError{std::string(o.cli_flag) + " expects " + o.expected() + ", got '" + text + "'", cmd};
+    }
+}
+
 // Subcommand entry points (one file each).
 int run_cook(const Args&);
 int run_validate(const Args&);
 int run_cache(const Args&);
 int run_nodes(const Args&);
+int run_options(const Args&);
 int run_info(const Args&);
 int run_preview(const Args&);
 int run_compress(const Args&);

@@ -2,87 +2,37 @@
 #include "cli.h"
 #include "progress_bar.h"
 
+#include "atlas/compress/compress_options.h"
 #include "atlas/compress/texture.h"
 #include "atlas/core/files.h"
+#include "atlas/io/dds_file.h"
 #include "atlas/io/readers.h"
 #include "atlas/io/writers.h"
 
-#include <charconv>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <sstream>
 
 namespace atlas::cli {
 
 namespace {
 
-std::vector<std::string> split(const std::string& s, char sep) {
-    std::vector<std::string> v;
-    std::stringstream ss(s);
-    for (std::string item; std::getline(ss, item, sep);)
-        if (!item.empty()) v.push_back(item);
-    return v;
-}
-
-float parse_float(const std::string& text, const std::string& option) {
-    try {
-        size_t used = 0;
-        float v = std::stof(text, &used);
-        if (used == text.size()) return v;
-    } catch (...) {
-    }
-    throw UsageError{option + " expects a number, got '" + text + "'", "compress"};
-}
-
-compress::CompressOptions parse_compress_options(const Args& a, const Field3D& field) {
+// Every option through the compress schema (atlas/compress/compress_options.h), the
+// one a graph's dds output parses its options with.
+// Channel names are resolved once the input is read (resolve_channels).
+compress::CompressOptions parse_compress_options(const Args& a) {
     compress::CompressOptions o;
     if (!a.has("--format")) throw UsageError{"--format is required (" + compress::format_names() + ")", "compress"};
-    o.format = compress::parse_format(a.get("--format"));
-    if (a.has("--quality")) o.quality = compress::parse_quality(a.get("--quality").c_str());
-    if (a.has("--max-error")) {
-        o.max_error = parse_float(a.get("--max-error"), "--max-error");
-        if (!(*o.max_error >= 0)) throw UsageError{"--max-error must be >= 0", "compress"};
-    }
-    if (a.has("--one-sided")) {
-        if (a.get("--one-sided") != "below") throw UsageError{"--one-sided accepts 'below' (decoded <= source), got '" + a.get("--one-sided") + "'", "compress"};
-        o.one_sided_below = true;
-    }
-    o.allow_over_bound = a.has("--allow-over-bound");
-    if (a.has("--mips")) {
-        // The same rule as the graph's dds option `mips`: a whole number of levels
-        // 1..kMaxMipLevels, or 'full'.
-        const std::string m = a.get("--mips");
-        const std::string expected = "--mips expects a whole number of levels from 1 to " + std::to_string(compress::kMaxMipLevels) +
-                                     ", or 'full', got '" + m + "'";
-        if (m == "full") {
-            o.mip_levels = 0;
-        } else {
-            int n = 0;
-            const auto [end, ec] = std::from_chars(m.data(), m.data() + m.size(), n);
-            if (ec != std::errc() || end != m.data() + m.size() || n < 1 || n > compress::kMaxMipLevels)
-                throw UsageError{expected, "compress"};
-            o.mip_levels = n;
-        }
-    }
-    if (a.has("--range")) {
-        auto parts = split(a.get("--range"), ',');
-        if (parts.size() != 2) throw UsageError{"--range expects LO,HI", "compress"};
-        o.value_range = std::make_pair(parse_float(parts[0], "--range"), parse_float(parts[1], "--range"));
-    }
-    if (a.has("--channels")) {
-        for (const auto& name : split(a.get("--channels"), ',')) {
-            int c = field.find_channel(name);
-            if (c < 0) throw Error("--channels: the input has no channel '" + name + "'");
-            o.channels.push_back(c);
-        }
-    }
-    if (a.has("--decoders")) {
-        o.decoders = 0;
-        for (const auto& d : split(a.get("--decoders"), ',')) o.decoders |= compress::decoder_bit(compress::parse_decoder(d));
-    }
-    o.as_array = a.has("--array");
+    read_schema_flags(a, compress::compress_options(), o, "compress");
     return o;
+}
+
+void resolve_channels(compress::CompressOptions& o, const Field3D& field) {
+    try {
+        compress::resolve_channel_names(o, field);
+    } catch (const Error& e) {
+        throw Error(std::string("--channels: ") + e.what());
+    }
 }
 
 void print_report(const compress::CompressReport& r) {
@@ -118,11 +68,11 @@ int run_compress(const Args& a) {
     if (a.positional.size() != 1) throw UsageError{"expected one input file", "compress"};
     const std::string in = a.positional[0];
     // Usage errors before the (possibly long) read of the input.
-    if (!a.has("--format")) throw UsageError{"--format is required (" + compress::format_names() + ")", "compress"};
     if (!a.has("--sweep") && !a.has("--out")) throw UsageError{"-o OUT.dds is required", "compress"};
+    compress::CompressOptions o = parse_compress_options(a);
     const MemoryBudget budget(a.has("--memory-budget") ? parse_byte_size(a.get("--memory-budget")) : MemoryBudget::kDefaultLimit);
     Field3DPtr field = io::as_field3d(io::read_field_file(in, &budget));
-    compress::CompressOptions o = parse_compress_options(a, *field);
+    resolve_channels(o, *field);
 
     if (a.has("--sweep")) {
         auto rows = compress::sweep(*field, o);
@@ -143,7 +93,7 @@ int run_compress(const Args& a) {
     ProgressSink sink = bar.sink();
     compress::CompressReport r;
     try {
-        r = compress::compress_to_dds(*field, out, o, &sink);
+        r = io::compress_to_dds(*field, out, o, &sink);
     } catch (const compress::BoundError& e) {
         bar.finish();
         print_report(e.report());
@@ -152,7 +102,7 @@ int run_compress(const Args& a) {
     bar.finish();
     print_report(r);
     const bool bounded = o.max_error || o.one_sided_below;
-    if ((bounded && !a.has("--no-verify")) || a.has("--verify")) print_verify(compress::verify_dds(out, *field, o.decoders, o.channels));
+    if ((bounded && !a.has("--no-verify")) || a.has("--verify")) print_verify(io::verify_dds(out, *field, o.decoders, o.channels));
     if (a.has("--report")) {
         std::string json = r.to_json();
         write_file_atomic(a.get("--report"), [&](const fs::path& tmp) {
@@ -167,7 +117,7 @@ int run_decompress(const Args& a) {
     if (a.positional.size() != 1) throw UsageError{"expected one input .dds file", "decompress"};
     if (!a.has("--out")) throw UsageError{"-o OUT.exr is required", "decompress"};
     const compress::Decoder decoder = a.has("--decoder") ? compress::parse_decoder(a.get("--decoder")) : compress::Decoder::Reference;
-    auto field = std::make_shared<Field3D>(compress::read_dds(a.positional[0], decoder));
+    auto field = std::make_shared<Field3D>(io::read_dds(a.positional[0], decoder));
     const fs::path out = a.get("--out");
     Value v = Field3DPtr(field);
     if (field->nz() == 1) {

@@ -1,4 +1,4 @@
-// atlas nodes [TYPE] [--markdown]
+// atlas nodes [TYPE] [--markdown], atlas options [--markdown]
 #include "cli.h"
 
 #include "atlas/graph/graph.h"
@@ -25,6 +25,13 @@ int run_nodes(const Args& a) {
         }
         std::cout << node_reference_text(*t);
     }
+    return 0;
+}
+
+// The Markdown is readable as text too: one generator, no second copy to drift.
+int run_options(const Args& a) {
+    if (!a.positional.empty()) throw UsageError{"expected no arguments", "options"};
+    std::cout << options_reference_markdown();
     return 0;
 }
 

@@ -1,5 +1,6 @@
 // field/constant: a field filled with one value per channel.
 #include "atlas/graph/node.h"
+#include "common/grid.h"
 
 namespace {
 using namespace atlas;
@@ -12,9 +13,7 @@ void declare(NodeDeclaration& d) {
         return TileGrid{{{r[0], r[1]}}, Box2d{{{lo[0], lo[1]}}, {{hi[0], hi[1]}}}};
     }));
     d.output("out", PortType::Field3D, "the constant field");
-    d.param_int3("resolution", {{64, 64, 16}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z");
-    d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");
-    d.param_float3("bounds_max", {{4096, 4096, 512}}).with_unit("m").describe("world-space maximum corner");
+    grid_nodes::declare_grid(d, grid_nodes::kCoarseCloudscapeGrid);
     d.param_int("channels", 1).range(1, 16).describe("number of channels");
     d.param_float("value", 0.0).describe("value of every voxel in every channel");
 }

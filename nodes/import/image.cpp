@@ -1,5 +1,6 @@
 // import/image: read a PNG, TGA, EXR, ... (anything OpenImageIO reads) as a 2D field.
 #include "atlas/core/files.h"
+#include "common/grid.h"
 #include "atlas/core/hash.h"
 #include "atlas/graph/node.h"
 #include "atlas/io/image.h"
@@ -12,8 +13,7 @@ void declare(NodeDeclaration& d) {
     d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field2D, "the image as a 2D field (row 0 is the bottom row)");
     d.param_path("file").describe("image file, relative to the graph file");
-    d.param_float2("bounds_min", {{0, 0}}).with_unit("m").describe("world-space minimum corner");
-    d.param_float2("bounds_max", {{4096, 4096}}).with_unit("m").describe("world-space maximum corner");
+    grid_nodes::declare_map_bounds(d, grid_nodes::kCloudscapeMap.bounds_min, grid_nodes::kCloudscapeMap.bounds_max);
 }
 
 void cook(CookContext& ctx) {

@@ -1,5 +1,6 @@
 // import/tga_slices: a 3D field from a TGA slice stack (the Nubis voxel-cloud-pack layout).
 #include "atlas/core/files.h"
+#include "common/grid.h"
 #include "atlas/core/hash.h"
 #include "atlas/graph/node.h"
 #include "atlas/io/tga_slices.h"
@@ -13,8 +14,7 @@ void declare(NodeDeclaration& d) {
     d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field3D, "the stack as a 3D field (x = column, y = row from the bottom, z = slice)");
     d.param_path("file").describe("the first slice (NAME.001.tga or NAME(0).tga), a pattern or DIR/NAME, relative to the graph file");
-    d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");
-    d.param_float3("bounds_max", {{4096, 4096, 512}}).with_unit("m").describe("world-space maximum corner");
+    grid_nodes::declare_bounds(d, grid_nodes::kCloudscapeGrid.bounds_min, grid_nodes::kCloudscapeGrid.bounds_max);
     d.param_int("channels", 4).range(1, 4).describe("channels to keep (R, RG, RGB or RGBA)");
 }
 

@@ -2,24 +2,16 @@
 #pragma once
 
 #include "atlas/graph/node.h"
+#include "common/grid.h"
 
 #include <string>
 
 namespace atlas::ndf_nodes {
 
-// resolution / bounds_min / bounds_max of a generated map; defaults: the HZD
-// weather map, 60 km x 60 km at 512 x 512 texels.
-inline void declare_map(NodeDeclaration& d) {
-    d.param_int2("resolution", {{512, 512}}).range(1, 65536).with_unit("texels").describe("texels along x, y");
-    d.param_float2("bounds_min", {{0, 0}}).with_unit("m").describe("world-space minimum corner");
-    d.param_float2("bounds_max", {{60000, 60000}}).with_unit("m").describe("world-space maximum corner");
-}
-
-inline Box2d map_bounds(const CookContext& ctx) {
-    Box2d box{ctx.get_float2("bounds_min"), ctx.get_float2("bounds_max")};
-    if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in x and y");
-    return box;
-}
+// resolution / bounds_min / bounds_max of a generated map (nodes/common/grid.h);
+// defaults: the HZD weather map, 60 km x 60 km at 512 x 512 texels.
+inline void declare_map(NodeDeclaration& d) { grid_nodes::declare_map(d, grid_nodes::kWeatherMap); }
+using grid_nodes::map_bounds;
 
 inline Vec2i map_resolution(const CookContext& ctx, int channels = 1) {
     const Vec2i r = ctx.get_int2("resolution");

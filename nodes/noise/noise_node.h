@@ -3,6 +3,7 @@
 #pragma once
 
 #include "atlas/graph/node.h"
+#include "common/grid.h"
 #include "atlas/noise/fill.h"
 
 #include <string>
@@ -20,9 +21,7 @@ inline void declare_common(NodeDeclaration& d, Vec3i period = {{4, 4, 4}}) {
     }));
     d.output("out", PortType::Field, "the noise field (Field3D, or Field2D when dimensions = 2d)");
     d.param_enum("dimensions", {"3d", "2d"}, "3d").describe("Field3D, or Field2D over x, y");
-    d.param_int3("resolution", {{128, 128, 128}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z (z unused in 2D)");
-    d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");
-    d.param_float3("bounds_max", {{1, 1, 1}}).with_unit("m").describe("world-space maximum corner");
+    grid_nodes::declare_grid(d, grid_nodes::kNoiseGrid, "voxels along x, y, z (z unused in 2D)");
     d.param_int3("period", period).range(1, 1 << 30).with_unit("cells").describe("lattice cells per tile along x, y, z (the tiling period)");
     d.param_float("frequency", 1).range(0, 1e6).describe("tiles across the field; an integer keeps the field seamless, 0 gives a constant");
     d.param_float3("offset", {{0, 0, 0}}).with_unit("cells").describe("lattice offset (e.g. for animation)");

@@ -1,5 +1,6 @@
 // noise/value: tileable value-noise FBM filling a 3D field.
 #include "atlas/graph/node.h"
+#include "common/grid.h"
 #include "atlas/noise/value_fbm.h"
 
 namespace {
@@ -9,9 +10,7 @@ void declare(NodeDeclaration& d) {
     d.doc("Tileable value noise with FBM octaves over a 3D field; values in [0, 1]. Tiles exactly every `period` lattice cells.");
     d.tiling(TileRule::pointwise());
     d.output("out", PortType::Field3D, "noise field (1 channel)");
-    d.param_int3("resolution", {{64, 64, 16}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z");
-    d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");
-    d.param_float3("bounds_max", {{4096, 4096, 512}}).with_unit("m").describe("world-space maximum corner");
+    grid_nodes::declare_grid(d, grid_nodes::kCoarseCloudscapeGrid);
     d.param_int3("period", {{4, 4, 1}}).range(1, 4096).with_unit("cells").describe("lattice cells across the field per axis (the tiling period)");
     d.param_int("octaves", 3).range(1, 16).describe("FBM octaves; octave k has period * 2^k");
     d.param_float("gain", 0.5).range(0, 1).describe("amplitude ratio between octaves");

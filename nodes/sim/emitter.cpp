@@ -19,7 +19,7 @@ void declare(NodeDeclaration& d) {
     d.input("mask", PortType::Field3D, "emitter shape (mode 'mask'): density-like, 0 = no source").optional = true;
     d.output("out", PortType::Field3D, "channels 'heat' (K/s) and 'vapour' (kg/kg/s)");
     d.param_enum("mode", {"ground_patch", "mask"}, "ground_patch").describe("where the sources come from");
-    volume_nodes::declare_grid(d, {{64, 64, 16}});
+    volume_nodes::declare_grid(d, grid_nodes::kCoarseCloudscapeGrid);
     d.param_float2("center", {{2048, 2048}}).with_unit("m").describe("ground_patch: world x, y of the disc centre");
     d.param_float("radius", 500).range(1e-3, 1e9).with_unit("m").describe("ground_patch: disc radius");
     d.param_float("depth", 200).range(1e-3, 1e9).with_unit("m").describe("ground_patch: heated layer depth above the floor");

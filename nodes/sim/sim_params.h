@@ -9,31 +9,23 @@
 #include "atlas/core/error.h"
 #include "atlas/graph/node.h"
 #include "atlas/sim/simulation.h"
+#include "atlas/sim/sounding_options.h"
 
-#include <array>
 #include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace atlas::sim_nodes {
 
-// Channel names of the sounding record, in order.
-inline const std::array<const char*, 11>& sounding_channels() {
-    static const std::array<const char*, 11> names = {"surface_pressure", "surface_theta",   "theta_lapse",       "inversion_height",
-                                                      "inversion_jump",   "inversion_depth", "theta_lapse_above", "surface_rh",
-                                                      "rh_lapse",         "rh_above",        "total_water"};
-    return names;
-}
-
-inline std::array<double*, 11> sounding_members(sim::Sounding& s) {
-    return {&s.surface_pressure, &s.surface_theta, &s.theta_lapse,       &s.inversion_height, &s.inversion_jump, &s.inversion_depth,
-            &s.theta_lapse_above, &s.surface_rh,   &s.rh_lapse,          &s.rh_above,         &s.total_water};
-}
-
-inline Field2D sounding_record(sim::Sounding s) {
-    const auto& names = sounding_channels();
-    Field2D f({{1, 1}}, int(names.size()), Box2d{{{0, 0}}, {{1, 1}}}, std::vector<std::string>(names.begin(), names.end()));
-    const auto members = sounding_members(s);
-    for (size_t c = 0; c < members.size(); ++c) f.channel(int(c))[0] = float(*members[c]);
+// The record's channels are the Sounding schema's options, in its order
+// (atlas/sim/sounding_options.h): one name and member list for node and record.
+inline Field2D sounding_record(const sim::Sounding& s) {
+    std::vector<std::string> names;
+    for (const auto& o : sim::sounding_options()) names.emplace_back(o.name);
+    Field2D f({{1, 1}}, int(names.size()), Box2d{{{0, 0}}, {{1, 1}}}, names);
+    int c = 0;
+    for (const auto& o : sim::sounding_options()) f.channel(c++)[0] = float(s.*o.member);
     return f;
 }
 
@@ -41,15 +33,13 @@ inline Field2D sounding_record(sim::Sounding s) {
 // the field is not one (a field from another node wired by mistake).
 inline sim::Sounding sounding_from_record(const CookContext& ctx, const Field2D& f, const std::string& port) {
     sim::Sounding s;
-    const auto& names = sounding_channels();
-    const auto members = sounding_members(s);
     if (f.width() != 1 || f.height() != 1)
         ctx.fail("input '" + port + "' must be a sim/sounding record (1 x 1), got " + std::to_string(f.width()) + " x " +
                  std::to_string(f.height()));
-    for (size_t c = 0; c < names.size(); ++c) {
-        const int ch = f.find_channel(names[c]);
-        if (ch < 0) ctx.fail("input '" + port + "' is not a sim/sounding record (no channel '" + names[c] + "')");
-        *members[c] = double(f.channel(ch)[0]);
+    for (const auto& o : sim::sounding_options()) {
+        const int ch = f.find_channel(o.name);
+        if (ch < 0) ctx.fail("input '" + port + "' is not a sim/sounding record (no channel '" + o.name + "')");
+        s.*o.member = double(f.channel(ch)[0]);
     }
     try {
         s.validate();

@@ -1,7 +1,9 @@
 // sim/sounding: the ambient atmosphere the cloud grows in (lapse rates, capping
 // inversion, humidity profile), as a record for sim/cloud_growth plus its
 // hydrostatic profile for inspection.
+#include "atlas/graph/option_params.h"
 #include "atlas/sim/simulation.h"
+#include "atlas/sim/sounding_options.h"
 #include "sim_params.h"
 
 #include <cmath>
@@ -16,27 +18,15 @@ void declare(NodeDeclaration& d) {
           "reference at 'levels' heights dz apart (channels theta K, temperature K, pressure Pa, rho kg/m^3, qv kg/kg, rh).");
     d.output("out", PortType::Field2D, "sounding record for sim/cloud_growth's 'sounding' input");
     d.output("profile", PortType::Field2D, "1 x levels: theta, temperature, pressure, rho, qv, rh at cell-centre heights");
-    d.param_float("surface_pressure", 1.0e5).range(3e4, 1.2e5).with_unit("Pa").describe("pressure at the grid bottom");
-    d.param_float("surface_theta", 300).range(200, 400).with_unit("K").describe("potential temperature at the grid bottom");
-    d.param_float("theta_lapse", 0.003).range(0, 0.05).with_unit("K/m").describe("dtheta/dz below the inversion (0 = neutral)");
-    d.param_float("inversion_height", 2500).range(0, 1e9).with_unit("m").describe("base of the capping inversion (1e9 = none)");
-    d.param_float("inversion_jump", 4).range(0, 20).with_unit("K").describe("theta increase across the inversion");
-    d.param_float("inversion_depth", 200).range(1, 2000).with_unit("m").describe("depth over which the jump is spread");
-    d.param_float("theta_lapse_above", 0.004).range(0, 0.05).with_unit("K/m").describe("dtheta/dz above the inversion");
-    d.param_float("surface_rh", 0.85).range(0, 1).describe("relative humidity at the ground");
-    d.param_float("rh_lapse", -1e-4).range(-1e-3, 1e-3).with_unit("1/m").describe("RH change per metre below the inversion");
-    d.param_float("rh_above", 0.3).range(0, 1).describe("relative humidity above the inversion");
-    d.param_float("total_water", 0).range(0, 0.05).with_unit("kg/kg")
-        .describe("> 0: saturated moist-neutral atmosphere with this total water (surface_theta is then theta_l; lapse and RH ignored)");
+    // The library's schema (ranges, units, docs) with the node's own defaults.
+    declare_options(d, sim::sounding_options(), sim::capped_boundary_layer_sounding());
     d.param_int("levels", 64).range(1, 4096).describe("heights in the 'profile' output");
     d.param_float("dz", 40).range(1e-3, 1e5).with_unit("m").describe("spacing of the 'profile' heights");
 }
 
 void cook(CookContext& ctx) {
     sim::Sounding s;
-    const auto& names = sim_nodes::sounding_channels();
-    const auto members = sim_nodes::sounding_members(s);
-    for (size_t c = 0; c < names.size(); ++c) *members[c] = ctx.get_float(names[c]);
+    read_options(ctx, sim::sounding_options(), s);
     const int levels = int(ctx.get_int("levels"));
     const double dz = ctx.get_float("dz");
     s.validate();

@@ -2,22 +2,16 @@
 #pragma once
 
 #include "atlas/graph/node.h"
+#include "common/grid.h"
 
 namespace atlas::volume_nodes {
 
-// resolution / bounds_min / bounds_max, defaulting to the Nubis cloudscape:
-// 4 km x 4 km x 512 m at 8 m voxels.
-inline void declare_grid(NodeDeclaration& d, Vec3i res = {{512, 512, 64}}) {
-    d.param_int3("resolution", res).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z");
-    d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("world-space minimum corner");
-    d.param_float3("bounds_max", {{4096, 4096, 512}}).with_unit("m").describe("world-space maximum corner");
+// resolution / bounds_min / bounds_max (nodes/common/grid.h), by default the
+// Nubis cloudscape: 4 km x 4 km x 512 m at 8 m voxels.
+inline void declare_grid(NodeDeclaration& d, const grid_nodes::GridDefaults& g = grid_nodes::kCloudscapeGrid) {
+    grid_nodes::declare_grid(d, g);
 }
-
-inline Box3d grid_bounds(const CookContext& ctx) {
-    Box3d box{ctx.get_float3("bounds_min"), ctx.get_float3("bounds_max")};
-    if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in every axis");
-    return box;
-}
+using grid_nodes::grid_bounds;
 
 inline void check_grid_memory(const CookContext& ctx, Vec3i res, int fields) {
     ctx.check_memory(field_bytes(uint64_t(res[0]) * uint64_t(res[1]) * uint64_t(res[2]), fields), "the volume grids");

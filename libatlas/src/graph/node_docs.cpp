@@ -1,5 +1,8 @@
 #include "atlas/graph/node_docs.h"
 
+#include "atlas/compress/compress_options.h"
+#include "atlas/io/writers.h"
+
 #include <sstream>
 
 namespace atlas {
@@ -101,6 +104,42 @@ std::string node_reference_markdown(const NodeRegistry& registry) {
                 out << "| `" << p.name << "` | " << param_type_name(p.type) << " | `" << format_param_value(p.default_value) << "` | "
                     << range_text(p) << " | " << p.unit << " | " << p.doc << " |\n";
         }
+    }
+    return out.str();
+}
+
+namespace {
+std::string md_cell(std::string s) {
+    for (size_t i = 0; (i = s.find('|', i)) != std::string::npos; i += 2) s.replace(i, 1, "\\|");
+    return s;
+}
+} // namespace
+
+std::string options_reference_markdown() {
+    std::ostringstream out;
+    out << "# Option reference\n\n"
+        << "Generated from the option schemas and the output format table by `atlas options --markdown`; do not\n"
+        << "edit by hand (a test fails when this file is stale: regenerate it with\n"
+        << "`build/bin/atlas options --markdown > docs/options.md`). Node parameters are in docs/nodes.md.\n\n"
+        << "## Compress options\n\n"
+        << "One schema (`compress::compress_options()`, atlas/compress/compress_options.h) for the `atlas compress`\n"
+        << "flags and the `dds` output's options: both accept exactly the same values.\n\n"
+        << "| dds option | `atlas compress` flag | accepts | description |\n|---|---|---|---|\n";
+    for (const auto& o : compress::compress_options())
+        out << "| `" << o.name << "` | " << md_cell(o.cli_flag ? "`" + std::string(o.cli_flag) + (*o.metavar ? " " + std::string(o.metavar) : "") + "`" : "")
+            << " | " << md_cell(o.kind == OptionKind::Flag ? "true or false (the flag alone: true)" : o.expected()) << " | " << md_cell(o.doc)
+            << " |\n";
+    out << "\n## Output formats\n\nA graph output's `format` (or its file extension) and its `options` map; option values are\n"
+        << "checked when the graph loads (`atlas validate` names the line).\n";
+    for (const io::OutputFormat& f : io::output_formats()) {
+        std::string ext, types;
+        for (const auto& e : f.extensions) ext += (ext.empty() ? "" : ", ") + ("`" + e + "`");
+        for (PortType t : f.accepts) types += (types.empty() ? "" : ", ") + std::string(port_type_name(t));
+        out << "\n### " << f.name << "\n\n" << f.doc << ".\n\nExtensions: " << (ext.empty() ? "none (give `format`)" : ext)
+            << ". Writes: " << types << ". Writer version " << f.version << ".\n\n";
+        if (f.options.empty()) continue;
+        out << "| option | description |\n|---|---|\n";
+        for (const auto& [name, doc] : f.options) out << "| `" << name << "` | " << md_cell(doc) << " |\n";
     }
     return out.str();
 }

@@ -1,7 +1,9 @@
 // The "dds" output format: graph outputs encoded through the error-bounded
 // compressor (atlas/compress/texture.h), with the same options as
 // `atlas compress`. Writes OUT.dds and its manifest OUT.dds.json.
+#include "atlas/compress/compress_options.h"
 #include "atlas/compress/texture.h"
+#include "atlas/io/dds_file.h"
 #include "atlas/io/output_options.h"
 #include "atlas/io/readers.h"
 #include "format_table.h"
@@ -9,29 +11,14 @@
 namespace atlas::io::detail {
 
 namespace {
-// Every option except the channel names' existence (checked when the graph loads too).
+// Every option through the compress schema (atlas/compress/compress_options.h), the
+// one `atlas compress` parses its flags with; channel names are resolved against
+// the value when it is written.
 compress::CompressOptions dds_options(const OptionReader& o) {
     compress::CompressOptions c;
-    try {
-        c.format = compress::parse_format(o.has("encoding") ? o.text("encoding") : std::string("rgba16f"));
-        if (o.has("quality")) c.quality = compress::parse_quality(o.text("quality").c_str());
-        if (o.has("decoders")) {
-            c.decoders = 0;
-            for (const auto& d : o.list("decoders")) c.decoders |= compress::decoder_bit(compress::parse_decoder(d));
-        }
-    } catch (const Error& e) {
-        throw Error(o.prefix() + e.what());
-    }
-    if (o.has("max_error")) c.max_error = o.number("max_error", 0.0f, 0.0f, INFINITY);
-    if (o.has("one_sided")) {
-        if (o.text("one_sided") != "below") o.bad("one_sided", "'below'");
-        c.one_sided_below = true;
-    }
-    c.allow_over_bound = o.flag("allow_over_bound");
-    if (o.has("mips")) c.mip_levels = o.text("mips") == "full" ? 0 : o.integer("mips", 1, 1, compress::kMaxMipLevels);
-    if (o.has("range")) c.value_range = o.range("range", 0.0f, 1.0f);
-    o.list("channels");
-    c.as_array = o.flag("array");
+    c.format = compress::kDdsOutputDefaultFormat;
+    for (const auto& option : compress::compress_options())
+        if (o.has(option.name) && !set_text_option(option, o.text(option.name), c)) o.bad(option.name, option.expected());
     return c;
 }
 } // namespace
@@ -42,12 +29,12 @@ std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path,
     const OptionReader o(options, path);
     const Field3DPtr field = as_field3d(value);
     compress::CompressOptions c = dds_options(o);
-    for (const auto& name : o.list("channels")) {
-        const int ch = field->find_channel(name);
-        if (ch < 0) o.bad("channels", "names of the value's channels");
-        c.channels.push_back(ch);
+    try {
+        compress::resolve_channel_names(c, *field);
+    } catch (const Error& e) {
+        throw Error(o.prefix() + e.what());
     }
-    const compress::CompressReport r = compress::compress_to_dds(*field, path, c);
+    const compress::CompressReport r = io::compress_to_dds(*field, path, c);
     // Error against run time, for the cook report.
     for (size_t ch = 0; ch < r.max_error.size(); ++ch) {
         metrics["max_error_" + std::to_string(ch)] = r.max_error[ch];

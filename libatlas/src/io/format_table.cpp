@@ -2,6 +2,7 @@
 // the end (the order is what `atlas` and docs list).
 #include "format_table.h"
 
+#include "atlas/compress/compress_options.h"
 #include "atlas/compress/texture.h"
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
@@ -69,6 +70,12 @@ std::vector<fs::path> write_json_output(const Value& v, const fs::path& p, const
         if (!out.flush()) throw Error(o.prefix() + "cannot write " + p.filename().string());
     });
     return {p};
+}
+// The dds output's option docs: the compress schema's (atlas compress takes the same values).
+std::vector<std::pair<std::string, std::string>> dds_option_docs() {
+    std::vector<std::pair<std::string, std::string>> docs;
+    for (const auto& o : compress::compress_options()) docs.emplace_back(o.name, o.doc + "; " + o.expected());
+    return docs;
 }
 } // namespace
 
@@ -139,16 +146,7 @@ const std::vector<FormatEntry>& format_table() {
           {".dds"},
           {PortType::Field2D, PortType::Field3D},
           "DDS texture (2D, array or volume) through the error-bounded compressor, with its manifest FILE.dds.json",
-          {{"encoding", compress::format_names() + " (default rgba16f)"},
-           {"quality", "fast, normal (default) or best"},
-           {"max_error", "guarantee |decoded - source| <= E for every texel, in source units (else the cook fails)"},
-           {"one_sided", "'below': guarantee decoded <= source (SDF field data)"},
-           {"allow_over_bound", "true: write even when blocks miss max_error"},
-           {"decoders", "comma-separated decoder models the bounds hold for: " + compress::decoder_names() + " (default all)"},
-           {"mips", "mip levels 1.." + std::to_string(compress::kMaxMipLevels) + ", or 'full' (default 1)"},
-           {"range", "'lo,hi': source values mapped to 0..1 (default: the data's min and max)"},
-           {"array", "true: a 3D field becomes a 2D texture array instead of a volume"},
-           kChannels},
+          dds_option_docs(),
           compress::kEncoderVersion},
          write_dds_output,
          check_dds_options},

@@ -1,5 +1,6 @@
 // The cloud-growth Simulation: sounding, sources, forces, stepping (see simulation.h).
 #include "atlas/sim/simulation.h"
+#include "atlas/sim/sounding_options.h"
 
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
@@ -19,6 +20,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
 
 void check_range(double v, double lo, double hi, const char* what) {
     if (!(v >= lo && v <= hi)) {
@@ -43,17 +45,7 @@ void check_finite(const std::vector<float>& a, const std::string& what) {
 } // namespace
 
 void Sounding::validate() const {
-    check_range(surface_pressure, 3e4, 1.2e5, "sounding.surface_pressure (Pa)");
-    check_range(surface_theta, 200, 400, "sounding.surface_theta (K)");
-    check_range(theta_lapse, 0, 0.05, "sounding.theta_lapse (K/m)");
-    check_range(inversion_height, 0, 1e9, "sounding.inversion_height (m)");
-    check_range(inversion_jump, 0, 20, "sounding.inversion_jump (K)");
-    check_range(inversion_depth, 1, 2000, "sounding.inversion_depth (m)");
-    check_range(theta_lapse_above, 0, 0.05, "sounding.theta_lapse_above (K/m)");
-    check_range(surface_rh, 0, 1, "sounding.surface_rh");
-    check_range(rh_lapse, -1e-3, 1e-3, "sounding.rh_lapse (1/m)");
-    check_range(rh_above, 0, 1, "sounding.rh_above");
-    check_range(total_water, 0, 0.05, "sounding.total_water (kg/kg)");
+    check_options(*this, sounding_options(), "sim: sounding"); // the ranges sim/sounding declares
     if (theta_e != 0) check_range(theta_e, 250, 400, "sounding.theta_e (K)");
     if (theta_e != 0 && !(total_water > 0)) throw Error("sim: sounding.theta_e needs sounding.total_water > 0");
 }

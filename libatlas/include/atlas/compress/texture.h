@@ -76,6 +76,9 @@ struct CompressOptions {
     // Field channels to store (empty = the first ones the format needs; missing
     // colour channels are 0, missing alpha is 1).
     std::vector<int> channels;
+    // The same by name, as the front ends' 'channels' option gives them;
+    // resolve_channel_names (compress_options.h) turns them into `channels`.
+    std::vector<std::string> channel_names;
     // A Field3D with nz > 1 becomes a 2D array instead of a volume texture.
     bool as_array = false;
     // BC1 textures that are not arrays get the legacy "DXT1" FourCC header instead

@@ -9,12 +9,14 @@
 
 #include "atlas/core/error.h"
 
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <span>
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace atlas {
 
@@ -57,6 +59,167 @@ void check_options(const T& value, std::span<const NumberOption<T>> schema, std:
 template <class T>
 const NumberOption<T>* find_option(std::span<const NumberOption<T>> schema, std::string_view name) {
     for (const NumberOption<T>& o : schema)
+        if (name == o.name) return &o;
+    return nullptr;
+}
+
+// ---------------------------------------------------------------------------
+// Options given as text (a graph output's `options` map, a CLI flag): one
+// TextOption<T> per option says what text it takes and how it fills T, and every
+// front end parses through parse_text_option, so they accept the same values.
+
+enum class OptionKind {
+    Number,  // a finite decimal number in [min, max] (a leading '+' and surrounding blanks allowed)
+    Integer, // a whole decimal number in [min, max], or one of `words`
+    Flag,    // true/1/yes/on or false/0/no/off; a CLI flag takes no value and means true
+    Choice,  // one of `words`
+    List,    // comma-separated non-empty items, each one of `words` (any name when `words` is empty)
+    Range,   // "lo,hi": two finite numbers in [min, max] with hi > lo
+};
+
+// What parse_text_option made of an option's text.
+struct OptionValue {
+    double number = 0;              // Number; Integer when no word was given
+    std::string word;               // Choice; Integer when one of its words was given
+    std::vector<std::string> items; // List
+    double lo = 0, hi = 0;          // Range
+    bool flag = false;              // Flag
+};
+
+struct TextOptionSpec {
+    const char* name;     // graph output option ("max_error")
+    const char* cli_flag; // the `atlas` flag taking it ("--max-error"), or nullptr
+    const char* metavar;  // the value's form in help ("E", "N|full", "LO,HI"); "" for a Flag
+    OptionKind kind;
+    std::string doc;      // one line, with the default
+    double min = -std::numeric_limits<double>::infinity(); // Number, Integer, Range: inclusive
+    double max = std::numeric_limits<double>::infinity();
+    std::vector<std::string> words; // see OptionKind
+
+    // What a value must be ("an integer in [1, 16] or 'full'"), for messages and docs.
+    std::string expected() const;
+};
+
+namespace detail {
+inline std::string_view trim_blanks(std::string_view s) {
+    const size_t a = s.find_first_not_of(" \t");
+    if (a == std::string_view::npos) return {};
+    return s.substr(a, s.find_last_not_of(" \t") - a + 1);
+}
+// The whole (trimmed, optionally '+'-signed) text as a finite double; locale-independent.
+inline bool parse_finite(std::string_view text, double& out) {
+    std::string_view s = trim_blanks(text);
+    const bool plus = !s.empty() && s[0] == '+';
+    if (plus) s.remove_prefix(1);
+    if (s.empty() || (plus && s[0] == '-')) return false; // from_chars refuses a '+' itself
+    const auto r = std::from_chars(s.data(), s.data() + s.size(), out);
+    return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(out);
+}
+inline std::string number_text(double v) {
+    std::ostringstream os;
+    os.precision(9);
+    os << v;
+    return os.str();
+}
+inline std::string quoted_words(const std::vector<std::string>& words, const char* last_sep) {
+    std::string s;
+    for (size_t i = 0; i < words.size(); ++i)
+        s += (i == 0 ? "" : i + 1 == words.size() ? last_sep : ", ") + ("'" + words[i] + "'");
+    return s;
+}
+inline bool is_word(const std::vector<std::string>& words, std::string_view w) {
+    for (const std::string& x : words)
+        if (w == x) return true;
+    return false;
+}
+} // namespace detail
+
+inline std::string TextOptionSpec::expected() const {
+    // A bound at the float limit (a member stored as float) reads "a 32-bit float".
+    constexpr double kFloatMax = std::numeric_limits<float>::max();
+    const bool lo = std::isfinite(min) && min > -kFloatMax, hi = std::isfinite(max) && max < kFloatMax;
+    const bool as_float = min == -kFloatMax || max == kFloatMax;
+    const std::string bounds = (lo && hi ? " in [" + detail::number_text(min) + ", " + detail::number_text(max) + "]"
+                                : lo     ? " >= " + detail::number_text(min)
+                                : hi     ? " <= " + detail::number_text(max)
+                                         : "") +
+                               (as_float ? " (a 32-bit float)" : "");
+    switch (kind) {
+    case OptionKind::Number: return "a finite number" + bounds;
+    case OptionKind::Integer: return "an integer" + bounds + (words.empty() ? "" : " or " + detail::quoted_words(words, " or "));
+    case OptionKind::Flag: return "true or false";
+    case OptionKind::Choice: return detail::quoted_words(words, " or ");
+    case OptionKind::List:
+        return words.empty() ? "a comma-separated list of names without empty entries"
+                             : "a comma-separated list of " + detail::quoted_words(words, ", ") + " without empty entries";
+    case OptionKind::Range: return "'lo,hi': two finite numbers" + bounds + " with hi > lo";
+    }
+    return "";
+}
+
+// Parses `text` as option `o` takes it; false (out unspecified) when it does not.
+inline bool parse_text_option(const TextOptionSpec& o, std::string_view text, OptionValue& out) {
+    const std::string_view s = detail::trim_blanks(text);
+    switch (o.kind) {
+    case OptionKind::Number: return detail::parse_finite(s, out.number) && out.number >= o.min && out.number <= o.max;
+    case OptionKind::Integer: {
+        if (detail::is_word(o.words, s)) {
+            out.word = std::string(s);
+            return true;
+        }
+        long long n = 0;
+        const auto r = std::from_chars(s.data(), s.data() + s.size(), n);
+        if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size() || double(n) < o.min || double(n) > o.max) return false;
+        out.number = double(n);
+        return true;
+    }
+    case OptionKind::Flag:
+        out.flag = s == "true" || s == "1" || s == "yes" || s == "on";
+        return out.flag || s == "false" || s == "0" || s == "no" || s == "off";
+    case OptionKind::Choice:
+        out.word = std::string(s);
+        return detail::is_word(o.words, s);
+    case OptionKind::List: {
+        out.items.clear();
+        size_t start = 0;
+        while (true) {
+            const size_t comma = text.find(',', start);
+            const std::string_view item = detail::trim_blanks(text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+            if (item.empty() || (!o.words.empty() && !detail::is_word(o.words, item))) return false;
+            out.items.emplace_back(item);
+            if (comma == std::string_view::npos) return true;
+            start = comma + 1;
+        }
+    }
+    case OptionKind::Range: {
+        const size_t comma = text.find(',');
+        if (comma == std::string_view::npos || text.find(',', comma + 1) != std::string_view::npos) return false;
+        return detail::parse_finite(text.substr(0, comma), out.lo) && detail::parse_finite(text.substr(comma + 1), out.hi) && out.hi > out.lo &&
+               out.lo >= o.min && out.hi <= o.max;
+    }
+    }
+    return false;
+}
+
+template <class T>
+struct TextOption : TextOptionSpec {
+    void (*apply)(T& out, const OptionValue& value) = nullptr; // fills T from a parsed value
+};
+
+// Parses `text` as option `o` and applies it to `out`; false (out untouched) when
+// the text is not what `o.expected()` says.
+template <class T>
+bool set_text_option(const TextOption<T>& o, std::string_view text, T& out) {
+    OptionValue v;
+    if (!parse_text_option(o, text, v)) return false;
+    o.apply(out, v);
+    return true;
+}
+
+// The option named `name` (graph option name), or nullptr.
+template <class T>
+const TextOption<T>* find_option(std::span<const TextOption<T>> schema, std::string_view name) {
+    for (const TextOption<T>& o : schema)
         if (name == o.name) return &o;
     return nullptr;
 }

@@ -15,5 +15,8 @@ std::string node_list_text(const NodeRegistry& registry);
 std::string node_reference_text(const NodeType& type);
 // The whole reference as Markdown (docs/nodes.md).
 std::string node_reference_markdown(const NodeRegistry& registry);
+// The output formats' options and the compress option schema (`atlas compress`
+// flags = `dds` output options) as Markdown (docs/options.md; a test compares).
+std::string options_reference_markdown();
 
 } // namespace atlas

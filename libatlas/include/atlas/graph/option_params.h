@@ -23,15 +23,24 @@ inline bool option_selected(std::initializer_list<std::string_view> only, std::s
 } // namespace detail
 
 // Declares one float parameter per option (all of them, or those named in `only`, in
-// the schema's order): default from T{}, the schema's inclusive range, unit and doc.
+// the schema's order): default from `defaults` (a node family whose defaults differ
+// from the library's passes its own, named preset), the schema's inclusive range,
+// unit and doc.
 template <class T>
-void declare_options(NodeDeclaration& d, std::span<const NumberOption<T>> schema, std::initializer_list<std::string_view> only = {}) {
+void declare_options(NodeDeclaration& d, std::span<const NumberOption<T>> schema, const T& defaults,
+                     std::initializer_list<std::string_view> only = {}) {
     for (const NumberOption<T>& o : schema) {
         if (!detail::option_selected(only, o.name)) continue;
-        ParamDecl& p = d.param_float(o.name, o.default_value()).with_unit(o.unit).describe(o.doc);
+        ParamDecl& p = d.param_float(o.name, defaults.*o.member).with_unit(o.unit).describe(o.doc);
         if (std::isfinite(o.min)) p.min = o.min;
         if (std::isfinite(o.max)) p.max = o.max;
     }
+}
+
+// The same with the library's defaults, T{}.
+template <class T>
+void declare_options(NodeDeclaration& d, std::span<const NumberOption<T>> schema, std::initializer_list<std::string_view> only = {}) {
+    declare_options(d, schema, T{}, only);
 }
 
 // Reads the parameters declare_options declared (same `only`) into `out`.

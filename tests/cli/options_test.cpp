@@ -1,0 +1,214 @@
+// One schema per option set (issue 13): every front end accepts exactly the values
+// another accepts, and docs/options.md is what the schemas generate.
+//  - compress: `atlas compress` flags (the program, run as a script runs it) and a
+//    graph's dds output options (checked as a graph load checks them);
+//  - sounding: the sim/sounding node's parameters and Sounding::validate();
+//  - grid parameters: one declaration for every node that has them.
+#include "atlas/compress/compress_options.h"
+#include "atlas/core/files.h"
+#include "atlas/graph/node.h"
+#include "atlas/graph/node_docs.h"
+#include "atlas/io/writers.h"
+#include "atlas/sim/sounding_options.h"
+
+#include "../support/cli_run.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace atlas {
+namespace {
+
+std::string num(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return buf;
+}
+
+// Boundary values of one option: at and just outside its bounds, a non-integer for
+// integers, NaN / Inf, malformed text, its first and last word and a wrong one.
+std::vector<std::string> probes(const TextOptionSpec& o) {
+    std::vector<std::string> v{"", "nan"};
+    switch (o.kind) {
+    case OptionKind::Number:
+        v.insert(v.end(), {"inf", "abc", num(o.min), num(std::nextafter(o.min, -INFINITY)), num(o.max), num(std::nextafter(o.max, INFINITY))});
+        break;
+    case OptionKind::Integer: v.insert(v.end(), {num(o.min), num(o.min - 1), num(o.max), num(o.max + 1), "2.7", "inf"}); break;
+    case OptionKind::Choice: break;
+    case OptionKind::List:
+        if (o.words.empty()) v.insert(v.end(), {"value", "value,", ",value"});
+        else v.insert(v.end(), {o.words[0] + "," + o.words[1], o.words[0] + ",," + o.words[1], o.words[0] + ","});
+        break;
+    case OptionKind::Range:
+        v.insert(v.end(), {"0,1", "1,0", "0,inf", "0,1,2", num(o.min) + ",0", "0," + num(o.max), "0," + num(std::nextafter(o.max, INFINITY) * 1.01)});
+        break;
+    case OptionKind::Flag: break;
+    }
+    if (!o.words.empty()) v.insert(v.end(), {o.words.front(), o.words.back(), o.words.back() + "x"});
+    return v;
+}
+
+bool dds_output_accepts(const std::string& option, const std::string& text) {
+    try {
+        io::check_output_options("dds", "x.dds", {{option, text}, {"encoding", "r8"}}, PortType::Field2D);
+        return true;
+    } catch (const Error&) {
+        return false;
+    }
+}
+
+using test::CliRun;
+
+CliRun run(const std::string& args) {
+    const fs::path dir = test::process_dir("atlas_options_test");
+    return test::run_shell(test::atlas_program() + " " + args + " 2>" + (dir / "err").string(), dir / "err");
+}
+
+TEST(OptionsSchema, DocsOptionsMdIsUpToDate) {
+    const std::string expected = options_reference_markdown();
+    std::string actual;
+    ASSERT_NO_THROW(actual = read_file_bytes(std::string(ATLAS_SOURCE_DIR) + "/docs/options.md"));
+    EXPECT_TRUE(actual == expected) << "docs/options.md is stale: regenerate it with 'build/bin/atlas options --markdown > docs/options.md'";
+    CliRun r = run("options --markdown");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out, expected);
+}
+
+// The dds output's options and `atlas compress`'s flags are the schema's, documented
+// with every word the option takes (bc6h and bc6h-sf16 were missing from 'encoding').
+TEST(OptionsSchema, EveryCompressOptionIsAFlagAndADdsOption) {
+    const io::OutputFormat* dds = nullptr;
+    for (const auto& f : io::output_formats())
+        if (f.name == "dds") dds = &f;
+    ASSERT_TRUE(dds);
+    CliRun help = run("compress --help");
+    for (const auto& o : compress::compress_options()) {
+        bool documented = false;
+        for (const auto& [name, doc] : dds->options)
+            if (name == o.name) {
+                documented = true;
+                for (const std::string& w : o.words) EXPECT_NE(doc.find("'" + w + "'"), std::string::npos) << o.name << " lacks " << w;
+            }
+        EXPECT_TRUE(documented) << o.name;
+        ASSERT_TRUE(o.cli_flag) << o.name;
+        EXPECT_NE(help.out.find(std::string("  ") + o.cli_flag + " "), std::string::npos) << o.cli_flag << "\n" << help.out;
+        for (const std::string& w : o.words) EXPECT_NE(help.out.find(w), std::string::npos) << o.cli_flag << " help lacks " << w;
+    }
+    EXPECT_EQ(dds->options.size(), compress::compress_options().size());
+}
+
+TEST(OptionsSchema, CompressFlagsAndDdsOptionsAcceptTheSameValues) {
+    const fs::path dir = test::process_dir("atlas_options_cli");
+    // A small 2D input with one channel named 'value' (the List-of-names probes use it).
+    auto field = std::make_shared<Field2D>(Vec2i{{8, 8}}, 1, Box2d{{{0, 0}}, {{1, 1}}}, std::vector<std::string>{"value"});
+    for (size_t i = 0; i < field->channel(0).size(); ++i) field->channel(0)[i] = float(i % 7) / 7.0f;
+    const fs::path in = dir / "in.exr";
+    io::write_value(Field2DPtr(field), in, "exr", {});
+    const fs::path out = dir / "out.dds";
+    int runs = 0;
+    for (const auto& o : compress::compress_options()) {
+        const std::string base = "compress " + in.string() + " --quiet --no-verify -o " + out.string();
+        // --format is the option itself for 'encoding'; the others use r8 (every option applies to it).
+        const std::string format = std::string(o.name) == "encoding" ? "" : " --format r8";
+        if (o.kind == OptionKind::Flag) {
+            // A flag takes no value and means true, as the option's 'true'.
+            EXPECT_TRUE(dds_output_accepts(o.name, "true"));
+            CliRun c = run(base + format + " " + o.cli_flag);
+            EXPECT_EQ(c.status, 0) << o.cli_flag << ": " << c.err;
+            EXPECT_EQ(run(base + format + " '" + o.cli_flag + "=true'").status, 2) << o.cli_flag << " takes no value";
+            continue;
+        }
+        for (const std::string& text : probes(o)) {
+            const bool graph = dds_output_accepts(o.name, text);
+            fs::remove(out);
+            CliRun c = run(base + format + " '" + o.cli_flag + "=" + text + "'");
+            ++runs;
+            const bool cli = c.status != 2;
+            EXPECT_EQ(cli, graph) << o.cli_flag << " '" << text << "': CLI status " << c.status << " " << c.err << " / graph "
+                                  << (graph ? "accepts" : "refuses");
+            // (An accepted value may still fail on this input, e.g. max_error 0 for r8: status 1.)
+            if (!cli) {
+                EXPECT_NE(c.err.find(std::string(o.cli_flag) + " expects " + o.expected()), std::string::npos) << c.err;
+            }
+        }
+    }
+    EXPECT_GT(runs, 40);
+    fs::remove_all(dir);
+}
+
+NodeDeclaration declaration_of(const std::string& type) {
+    const NodeRegistry registry = builtin_nodes();
+    const NodeType* t = registry.find(type);
+    if (!t) throw std::runtime_error("no node type " + type);
+    NodeDeclaration d;
+    t->declare(d);
+    return d;
+}
+
+// The node's parameters and the library's validate() take the same sounding values;
+// the node's defaults are the named preset, valid by the library's rule.
+TEST(OptionsSchema, SoundingNodeAndLibraryAcceptTheSameValues) {
+    const NodeDeclaration d = declaration_of("sim/sounding");
+    const sim::Sounding preset = sim::capped_boundary_layer_sounding();
+    EXPECT_NO_THROW(preset.validate());
+    EXPECT_NO_THROW(sim::Sounding{}.validate());
+    for (const auto& o : sim::sounding_options()) {
+        const ParamDecl* p = d.find_param(o.name);
+        ASSERT_TRUE(p) << o.name;
+        EXPECT_EQ(std::get<double>(p->default_value), preset.*o.member) << o.name;
+        EXPECT_EQ(p->unit, o.unit) << o.name;
+        std::vector<double> values{0.0, -1.0, 0.5, 1.0, 1e9, -1e9, std::nan(""), std::numeric_limits<double>::infinity()};
+        for (double b : {o.min, o.max})
+            for (double x : {b, std::nextafter(b, -INFINITY), std::nextafter(b, INFINITY)}) values.push_back(x);
+        for (double v : values) {
+            sim::Sounding s = preset;
+            s.*o.member = v;
+            bool library = true;
+            try {
+                s.validate();
+            } catch (const Error&) {
+                library = false;
+            }
+            // The graph refuses non-finite numbers when it parses them.
+            const bool node = p->check(ParamValue(v)).empty() && std::isfinite(v);
+            EXPECT_EQ(node, library) << o.name << " = " << v;
+        }
+    }
+}
+
+// Every node with grid parameters declares them alike (type, range, unit, doc); the
+// defaults are the family's own (nodes/common/grid.h).
+TEST(OptionsSchema, GridParametersAreDeclaredAlike) {
+    const NodeRegistry registry = builtin_nodes();
+    std::map<std::string, const ParamDecl*> first; // "resolution/2" etc. -> first declaration seen
+    int nodes = 0;
+    for (const NodeType* t : registry.all()) {
+        NodeDeclaration d;
+        t->declare(d);
+        const ParamDecl* lo = d.find_param("bounds_min");
+        const ParamDecl* hi = d.find_param("bounds_max");
+        if (!lo || !hi || lo->doc != "world-space minimum corner") continue; // other meanings (resample, transform) are their own
+        ++nodes;
+        EXPECT_EQ(lo->type, hi->type) << t->name;
+        EXPECT_EQ(lo->unit, "m") << t->name;
+        EXPECT_EQ(hi->doc, "world-space maximum corner") << t->name;
+        if (const ParamDecl* r = d.find_param("resolution")) {
+            EXPECT_EQ(r->min, 1.0) << t->name;
+            EXPECT_EQ(r->max, 65536.0) << t->name;
+            EXPECT_EQ(r->unit, r->type == ParamType::Int2 ? "texels" : "voxels") << t->name;
+        }
+    }
+    EXPECT_GE(nodes, 20);
+}
+
+} // namespace
+} // namespace atlas

@@ -1,0 +1,110 @@
+// The text-option parser every front end goes through (atlas/core/option_schema.h),
+// checked against independent readers: strtod / strtoll on the same text, and the
+// kind's rule written out by hand.
+#include "atlas/core/option_schema.h"
+
+#include <gtest/gtest.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace atlas {
+namespace {
+
+// Probes around the bounds of [lo, hi] plus text no number reader should take.
+std::vector<std::string> number_probes(double lo, double hi) {
+    std::vector<std::string> v{"", " ", "abc", "nan", "NaN", "inf", "-inf", "1e999", "0x10", "1,5", "1 2", "--1", "++1", "+-1",
+                               "0", "-0", "+3", " 2.5 ", "2.7", "17", "-1", "1e3", "1e-300", "12abc"};
+    for (double b : {lo, hi})
+        for (double x : {b, std::nextafter(b, -INFINITY), std::nextafter(b, INFINITY), b - 1, b + 1, b - 0.5, b + 0.5}) {
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%.17g", x);
+            v.push_back(buf);
+        }
+    return v;
+}
+
+std::string trimmed(const std::string& s) {
+    const size_t a = s.find_first_not_of(" \t");
+    return a == std::string::npos ? "" : s.substr(a, s.find_last_not_of(" \t") - a + 1);
+}
+
+// strtod reading of the kind's rule: the whole trimmed text, decimal (no hex, no
+// inf/nan words), one optional sign.
+bool reference_number(const std::string& text, double lo, double hi, double& out) {
+    std::string s = trimmed(text);
+    if (s.empty()) return false;
+    for (char c : s)
+        if (!(std::isdigit((unsigned char)c) || c == '.' || c == 'e' || c == 'E' || c == '-' || c == '+')) return false;
+    if (s.find("0x") != std::string::npos || s.find("0X") != std::string::npos) return false;
+    if (s.size() > 1 && (s[0] == '+' || s[0] == '-') && (s[1] == '+' || s[1] == '-')) return false;
+    char* end = nullptr;
+    errno = 0;
+    out = std::strtod(s.c_str(), &end);
+    // ERANGE with a non-zero result is a subnormal number: a number all the same.
+    const bool representable = errno != ERANGE || (out != 0 && std::isfinite(out));
+    return end == s.c_str() + s.size() && representable && std::isfinite(out) && out >= lo && out <= hi;
+}
+
+TEST(OptionSchema, NumberTakesWhatStrtodTakesInRange) {
+    const TextOptionSpec o{"x", nullptr, "X", OptionKind::Number, "", 0.0, 3.4e38};
+    for (const std::string& t : number_probes(o.min, o.max)) {
+        OptionValue v;
+        double ref = 0;
+        const bool want = reference_number(t, o.min, o.max, ref);
+        EXPECT_EQ(parse_text_option(o, t, v), want) << "'" << t << "'";
+        if (want) {
+            EXPECT_EQ(v.number, ref) << t;
+        }
+    }
+}
+
+TEST(OptionSchema, IntegerTakesWholeNumbersInRangeAndItsWords) {
+    const TextOptionSpec o{"n", nullptr, "N", OptionKind::Integer, "", 1, 16, {"full"}};
+    for (std::string t : number_probes(o.min, o.max)) {
+        OptionValue v;
+        const std::string s = trimmed(t);
+        char* end = nullptr;
+        const long long n = s.empty() ? 0 : std::strtoll(s.c_str(), &end, 10);
+        const bool whole = !s.empty() && s[0] != '+' && end == s.c_str() + s.size();
+        EXPECT_EQ(parse_text_option(o, t, v), whole && n >= 1 && n <= 16) << "'" << t << "'";
+    }
+    OptionValue v;
+    EXPECT_TRUE(parse_text_option(o, "full", v));
+    EXPECT_EQ(v.word, "full");
+    EXPECT_FALSE(parse_text_option(o, "Full", v));
+    EXPECT_EQ(o.expected(), "an integer in [1, 16] or 'full'");
+}
+
+TEST(OptionSchema, ChoiceListFlagAndRange) {
+    const TextOptionSpec choice{"c", nullptr, "C", OptionKind::Choice, "", -INFINITY, INFINITY, {"a", "bb"}};
+    const TextOptionSpec list{"l", nullptr, "L", OptionKind::List, "", -INFINITY, INFINITY, {"a", "bb"}};
+    const TextOptionSpec names{"l", nullptr, "L", OptionKind::List, ""};
+    const TextOptionSpec flag{"f", nullptr, "", OptionKind::Flag, ""};
+    const TextOptionSpec range{"r", nullptr, "LO,HI", OptionKind::Range, ""};
+    OptionValue v;
+    for (const char* t : {"a", "bb", " a "}) EXPECT_TRUE(parse_text_option(choice, t, v)) << t;
+    for (const char* t : {"", "b", "A", "a,bb"}) EXPECT_FALSE(parse_text_option(choice, t, v)) << t;
+    ASSERT_TRUE(parse_text_option(list, " bb , a", v));
+    EXPECT_EQ(v.items, (std::vector<std::string>{"bb", "a"}));
+    for (const char* t : {"", ",", "a,", "a,,bb", "a,c"}) EXPECT_FALSE(parse_text_option(list, t, v)) << t;
+    EXPECT_TRUE(parse_text_option(names, "x,y z", v));
+    EXPECT_FALSE(parse_text_option(names, "x,", v));
+    for (const char* t : {"true", "1", "yes", "on"}) EXPECT_TRUE(parse_text_option(flag, t, v) && v.flag) << t;
+    for (const char* t : {"false", "0", "no", "off"}) EXPECT_TRUE(parse_text_option(flag, t, v) && !v.flag) << t;
+    for (const char* t : {"", "2", "True", "maybe"}) EXPECT_FALSE(parse_text_option(flag, t, v)) << t;
+    ASSERT_TRUE(parse_text_option(range, " -1 , 2.5", v));
+    EXPECT_EQ(v.lo, -1.0);
+    EXPECT_EQ(v.hi, 2.5);
+    for (const char* t : {"", "1", "1,1", "2,1", "0,1,2", "nan,1", "0,inf", ",1", "0,"}) EXPECT_FALSE(parse_text_option(range, t, v)) << t;
+    const TextOptionSpec bounded{"r", nullptr, "LO,HI", OptionKind::Range, "", -10, 10};
+    EXPECT_TRUE(parse_text_option(bounded, "-10,10", v));
+    EXPECT_FALSE(parse_text_option(bounded, "-10.5,0", v));
+    EXPECT_FALSE(parse_text_option(bounded, "0,11", v));
+}
+
+} // namespace
+} // namespace atlas
