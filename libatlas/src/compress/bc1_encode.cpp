@@ -40,8 +40,11 @@ class Search {
 public:
     Search(const float* src, const BlockOptions& o) : src_(src), o_(o), planes_(src), avx2_(use_avx2()) {}
 
-    // Evaluates the ordered pair (c0, c1); keeps it when better.
+    // Evaluates the ordered pair (c0, c1); keeps it when better. A pair evaluated before
+    // in this block is skipped: it was not better than the incumbent then, and the
+    // incumbent has only improved since (so skipping changes no result).
     void try_pair(uint16_t c0, uint16_t c1) {
+        if (seen(c0, c1)) return;
         const float stop = best.valid ? best.sel.max_err : INFINITY;
         detail::Selection s;
 #if defined(ATLAS_BC1_AVX2)
@@ -87,10 +90,26 @@ public:
     Candidate best;
 
 private:
+    // Open addressing over the pairs evaluated so far (key + 1, 0 = empty); once the
+    // table is half full, further pairs are evaluated without being remembered.
+    bool seen(uint16_t c0, uint16_t c1) {
+        const uint32_t key = ((uint32_t(c0) << 16) | c1) + 1u; // 0 stays free (wraps only for 65535, 65535)
+        if (key == 0) return false;
+        uint32_t h = (key * 0x9E3779B1u) >> 24;
+        for (;; h = (h + 1) & 255) {
+            if (seen_[h] == key) return true;
+            if (seen_[h] == 0) break;
+        }
+        if (nseen_ < 128) { seen_[h] = key; ++nseen_; }
+        return false;
+    }
+
     const float* src_;
     const BlockOptions& o_;
     detail::Bc1Planes planes_;
     bool avx2_;
+    uint32_t seen_[256] = {};
+    int nseen_ = 0;
 };
 
 } // namespace

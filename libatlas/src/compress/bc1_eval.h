@@ -63,7 +63,6 @@ __attribute__((target("avx2"))) inline Selection bc1_select_avx2(const Bc1Palett
     float block_max = 0;
     for (int j = 0; j < 8; ++j) block_max = std::max(block_max, bm[j]);
     out.max_err = block_max;
-    const __m256d vmax = _mm256_set1_pd(double(block_max));
     // Texels in groups of 4 (double lanes): group g holds texels 4g .. 4g + 3.
     __m256d best_sq[4], best_i[4];
     for (int g = 0; g < 4; ++g) { best_sq[g] = _mm256_set1_pd(std::numeric_limits<double>::infinity()); best_i[g] = _mm256_setzero_pd(); }
@@ -73,9 +72,14 @@ __attribute__((target("avx2"))) inline Selection bc1_select_avx2(const Bc1Palett
     for (int i = 0; i < 4; ++i) {
         const __m256d r0 = _mm256_set1_pd(double(p.ref[0][i])), r1 = _mm256_set1_pd(double(p.ref[1][i])), r2 = _mm256_set1_pd(double(p.ref[2][i]));
         const __m256d vi = _mm256_set1_pd(double(i));
+        // Entries no texel may use are skipped (they change nothing below).
+        const __m256 vmaxf = _mm256_set1_ps(block_max);
+        const __m256 ok0 = _mm256_cmp_ps(err[i][0], vmaxf, _CMP_LE_OQ), ok1 = _mm256_cmp_ps(err[i][1], vmaxf, _CMP_LE_OQ);
+        if (!_mm256_movemask_ps(_mm256_or_ps(ok0, ok1))) continue;
         for (int g = 0; g < 4; ++g) {
-            const __m128 e4 = (g & 1) ? _mm256_extractf128_ps(err[i][g >> 1], 1) : _mm256_castps256_ps128(err[i][g >> 1]);
-            const __m256d allowed = _mm256_cmp_pd(_mm256_cvtps_pd(e4), vmax, _CMP_LE_OQ); // exact widening: the same comparison
+            const __m256 okh = (g >> 1) ? ok1 : ok0;
+            const __m128 ok4 = (g & 1) ? _mm256_extractf128_ps(okh, 1) : _mm256_castps256_ps128(okh);
+            const __m256d allowed = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_castps_si128(ok4))); // the lanes' masks, widened
             const __m256d d0 = _mm256_sub_pd(r0, sd[0][g]), d1 = _mm256_sub_pd(r1, sd[1][g]), d2 = _mm256_sub_pd(r2, sd[2][g]);
             const __m256d sq = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
             const __m256d take = _mm256_and_pd(allowed, _mm256_cmp_pd(sq, best_sq[g], _CMP_LT_OQ)); // first minimum wins
