@@ -15,6 +15,7 @@
 #include "atlas/compress/bc1.h"
 #include "atlas/compress/bc4.h"
 #include "atlas/compress/texture.h"
+#include "atlas/io/dds_file.h"
 
 #include <OpenImageIO/imageio.h>
 #include <benchmark/benchmark.h>
@@ -39,6 +40,7 @@
 namespace {
 
 using namespace atlas::compress;
+using atlas::io::read_dds;
 
 // 8-bit RGB image, width and height multiples of 4.
 struct Image {

@@ -4,6 +4,7 @@
 #include "atlas/compress/texture.h"
 #include "atlas/core/error.h"
 #include "atlas/core/field_math.h"
+#include "atlas/io/dds_file.h"
 #include "atlas/io/readers.h"
 #include "atlas/io/vdb.h"
 
@@ -45,11 +46,11 @@ int run_info(const Args& a) {
         std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
         std::printf("%s\n", file.c_str());
         if (ext == ".dds") {
-            const compress::DdsTexture t = compress::read_dds_file(file);
+            const compress::DdsTexture t = io::read_dds_file(file);
             std::printf("  DDS %s %dx%dx%d%s, %d array element(s), %d mip level(s), %zu bytes of data\n",
                         compress::dxgi_format_name(t.format), t.width, t.height, t.depth, t.volume ? " (volume)" : "", t.array_size,
                         t.mip_levels, t.data.size());
-            describe(Field3DPtr(std::make_shared<Field3D>(compress::read_dds(file))));
+            describe(Field3DPtr(std::make_shared<Field3D>(io::read_dds(file))));
             continue;
         }
         if (ext == ".vdb") {

@@ -4,6 +4,7 @@
 #include "atlas/graph/node_docs.h"
 #include "atlas/core/files.h"
 #include "atlas/compress/texture.h"
+#include "atlas/io/dds_file.h"
 
 #include "../support/cli_run.h"
 
@@ -496,7 +497,7 @@ TEST(CliForeign, CompressMipsAgreesWithTheGraphOption) {
     for (const std::string good : {"1", "3", "full"}) {
         CliRun c = run("compress " + in + " --format r8 --quiet --mips " + good + " -o " + (dir / "y.dds").string());
         EXPECT_EQ(c.status, 0) << good << ": " << c.err;
-        const atlas::compress::DdsTexture t = atlas::compress::read_dds_file(dir / "y.dds");
+        const atlas::compress::DdsTexture t = atlas::io::read_dds_file(dir / "y.dds");
         EXPECT_EQ(t.mip_levels, good == "full" ? 6 : std::stoi(good)) << good;
     }
     fs::remove_all(dir);

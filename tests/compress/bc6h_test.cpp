@@ -2,6 +2,7 @@
 // table, and the encoder's properties (bounds, round trips, adversarial blocks).
 #include "atlas/compress/bc6h.h"
 #include "atlas/compress/texture.h"
+#include "atlas/io/dds_file.h"
 #include "atlas/core/error.h"
 
 #include "test_blocks.h"
@@ -22,6 +23,10 @@
 #include <unistd.h>
 
 namespace atlas::compress {
+using io::compress_to_dds;
+using io::read_dds;
+using io::read_dds_file;
+using io::verify_dds;
 namespace {
 
 // ---------------------------------------------------------------------------------

@@ -1,6 +1,7 @@
 // OpenImageIO's DDS reader opens Atlas's BC1 and BC4 files and agrees with Atlas's
 // decoder (OIIO 2.4 decodes through squish: the Tool8 model).
 #include "atlas/compress/texture.h"
+#include "atlas/io/dds_file.h"
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
@@ -13,6 +14,10 @@
 #include <unistd.h>
 
 namespace atlas::compress {
+using io::compress_to_dds;
+using io::read_dds;
+using io::read_dds_file;
+using io::verify_dds;
 namespace {
 
 Field3D smooth_rgb(int nx, int ny) {

@@ -1,6 +1,7 @@
 // Texture API: DDS round trips (2D, arrays, volumes with mips), one-sided SDF fields
 // under every decoder, bounds and their reports, determinism, bad input.
 #include "atlas/compress/texture.h"
+#include "atlas/io/dds_file.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -11,6 +12,10 @@
 #include <fstream>
 
 namespace atlas::compress {
+using io::compress_to_dds;
+using io::read_dds;
+using io::read_dds_file;
+using io::verify_dds;
 namespace {
 
 fs::path temp_dir() {

@@ -209,18 +209,4 @@ DdsTexture decode_dds(const std::vector<uint8_t>& b, const std::string& what) {
     return t;
 }
 
-void write_dds_file(const fs::path& path, const DdsTexture& tex) {
-    const std::vector<uint8_t> bytes = encode_dds(tex);
-    write_file_atomic(path, [&](const fs::path& tmp) {
-        std::ofstream f(tmp, std::ios::binary);
-        f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-        if (!f) throw Error("cannot write " + path.string());
-    });
-}
-
-DdsTexture read_dds_file(const fs::path& path) {
-    const std::string s = read_file_bytes(path);
-    return decode_dds(std::vector<uint8_t>(s.begin(), s.end()), path.string());
-}
-
 } // namespace atlas::compress

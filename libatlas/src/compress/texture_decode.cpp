@@ -160,17 +160,6 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
 
 } // namespace detail
 
-namespace {
-
-std::optional<TextureManifest> load_manifest(const fs::path& dds) {
-    fs::path side = dds;
-    side += ".json";
-    if (!fs::exists(side)) return std::nullopt;
-    return TextureManifest::from_json(read_file_bytes(side), side.string());
-}
-
-} // namespace
-
 Field3D decode_texture(const DdsTexture& tex, const TextureManifest* manifest, Decoder decoder) {
     const bool scalar = manifest && manifest->encoding == "bc1-scalar";
     ScalarUnpack unpack;
@@ -204,20 +193,6 @@ Field3D decode_texture(const DdsTexture& tex, const TextureManifest* manifest, D
         }
     }
     return out;
-}
-
-Field3D read_dds(const fs::path& path, Decoder decoder) {
-    const DdsTexture tex = read_dds_file(path);
-    const auto manifest = load_manifest(path);
-    return decode_texture(tex, manifest ? &*manifest : nullptr, decoder);
-}
-
-CompressReport verify_dds(const fs::path& path, const Field3D& source, DecoderSet decoders, const std::vector<int>& channels) {
-    const DdsTexture tex = read_dds_file(path);
-    const auto manifest = load_manifest(path);
-    CompressReport r = verify_texture(tex, manifest ? &*manifest : nullptr, source, decoders, channels, path.string());
-    r.file = path.string();
-    return r;
 }
 
 CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* manifest, const Field3D& source, DecoderSet decoders,

@@ -11,13 +11,10 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <filesystem>
 #include <string>
 #include <vector>
 
 namespace atlas::compress {
-
-namespace fs = std::filesystem;
 
 // DXGI_FORMAT values of the formats Atlas reads and writes.
 enum class DxgiFormat : uint32_t {
@@ -75,8 +72,6 @@ std::vector<uint8_t> encode_dds(const DdsTexture& tex);
 // throws atlas::Error naming `what` on truncated or unsupported files.
 DdsTexture decode_dds(const std::vector<uint8_t>& bytes, const std::string& what = "DDS data");
 
-// Writes atomically (atlas::write_file_atomic) / reads a file.
-void write_dds_file(const fs::path& path, const DdsTexture& tex);
-DdsTexture read_dds_file(const fs::path& path);
+// Files: atlas/io/dds_file.h (io::write_dds_file, io::read_dds_file).
 
 } // namespace atlas::compress

@@ -160,16 +160,11 @@ struct TextureManifest {
     static TextureManifest from_json(const std::string& text, const std::string& what);
 };
 
-// Encodes a field (2D, or 3D as a volume or an array) to a DDS file and writes
-// OUT.dds.json beside it; both appear atomically or not at all. Throws
-// atlas::Error on NaN / Inf input (naming the texel and channel), bad options,
-// an unimplemented format, and BoundError as described above.
-CompressReport compress_to_dds(const Field3D& field, const fs::path& out, const CompressOptions& options,
-                               const ProgressSink* progress = nullptr);
-CompressReport compress_to_dds(const Field2D& field, const fs::path& out, const CompressOptions& options,
-                               const ProgressSink* progress = nullptr);
-
-// Encodes without writing: the DDS texture, its manifest and the report.
+// Encodes a field (2D as 1 slice, or 3D as a volume or an array): the DDS texture, its
+// manifest and the report; blocks that miss the bound are listed in the report.
+// Throws atlas::Error on NaN / Inf input (naming the texel and channel), bad options
+// and an unimplemented format. Writing OUT.dds and OUT.dds.json (and BoundError when
+// blocks miss the bound): io::compress_to_dds (atlas/io/dds_file.h).
 struct EncodedTexture {
     DdsTexture dds;
     TextureManifest manifest;
@@ -178,18 +173,15 @@ struct EncodedTexture {
 EncodedTexture encode_texture(const Field3D& field, const CompressOptions& options, const ProgressSink* progress = nullptr);
 
 // Decodes level 0 of every slice / array element to float in source units (the
-// manifest's mapping if OUT.dds.json exists, else the normalized values; a
-// bc1-scalar file without manifest decodes as RGB). Arrays stack along z.
-Field3D read_dds(const fs::path& dds, Decoder decoder = Decoder::Reference);
+// manifest's mapping when there is one, else the normalized values; a bc1-scalar
+// texture without manifest decodes as RGB). Arrays stack along z. From a file:
+// io::read_dds (atlas/io/dds_file.h).
 Field3D decode_texture(const DdsTexture& dds, const TextureManifest* manifest, Decoder decoder = Decoder::Reference);
 
 // Decodes level 0 with every decoder in `decoders` and compares to `source`
-// (whose stored channels are taken as in `options.channels`): max error and
-// one-sided error per model. Uses the manifest next to the file for the mapping.
-CompressReport verify_dds(const fs::path& dds, const Field3D& source, DecoderSet decoders = kAllDecoders,
-                          const std::vector<int>& channels = {});
-
-// verify_dds on an in-memory texture; `manifest` may be null (values compared as stored).
+// (whose stored channels are taken as in `channels`): max error and one-sided error
+// per model; `manifest` may be null (values compared as stored). On a file with its
+// manifest: io::verify_dds (atlas/io/dds_file.h).
 CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* manifest, const Field3D& source,
                               DecoderSet decoders = kAllDecoders, const std::vector<int>& channels = {},
                               const std::string& what = "texture");

@@ -1,0 +1,96 @@
+// DDS files and their manifests (see atlas/io/dds_file.h): the file side of the compress
+// module, which itself works on memory only.
+#include "atlas/io/dds_file.h"
+
+#include "atlas/core/error.h"
+#include "atlas/core/files.h"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+namespace atlas::io {
+
+namespace fs = std::filesystem;
+using namespace atlas::compress;
+
+void write_dds_file(const fs::path& path, const DdsTexture& tex) {
+    const std::vector<uint8_t> bytes = encode_dds(tex);
+    write_file_atomic(path, [&](const fs::path& tmp) {
+        std::ofstream f(tmp, std::ios::binary);
+        f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        if (!f) throw Error("cannot write " + path.string());
+    });
+}
+
+DdsTexture read_dds_file(const fs::path& path) {
+    const std::string s = read_file_bytes(path);
+    return decode_dds(std::vector<uint8_t>(s.begin(), s.end()), path.string());
+}
+
+std::optional<TextureManifest> read_dds_manifest(const fs::path& dds) {
+    fs::path side = dds;
+    side += ".json";
+    if (!fs::exists(side)) return std::nullopt;
+    return TextureManifest::from_json(read_file_bytes(side), side.string());
+}
+
+CompressReport compress_to_dds(const Field3D& field, const fs::path& path, const CompressOptions& o, const ProgressSink* progress) {
+    EncodedTexture enc = encode_texture(field, o, progress);
+    enc.report.file = path.string();
+    if (!enc.report.blocks_over_bound.empty() && !o.allow_over_bound) {
+        std::ostringstream msg;
+        msg << "compress: " << enc.report.blocks_over_bound.size() << " block(s) cannot meet the bound";
+        if (o.max_error) msg << " max_error " << *o.max_error;
+        if (o.one_sided_below) msg << (o.max_error ? " with" : "") << " one-sided below";
+        msg << " for format '" << format_name(o.format) << "'; first (DDS texel x, row from the top, slice):";
+        for (size_t i = 0; i < std::min<size_t>(5, enc.report.blocks_over_bound.size()); ++i) {
+            const BlockMiss& b = enc.report.blocks_over_bound[i];
+            msg << " [mip " << b.mip << " layer " << b.array_index << " block at (" << b.x << ", " << b.y << ", " << b.z
+                << ") best error " << b.best_error << (b.one_sided_failed ? ", one-sided failed" : "") << "]";
+        }
+        msg << " (allow_over_bound writes the file anyway)";
+        throw BoundError(msg.str(), enc.report);
+    }
+    const std::vector<uint8_t> bytes = encode_dds(enc.dds);
+    const std::string manifest = enc.manifest.to_json();
+    StagedOutputs staged(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+    {
+        std::ofstream f(staged.stage(path.filename()), std::ios::binary);
+        f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        if (!f) throw Error("compress: cannot write " + path.string());
+    }
+    {
+        fs::path side = path.filename();
+        side += ".json";
+        std::ofstream f(staged.stage(side), std::ios::binary);
+        f << manifest;
+        if (!f) throw Error("compress: cannot write the manifest of " + path.string());
+    }
+    staged.commit();
+    return enc.report;
+}
+
+CompressReport compress_to_dds(const Field2D& field, const fs::path& path, const CompressOptions& o, const ProgressSink* progress) {
+    Field3D f3(Vec3i{{field.width(), field.height(), 1}}, field.channels(),
+               Box3d{{{field.bounds().min[0], field.bounds().min[1], 0}}, {{field.bounds().max[0], field.bounds().max[1], 1}}},
+               field.channel_names());
+    for (int c = 0; c < field.channels(); ++c) std::copy(field.channel(c).begin(), field.channel(c).end(), f3.channel(c).begin());
+    return io::compress_to_dds(f3, path, o, progress);
+}
+
+Field3D read_dds(const fs::path& path, Decoder decoder) {
+    const DdsTexture tex = io::read_dds_file(path);
+    const auto manifest = io::read_dds_manifest(path);
+    return decode_texture(tex, manifest ? &*manifest : nullptr, decoder);
+}
+
+CompressReport verify_dds(const fs::path& path, const Field3D& source, DecoderSet decoders, const std::vector<int>& channels) {
+    const DdsTexture tex = io::read_dds_file(path);
+    const auto manifest = io::read_dds_manifest(path);
+    CompressReport r = verify_texture(tex, manifest ? &*manifest : nullptr, source, decoders, channels, path.string());
+    r.file = path.string();
+    return r;
+}
+
+} // namespace atlas::io
