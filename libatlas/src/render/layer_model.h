@@ -35,6 +35,22 @@ struct Bilinear {
 using detail::axis_clamp;
 using detail::axis_wrap;
 
+// axis_wrap for n a power of two (mask = n - 1): the same texels and weight
+// (two's complement & is the positive modulo) without an integer division.
+inline void axis_wrap_pow2(double u, int mask, int& i0, int& i1, float& t) {
+    u -= 0.5;
+    const double f = std::floor(u);
+    t = static_cast<float>(u - f);
+    i0 = static_cast<int>(static_cast<long long>(f) & mask);
+    i1 = (i0 + 1) & mask;
+}
+inline bool is_pow2(int n) { return n > 0 && (n & (n - 1)) == 0; }
+// axis_wrap, or its division-free form when mask >= 0 (n a power of two).
+inline void wrap_axis(double u, int n, int mask, int& i0, int& i1, float& t) {
+    if (mask >= 0) axis_wrap_pow2(u, mask, i0, i1, t);
+    else axis_wrap(u, n, i0, i1, t);
+}
+
 inline float lerp2(const float* p, int nx, const Bilinear& b) {
     const float* r0 = p + size_t(b.y0) * size_t(nx);
     const float* r1 = p + size_t(b.y1) * size_t(nx);
@@ -48,6 +64,7 @@ inline float lerp2(const float* p, int nx, const Bilinear& b) {
 struct Noise3 {
     std::vector<std::array<float, 4>> texels;
     int n = 0, nx = 0, ny = 0, nz = 0;
+    int mx = -1, my = -1, mz = -1; // n - 1 for power-of-two sizes, else -1
     double inv_tile = 0;
     bool ok() const { return n > 0; }
     void init(const Field3D* f, double tile) {
@@ -56,6 +73,9 @@ struct Noise3 {
         nx = f->nx();
         ny = f->ny();
         nz = f->nz();
+        mx = is_pow2(nx) ? nx - 1 : -1;
+        my = is_pow2(ny) ? ny - 1 : -1;
+        mz = is_pow2(nz) ? nz - 1 : -1;
         texels.resize(size_t(nx) * size_t(ny) * size_t(nz));
         for (int c = 0; c < 4; ++c) {
             auto ch = f->channel(std::min(c, n - 1));
@@ -66,9 +86,9 @@ struct Noise3 {
     void sample(double x, double y, double z, float out[4]) const {
         int x0, x1, y0, y1, z0, z1;
         float tx, ty, tz;
-        axis_wrap(x * inv_tile * nx, nx, x0, x1, tx);
-        axis_wrap(y * inv_tile * ny, ny, y0, y1, ty);
-        axis_wrap(z * inv_tile * nz, nz, z0, z1, tz);
+        wrap_axis(x * inv_tile * nx, nx, mx, x0, x1, tx);
+        wrap_axis(y * inv_tile * ny, ny, my, y0, y1, ty);
+        wrap_axis(z * inv_tile * nz, nz, mz, z0, z1, tz);
         const size_t sy = size_t(nx), sz = size_t(nx) * size_t(ny);
         const std::array<float, 4>* t = texels.data();
         const size_t r0 = size_t(z0) * sz + size_t(y0) * sy, r1 = size_t(z0) * sz + size_t(y1) * sy;
@@ -138,6 +158,7 @@ public:
         origin_ = {{b.min[0], b.min[1]}};
         size_ = {{b.max[0] - b.min[0], b.max[1] - b.min[1]}};
         inv_texel_ = {{ndf_.width() / size_[0], ndf_.height() / size_[1]}};
+        map_mask_ = {is_pow2(ndf_.width()) ? ndf_.width() - 1 : -1, is_pow2(ndf_.height()) ? ndf_.height() - 1 : -1};
         centre_ = {{0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), -s.earth_radius}};
         bottom_ = std::numeric_limits<double>::infinity();
         top_ = -bottom_;
@@ -161,8 +182,10 @@ public:
             curl_ = s.curl.get();
             curl_r_ = curl_->channel(0).data();
             curl_g_ = curl_->channel(std::min(1, curl_->channels() - 1)).data();
+            curl_mask_ = {is_pow2(curl_->width()) ? curl_->width() - 1 : -1, is_pow2(curl_->height()) ? curl_->height() - 1 : -1};
         }
         const double w = std::hypot(s.wind[0], s.wind[1]);
+        rise_ = 0.1 * w * s.time; // the noise's upward scroll (clouds seem to grow)
         wind_dir_ = w > 0 ? Vec2d{{s.wind[0] / w, s.wind[1] / w}} : Vec2d{{1, 0}};
         map_shift_ = {{s.wind[0] * s.time, s.wind[1] * s.time}};
         if (s.envelope.cone_map) {
@@ -268,8 +291,8 @@ public:
         Bilinear b;
         if (s_.edge == MapEdge::Empty && (u < 0 || v < 0 || u > nx || v > ny)) return false;
         if (s_.edge == MapEdge::Wrap) {
-            axis_wrap(u, nx, b.x0, b.x1, b.tx);
-            axis_wrap(v, ny, b.y0, b.y1, b.ty);
+            wrap_axis(u, nx, map_mask_[0], b.x0, b.x1, b.tx);
+            wrap_axis(v, ny, map_mask_[1], b.y0, b.y1, b.ty);
         } else {
             axis_clamp(u, nx, b.x0, b.x1, b.tx);
             axis_clamp(v, ny, b.y0, b.y1, b.ty);
@@ -354,7 +377,7 @@ public:
         const double skew = f * s_.cloud_top_offset;
         const double qx = p[0] + wind_dir_[0] * skew - s_.wind[0] * s_.time;
         const double qy = p[1] + wind_dir_[1] * skew - s_.wind[1] * s_.time;
-        const double qz = h - 0.1 * std::hypot(s_.wind[0], s_.wind[1]) * s_.time;
+        const double qz = h - rise_;
         const double thr = coverage_threshold(c.coverage);
         // The base is at most the texture's largest value: skip the lookup
         // where even that stays under the coverage threshold.
@@ -378,8 +401,8 @@ public:
         if (curl_) {
             // Turbulence at the cloud base: curl-distorted detail coordinates.
             Bilinear b;
-            axis_wrap(dx / s_.curl_tile * curl_->width(), curl_->width(), b.x0, b.x1, b.tx);
-            axis_wrap(dy / s_.curl_tile * curl_->height(), curl_->height(), b.y0, b.y1, b.ty);
+            wrap_axis(dx / s_.curl_tile * curl_->width(), curl_->width(), curl_mask_[0], b.x0, b.x1, b.tx);
+            wrap_axis(dy / s_.curl_tile * curl_->height(), curl_->height(), curl_mask_[1], b.y0, b.y1, b.ty);
             const double k = s_.curl_amount * (1.0 - f);
             dx += (2.0 * lerp2(curl_r_, curl_->width(), b) - 1.0) * k;
             dy += (2.0 * lerp2(curl_g_, curl_->width(), b) - 1.0) * k;
@@ -453,6 +476,7 @@ private:
     const float *lut_bottom_, *lut_top_;
     std::vector<std::array<float, 8>> texels_;
     Vec2d origin_, size_, inv_texel_;
+    std::array<int, 2> map_mask_{{-1, -1}}, curl_mask_{{-1, -1}};
     Vec3d centre_;
     double bottom_ = 0, top_ = 0, set_top_ = 0; // set_top_: without the anvil's lift
     bool any_cloud_ = false, precipitation_ = false;
@@ -460,6 +484,7 @@ private:
     const Field2D* curl_ = nullptr;
     const float *curl_r_ = nullptr, *curl_g_ = nullptr;
     Vec2d wind_dir_, map_shift_;
+    double rise_ = 0;
     const Field2D* cone_ = nullptr;
     const float *cone_apex_ = nullptr, *cone_ratio_ = nullptr;
     const Field3D* dist_ = nullptr;
