@@ -67,7 +67,7 @@ TEST(Nvdf, PackTgaLayoutsRoundTrip) {
         ds.channel(0)[i] = 0.25f + float(i % 3) / 4.0f;
     }
     const Field3D nvdf = assemble_modeling_nvdf(dp, dt, ds);
-    const auto files = write_nubis_modeling_tga(nvdf, dir.path, "modeling", {io::SliceNaming::atlas, false});
+    const auto files = io::write_nubis_modeling_tga(nvdf, dir.path, "modeling", {io::SliceNaming::atlas, false});
     ASSERT_EQ(files.size(), 8u);
     // Raw layout, from the file's bytes: BGRA pixels after an 18-byte header, A = 0.
     {
@@ -87,14 +87,14 @@ TEST(Nvdf, PackTgaLayoutsRoundTrip) {
                 ASSERT_EQ(p[3], 0);                                       // A
             }
     }
-    const Field3D back = read_nubis_modeling_tga(files[0], kBox);
+    const Field3D back = io::read_nubis_modeling_tga(files[0], kBox);
     EXPECT_EQ(back.channel_names(), nvdf.channel_names());
     for (size_t i = 0; i < back.voxel_count(); ++i)
         for (int c = 0; c < 3; ++c) ASSERT_NEAR(back.channel(c)[i], nvdf.channel(c)[i], 0.5 / 255 + 1e-6);
 
-    const auto fd = write_nubis_field_data_tga(sdf, dir.path, "field");
+    const auto fd = io::write_nubis_field_data_tga(sdf, dir.path, "field");
     const Field3D fraw = io::read_tga_slices(fd[0], kBox, 4);
-    const Field3D fback = read_nubis_field_data_tga(fd[0], kBox);
+    const Field3D fback = io::read_nubis_field_data_tga(fd[0], kBox);
     for (size_t i = 0; i < fraw.voxel_count(); ++i) {
         // d = R/255 * 4352 - 256 with R the byte; G = B = 0, A = 255.
         const double r_byte = std::round(fraw.channel(0)[i] * 255.0);
@@ -113,8 +113,8 @@ TEST(Nvdf, PackVdbRoundTrip) {
     Field3D dt(sdf.resolution(), 1, kBox), ds(sdf.resolution(), 1, kBox);
     std::fill(ds.channel(0).begin(), ds.channel(0).end(), 1.0f);
     const Field3D nvdf = assemble_modeling_nvdf(dp, dt, ds);
-    write_nubis_vdb(nvdf, sdf, dir.path / "cloud.vdb");
-    const Field3D back = read_nubis_vdb(dir.path / "cloud.vdb");
+    io::write_nubis_vdb(nvdf, sdf, dir.path / "cloud.vdb");
+    const Field3D back = io::read_nubis_vdb(dir.path / "cloud.vdb");
     ASSERT_EQ(back.channels(), 4);
     EXPECT_EQ(back.channel_name(3), "sdf");
     ASSERT_EQ(back.resolution(), sdf.resolution());
@@ -136,7 +136,7 @@ TEST(Nvdf, PackTgaNubisNamingAndRle) {
         ds.channel(0)[i] = 0.5f;
     }
     const Field3D nvdf = assemble_modeling_nvdf(dimensional_profile(sdf), dt, ds);
-    const auto files = write_nubis_modeling_tga(nvdf, dir.path, "modeling_data", {io::SliceNaming::nubis, true});
+    const auto files = io::write_nubis_modeling_tga(nvdf, dir.path, "modeling_data", {io::SliceNaming::nubis, true});
     ASSERT_EQ(files.size(), 8u);
     EXPECT_EQ(files[7].filename(), "modeling_data(7).tga");
     std::ifstream in(files[3], std::ios::binary);
@@ -144,11 +144,11 @@ TEST(Nvdf, PackTgaNubisNamingAndRle) {
     ASSERT_GE(b.size(), 18u);
     EXPECT_EQ(b[2], 10); // RLE true colour
     EXPECT_EQ(b[16], 32);
-    const Field3D back = read_nubis_modeling_tga(dir.path / "modeling_data(0).tga", kBox);
+    const Field3D back = io::read_nubis_modeling_tga(dir.path / "modeling_data(0).tga", kBox);
     for (size_t i = 0; i < back.voxel_count(); ++i)
         for (int c = 0; c < 3; ++c) ASSERT_NEAR(back.channel(c)[i], nvdf.channel(c)[i], 0.5 / 255 + 1e-6);
-    const auto fd = write_nubis_field_data_tga(sdf, dir.path, "field_data", {io::SliceNaming::nubis, true});
-    const Field3D fback = read_nubis_field_data_tga(dir.path / "field_data", kBox);
+    const auto fd = io::write_nubis_field_data_tga(sdf, dir.path, "field_data", {io::SliceNaming::nubis, true});
+    const Field3D fback = io::read_nubis_field_data_tga(dir.path / "field_data", kBox);
     for (size_t i = 0; i < fback.voxel_count(); ++i) ASSERT_NEAR(fback.channel(0)[i], sdf.channel(0)[i], 4352.0 / 255 / 2 + 1e-2);
 }
 

@@ -1,12 +1,13 @@
-// The Nubis voxel cloud pack layouts, through the io module's TGA slice and VDB code.
+// The Nubis voxel cloud pack layouts (see atlas/io/nubis_pack.h), through io's TGA slice and VDB code.
+#include "atlas/io/nubis_pack.h"
+
 #include "atlas/core/error.h"
 #include "atlas/io/tga_slices.h"
 #include "atlas/io/vdb.h"
-#include "atlas/volume/nvdf.h"
 
 #include <algorithm>
 
-namespace atlas::volume {
+namespace atlas::io {
 namespace {
 constexpr const char* kModelingNames[3] = {"dimensional_profile", "detail_type", "density_scale"};
 
@@ -15,7 +16,7 @@ constexpr const char* kModelingNames[3] = {"dimensional_profile", "detail_type",
 // which premultiplying readers turn into black.
 Field3D read_slices_rgba(const std::filesystem::path& first, Box3d bounds, int channels, std::vector<std::string> names,
                          const MemoryBudget* budget) {
-    Field3D out = io::read_tga_slices(first, bounds, channels, budget);
+    Field3D out = read_tga_slices(first, bounds, channels, budget);
     out.set_channel_names(std::move(names));
     return out;
 }
@@ -50,7 +51,12 @@ Field3D read_nubis_modeling_tga(const std::filesystem::path& first, Box3d bounds
 
 Field3D read_nubis_field_data_tga(const std::filesystem::path& first, Box3d bounds, const MemoryBudget* budget) {
     Field3D r = read_slices_rgba(first, bounds, 1, {"field_data"}, budget);
-    return decode_field_data(r, kNubisSdfMin, kNubisSdfMax, 0, budget);
+    // d = lo + v (hi - lo), v the stored R in [0, 1] (volume::decode_field_data's mapping).
+    Field3D out(r.resolution(), 1, r.bounds(), {"sdf"}, budget);
+    auto s = r.channel(0);
+    auto d = out.channel(0);
+    for (size_t i = 0; i < s.size(); ++i) d[i] = float(kNubisSdfMin + double(s[i]) * (kNubisSdfMax - kNubisSdfMin));
+    return out;
 }
 
 void write_nubis_vdb(const Field3D& nvdf, const Field3D& sdf, const std::filesystem::path& file) {
@@ -67,4 +73,4 @@ Field3D read_nubis_vdb(const std::filesystem::path& file, const MemoryBudget* bu
     return io::read_vdb(file, {kModelingNames[0], kModelingNames[1], kModelingNames[2], "sdf"}, budget);
 }
 
-} // namespace atlas::volume
+} // namespace atlas::io
