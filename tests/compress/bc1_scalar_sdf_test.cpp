@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <vector>
 
 namespace atlas::compress {
@@ -158,6 +159,14 @@ public:
             palette(m, c0, c1, f, e);
             for (int i = 0; i < 4; ++i) { lo[i] = std::min(lo[i], e[i]); hi[i] = std::max(hi[i], e[i]); }
         }
+        // One-sided must hold in exact arithmetic (issue 14 item 4): the float palette
+        // rounds 4 times (channel value, product, two sums; terms >= 0), so the exact
+        // entry lies within 2^-21 relative of it, and only an entry whose float value is
+        // below the source by that much is provably below it. Without this, pairs one
+        // float ulp from the source count (block 9570: an optimum of 0.015 m whose entry
+        // is 1.3 ulp below its texel, against the encoder's provable 0.038 m).
+        constexpr float kExact = 1.0f / 2097152.0f;
+        for (int i = 0; i < 4; ++i) { hi[i] += std::fabs(hi[i]) * kExact; lo[i] -= std::fabs(lo[i]) * kExact; }
         float worst = 0;
         for (int t = 0; t < 16; ++t) {
             float best = INFINITY;
@@ -321,6 +330,7 @@ float measured_error(const uint8_t blk[8], const ScalarUnpack& u, const float sr
 // endpoint slack added (err <= 2 opt + slack) and the strict misses counted and bounded
 // by `max_strict_misses`. Blocks are checked in parallel (the search is read-only).
 void check_sdf_blocks(DecoderSet set, Quality q, int count, bool strict, int max_strict_misses = 0) {
+    if (const char* c = std::getenv("ATLAS_SDF_COUNT")) count = std::atoi(c); // diagnosis
     const ExhaustiveSearch search(set);
     const ScalarUnpack& u = search.unpack();
     const float slack = strict ? 0.0f : search.endpoint_slack();
@@ -335,7 +345,19 @@ void check_sdf_blocks(DecoderSet set, Quality q, int count, bool strict, int max
         bool one_sided = false, bound_ok = false;
     };
     std::vector<Outcome> out(static_cast<size_t>(count));
+    std::vector<char> only;
+    if (const char* list = std::getenv("ATLAS_SDF_ONLY")) { // diagnosis: check only these block numbers
+        only.assign(size_t(count), 0);
+        for (const char* p = list; *p;) {
+            char* end;
+            const long b = std::strtol(p, &end, 10);
+            if (end == p) break;
+            if (b >= 0 && b < count) only[size_t(b)] = 1;
+            p = *end ? end + 1 : end;
+        }
+    }
     tbb::parallel_for(0, count, [&](int k) {
+        if (!only.empty() && !only[size_t(k)]) return;
         float src[16];
         sdf_block(uint64_t(k), src);
         uint8_t blk[8];
@@ -353,6 +375,7 @@ void check_sdf_blocks(DecoderSet set, Quality q, int count, bool strict, int max
     int worse = 0, strict_misses = 0;
     double sum_err = 0, worst_err = 0, worst_ratio = 0;
     for (int k = 0; k < count; ++k) {
+        if (!only.empty() && !only[size_t(k)]) continue;
         const Outcome& oc = out[size_t(k)];
         ASSERT_TRUE(oc.one_sided) << "block " << k << " is not one-sided";
         ASSERT_TRUE(oc.bound_ok) << "block " << k << ": measured error above the reported one";
@@ -363,6 +386,16 @@ void check_sdf_blocks(DecoderSet set, Quality q, int count, bool strict, int max
             worst_ratio = std::max(worst_ratio, double(oc.err / oc.better));
         }
         const bool fails = strict ? oc.better < INFINITY : oc.slack_better < INFINITY;
+        if (oc.better < INFINITY && std::getenv("ATLAS_SDF_MISSES"))
+            std::printf("miss block %d spread %.3f m: encoder (%u, %u) %.3f m, pair (%u, %u) %.3f m\n", k, oc.spread * (kHi - kLo), oc.e0, oc.e1,
+                        oc.err * (kHi - kLo), oc.c0, oc.c1, oc.better * (kHi - kLo));
+        if (oc.better < INFINITY && std::getenv("ATLAS_SDF_MISSES")) {
+            float src[16];
+            sdf_block(uint64_t(k), src);
+            std::sort(src, src + 16);
+            for (float v : src) std::printf(" %.3f", v * (kHi - kLo) + kLo);
+            std::printf("\n");
+        }
         if (fails && ++worse <= 5)
             ADD_FAILURE() << "block " << k << " (spread " << oc.spread * (kHi - kLo) << " m): encoder pair (" << oc.e0 << ", " << oc.e1 << ") "
                           << oc.err * (kHi - kLo) << " m, pair (" << oc.c0 << ", " << oc.c1 << ") reaches " << oc.better * (kHi - kLo)
@@ -405,13 +438,12 @@ TEST(Bc1ScalarSdf, ExhaustiveSearchNeverMissesAKnownPair) {
     }
 }
 
-// The decoder set graphs/cloudscape.yaml uses for its field data. Its 8-bit decoders
-// disagree on an endpoint by up to ~0.003 of the range (12.1 m here, the slack); Normal
-// stays within twice the optimum plus that on every block and misses twice the optimum
-// outright on about 0.1% (10 of 10^4 when written; the bound leaves room for 2x that).
-TEST(Bc1ScalarSdf, NormalWithinTwiceTheExhaustiveOptimumPlusSlackReferenceNvidiaAmd) {
-    check_sdf_blocks(kReferenceOnly | decoder_bit(Decoder::Nvidia) | decoder_bit(Decoder::Amd), Quality::Normal, kSdfBlocks, false,
-                     kSdfBlocks / 500);
+// The decoder set graphs/cloudscape.yaml uses for its field data, at the default level:
+// strictly within twice the exhaustive optimum on every block (issue 14's criterion;
+// before the fit's endpoint-unused assignments, the shared-R bottom after the first
+// pass and the wider single-entry gate, 10 of 10^4 blocks missed it, worst 2.71x).
+TEST(Bc1ScalarSdf, NormalStrictlyWithinTwiceTheExhaustiveOptimumReferenceNvidiaAmd) {
+    check_sdf_blocks(kReferenceOnly | decoder_bit(Decoder::Nvidia) | decoder_bit(Decoder::Amd), Quality::Normal, kSdfBlocks, true);
 }
 
 // Reference only: the slack is one 16-bit endpoint step (0.07 m here).

@@ -32,7 +32,9 @@ namespace fs = std::filesystem;
 // one-sided search that never falls back to black.
 // 3: bc1-scalar single-entry search for near-constant blocks and normal's nudges.
 // 4: BC4 fast / normal one-pass key evaluation (ties within 8 ulps may pick differently).
-constexpr int kEncoderVersion = 4;
+// 5: bc1-scalar one-sided fit with an endpoint or both unused, shared-R bottom after the
+// first pass, single-entry search for blocks whose spread is under their error.
+constexpr int kEncoderVersion = 5;
 
 // The most mip levels a front end asks for by number (a 65536 texture has 17
 // levels; "full" asks for all of them).
