@@ -66,12 +66,21 @@ def cook_tile(atlas: str, graph: str, tiles: tuple[int, int], tile: tuple[int, i
            "--out", out, "--quiet", *extra]
     if cache:
         cmd += ["--cache", cache]
-    code, stdout, stderr, seconds, rss = _run_atlas(cmd)
+    # atlas's own report of the tile (docs/report.md, "Tiled cooks"): its files with
+    # hashes, CPU time and the values it held, for the driver's --report.
+    with tempfile.TemporaryDirectory(prefix="atlas-dask-") as tmp:
+        report = os.path.join(tmp, "tile.json")
+        code, stdout, stderr, seconds, rss = _run_atlas(cmd + ["--report", report])
+        try:
+            with open(report, encoding="utf-8") as f:
+                tile_report = json.load(f)["tiles"][0]
+        except (OSError, ValueError, KeyError, IndexError):
+            tile_report = None
     if code != 0:
         raise TileError(f"tile {tile[0]},{tile[1]}: atlas exited with {code} on {socket.gethostname()}: "
                         f"{stderr.strip() or stdout.strip()}")
     return {"tile": list(tile), "seconds": seconds, "peak_rss_bytes": rss, "host": socket.gethostname(),
-            "pid": os.getpid(), "files": [l for l in stdout.splitlines()[1:] if l]}
+            "pid": os.getpid(), "files": [l for l in stdout.splitlines()[1:] if l], "atlas": tile_report}
 
 
 def _client(scheduler: str, workers: int):

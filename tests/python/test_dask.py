@@ -82,6 +82,12 @@ def test_local_cluster_matches_single_cook(single, tmp_path):
                 assert hashlib.sha256(data).hexdigest() == f["sha256"], f["path"]
                 checked += 1
     assert checked > 6 * 7
+    # Each task's result carries atlas's own report of its tile (status, files with hashes).
+    for r in summary["tile_results"]:
+        assert r["atlas"]["status"] == "cooked" and r["atlas"]["tile"] == r["tile"]
+        assert r["atlas"]["value_bytes_peak"] > 0
+        assert {f["path"] for f in r["atlas"]["files"]} >= {f"tiles/{r['tile'][0]}_{r['tile'][1]}.json"}
+    assert json.loads((tmp_path / "report.json").read_text())["tile_results"][0]["atlas"]["files"]
 
 
 def test_failed_tile_is_retried(single, tmp_path):
