@@ -167,7 +167,8 @@ outputs:
     EXPECT_EQ(d.status, 0) << d.err;
     EXPECT_TRUE(fs::exists(out / "back.exr"));
     CliRun bad = run("compress " + (out / "n.exr").string() + " --format bc9 -o " + (out / "x.dds").string());
-    EXPECT_EQ(bad.status, 1);
+    EXPECT_EQ(bad.status, 2); // a usage error, as every value the option schema refuses
+    EXPECT_NE(bad.err.find("--format expects"), std::string::npos) << bad.err;
     EXPECT_FALSE(fs::exists(out / "x.dds"));
     fs::remove_all(out);
 }
@@ -258,7 +259,7 @@ TEST(CliForeign, CompressHelpNamesEveryDecoder) {
     const std::string text = help.out + help.err;
     for (int i = 0; i < atlas::compress::kDecoderCount; ++i) {
         const std::string name = atlas::compress::decoder_name(static_cast<atlas::compress::Decoder>(i));
-        EXPECT_TRUE(text.find(name + ",") != std::string::npos || text.find(name + " ") != std::string::npos) << name << " is missing from:\n" << text;
+        EXPECT_NE(text.find("'" + name + "'"), std::string::npos) << name << " is missing from:\n" << text;
     }
 }
 
