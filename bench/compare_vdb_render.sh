@@ -10,11 +10,14 @@
 #    surfaces sit at 0.3), written as density.vdb (float grid "density", 8 m
 #    voxels, world metres).
 # 2. Renders 960x540 from the benchmark's ground camera with both renderers in
-#    the same run and times each render (Atlas: its own "rendered ... in" line,
-#    the NVDF set coming from the disk cache; vdb_render: wall time of the
-#    process, which includes reading the 512x512x64 grid).
+#    the same run, interleaved (atlas, vdb_render, atlas, vdb_render, ... ROUNDS
+#    times, default 3), each whole process timed by /usr/bin/time -f '%e %U %M'
+#    (wall s, user CPU s, max RSS KB): Atlas from a warm cache (one untimed
+#    preview first cooks the graph and the noise into it), its render-only
+#    time from its "rendered ... in" line; vdb_render including the read of
+#    the 512x512x64 grid, its ray-tracing time from its -v output.
 # 3. Writes docs/images/render_vdb_ground.png and render_atlas_ground_cmp.png
-#    and prints a Markdown table row.
+#    and prints a Markdown table: one row per run plus the medians.
 #
 # Camera translation: Atlas --camera P,L --fov V (vertical degrees) ->
 # vdb_render -translate P -lookat L -up 0,0,1 -fov H with H the horizontal
@@ -30,6 +33,8 @@ set -euo pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-$ROOT/build}
+ROUNDS=${ROUNDS:-3}
+PY=/usr/bin/python3
 ATLAS=$BUILD/bin/atlas
 command -v vdb_render >/dev/null || { echo "vdb_render not found (scripts/setup.sh --bench installs libopenvdb-tools)" >&2; exit 1; }
 command -v oiiotool >/dev/null || { echo "oiiotool not found (apt install openimageio-tools)" >&2; exit 1; }
@@ -43,8 +48,8 @@ OUT_DIR=$ROOT/docs/images
 W=960 H=540
 CAM_POS=2000,-300,2 CAM_AT=2000,2000,300 VFOV=60
 SUN_AZ=60 SUN_EL=35
-HFOV=$(python3 -c "import math; print(round(math.degrees(2*math.atan(math.tan(math.radians($VFOV/2))*$W/$H)), 4))")
-LIGHT=$(python3 -c "import math; a,e=math.radians($SUN_AZ),math.radians($SUN_EL); print(f'{math.cos(e)*math.sin(a):.5f},{-math.cos(e)*math.cos(a):.5f},{math.sin(e):.5f}')")
+HFOV=$($PY -c "import math; print(round(math.degrees(2*math.atan(math.tan(math.radians($VFOV/2))*$W/$H)), 4))")
+LIGHT=$($PY -c "import math; a,e=math.radians($SUN_AZ),math.radians($SUN_EL); print(f'{math.cos(e)*math.sin(a):.5f},{-math.cos(e)*math.cos(a):.5f},{math.sin(e):.5f}')")
 
 # 1. The cloudscape plus a density output.
 awk '
@@ -64,19 +69,25 @@ awk '
 "$ATLAS" cook "$WORK/cloudscape_vdb.yaml" --out "$WORK/out" --output density.vdb --cache "$CACHE" --quiet >/dev/null
 "$ATLAS" info "$WORK/out/density.vdb" >&2
 
-# 2a. Atlas: the graph's NVDF set (same cache), default quality.
-ATLAS_LOG=$("$ATLAS" preview "$ROOT/graphs/cloudscape.yaml" --cache "$CACHE" --size ${W}x${H} \
-  --camera $CAM_POS,$CAM_AT --fov $VFOV --sun $SUN_AZ,$SUN_EL -o "$OUT_DIR/render_atlas_ground_cmp.png" 2>&1 >/dev/null)
-echo "$ATLAS_LOG" >&2
-ATLAS_S=$(echo "$ATLAS_LOG" | sed -n 's/.*rendered [0-9x]* in \([0-9.]*\) s.*/\1/p')
-
-# 2b. vdb_render, same camera and sun.
-T0=$(date +%s.%N)
-vdb_render "$WORK/out/density.vdb" "$WORK/vdb.exr" -name density -res ${W}x${H} \
-  -translate $CAM_POS -lookat $CAM_AT -up 0,0,1 -fov $HFOV \
-  -light $LIGHT,1,0.95,0.88 -scatter 0.30,0.30,0.30 -absorb 0.02,0.02,0.02 -gain 0.2 -step 1 -shadowstep 3 -v >&2
-T1=$(date +%s.%N)
-VDB_S=$(python3 -c "print(f'{$T1 - $T0:.2f}')")
+# 2. Both renderers, same camera and sun, whole processes timed, interleaved.
+ATLAS_CMD=("$ATLAS" preview "$ROOT/graphs/cloudscape.yaml" --cache "$CACHE" --size ${W}x${H}
+  --camera $CAM_POS,$CAM_AT --fov $VFOV --sun $SUN_AZ,$SUN_EL -o "$OUT_DIR/render_atlas_ground_cmp.png")
+VDB_CMD=(vdb_render "$WORK/out/density.vdb" "$WORK/vdb.exr" -name density -res ${W}x${H}
+  -translate $CAM_POS -lookat $CAM_AT -up 0,0,1 -fov $HFOV
+  -light $LIGHT,1,0.95,0.88 -scatter 0.30,0.30,0.30 -absorb 0.02,0.02,0.02 -gain 0.2 -step 1 -shadowstep 3 -v)
+"${ATLAS_CMD[@]}" --quiet >/dev/null 2>&1   # warm the cache (graph, noise set): not timed
+ROWS=()
+for r in $(seq 1 "$ROUNDS"); do
+  /usr/bin/time -f '%e %U %S %M' -o "$WORK/t_atlas" "${ATLAS_CMD[@]}" >/dev/null 2>"$WORK/log_atlas"
+  /usr/bin/time -f "%e %U %S %M" -o "$WORK/t_vdb" "${VDB_CMD[@]}" >"$WORK/log_vdb" 2>&1
+  A_RENDER=$(sed -n 's/.*rendered [0-9x]*[^)]*) in \([0-9.]*\) s.*/\1/p' "$WORK/log_atlas" | tail -1)
+  V_RENDER=$(awk '/ray-tracing/ {f = 1; next} f && /completed in/ {print $(NF - 1); exit}' "$WORK/log_vdb")
+  read -r AW AU AS AM < "$WORK/t_atlas"
+  read -r VW VU VS VM < "$WORK/t_vdb"
+  ROWS+=("$r $AW $AU $AS $AM ${A_RENDER:-?} $VW $VU $VS $VM ${V_RENDER:-?}")
+  echo "round $r: atlas ${AW}s wall ${AU}+${AS}s CPU ${AM}KB (render ${A_RENDER:-?} s); vdb_render ${VW}s wall ${VU}+${VS}s CPU ${VM}KB (ray-tracing ${V_RENDER:-?} s)" >&2
+done
+cat "$WORK/log_atlas" >&2
 # vdb_render's EXR has straight colour plus alpha: composite over the same
 # uniform sky Atlas uses (0.30, 0.45, 0.75) and tone-map like Atlas' PNG
 # (x * 1.5, Reinhard, sRGB) so the two pictures are comparable.
@@ -84,7 +95,18 @@ oiiotool "$WORK/vdb.exr" --ch R,G,B,A --unpremult --premult \
   --pattern constant:color=0.30,0.45,0.75,1 ${W}x${H} 4 --over \
   --ch R,G,B --mulc 1.5 --dup --addc 1 --div --colorconvert linear sRGB -d uint8 --nosoftwareattrib -o "$OUT_DIR/render_vdb_ground.png"
 
-echo "| renderer | picture | seconds |"
-echo "|---|---|---|"
-echo "| atlas preview (fast, quality 1, NVDF set) | render_atlas_ground_cmp.png | $ATLAS_S (render only) |"
-echo "| vdb_render (density.vdb, step 1 voxel, shadow step 3) | render_vdb_ground.png | $VDB_S (process, incl. VDB read) |"
+echo "load average after the runs: $(cat /proc/loadavg)"
+echo
+echo "| round | atlas wall | atlas user + sys CPU | atlas max RSS | atlas render only (wall) | vdb_render wall | vdb_render user + sys CPU | vdb_render max RSS | vdb_render ray-tracing (wall) |"
+echo "|---|---|---|---|---|---|---|---|---|"
+for row in "${ROWS[@]}"; do
+  set -- $row
+  echo "| $1 | $2 s | $3 + $4 s | $(( $5 / 1024 )) MB | $6 s | $7 s | $8 + $9 s | $(( ${10} / 1024 )) MB | ${11} s |"
+done
+printf '%s\n' "${ROWS[@]}" | $PY -c '
+import sys, statistics as st
+rows = [l.split() for l in sys.stdin if l.strip()]
+col = lambda i: st.median(float(r[i]) for r in rows)
+print(f"| median | {col(1):.2f} s | {col(2):.2f} + {col(3):.2f} s | {col(4)/1024:.0f} MB | - | {col(6):.2f} s | {col(7):.2f} + {col(8):.2f} s | {col(9)/1024:.0f} MB | - |")'
+echo
+echo "atlas: fast mode, quality 1, NVDF set from the disk cache, default noise up-rez; pictures render_atlas_ground_cmp.png, render_vdb_ground.png"
