@@ -25,6 +25,8 @@ PACKAGES=(
   blender
   # The Cycles reference (scripts/cycles_reference.py, bench/render_vs_cycles.sh): its error plots.
   python3-matplotlib
+  # docs/images/architecture.svg (scripts/module_graph.py | dot): the module dependency picture.
+  graphviz
 )
 # `scripts/setup.sh --bench`: also the peers the benchmarks compare against (not needed by CI):
 # OpenVDB's vdb_tool and vdb_render (mesh SDF, voxel preview) and nvcompress (BC encoders).
