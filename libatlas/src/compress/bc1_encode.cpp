@@ -128,7 +128,7 @@ BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, u
             for (int b = 0; b < 3; ++b) cov[a][b] += (rgb[3 * t + a] - mean[a]) * (rgb[3 * t + b] - mean[b]);
     double axis[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
     if (axis[0] + axis[1] + axis[2] <= 0) axis[0] = axis[1] = axis[2] = 1;
-    for (int it = 0; it < 8; ++it) { // power iteration, deterministic start
+    for (int it = 0; it < 4; ++it) { // power iteration, deterministic start
         double n[3];
         for (int a = 0; a < 3; ++a) n[a] = cov[a][0] * axis[0] + cov[a][1] * axis[1] + cov[a][2] * axis[2];
         double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
@@ -151,6 +151,16 @@ BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, u
     s.try_both(pack(quantize(e0)), pack(quantize(e1)));
     if (options.quality != Quality::Fast) {
         s.try_both(pack(quantize(hi)), pack(quantize(lo))); // box diagonal
+        for (int corner = 1; corner < 4; ++corner) { // the other box diagonals, 4-colour mode
+            double a[3], b[3];
+            for (int c = 0; c < 3; ++c) {
+                const bool flip = c < 2 && ((corner >> c) & 1);
+                a[c] = flip ? lo[c] : hi[c];
+                b[c] = flip ? hi[c] : lo[c];
+            }
+            const uint16_t pa = pack(quantize(a)), pb = pack(quantize(b));
+            if (pa != pb) s.try_pair(std::max(pa, pb), std::min(pa, pb));
+        }
         s.refine(3);
     }
     const bool missed = !s.best.valid || (options.max_error >= 0 && s.best.sel.max_err > options.max_error);

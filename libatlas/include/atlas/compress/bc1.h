@@ -21,8 +21,8 @@ void decode_bc1_block(const uint8_t block[8], Decoder d, float rgb[48]);
 
 // Encodes 16 RGB texels (rgb[3*t + c], nominally in [0,1]) minimising the max
 // per-channel error under options.decoders, then the squared Reference error.
-// Fast: principal-axis endpoints only; Normal: + 3 rounds of +-1 endpoint
-// refinement; Best: more starts and rounds. Thread-safe, deterministic.
+// Fast: principal-axis endpoints only; Normal: + the box diagonals and 3 rounds of
+// +-1 endpoint refinement; Best: more starts and rounds. Thread-safe, deterministic.
 BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, uint8_t out[8]);
 
 } // namespace atlas::compress
