@@ -679,3 +679,51 @@ outputs:
     }
     EXPECT_TRUE(files_under(bad).empty());
 }
+
+// field/resample tiles when it keeps the XY grid (z only, and a 2D identity):
+// the assembled bytes are the untiled cook's; a new XY resolution fails the
+// tile naming the node, and keep_bounds: false is refused.
+TEST(Tiling, ResampleOfZOnlyTiles) {
+    const std::string head = R"(atlas: 1
+nodes:
+  vol:  { type: noise/perlin_worley, params: { resolution: [48, 32, 8], bounds_min: [-30, 10, 0], bounds_max: [4770, 3210, 800], seed: 5 } }
+  base: { type: ndf/noise, params: { resolution: [48, 32], bounds_min: [-30, 10], bounds_max: [4770, 3210], octaves: 3, seed: 1 } }
+)";
+    const std::string text = head + R"(  fine: { type: field/resample, inputs: { in: vol }, params: { resolution: [48, 32, 13] } }
+  flat: { type: field/resample, inputs: { in: base }, params: { resolution: [48, 32, 1] } }
+outputs:
+  - { node: fine, file: fine.vdb }
+  - { node: fine, file: fine.exr }
+  - { node: flat, file: flat.exr }
+)";
+    const fs::path single = scratch("single");
+    Session a = load_text(text, single);
+    a.cook(options(single));
+    EXPECT_EQ(std::get<Field3DPtr>(a.get("fine", "out"))->nz(), 13);
+    for (auto [nx, ny] : {std::pair{1, 1}, std::pair{2, 2}, std::pair{3, 2}}) {
+        const fs::path tiled = scratch("tiled" + std::to_string(nx) + std::to_string(ny));
+        Session b = load_text(text, tiled);
+        TileOptions t;
+        t.tiles = {{nx, ny}};
+        t.assemble = true;
+        cook_tiled(b, options(tiled), t);
+        const auto files = files_under(single);
+        ASSERT_EQ(files.size(), size_t(3));
+        for (const auto& f : files) EXPECT_TRUE(bytes_of(single / f) == bytes_of(tiled / f)) << f << " " << nx << "x" << ny;
+    }
+    const fs::path bad = scratch("bad");
+    for (const auto& [params, expect] : {std::pair<std::string, std::string>{"{ resolution: [24, 32, 8] }", "needs the XY resolution kept (48 x 32)"},
+                                         {"{ resolution: [48, 32, 8], keep_bounds: false, bounds_max: [10, 10, 10] }", "keep_bounds: false"}}) {
+        Session c = load_text(head + "  x: { type: field/resample, inputs: { in: vol }, params: " + params + " }\noutputs:\n  - { node: x, file: x.exr }\n", bad);
+        TileOptions t;
+        t.tiles = {{2, 2}};
+        try {
+            cook_tiled(c, options(bad), t);
+            ADD_FAILURE() << "no error for " << params;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("node 'x' (field/resample)"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+        }
+        EXPECT_TRUE(files_under(bad).empty());
+    }
+}
