@@ -2,7 +2,7 @@
 # The voxel preview's luminance error against Blender's Cycles, and Cycles' own error against
 # its converged image per sample count (docs/render.md, "Reference: Cycles").
 #
-#   bench/render_vs_cycles.sh [--smoke] [--build DIR] [--out DIR] [--size WxH] [--ref-spp N]
+#   bench/render_vs_cycles.sh [--smoke] [--build DIR] [--out DIR] [--size WxH] [--ref-spp N] [--reuse-ref] [--ladder "1 4 .."]
 #
 # Per scene: atlas preview --artistic off --export-scene (the scene for Cycles), then
 #   - Cycles with --ref-spp samples (default 512) and 128 volume bounces: the reference;
@@ -11,6 +11,8 @@
 #   - Cycles at 1, 4, 16, 64 samples (another seed): its error and time.
 # Writes OUT/results.csv, OUT/table.md and docs/images/cycles_error_vs_time.png (matplotlib).
 # --smoke: one scene, 64x36, 8 reference samples, no plot (CI: checks the pipeline runs).
+# --reuse-ref: keep OUT/SCENE/cycles_ref.exr when its stats say --ref-spp samples (a converged
+# 1024+ spp reference takes minutes; render it once, at nice -n 10, off CI).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=$ROOT/build
@@ -18,6 +20,8 @@ OUT=$ROOT/build/render_vs_cycles
 SIZE=160x90
 REF_SPP=512
 SMOKE=0
+REUSE=0
+LADDER="1 4 16 64"
 while [ $# -gt 0 ]; do
   case $1 in
     --smoke) SMOKE=1; shift ;;
@@ -25,13 +29,14 @@ while [ $# -gt 0 ]; do
     --out) OUT=$2; shift 2 ;;
     --size) SIZE=$2; shift 2 ;;
     --ref-spp) REF_SPP=$2; shift 2 ;;
+    --reuse-ref) REUSE=1; shift ;;
+    --ladder) LADDER=$2; shift 2 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
 ATLAS=$BUILD/bin/atlas
 PY=/usr/bin/python3
 if ! command -v blender > /dev/null; then echo "render_vs_cycles: blender not found (scripts/setup.sh installs it)" >&2; exit 77; fi
-LADDER="1 4 16 64"
 # name|atlas preview arguments
 SCENES=(
   "quickstart|$ROOT/examples/quickstart.yaml"
@@ -67,7 +72,11 @@ for entry in "${SCENES[@]}"; do
   # shellcheck disable=SC2086
   t=$(atlas "$d/physical_default.exr" $args --artistic off --export-scene "$d/scene")
   ref=$d/cycles_ref.exr
-  tref=$(cycles "$d/scene" "$ref" "$REF_SPP" 0)
+  if [ $REUSE = 1 ] && [ -f "$ref" ] && [ "$($PY -c "import json; print(json.load(open('$ref.json'))['samples'])" 2>/dev/null)" = "$REF_SPP" ]; then
+    tref=$($PY -c "import json; print('%.2f' % json.load(open('$ref.json'))['seconds'])")
+  else
+    tref=$(cycles "$d/scene" "$ref" "$REF_SPP" 0)
+  fi
   echo "$name: cycles reference $REF_SPP spp in $tref s" >&2
   row "$name" cycles "$REF_SPP spp (reference)" "$tref" "$ref" "$ref"
   row "$name" atlas "artistic off; defaults" "$t" "$d/physical_default.exr" "$ref"

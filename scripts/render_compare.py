@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Luminance error of a preview EXR against a reference EXR (docs/render.md, "Reference: Cycles").
 
-    /usr/bin/python3 scripts/render_compare.py PREVIEW.exr REFERENCE.exr [--threshold T] [--json]
+    /usr/bin/python3 scripts/render_compare.py PREVIEW.exr REFERENCE.exr [--threshold T] [--background BG.exr] [--json]
 
 Both images are linear radiance (Atlas's preview EXR: channels r, g, b, transmittance; Cycles: R, G, B).
 Luminance Y = 0.2126 R + 0.7152 G + 0.0722 B (Rec. 709 primaries, the linear space of both).
@@ -10,6 +10,10 @@ mean(Yref) (default 0.05), the RMSE of Y, the RMSE relative to mean(Yref), the s
 sum(Y) / sum(Yref) - 1 (a brightness bias), and the pixel count used; when PREVIEW has a
 transmittance channel, also cloud_* = the same over the pixels where the preview sees cloud
 (transmittance < 0.9), which leaves out the sky the two renderers draw identically.
+--background BG.exr: REFERENCE is a transparent-film Cycles render (RGBA, premultiplied: the clouds'
+own radiance and A = 1 - transmittance) and BG.exr the preview's background (the same preview at
+extinction 0): the reference compared is RGB + (1 - A) x BG, the Cycles clouds over Atlas's own
+background (the 2.5D mode draws a ground Cycles does not have; docs/render.md, "2.5D against Cycles").
 """
 import json
 import sys
@@ -32,6 +36,16 @@ def channels(path):
 def luminance(path):
     c = channels(path)
     return 0.2126 * c["r"] + 0.7152 * c["g"] + 0.0722 * c["b"]
+
+
+def composite_luminance(reference, background):
+    """Luminance of a premultiplied RGBA reference over a background image."""
+    c, b = channels(reference), channels(background)
+    if "a" not in c:
+        raise SystemExit(f"{reference}: no alpha channel (render it with cycles_reference.py --alpha)")
+    y = 0.2126 * c["r"] + 0.7152 * c["g"] + 0.0722 * c["b"]
+    yb = 0.2126 * b["r"] + 0.7152 * b["g"] + 0.0722 * b["b"]
+    return y + (1 - c["a"]) * yb
 
 
 def cloud_mask(path, max_transmittance=0.9):
@@ -65,10 +79,15 @@ def main(argv):
     if "--threshold" in argv:
         threshold = float(argv[argv.index("--threshold") + 1])
         args.remove(argv[argv.index("--threshold") + 1])
+    background = None
+    if "--background" in argv:
+        background = argv[argv.index("--background") + 1]
+        args.remove(background)
     if len(args) != 2:
         raise SystemExit(__doc__)
     cloud = cloud_mask(args[0]) if "transmittance" in channels(args[0]) else None
-    m = metrics(luminance(args[0]), luminance(args[1]), threshold, cloud)
+    ref = composite_luminance(args[1], background) if background else luminance(args[1])
+    m = metrics(luminance(args[0]), ref, threshold, cloud)
     if "--json" in argv:
         print(json.dumps(m))
     else:

@@ -291,10 +291,12 @@ void apply_physics_options(const Args& a, render::RenderSettings& s) {
     if (a.has("--ms-octaves")) {
         if (s.artistic) throw UsageError{"--ms-octaves sets the physical model's multiple scattering; it needs --artistic off", "preview"};
         const std::string t = a.get("--ms-octaves");
-        const bool four = std::count(t.begin(), t.end(), ',') == 3;
-        auto v = numbers(t, four ? 4 : 1, "--ms-octaves");
+        const auto commas = std::count(t.begin(), t.end(), ',');
+        const bool four = commas == 3 || commas == 4;
+        auto v = numbers(t, four ? size_t(commas + 1) : 1, "--ms-octaves");
         s.ms_octaves = static_cast<int>(v[0]);
         if (four) s.ms_energy = v[1], s.ms_extinction = v[2], s.ms_anisotropy = v[3];
+        if (commas == 4) s.ms_scatter_power = v[4];
     }
     if (a.has("--light-grid")) {
         auto v = numbers(a.get("--light-grid"), 3, "--light-grid");
@@ -533,8 +535,8 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
     const double exposure = a.has("--exposure") ? numbers(a.get("--exposure"), 1, "--exposure")[0] : 1.5;
     apply_physics_options(a, s); // --artistic, --ms-octaves, --light-grid
     if (a.has("--export-scene")) {
-        if (!have_voxel || have_layer) throw UsageError{"--export-scene exports a voxel scene; this preview has no (or not only a) volume/nvdf set", "preview"};
-        const std::string note = export_scene(a.get("--export-scene"), scene, s);
+        if (have_voxel && have_layer) throw UsageError{"--export-scene exports a voxel or a 2.5D scene, not both at once (use --mode)", "preview"};
+        const std::string note = have_layer ? export_layer_scene(a.get("--export-scene"), layer, s) : export_scene(a.get("--export-scene"), scene, s);
         if (!quiet) std::fprintf(stderr, "%s\n", note.c_str());
     }
 

@@ -92,6 +92,33 @@ TEST(CyclesPhysical, NoPowderAndTheLookDiffers) {
     EXPECT_NEAR(render_clouds(box, ms).image.at(1, 4, 4), render_clouds(box, phys).image.at(1, 4, 4), 1e-9);
 }
 
+TEST(CyclesPhysical, ScatterPowerWeightsTheOctaves) {
+    // The octaves are weighted by q^ms_scatter_power, q = 1 - e^-(tau_sun + tau_zenith) < 1:
+    // power 0 drops the weighting (more light), a higher power gives less; the
+    // default (1) is the weighting itself, and the difference to single
+    // scattering scales with q^p sample by sample, so with q < 1 everywhere the
+    // octave light at power 2 is below that at power 1 by at least the largest q.
+    const CloudScene box = uniform_box();
+    RenderSettings s = thin_box_settings(RenderMode::Fast);
+    const double single = render_clouds(box, s).image.at(1, 4, 4);
+    s.ms_octaves = 8;
+    const double p1 = render_clouds(box, s).image.at(1, 4, 4);
+    s.ms_scatter_power = 0;
+    const double p0 = render_clouds(box, s).image.at(1, 4, 4);
+    s.ms_scatter_power = 2;
+    const double p2 = render_clouds(box, s).image.at(1, 4, 4);
+    EXPECT_GT(p0, p1);
+    EXPECT_GT(p1, p2);
+    EXPECT_GT(p2, single);
+    // Optical depth 0.1 across the box: tau_sun + tau_zenith < 0.3 at every sample, so q < 1 - e^-0.3.
+    EXPECT_LT((p2 - single) / (p1 - single), 1 - std::exp(-0.3));
+    RenderSettings bad = s;
+    bad.ms_scatter_power = -1;
+    EXPECT_THROW(render_clouds(box, bad), Error);
+    bad.ms_scatter_power = 9;
+    EXPECT_THROW(render_clouds(box, bad), Error);
+}
+
 TEST(CyclesPhysical, SkyIsTheSphereMeanUnderMultipleScattering) {
     // A thick uniform box under a uniform sky and no sun, albedo 1: with multiple
     // scattering the cloud is exactly as bright as the sky (the furnace test).

@@ -112,7 +112,8 @@ inline void shade(const RenderSettings& s, const SunTerms& st, double tau, doubl
         // Light scatters again only where there is medium around the sample:
         // the octaves are weighted by the probability of a further scattering
         // event along the two paths we know, toward the sun and the zenith.
-        const double again = -std::expm1(-(tau + sky_tau));
+        const double q = -std::expm1(-(tau + sky_tau));
+        const double again = s.ms_scatter_power == 1 ? q : std::pow(q, s.ms_scatter_power);
         sun_w = direct + s.multiple_scattering * ms * again;
         sky_w = s.ambient_strength * (s.ms_octaves > 0 ? 1.0 : std::exp(-sky_tau));
         return;

@@ -63,6 +63,7 @@ void check_settings(const RenderSettings& s) {
     if (s.threads < 0) bad("threads must be >= 0 (0 = all cores)");
     if (s.light_samples < 1 || s.light_samples > 64) bad("light_samples must be 1..64");
     if (s.ms_octaves < 0 || s.ms_octaves > 16) bad("ms_octaves must be 0..16");
+    if (!(s.ms_scatter_power >= 0 && s.ms_scatter_power <= 8)) bad("ms_scatter_power must be in [0, 8]");
     for (double v : {s.ms_energy, s.ms_extinction, s.ms_anisotropy})
         if (!(v >= 0 && v <= 1)) bad("ms_energy, ms_extinction and ms_anisotropy must be in [0, 1]");
     for (size_t i = 0; i < s.lights.size(); ++i) validate_light(s.lights[i], "lights[" + std::to_string(i) + "]");

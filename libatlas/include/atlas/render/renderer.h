@@ -94,8 +94,12 @@ struct RenderSettings {
     // "Art-directable multiple volumetric scattering", 2015): octave n >= 1
     // adds ms_energy^n x Beer(ms_extinction^n tau) x phase with both g
     // scaled by ms_anisotropy^n. 0 = single scattering only, 0..16.
+    // The octaves are weighted by q^ms_scatter_power, q = 1 - e^-(tau_sun +
+    // tau_zenith) the probability of scattering again (docs/render.md,
+    // "Calibration against Cycles"), ms_scatter_power in [0, 8].
     int ms_octaves = 0;
     double ms_energy = 0.5, ms_extinction = 0.5, ms_anisotropy = 0.5; // each in [0, 1]
+    double ms_scatter_power = 1;
 };
 
 // Which parts of the method ran (features the scene does not need are left

@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# The 2.5D preview's luminance error against Blender's Cycles (docs/render.md, "2.5D against Cycles").
+#
+#   bench/render_vs_cycles_layer.sh [--build DIR] [--out DIR] [--size WxH] [--ref-spp N] [--ladder "1 4 .."] [--reuse-ref]
+#
+# Per graph (superstorm, hzd_weather, fc6_forecast; camera --view orbit:30,25): atlas preview
+# --artistic off --export-scene bakes the layer's density over a 16 km patch under the camera's
+# look-at point (the preview then draws only that patch, without haze, rain absorption or sky
+# layers); the same at --extinction 0 gives the preview's background (sky and ground); Cycles
+# renders the patch with a transparent film (--alpha), composited over that background by
+# render_compare.py --background. Rows: Cycles reference, Atlas artistic off / on, Atlas quality
+# 0.5 / 2, Cycles at the ladder's sample counts (seed 7). Writes OUT/results.csv and OUT/table.md.
+set -euo pipefail
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=$ROOT/build
+OUT=$ROOT/build/render_vs_cycles_layer
+SIZE=160x90
+REF_SPP=1024
+LADDER="1 4 16 64"
+REUSE=0
+while [ $# -gt 0 ]; do
+  case $1 in
+    --build) BUILD=$2; shift 2 ;;
+    --out) OUT=$2; shift 2 ;;
+    --size) SIZE=$2; shift 2 ;;
+    --ref-spp) REF_SPP=$2; shift 2 ;;
+    --ladder) LADDER=$2; shift 2 ;;
+    --reuse-ref) REUSE=1; shift ;;
+    *) echo "unknown option $1" >&2; exit 2 ;;
+  esac
+done
+ATLAS=$BUILD/bin/atlas
+PY=/usr/bin/python3
+if ! command -v blender > /dev/null; then echo "render_vs_cycles_layer: blender not found (scripts/setup.sh installs it)" >&2; exit 77; fi
+mkdir -p "$OUT"
+CSV=$OUT/results.csv
+echo "scene,renderer,setting,seconds,mean_rel,rmse,cloud_mean_rel,cloud_rmse,cloud_bias" > "$CSV"
+echo "render_vs_cycles_layer: $(date -u), load $(cat /proc/loadavg)" >&2
+cycles() { # DIR OUT SPP SEED -> prints wall seconds
+  local d=$1 o=$2 n=$3 seed=$4
+  blender -b --factory-startup --python-exit-code 1 --python "$ROOT/scripts/cycles_reference.py" -- "$d" "$o" \
+    --samples "$n" --bounces 128 --seed "$seed" --threads 2 --alpha --stats "$o.json" > "$o.log" 2>&1
+  $PY -c "import json; print('%.2f' % json.load(open('$o.json'))['seconds'])"
+}
+atlas() { # OUT args... -> prints render seconds
+  local o=$1; shift
+  "$ATLAS" preview "$@" --size "$SIZE" --cache "$OUT/cache" -o "$o" 2> "$o.log" > /dev/null
+  sed -n 's/.*rendered [0-9x]* (2.5D) in \([0-9.]*\) s.*/\1/p' "$o.log" | tail -1
+}
+row() { # scene renderer setting seconds image reference background mask
+  $PY -c "
+import sys; sys.path.insert(0, '$ROOT/scripts')
+import render_compare as rc
+ref = rc.composite_luminance('$6', '$7')
+y = rc.composite_luminance('$5', '$7') if '$5'.endswith('.cycles.exr') else rc.luminance('$5')
+m = rc.metrics(y, ref, cloud=rc.cloud_mask('$8'))
+print(','.join(['$1', '$2', '$3', '$4'] + ['%.4f' % m.get(k, float('nan')) for k in ('mean_rel', 'rmse', 'cloud_mean_rel', 'cloud_rmse', 'cloud_bias')]))
+" >> "$CSV"
+}
+for name in superstorm hzd_weather fc6_forecast; do
+  d=$OUT/$name; mkdir -p "$d"
+  g=$ROOT/graphs/$name.yaml
+  t=$(atlas "$d/physical_default.exr" "$g" --view orbit:30,25 --artistic off --export-scene "$d/scene")
+  atlas "$d/background.exr" "$g" --view orbit:30,25 --artistic off --extinction 0 --export-scene "$d/scene_bg" > /dev/null
+  ref=$d/ref.cycles.exr
+  if [ $REUSE = 1 ] && [ -f "$ref" ] && [ "$($PY -c "import json; print(json.load(open('$ref.json'))['samples'])" 2>/dev/null)" = "$REF_SPP" ]; then
+    tref=$($PY -c "import json; print('%.2f' % json.load(open('$ref.json'))['seconds'])")
+  else
+    tref=$(cycles "$d/scene" "$ref" "$REF_SPP" 0)
+  fi
+  echo "$name: cycles reference $REF_SPP spp in $tref s; $(grep -o 'exported.*voxels of [0-9.]* m' "$d/physical_default.exr.log")" >&2
+  mask=$d/physical_default.exr
+  row "$name" cycles "$REF_SPP spp (reference)" "$tref" "$ref" "$ref" "$d/background.exr" "$mask"
+  row "$name" atlas "artistic off; defaults" "$t" "$d/physical_default.exr" "$ref" "$d/background.exr" "$mask"
+  t=$(atlas "$d/artistic_on.exr" "$g" --view orbit:30,25 --artistic on --export-scene "$d/scene_on")
+  row "$name" atlas "artistic on (the look); defaults" "$t" "$d/artistic_on.exr" "$ref" "$d/background.exr" "$mask"
+  for q in 0.5 2; do
+    t=$(atlas "$d/q$q.exr" "$g" --view orbit:30,25 --artistic off --quality $q --export-scene "$d/scene_q")
+    row "$name" atlas "artistic off; quality $q" "$t" "$d/q$q.exr" "$ref" "$d/background.exr" "$mask"
+  done
+  for n in $LADDER; do
+    t=$(cycles "$d/scene" "$d/l$n.cycles.exr" "$n" 7)
+    row "$name" cycles "$n spp" "$t" "$d/l$n.cycles.exr" "$ref" "$d/background.exr" "$mask"
+  done
+  echo "$name: done" >&2
+done
+$PY - "$CSV" "$OUT/table.md" <<'PYEOF'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+with open(sys.argv[2], "w") as f:
+    f.write("| scene | renderer: setting | wall s | mean rel. | RMSE | cloud mean rel. | cloud RMSE | cloud bias |\n|---|---|---|---|---|---|---|---|\n")
+    for r in rows:
+        f.write(f"| {r['scene']} | {r['renderer'].capitalize()}: {r['setting']} | {r['seconds']} | {r['mean_rel']} | {r['rmse']} | {r['cloud_mean_rel']} | {r['cloud_rmse']} | {r['cloud_bias']} |\n")
+print(open(sys.argv[2]).read())
+PYEOF
