@@ -126,6 +126,14 @@ void expect_paths_equal(const detail::Palette<1>& p, const float* src, float sto
             ASSERT_EQ(std::memcmp(&a.max_err, &f.max_err, 4), 0) << "case " << k;
             ASSERT_EQ(std::memcmp(&a.sum, &f.sum, 4), 0) << "case " << k;
             ASSERT_EQ(std::memcmp(a.key, f.key, sizeof a.key), 0) << "case " << k;
+            float m0, m1;
+            double q0, q1;
+            uint64_t b0, b1;
+            detail::bc4_exact_portable<OS>(p, src, a, m0, q0, b0);
+            detail::bc4_exact_flat<OS>(p, src, a, m1, q1, b1);
+            ASSERT_EQ(std::memcmp(&m0, &m1, 4), 0) << "case " << k;
+            ASSERT_EQ(std::memcmp(&q0, &q1, 8), 0) << "case " << k;
+            ASSERT_EQ(b0, b1) << "case " << k;
         }
     }
     if (!ra) return;

@@ -625,7 +625,10 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     }
     if (finite && best_k >= 0) {
         const auto& p = pal[1 - cur];
-        if (os) exact_selection<true>(*tables_, p, src, keys[1 - cur], best, bits);
+        if (flat) { // one texel stands for all 16 (the same result, bc4_eval.h)
+            if (os) detail::bc4_exact_flat<true>(p, src, keys[1 - cur], best.max_err, best.sum_sq, bits);
+            else detail::bc4_exact_flat<false>(p, src, keys[1 - cur], best.max_err, best.sum_sq, bits);
+        } else if (os) exact_selection<true>(*tables_, p, src, keys[1 - cur], best, bits);
         else exact_selection<false>(*tables_, p, src, keys[1 - cur], best, bits);
         keyed = true;
     }

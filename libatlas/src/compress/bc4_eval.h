@@ -182,6 +182,19 @@ inline void bc4_exact_portable(const Palette<1>& p, const float* src, const Bc4K
     sum_sq = (sq[0] + sq[1]) + (sq[2] + sq[3]);
 }
 
+// bc4_exact_portable for a flat block (16 texels with the same bits, all with the same key):
+// one texel's error, and the squared error summed as there (4 per partial sum).
+template <bool OneSided>
+inline void bc4_exact_flat(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err, double& sum_sq, uint64_t& bits) {
+    const int i = int(k.key[0] & 7u);
+    const float e = entry_error_t<1, OneSided>(p, i, src);
+    max_err = e > 0.0f ? e : 0.0f;
+    const double d = double(p.ref[i][0]) - src[0], q = d * d;
+    const double lane = ((q + q) + q) + q;
+    sum_sq = (lane + lane) + (lane + lane);
+    bits = uint64_t(i) * 0x249249249249ull; // i in each of the 16 3-bit fields
+}
+
 #if defined(ATLAS_BC4_AVX2)
 // AVX2: 8 texels at a time, the same operations per texel; the sums are formed in the
 // portable order (lanes of texels j, 4 + j, 8 + j, 12 + j, then (0 + 1) + (2 + 3)).
