@@ -136,7 +136,7 @@ std::string options_reference_markdown() {
         for (const auto& e : f.extensions) ext += (ext.empty() ? "" : ", ") + ("`" + e + "`");
         for (PortType t : f.accepts) types += (types.empty() ? "" : ", ") + std::string(port_type_name(t));
         out << "\n### " << f.name << "\n\n" << f.doc << ".\n\nExtensions: " << (ext.empty() ? "none (give `format`)" : ext)
-            << ". Writes: " << types << ". Writer version " << f.version << ".\n\n";
+            << ". Writes: " << types << ".\n\n"; // not the writer version: an encoder change is no docs change
         if (f.options.empty()) continue;
         out << "| option | description |\n|---|---|\n";
         for (const auto& [name, doc] : f.options) out << "| `" << name << "` | " << md_cell(doc) << " |\n";
