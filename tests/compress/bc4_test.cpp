@@ -89,19 +89,19 @@ void random_palette(uint64_t k, detail::Palette<1>& p) {
 }
 
 template <bool OS>
-void expect_paths_equal(const detail::Palette<1>& p, const float* src, float stop, uint64_t k) {
+void expect_paths_equal(const detail::Palette<1>& p, const float* src, float stop, float inc_sum, uint64_t k) {
     detail::Bc4Keys a, b;
-    const bool ra = detail::bc4_keys_portable<OS>(p, src, stop, a);
+    const bool ra = detail::bc4_keys_portable<OS>(p, src, stop, inc_sum, a);
 #if defined(__SSE2__)
-    const bool rb = detail::bc4_keys_sse2<OS>(p, src, stop, b);
+    const bool rb = detail::bc4_keys_sse2<OS>(p, src, stop, inc_sum, b);
 #else
-    const bool rb = detail::bc4_keys_portable<OS>(p, src, stop, b);
+    const bool rb = detail::bc4_keys_portable<OS>(p, src, stop, inc_sum, b);
 #endif
     ASSERT_EQ(ra, rb) << "case " << k;
 #if defined(ATLAS_BC4_AVX2)
     if (detail::bc4_cpu_has_avx2()) {
         detail::Bc4Keys c;
-        ASSERT_EQ(detail::bc4_keys_avx2<OS>(p, src, stop, c), ra) << "case " << k;
+        ASSERT_EQ(detail::bc4_keys_avx2<OS>(p, src, stop, inc_sum, c), ra) << "case " << k;
         if (ra) {
             ASSERT_EQ(std::memcmp(&a.max_err, &c.max_err, 4), 0) << "case " << k;
             ASSERT_EQ(std::memcmp(&a.sum, &c.sum, 4), 0) << "case " << k;
@@ -121,7 +121,7 @@ void expect_paths_equal(const detail::Palette<1>& p, const float* src, float sto
     for (int t = 1; t < 16; ++t) all_same = all_same && std::memcmp(&src[t], &src[0], 4) == 0;
     if (all_same) {
         detail::Bc4Keys f;
-        ASSERT_EQ(detail::bc4_keys_flat<OS>(p, src, stop, f), ra) << "case " << k;
+        ASSERT_EQ(detail::bc4_keys_flat<OS>(p, src, stop, inc_sum, f), ra) << "case " << k;
         if (ra) {
             ASSERT_EQ(std::memcmp(&a.max_err, &f.max_err, 4), 0) << "case " << k;
             ASSERT_EQ(std::memcmp(&a.sum, &f.sum, 4), 0) << "case " << k;
@@ -176,8 +176,23 @@ TEST(Bc4Eval, Sse2EqualsPortable) {
         float src[16];
         test::scalar_block(k, 0.0f, 1.0f, src);
         const float stop = k % 4 == 0 ? float(test::unit(k, 7)) * 0.05f : detail::kBc4Infeasible;
-        expect_paths_equal<false>(p, src, stop, k);
-        expect_paths_equal<true>(p, src, stop, k);
+        expect_paths_equal<false>(p, src, stop, INFINITY, k);
+        expect_paths_equal<true>(p, src, stop, INFINITY, k);
+        // An incumbent tied with the candidate's own max error: the sum decides (below, equal, above).
+        for (bool os : {false, true}) {
+            detail::Bc4Keys own;
+            const bool ok = os ? detail::bc4_keys_portable<true>(p, src, detail::kBc4Infeasible, INFINITY, own)
+                               : detail::bc4_keys_portable<false>(p, src, detail::kBc4Infeasible, INFINITY, own);
+            if (!ok) continue;
+            for (float f : {0.5f, 1.0f, 2.0f}) {
+                if (os) expect_paths_equal<true>(p, src, own.max_err, own.sum * f, k);
+                else expect_paths_equal<false>(p, src, own.max_err, own.sum * f, k);
+            }
+            detail::Bc4Keys tied;
+            const bool r = os ? detail::bc4_keys_portable<true>(p, src, own.max_err, own.sum, tied)
+                              : detail::bc4_keys_portable<false>(p, src, own.max_err, own.sum, tied);
+            EXPECT_EQ(r, false) << "case " << k << ": a tie with an equal sum cannot win";
+        }
     }
 }
 

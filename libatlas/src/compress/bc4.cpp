@@ -523,13 +523,13 @@ void exact_selection(const PairTables& T, const detail::Palette<1>& p, const flo
 }
 
 template <bool OneSided>
-bool keys_of(const PairTables& T, const detail::Palette<1>& p, const float src[16], float stop, detail::Bc4Keys& k) {
+bool keys_of(const PairTables& T, const detail::Palette<1>& p, const float src[16], float stop, float inc_sum, detail::Bc4Keys& k) {
 #if defined(ATLAS_BC4_AVX2)
-    if (T.avx2) return detail::bc4_keys_avx2<OneSided>(p, src, stop, k);
+    if (T.avx2) return detail::bc4_keys_avx2<OneSided>(p, src, stop, inc_sum, k);
 #else
     (void)T;
 #endif
-    return detail::bc4_keys<OneSided>(p, src, stop, k);
+    return detail::bc4_keys<OneSided>(p, src, stop, inc_sum, k);
 }
 } // namespace
 
@@ -617,9 +617,10 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
             entry_palette(*tables_, k, snorm_, pal[cur]);
             const auto& p = pal[cur];
             const float stop = best_k < 0 ? detail::kBc4Infeasible : keys[1 - cur].max_err;
+            const float inc_sum = best_k < 0 ? INFINITY : keys[1 - cur].sum;
             // A flat block is evaluated on one texel (the same keys and sums, bc4_eval.h).
-            const bool ok = flat ? (os ? detail::bc4_keys_flat<true>(p, src, stop, keys[cur]) : detail::bc4_keys_flat<false>(p, src, stop, keys[cur]))
-                                 : (os ? keys_of<true>(*tables_, p, src, stop, keys[cur]) : keys_of<false>(*tables_, p, src, stop, keys[cur]));
+            const bool ok = flat ? (os ? detail::bc4_keys_flat<true>(p, src, stop, inc_sum, keys[cur]) : detail::bc4_keys_flat<false>(p, src, stop, inc_sum, keys[cur]))
+                                 : (os ? keys_of<true>(*tables_, p, src, stop, inc_sum, keys[cur]) : keys_of<false>(*tables_, p, src, stop, inc_sum, keys[cur]));
             if (ok && (best_k < 0 || detail::bc4_keys_better(keys[cur], keys[1 - cur]))) { best_k = k; cur = 1 - cur; }
         }
     }

@@ -57,9 +57,14 @@ inline bool bc4_keys_better(const Bc4Keys& a, const Bc4Keys& b) {
     return a.max_err < b.max_err || (a.max_err == b.max_err && a.sum < b.sum);
 }
 
+// inc_sum: the incumbent's sum (with stop its max error; +inf and kBc4Infeasible: none).
+// Returns false too when the max error equals stop and the sum is not below inc_sum (the
+// candidate cannot win: ranking is by max error, then sum); the partial sums of squares
+// only grow, so each path drops such a candidate as soon as a texel ties and its partial
+// sum reaches inc_sum, and all paths return the same.
 // src: 16 finite texels within +-1e30. Returns false when some texel has no feasible entry or a key error exceeds `stop`.
 template <bool OneSided>
-inline bool bc4_keys_portable(const Palette<1>& p, const float* src, float stop, Bc4Keys& out) {
+inline bool bc4_keys_portable(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
     float acc[4] = {0, 0, 0, 0}, mx = 0;
     for (int q = 0; q < 4; ++q) {
         float qmax = 0;
@@ -87,6 +92,7 @@ inline bool bc4_keys_portable(const Palette<1>& p, const float* src, float stop,
         }
         if (qmax > stop || !(qmax < kBc4Infeasible)) return false;
         mx = qmax > mx ? qmax : mx;
+        if (mx == stop && !(((acc[0] + acc[1]) + (acc[2] + acc[3])) < inc_sum)) return false; // tied, not below
     }
     out.max_err = mx;
     out.sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
@@ -95,7 +101,7 @@ inline bool bc4_keys_portable(const Palette<1>& p, const float* src, float stop,
 
 #if defined(__SSE2__)
 template <bool OneSided>
-inline bool bc4_keys_sse2(const Palette<1>& p, const float* src, float stop, Bc4Keys& out) {
+inline bool bc4_keys_sse2(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
     const __m128 zero = _mm_setzero_ps(), vstop = _mm_set1_ps(stop), vinf = _mm_set1_ps(kBc4Infeasible);
     const __m128 clear = _mm_castsi128_ps(_mm_set1_epi32(int(kBc4KeyMask)));
     __m128 acc = zero, mx = zero;
@@ -118,6 +124,11 @@ inline bool bc4_keys_sse2(const Palette<1>& p, const float* src, float stop, Bc4
         if (_mm_movemask_ps(_mm_or_ps(_mm_cmpgt_ps(ek, vstop), _mm_cmpge_ps(ek, vinf)))) return false;
         mx = _mm_max_ps(ek, mx);
         acc = _mm_add_ps(acc, _mm_mul_ps(ek, ek));
+        if (_mm_movemask_ps(_mm_cmpeq_ps(mx, vstop))) { // a texel ties the incumbent's max: the sum decides
+            float a[4];
+            _mm_storeu_ps(a, acc);
+            if (!(((a[0] + a[1]) + (a[2] + a[3])) < inc_sum)) return false;
+        }
     }
     float a[4], m[4];
     _mm_storeu_ps(a, acc);
@@ -133,7 +144,7 @@ inline bool bc4_keys_sse2(const Palette<1>& p, const float* src, float stop, Bc4
 // A flat block (16 equal texels): one texel's evaluation, with the sums formed as above,
 // so the same keys, maxima and sums as the 16-texel paths.
 template <bool OneSided>
-inline bool bc4_keys_flat(const Palette<1>& p, const float* src, float stop, Bc4Keys& out) {
+inline bool bc4_keys_flat(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
     const float s = src[0];
     uint32_t best = 0;
     float best_f = 0;
@@ -151,6 +162,10 @@ inline bool bc4_keys_flat(const Palette<1>& p, const float* src, float stop, Bc4
     }
     const float ek = bc4_key_error(best);
     if (ek > stop || !(ek < kBc4Infeasible)) return false;
+    {
+        const float sq = ek * ek, lane = ((sq + sq) + sq) + sq;
+        if (ek == stop && !(((lane + lane) + (lane + lane)) < inc_sum)) return false;
+    }
     for (int t = 0; t < 16; ++t) out.key[t] = best;
     const float sq = ek * ek, lane = ((sq + sq) + sq) + sq;
     out.max_err = ek > 0.0f ? ek : 0.0f;
@@ -199,7 +214,7 @@ inline void bc4_exact_flat(const Palette<1>& p, const float* src, const Bc4Keys&
 // AVX2: 8 texels at a time, the same operations per texel; the sums are formed in the
 // portable order (lanes of texels j, 4 + j, 8 + j, 12 + j, then (0 + 1) + (2 + 3)).
 template <bool OneSided>
-__attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, const float* src, float stop, Bc4Keys& out) {
+__attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
     const __m256 vstop = _mm256_set1_ps(stop), vinf = _mm256_set1_ps(kBc4Infeasible);
     const __m256 clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask)));
     __m256 ek[2];
@@ -219,6 +234,14 @@ __attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, c
         _mm256_storeu_ps(reinterpret_cast<float*>(out.key + 8 * h), best);
         ek[h] = _mm256_and_ps(best, clear);
         if (_mm256_movemask_ps(_mm256_or_ps(_mm256_cmp_ps(ek[h], vstop, _CMP_GT_OQ), _mm256_cmp_ps(ek[h], vinf, _CMP_GE_OQ)))) return false;
+        if (h == 0 && _mm256_movemask_ps(_mm256_cmp_ps(ek[0], vstop, _CMP_EQ_OQ))) {
+            // A texel ties the incumbent's max: the sum decides; the first two groups' lane sums
+            // can only grow, so the candidate is dropped once they reach the incumbent's.
+            const __m256 sq = _mm256_mul_ps(ek[0], ek[0]);
+            float a[4];
+            _mm_storeu_ps(a, _mm_add_ps(_mm256_castps256_ps128(sq), _mm256_extractf128_ps(sq, 1)));
+            if (!(((a[0] + a[1]) + (a[2] + a[3])) < inc_sum)) return false;
+        }
     }
     const __m256 sq0 = _mm256_mul_ps(ek[0], ek[0]), sq1 = _mm256_mul_ps(ek[1], ek[1]);
     const __m128 acc = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm256_castps256_ps128(sq0), _mm256_extractf128_ps(sq0, 1)), _mm256_castps256_ps128(sq1)),
@@ -231,7 +254,7 @@ __attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, c
     for (int j = 1; j < 8; ++j) r = m[j] > r ? m[j] : r;
     out.max_err = r;
     out.sum = (a[0] + a[1]) + (a[2] + a[3]);
-    return true;
+    return !(r == stop && !(out.sum < inc_sum));
 }
 
 // The exact errors of the chosen entries (entry_error_t's terms; every chosen entry is
@@ -281,11 +304,11 @@ inline bool bc4_cpu_has_avx2() { return false; }
 #endif
 
 template <bool OneSided>
-inline bool bc4_keys(const Palette<1>& p, const float* src, float stop, Bc4Keys& out) {
+inline bool bc4_keys(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
 #if defined(__SSE2__)
-    return bc4_keys_sse2<OneSided>(p, src, stop, out);
+    return bc4_keys_sse2<OneSided>(p, src, stop, inc_sum, out);
 #else
-    return bc4_keys_portable<OneSided>(p, src, stop, out);
+    return bc4_keys_portable<OneSided>(p, src, stop, inc_sum, out);
 #endif
 }
 
