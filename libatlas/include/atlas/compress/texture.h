@@ -34,7 +34,8 @@ namespace fs = std::filesystem;
 // 4: BC4 fast / normal one-pass key evaluation (ties within 8 ulps may pick differently).
 // 5: bc1-scalar one-sided fit with an endpoint or both unused, shared-R bottom after the
 // first pass, single-entry search for blocks whose spread is under their error.
-constexpr int kEncoderVersion = 5;
+// 6: BC1 RGB normal also starts from the other three box diagonals, 4 power iterations.
+constexpr int kEncoderVersion = 6;
 
 // The most mip levels a front end asks for by number (a 65536 texture has 17
 // levels; "full" asks for all of them).
