@@ -197,8 +197,8 @@ TEST(MeshSdf, OpenVdbVariantSignAndError) {
     const Field3D ours2 = mesh_to_sdf(m, {{24, 24, 24}}, grid_box(48));
     for (size_t i = 0; i < vdb.voxel_count(); ++i) {
         ASSERT_EQ(vdb.channel(0)[i] < 0, ours2.channel(0)[i] < 0) << i;
-        // Exact band, then first-order fast sweeping: within one voxel (2 m) here.
-        ASSERT_NEAR(vdb.channel(0)[i], ours2.channel(0)[i], 2.0) << i;
+        // Exact band, then the same EDT as `edt`: within half a voxel (1 m) of it here.
+        ASSERT_NEAR(vdb.channel(0)[i], ours2.channel(0)[i], 1.0) << i;
     }
     (void)ours;
 }
@@ -500,5 +500,70 @@ TEST(MeshSdf, AccuracyNearOpenRimsAndGridEdges) {
         std::printf("%s: max over-estimate %.3f voxel, max under-estimate %.2g voxel\n", c.name, over, under);
         EXPECT_LT(over, c.bound) << c.name;
         EXPECT_LT(under, 1e-4) << c.name; // distances to surface points never fall short
+    }
+}
+
+// `method: openvdb` against brute force, to the accuracy the native method is held to:
+// the CGAL bunny (every 13th voxel: distance to every triangle, sign by the
+// fast winding number) and two overlapping spheres plus a buried one (analytic distance to
+// the union; straddling triangles, which OpenVDB alone would measure whole, short by up
+// to a triangle's size near the intersection circle: before, 0.53 voxel beyond the band).
+TEST(MeshSdf, OpenVdbMatchesBruteForce) {
+    struct Err {
+        double band = 0, far = 0;
+        int sign = 0;
+    };
+    auto tally = [](Err& e, double got, double ref, double h, bool check_sign) {
+        if (check_sign && (got < 0) != (ref < 0)) ++e.sign;
+        const double d = std::abs(got - ref) / h;
+        (std::abs(ref) <= 1.5 * h ? e.band : e.far) = std::max(std::abs(ref) <= 1.5 * h ? e.band : e.far, d);
+    };
+    {
+        const Mesh bunny = read_mesh(bunny_file());
+        const Vec3i res{{32, 32, 32}};
+        const Box3d box{{{-0.55, -0.55, -0.55}}, {{0.55, 0.55, 0.55}}};
+        const Field3D s = mesh_to_sdf_openvdb(bunny, res, box);
+        const Field3D native = mesh_to_sdf(bunny, res, box);
+        const double h = s.voxel_size()[0];
+        Err e, en;
+        std::vector<Vec3d> pts;
+        std::vector<size_t> at;
+        for (size_t i = 0; i < s.voxel_count(); i += 13) { // ~2,500 voxels
+            pts.push_back(s.voxel_center(int(i % 32), int(i / 32 % 32), int(i / 1024)));
+            at.push_back(i);
+        }
+        const std::vector<double> w = fast_winding_numbers(bunny, pts); // checked against the exact sum above
+        for (size_t k = 0; k < pts.size(); ++k) {
+            const double ref = (w[k] > 0.5 ? -1 : 1) * closest_distance(bunny, pts[k]);
+            tally(e, s.channel(0)[at[k]], ref, h, std::abs(ref) > 1e-3 * h);
+            tally(en, native.channel(0)[at[k]], ref, h, std::abs(ref) > 1e-3 * h);
+        }
+        std::printf("openvdb bunny: band %.3f voxel, far %.3f voxel, %d sign errors (edt: %.3f, %.3f, %d)\n", e.band, e.far, e.sign, en.band,
+                    en.far, en.sign);
+        EXPECT_EQ(e.sign, 0);
+        EXPECT_LE(e.band, 0.3);
+        // Beyond the band both methods use the same EDT: no worse than `edt`, whose 0.5
+        // voxel claim this bunny breaks (0.61 voxel measured here, docs/volumes.md).
+        EXPECT_LE(e.far, en.far + 1e-3);
+        EXPECT_LE(e.far, 0.65);
+    }
+    {
+        const Vec3d c1{{9.2, 12.1, 11.9}}, c2{{14.6, 11.7, 12.3}};
+        const double r1 = 6, r2 = 5;
+        const Mesh m = merged(merged(uv_sphere(c1, r1, 32, 64), uv_sphere(c2, r2, 32, 64)), uv_sphere({{7.5, 12, 12}}, 2, 8, 16));
+        MeshSdfStats st;
+        const Field3D s = mesh_to_sdf_openvdb(m, {{24, 24, 24}}, grid_box(24), nullptr, &st);
+        EXPECT_GT(st.straddling_triangles, 0u);
+        Err e;
+        for (int z = 0; z < 24; ++z)
+            for (int y = 0; y < 24; ++y)
+                for (int x = 0; x < 24; ++x) {
+                    const double ref = union_of_spheres_distance(s.voxel_center(x, y, z), c1, r1, c2, r2);
+                    tally(e, s.at(0, x, y, z), ref, 1.0, std::abs(ref) > 0.05);
+                }
+        std::printf("openvdb overlapping spheres: band %.3f voxel, far %.3f voxel, %d sign errors\n", e.band, e.far, e.sign);
+        EXPECT_EQ(e.sign, 0);
+        EXPECT_LE(e.band, 0.3);
+        EXPECT_LE(e.far, 0.5);
     }
 }

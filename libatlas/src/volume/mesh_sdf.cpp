@@ -55,6 +55,28 @@ Vec3d closest_on_segment(const Vec3d& p, const Vec3d& a, const Vec3d& b) {
 
 } // namespace
 
+namespace detail {
+
+double straddling_squared_distance(const Mesh& m, const UnionSurface& us, uint32_t ti, const Vec3d& p) {
+    const auto& t = m.triangles[ti];
+    const Vec3d v[3] = {to_d(m.vertices[t[0]]), to_d(m.vertices[t[1]]), to_d(m.vertices[t[2]])};
+    double best = std::numeric_limits<double>::infinity();
+    auto offer = [&](const Vec3d& q) { best = std::min(best, dot(q - p, q - p)); };
+    const Vec3d q = closest_on_triangle(p, v[0], v[1], v[2]);
+    if (!us.point_buried(m, ti, q)) offer(q);
+    else {
+        for (int k = 0; k < 3; ++k) {
+            if (!us.corner_buried[ti][size_t(k)]) offer(v[k]);
+            const Vec3d qe = closest_on_segment(p, v[k], v[(k + 1) % 3]);
+            if (dot(qe - p, qe - p) < best && !us.point_buried(m, ti, qe)) offer(qe);
+        }
+        for (const auto& sg : us.segments[ti]) offer(closest_on_segment(p, sg[0], sg[1]));
+    }
+    return best;
+}
+
+} // namespace detail
+
 double winding_number(const Mesh& m, Vec3d p) {
     validate_mesh(m, "winding_number");
     // Van Oosterom & Strackee: tan(omega/2) = det / (|a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|).
@@ -180,23 +202,10 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
             const Vec3d v[3] = {to_d(m.vertices[t[0]]), to_d(m.vertices[t[1]]), to_d(m.vertices[t[2]])};
             int lo[3], hi[3];
             if (!voxel_range(v[0], v[1], v[2], lo, hi, needs_wide[ti] ? wide : band)) return;
-            const auto& segs = us.segments[ti];
             for (int z = lo[2]; z <= hi[2]; ++z)
                 for (int y = lo[1]; y <= hi[1]; ++y)
                     for (int x = lo[0]; x <= hi[0]; ++x) {
-                        const Vec3d p = out.voxel_center(x, y, z);
-                        double best = std::numeric_limits<double>::infinity();
-                        auto offer = [&](const Vec3d& q) { best = std::min(best, dot(q - p, q - p)); };
-                        const Vec3d q = closest_on_triangle(p, v[0], v[1], v[2]);
-                        if (!us.point_buried(m, ti, q)) offer(q);
-                        else {
-                            for (int k = 0; k < 3; ++k) {
-                                if (!us.corner_buried[ti][size_t(k)]) offer(v[k]);
-                                const Vec3d qe = closest_on_segment(p, v[k], v[(k + 1) % 3]);
-                                if (dot(qe - p, qe - p) < best && !us.point_buried(m, ti, qe)) offer(qe);
-                            }
-                            for (const auto& sg : segs) offer(closest_on_segment(p, sg[0], sg[1]));
-                        }
+                        const double best = detail::straddling_squared_distance(m, us, ti, out.voxel_center(x, y, z));
                         if (best < std::numeric_limits<double>::infinity()) found[si].push_back({out.index(x, y, z), float(best)});
                     }
         });
