@@ -677,6 +677,42 @@ TEST(CliBudget, LiveTotalStaysUnderTheBudgetOrIsRefusedByName) {
     EXPECT_NE(tiny.err.find("node 'a'"), std::string::npos) << tiny.err;
 }
 
+// A running node's scratch counts too (issue 17 item 6): volume/sdf works on
+// more than one field besides its output. With room for the two values
+// (density, distance) and one field more, the cook is refused naming 'sdf'
+// (counting only finished values, it went through); with room for eight
+// fields it cooks, the kernel-measured peak over the program's baseline stays
+// under the budget plus a slack, and the bytes equal an unbudgeted cook.
+TEST(CliBudget, RunningNodesScratchCountsAgainstTheBudget) {
+    const fs::path d = fresh_dir("scratch");
+    auto g = write_graph("scratch.yaml",
+                         "atlas: 1\nnodes:\n"
+                         "  puff:\n    type: volume/metaballs\n"
+                         "    params: {kernel: metaball, weight: 2.5, resolution: [256, 256, 64], spheres: \"2000 2000 250 900\"}\n"
+                         "  sdf:\n    type: volume/sdf\n    inputs: {in: puff}\n"
+                         "outputs:\n  - {node: sdf, file: s.exr}\n");
+    const long field_mib = 256 * 256 * 64 * 4 / (1 << 20); // one float channel
+    const MeasuredRun base = run_measured({"validate", g.string()});
+    ASSERT_EQ(base.status, 0) << base.err;
+    const MeasuredRun free_run = run_measured({"cook", g.string(), "--no-cache", "--quiet", "--out", (d / "free").string(), "--jobs", "1"});
+    ASSERT_EQ(free_run.status, 0) << free_run.err;
+    const std::string tight = std::to_string(3 * field_mib) + "MiB";
+    const MeasuredRun refused = run_measured({"cook", g.string(), "--no-cache", "--quiet", "--out", (d / "tight").string(), "--memory-budget", tight});
+    EXPECT_EQ(refused.status, 1) << refused.err;
+    EXPECT_NE(refused.err.find("node 'sdf'"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find("over the memory budget"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(d / "tight" / "s.exr"));
+    const long budget_kb = 8 * field_mib * 1024;
+    for (const char* jobs : {"1", "2"}) {
+        const MeasuredRun r = run_measured({"cook", g.string(), "--no-cache", "--quiet", "--out", (d / "roomy").string(), "--memory-budget",
+                                            std::to_string(8 * field_mib) + "MiB", "--jobs", jobs});
+        ASSERT_EQ(r.status, 0) << r.err;
+        // Slack: what the budget does not see (the EXR writer's buffers, allocator slack).
+        EXPECT_LE(r.peak_rss_kb - base.peak_rss_kb, budget_kb + budget_kb / 8) << "jobs " << jobs;
+        EXPECT_EQ(atlas::read_file_bytes(d / "roomy" / "s.exr"), atlas::read_file_bytes(d / "free" / "s.exr"));
+    }
+}
+
 // An input file larger than the memory budget is refused before a byte of it
 // is read or hashed (a 20 GB sparse file used to be hashed whole first).
 TEST(CliBudget, InputLargerThanTheBudgetIsRefusedBeforeReading) {

@@ -3,6 +3,7 @@
 
 #include "atlas/core/error.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <mutex>
@@ -26,6 +27,13 @@ std::string format_bytes(uint64_t bytes) {
 namespace detail {
 struct LedgerState {
     std::atomic<uint64_t> used{0};
+    std::atomic<uint64_t> peak{0};
+    void add(uint64_t bytes) {
+        const uint64_t now = used.fetch_add(bytes) + bytes;
+        uint64_t p = peak.load();
+        while (now > p && !peak.compare_exchange_weak(p, now)) {
+        }
+    }
     std::mutex mutex; // guards held and evictor
     std::unordered_map<const void*, uint64_t> held;
     std::shared_ptr<std::function<void(uint64_t)>> evictor;
@@ -33,25 +41,42 @@ struct LedgerState {
 } // namespace detail
 
 namespace {
+// What a node's scratch scope holds (see MemoryLedger::ScratchScope).
+struct ScratchState {
+    std::atomic<uint64_t> held{0};
+};
+struct Attached {
+    std::shared_ptr<detail::LedgerState> ledger;
+    std::shared_ptr<ScratchState> scratch; // null for a cook's own budget
+};
 // Which budgets have a ledger attached (a session's, for the length of a
-// cook). Keyed by the budget's address; entries live only while attached.
+// cook; a node's, for the length of its cook). Keyed by the budget's
+// address; entries live only while attached.
 std::mutex g_attached_mutex;
-std::unordered_map<const MemoryBudget*, std::shared_ptr<detail::LedgerState>>& attached() {
-    static std::unordered_map<const MemoryBudget*, std::shared_ptr<detail::LedgerState>> m;
+std::unordered_map<const MemoryBudget*, Attached>& attached() {
+    static std::unordered_map<const MemoryBudget*, Attached> m;
     return m;
 }
-std::shared_ptr<detail::LedgerState> ledger_of(const MemoryBudget* b) {
+Attached attachment_of(const MemoryBudget* b) {
     std::lock_guard<std::mutex> lock(g_attached_mutex);
     auto it = attached().find(b);
-    return it == attached().end() ? nullptr : it->second;
+    return it == attached().end() ? Attached{} : it->second;
 }
 } // namespace
 
 void MemoryBudget::check(uint64_t bytes, std::string_view what) const {
-    const std::shared_ptr<detail::LedgerState> st = ledger_of(this);
+    const Attached at = attachment_of(this);
+    const std::shared_ptr<detail::LedgerState>& st = at.ledger;
+    // A node's scratch: what passes is counted until the node's cook ends.
+    auto reserve = [&] {
+        if (at.scratch && bytes) {
+            at.scratch->held += bytes;
+            st->add(bytes);
+        }
+    };
     auto used = [&]() -> uint64_t { return st ? st->used.load() : 0; };
     auto over = [&] { return bytes > limit_ || used() > limit_ - bytes; };
-    if (!over()) return;
+    if (!over()) return reserve();
     if (st && bytes <= limit_) {
         // The evictor runs without the lock: what it frees comes back through tokens.
         std::shared_ptr<std::function<void(uint64_t)>> evict;
@@ -60,11 +85,11 @@ void MemoryBudget::check(uint64_t bytes, std::string_view what) const {
             evict = st->evictor;
         }
         if (evict) (*evict)(used() + bytes - limit_);
-        if (!over()) return;
+        if (!over()) return reserve();
     }
     const uint64_t held = used();
     throw MemoryBudgetError(std::string(what) + " needs " + format_bytes(bytes) + ", over the memory budget of " + format_bytes(limit_) +
-                            (held ? " (" + format_bytes(held) + " already held by the cook's values and cache)" : std::string()) +
+                            (held ? " (" + format_bytes(held) + " already held by the cook's values, cache and running nodes)" : std::string()) +
                             " (raise it with --memory-budget, or lower the resolution)");
 }
 
@@ -73,6 +98,8 @@ namespace detail {
 MemoryLedger::MemoryLedger() : state_(std::make_shared<LedgerState>()) {}
 
 uint64_t MemoryLedger::in_use() const { return state_->used.load(); }
+uint64_t MemoryLedger::peak() const { return state_->peak.load(); }
+void MemoryLedger::reset_peak() const { state_->peak = state_->used.load(); }
 
 void MemoryLedger::set_evictor(std::function<void(uint64_t)> evictor) const {
     std::lock_guard<std::mutex> lock(state_->mutex);
@@ -86,7 +113,7 @@ std::shared_ptr<void> hold_in(const std::shared_ptr<LedgerState>& st, const void
         std::lock_guard<std::mutex> lock(st->mutex);
         if (!st->held.emplace(key, bytes).second) return nullptr;
     }
-    st->used += bytes;
+    st->add(bytes);
     // The token: a non-null pointer whose deleter gives the bytes back.
     return std::shared_ptr<void>(reinterpret_cast<void*>(uintptr_t(1)), [st, key, bytes](void*) {
         {
@@ -101,12 +128,52 @@ std::shared_ptr<void> hold_in(const std::shared_ptr<LedgerState>& st, const void
 std::shared_ptr<void> MemoryLedger::hold(const void* key, uint64_t bytes) const { return hold_in(state_, key, bytes); }
 
 std::shared_ptr<void> hold_against(const MemoryBudget& budget, const void* key, uint64_t bytes) {
-    return hold_in(ledger_of(&budget), key, bytes);
+    const Attached at = attachment_of(&budget);
+    if (!at.scratch) return hold_in(at.ledger, key, bytes);
+    // The field's check() put its bytes into the node's scratch; from now on
+    // its token counts them (and gives them back when it dies). Taken out of
+    // the scratch first, so the high-water mark never counts them twice.
+    uint64_t h = at.scratch->held.load();
+    uint64_t moved = 0;
+    while (true) {
+        moved = std::min(h, bytes);
+        if (at.scratch->held.compare_exchange_weak(h, h - moved)) break;
+    }
+    at.ledger->used -= moved;
+    auto token = hold_in(at.ledger, key, bytes);
+    if (!token) {
+        // Already held (or nothing to hold): the scratch keeps counting it.
+        at.scratch->held += moved;
+        at.ledger->add(moved);
+    }
+    return token;
 }
 
 MemoryLedger::Attachment::Attachment(const MemoryBudget& budget, const MemoryLedger& ledger) : budget_(&budget) {
     std::lock_guard<std::mutex> lock(g_attached_mutex);
-    attached()[budget_] = ledger.state_;
+    attached()[budget_] = Attached{ledger.state_, nullptr};
+}
+
+MemoryLedger::ScratchScope::ScratchScope(const MemoryBudget& node_budget, const MemoryLedger& ledger) : budget_(&node_budget) {
+    std::lock_guard<std::mutex> lock(g_attached_mutex);
+    attached()[budget_] = Attached{ledger.state_, std::make_shared<ScratchState>()};
+}
+
+MemoryLedger::ScratchScope::~ScratchScope() {
+    Attached at;
+    {
+        std::lock_guard<std::mutex> lock(g_attached_mutex);
+        auto it = attached().find(budget_);
+        if (it == attached().end()) return;
+        at = it->second;
+        attached().erase(it);
+    }
+    if (at.scratch) at.ledger->used -= at.scratch->held.exchange(0);
+}
+
+uint64_t MemoryLedger::ScratchScope::held() const {
+    const Attached at = attachment_of(budget_);
+    return at.scratch ? at.scratch->held.load() : 0;
 }
 
 MemoryLedger::Attachment::~Attachment() {

@@ -23,8 +23,11 @@ struct LedgerState;
 class MemoryLedger {
 public:
     MemoryLedger();
-    // Bytes held by live tokens.
+    // Bytes held by live tokens and open scratch scopes.
     uint64_t in_use() const;
+    // The most in_use() has been since construction or reset_peak().
+    uint64_t peak() const;
+    void reset_peak() const;
     // Counts `bytes` of the object at `key` until the token dies; null when
     // `key` is already held (or null, or 0 bytes). Never refuses.
     std::shared_ptr<void> hold(const void* key, uint64_t bytes) const;
@@ -43,8 +46,31 @@ public:
         const MemoryBudget* budget_;
     };
 
+    // A node's cook (issue 17 item 6: scratch counts). While alive, every
+    // allocation `node_budget` passes in check() is counted against the
+    // ledger until the scope ends (a node's scratch fields and buffers live
+    // at most as long as its cook), so the live total includes what running
+    // nodes hold, not only finished values. A field made through a
+    // CookContext is handed from the scope to its own token (hold_against),
+    // so it stops counting when it dies, and an output is counted once.
+    // `node_budget` must have the same limit as the cook's budget and must
+    // not be attached otherwise.
+    class ScratchScope {
+    public:
+        ScratchScope(const MemoryBudget& node_budget, const MemoryLedger& ledger);
+        ~ScratchScope();
+        ScratchScope(const ScratchScope&) = delete;
+        ScratchScope& operator=(const ScratchScope&) = delete;
+        // Bytes the scope holds now (checked allocations not handed to a token).
+        uint64_t held() const;
+
+    private:
+        const MemoryBudget* budget_;
+    };
+
 private:
     friend class Attachment;
+    friend class ScratchScope;
     std::shared_ptr<LedgerState> state_;
 };
 
