@@ -243,3 +243,65 @@ TEST(Render, ReportListsOnlyWhatRan) {
     EXPECT_FALSE(rr.report.light_grid);
     EXPECT_FALSE(rr.report.sdf_skipping);
 }
+
+// A plain density grid (one float grid "density", what vdb_render reads)
+// through load_scene: the sampled density is density_scene's (itself checked
+// against the grid above), and the empty-space SDF never claims more room
+// than there is: at random points its interpolated value stays under the
+// brute-force distance to the nearest non-zero voxel's cell.
+#include "atlas/io/vdb.h"
+
+#include <filesystem>
+#include <random>
+
+TEST(RenderLoadScene, DensityGridGetsTheSameDensityAndASafeSdf) {
+    const Vec3i res{{24, 20, 12}};
+    Field3D d(res, 1, Box3d{{{-100, 50, 0}}, {{92, 210, 96}}}, {"density"});
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0, 1);
+    // Two blobs and a few stray voxels.
+    for (int z = 0; z < res[2]; ++z)
+        for (int y = 0; y < res[1]; ++y)
+            for (int x = 0; x < res[0]; ++x) {
+                const double a = std::hypot(x - 6.0, y - 5.0, z - 4.0), b = std::hypot(x - 17.0, y - 13.0, z - 7.0);
+                double v = std::max(0.0, 1 - a / 4) + 0.5 * std::max(0.0, 1 - b / 3);
+                if (u(rng) < 0.003) v = u(rng);
+                d.at(0, x, y, z) = static_cast<float>(v);
+            }
+    const auto path = std::filesystem::temp_directory_path() / "atlas_load_scene_density.vdb";
+    io::write_vdb(d, path);
+    const CloudScene s = load_scene({path});
+    std::filesystem::remove(path);
+    const CloudScene ref = density_scene(d);
+    const Field3D a = sample_density(s, res), b = sample_density(ref, res);
+    for (size_t i = 0; i < a.voxel_count(); ++i) ASSERT_NEAR(a.channel(0)[i], b.channel(0)[i], 1e-6f) << i;
+    // SDF bound, brute force over the non-zero voxels.
+    const Field3D& sdf = *s.sdf;
+    const int c = sdf.find_channel("sdf");
+    ASSERT_GE(c, 0);
+    const Vec3d vox = d.voxel_size();
+    const double diag = std::sqrt(vox[0] * vox[0] + vox[1] * vox[1] + vox[2] * vox[2]);
+    std::vector<Vec3d> occupied;
+    for (int z = 0; z < res[2]; ++z)
+        for (int y = 0; y < res[1]; ++y)
+            for (int x = 0; x < res[0]; ++x)
+                if (d.at(0, x, y, z) > 0) occupied.push_back(d.voxel_center(x, y, z));
+    int skipping = 0;
+    for (int k = 0; k < 4000; ++k) {
+        const Box3d bb = d.bounds();
+        Vec3d p;
+        for (int ax = 0; ax < 3; ++ax) p[ax] = bb.min[ax] + u(rng) * (bb.max[ax] - bb.min[ax]);
+        double nearest = 1e30;
+        for (const auto& o : occupied) nearest = std::min(nearest, length(p - o));
+        // Non-zero density lies within one cell diagonal of a non-zero voxel's centre.
+        const double room = nearest - diag;
+        const float v = sdf.sample_world(c, p, WrapMode::Clamp);
+        if (v > 0) ++skipping;
+        ASSERT_LE(v, std::max(room, 0.0)) << p[0] << " " << p[1] << " " << p[2];
+        // Wherever density_scene's profile is non-zero the point is inside.
+        if (ref.modeling->sample_world(0, p, WrapMode::Clamp) > 0) {
+            ASSERT_LT(v, 0.0f);
+        }
+    }
+    EXPECT_GT(skipping, 400); // the SDF does let the march skip
+}

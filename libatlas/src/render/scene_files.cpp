@@ -3,7 +3,11 @@
 #include "atlas/core/error.h"
 #include "atlas/io/readers.h"
 
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace atlas::render {
 
@@ -17,6 +21,117 @@ Field3DPtr rebound(Field3DPtr f, double voxel) {
     return std::make_shared<Field3D>(std::move(re));
 }
 
+
+// 1D squared distance transform along one line (Felzenszwalb & Huttenlocher):
+// f holds 0 at occupied samples and +inf elsewhere, spacing w metres; out[i] =
+// min_j f[j] + (w (i - j))^2.
+void edt_line(const double* f, int n, double w, double* out, int* v, double* z) {
+    const double w2 = w * w;
+    int k = 0;
+    v[0] = -1;
+    for (int q = 0; q < n; ++q) {
+        if (!std::isfinite(f[q])) continue;
+        if (v[0] < 0) {
+            v[0] = q;
+            z[0] = -std::numeric_limits<double>::infinity();
+            z[1] = std::numeric_limits<double>::infinity();
+            continue;
+        }
+        double sq;
+        while (true) {
+            const int r = v[k];
+            sq = ((f[q] / w2 + double(q) * q) - (f[r] / w2 + double(r) * r)) / (2.0 * (q - r));
+            if (sq <= z[k] && k > 0) --k;
+            else break;
+        }
+        if (sq <= z[k]) { // k == 0 and the new parabola hides the old one everywhere
+            v[0] = q;
+            z[0] = -std::numeric_limits<double>::infinity();
+        } else {
+            ++k;
+            v[k] = q;
+            z[k] = sq;
+        }
+        z[k + 1] = std::numeric_limits<double>::infinity();
+    }
+    if (v[0] < 0) {
+        std::fill(out, out + n, std::numeric_limits<double>::infinity());
+        return;
+    }
+    k = 0;
+    for (int q = 0; q < n; ++q) {
+        while (z[k + 1] < q) ++k;
+        const double d = w * (q - v[k]);
+        out[q] = f[v[k]] + d * d;
+    }
+}
+
+// A plain density grid (one channel, e.g. the float grid "density" that
+// vdb_render draws) as an NVDF set the sampler reads as the same density:
+// density_scene's mapping (profile D^(1/0.6) / S, detail type 0, density
+// scale S = max(1, max D^(1/0.6))), and an SDF that lets the march skip empty
+// space: -min voxel inside the cells next to a non-zero voxel (so wherever
+// the density is non-zero every corner is "inside" and the picture is
+// density_scene's), elsewhere the Euclidean distance between voxel centres to
+// the nearest non-zero voxel less 4 voxel diagonals' worth (4 max voxel): a
+// lower bound on the distance from any point of the cell to non-zero density.
+Field3DPtr set_from_density(const Field3D& density) {
+    float dmax = 0;
+    for (float d : density.channel(0)) {
+        if (!(d >= 0) || !std::isfinite(d)) throw Error("render: a density grid needs finite densities >= 0");
+        dmax = std::max(dmax, d);
+    }
+    const double S = std::max(1.0, std::pow(double(dmax), 1.0 / 0.6));
+    const Vec3i r = density.resolution();
+    auto set = std::make_shared<Field3D>(r, 4, density.bounds(),
+                                         std::vector<std::string>{"dimensional_profile", "detail_type", "density_scale", "sdf"});
+    const Vec3d vox = density.voxel_size();
+    const double vmin = std::min({vox[0], vox[1], vox[2]}), vmax = std::max({vox[0], vox[1], vox[2]});
+    auto d = density.channel(0);
+    auto p = set->channel(0), sc = set->channel(2), sd = set->channel(3);
+    const size_t nx = size_t(r[0]), ny = size_t(r[1]), nz = size_t(r[2]), sxy = nx * ny;
+    // Profile and scale; sd = squared distance seed (0 occupied, inf empty).
+    tbb::parallel_for(size_t(0), nz, [&](size_t z) {
+        for (size_t i = z * sxy; i < (z + 1) * sxy; ++i) {
+            p[i] = static_cast<float>(std::pow(double(d[i]), 1.0 / 0.6) / S);
+            sc[i] = static_cast<float>(S);
+            sd[i] = d[i] > 0 ? 0.0f : std::numeric_limits<float>::infinity();
+        }
+    });
+    // Separable squared EDT, one axis at a time, lines in parallel.
+    auto pass = [&](int axis) {
+        const size_t n = size_t(r[axis]);
+        const size_t stride = axis == 0 ? 1 : (axis == 1 ? nx : sxy);
+        const size_t lines = (nx * ny * nz) / n;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, lines), [&](const tbb::blocked_range<size_t>& range) {
+            std::vector<double> f(n), out(n), z(n + 1);
+            std::vector<int> v(n);
+            for (size_t l = range.begin(); l < range.end(); ++l) {
+                size_t base;
+                if (axis == 0) base = l * nx;
+                else if (axis == 1) base = (l / nx) * sxy + (l % nx);
+                else base = l;
+                for (size_t i = 0; i < n; ++i) f[i] = sd[base + i * stride];
+                edt_line(f.data(), int(n), vox[axis], out.data(), v.data(), z.data());
+                for (size_t i = 0; i < n; ++i) sd[base + i * stride] = static_cast<float>(out[i]);
+            }
+        });
+    };
+    for (int a = 0; a < 3; ++a) pass(a);
+    const float inside = -static_cast<float>(vmin);
+    const double margin = 4.0 * vmax;
+    tbb::parallel_for(size_t(0), nz, [&](size_t z) {
+        for (size_t i = z * sxy; i < (z + 1) * sxy; ++i) {
+            const double dist = std::sqrt(double(sd[i]));
+            // Within one voxel per axis of a non-zero voxel: inside.
+            sd[i] = !std::isfinite(dist) ? static_cast<float>(1e30)
+                    : dist - margin < double(inside) ? inside
+                                                      : static_cast<float>(dist - margin);
+        }
+    });
+    return set;
+}
+
 } // namespace
 
 CloudScene load_scene(const std::vector<std::filesystem::path>& files, double voxel_size) {
@@ -26,7 +141,10 @@ CloudScene load_scene(const std::vector<std::filesystem::path>& files, double vo
     Field3DPtr first = read(files[0]);
     if (files.size() == 1) {
         try {
-            return scene_from_nvdf_set(first);
+            // A plain density grid (set_from_density); the grid itself is
+            // released once the set is built.
+            if (first->find_channel("dimensional_profile") < 0 && first->channels() == 1) first = set_from_density(*first);
+            return scene_from_nvdf_set(std::move(first));
         } catch (const Error& e) {
             throw Error(files[0].string() + ": " + e.what());
         }

@@ -66,7 +66,12 @@ namespace atlas::render {
 
 // A scene from files Atlas (or the Nubis pack) wrote, via io::read_field_file:
 //   one file   a VDB or EXR with channels dimensional_profile, detail_type,
-//              density_scale, sdf (volume/nvdf's vdb_set)
+//              density_scale, sdf (volume/nvdf's vdb_set), or a single
+//              density channel (e.g. a float grid "density", as vdb_render
+//              reads): density_scene's mapping (the sampled density is the
+//              grid's) with an SDF for empty-space skipping (-min voxel in
+//              the cells next to non-zero voxels, elsewhere a lower bound on
+//              the distance to them)
 //   two files  the modeling NVDF (named channels, else the first three:
 //              a TGA slice stack STEM.001.tga is R, G, B), then the SDF:
 //              channel "sdf" in metres, or encoded field data ("field_data",
