@@ -1,5 +1,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
+#include "atlas/core/hash.h"
+#include "../../libatlas/src/core/file_limits.h"
 
 #include <gtest/gtest.h>
 
@@ -103,4 +105,33 @@ TEST(ReadFile, ReadsBinaryFilesAndPipes) {
     const std::string got = read_file_bytes(fifo);
     writer.join();
     EXPECT_EQ(got, "through a pipe");
+}
+
+// Hashing a large input stops at a cancellation (issue 17 item 8): the hasher
+// polls between chunks, so a cancel raised on its second poll ends the hash
+// there (CancelledError) instead of reading the 8 GiB sparse file to its end,
+// and no poll follows. Without a cancel the same poll counts the whole file.
+TEST(HashFile, CancellingWhileHashingALargeInputStopsAtTheNextPoll) {
+    const fs::path d = temp_dir("hash_cancel");
+    const fs::path big = d / "big.bin";
+    { std::ofstream(big) << ""; }
+    fs::resize_file(big, uint64_t(8) << 30); // sparse: no disk used
+    int polls = 0;
+    {
+        const detail::FileReadLimits limits(~uint64_t(0), [&] { return ++polls >= 2; });
+        Hasher h;
+        EXPECT_THROW(hash_file(h, big), CancelledError);
+    }
+    EXPECT_EQ(polls, 2);
+    // The reference: a small file, never cancelled, is read to its end and polled at least once.
+    const fs::path small = d / "small.bin";
+    write(small, std::string(1000, 'x'));
+    int small_polls = 0;
+    {
+        const detail::FileReadLimits limits(~uint64_t(0), [&] { return ++small_polls < 0; });
+        Hasher h;
+        hash_file(h, small);
+    }
+    EXPECT_GE(small_polls, 1);
+    fs::remove_all(d);
 }
