@@ -129,7 +129,7 @@ scenes = sorted({r["scene"] for r in rows}, key=[r["scene"] for r in rows].index
 fig, axes = plt.subplots(1, len(scenes), figsize=(4.2 * len(scenes), 3.6), squeeze=False)
 for ax, s in zip(axes[0], scenes):
     cyc = [r for r in rows if r["scene"] == s and r["renderer"] == "cycles" and "reference" not in r["setting"]]
-    ax.loglog([float(r["seconds"]) for r in cyc], [float(r["cloud_mean_rel"]) for r in cyc], "o-", label="Cycles (1..64 spp)")
+    ax.loglog([float(r["seconds"]) for r in cyc], [float(r["cloud_mean_rel"]) for r in cyc], "o-", label="Cycles (" + ", ".join(r["setting"].split()[0] for r in cyc) + " spp)")
     for r in cyc:
         ax.annotate(r["setting"].split()[0], (float(r["seconds"]), float(r["cloud_mean_rel"])), fontsize=7)
     at = [r for r in rows if r["scene"] == s and r["renderer"] == "atlas"]

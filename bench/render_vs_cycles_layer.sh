@@ -3,7 +3,7 @@
 #
 #   bench/render_vs_cycles_layer.sh [--build DIR] [--out DIR] [--size WxH] [--ref-spp N] [--ladder "1 4 .."] [--reuse-ref]
 #
-# Per graph (superstorm, hzd_weather, fc6_forecast; camera --view orbit:30,25): atlas preview
+# Per graph (superstorm: --view orbit:30,25; hzd_weather, fc6_forecast: the same with --fov 20): atlas preview
 # --artistic off --export-scene bakes the layer's density over a 16 km patch under the camera's
 # look-at point (the preview then draws only that patch, without haze, rain absorption or sky
 # layers); the same at --extinction 0 gives the preview's background (sky and ground); Cycles
@@ -58,10 +58,12 @@ print(','.join(['$1', '$2', '$3', '$4'] + ['%.4f' % m.get(k, float('nan')) for k
 " >> "$CSV"
 }
 for name in superstorm hzd_weather fc6_forecast; do
+  # the orbit camera frames the whole map; the weather maps zoom in on the patch
+  FOV=""; [ $name = superstorm ] || FOV="--fov 20"
   d=$OUT/$name; mkdir -p "$d"
   g=$ROOT/graphs/$name.yaml
-  t=$(atlas "$d/physical_default.exr" "$g" --view orbit:30,25 --artistic off --export-scene "$d/scene")
-  atlas "$d/background.exr" "$g" --view orbit:30,25 --artistic off --extinction 0 --export-scene "$d/scene_bg" > /dev/null
+  t=$(atlas "$d/physical_default.exr" "$g" --view orbit:30,25 $FOV --artistic off --export-scene "$d/scene")
+  atlas "$d/background.exr" "$g" --view orbit:30,25 $FOV --artistic off --extinction 0 --export-scene "$d/scene_bg" > /dev/null
   ref=$d/ref.cycles.exr
   if [ $REUSE = 1 ] && [ -f "$ref" ] && [ "$($PY -c "import json; print(json.load(open('$ref.json'))['samples'])" 2>/dev/null)" = "$REF_SPP" ]; then
     tref=$($PY -c "import json; print('%.2f' % json.load(open('$ref.json'))['seconds'])")
@@ -72,10 +74,10 @@ for name in superstorm hzd_weather fc6_forecast; do
   mask=$d/physical_default.exr
   row "$name" cycles "$REF_SPP spp (reference)" "$tref" "$ref" "$ref" "$d/background.exr" "$mask"
   row "$name" atlas "artistic off; defaults" "$t" "$d/physical_default.exr" "$ref" "$d/background.exr" "$mask"
-  t=$(atlas "$d/artistic_on.exr" "$g" --view orbit:30,25 --artistic on --export-scene "$d/scene_on")
+  t=$(atlas "$d/artistic_on.exr" "$g" --view orbit:30,25 $FOV --artistic on --export-scene "$d/scene_on")
   row "$name" atlas "artistic on (the look); defaults" "$t" "$d/artistic_on.exr" "$ref" "$d/background.exr" "$mask"
   for q in 0.5 2; do
-    t=$(atlas "$d/q$q.exr" "$g" --view orbit:30,25 --artistic off --quality $q --export-scene "$d/scene_q")
+    t=$(atlas "$d/q$q.exr" "$g" --view orbit:30,25 $FOV --artistic off --quality $q --export-scene "$d/scene_q")
     row "$name" atlas "artistic off; quality $q" "$t" "$d/q$q.exr" "$ref" "$d/background.exr" "$mask"
   done
   for n in $LADDER; do
