@@ -10,14 +10,19 @@
 #    surfaces sit at 0.3), written as density.vdb (float grid "density", 8 m
 #    voxels, world metres).
 # 2. Renders 960x540 from the benchmark's ground camera with both renderers in
-#    the same run, interleaved (atlas, vdb_render, atlas, vdb_render, ... ROUNDS
-#    times, default 3), each whole process timed by /usr/bin/time -f '%e %U %M'
-#    (wall s, user CPU s, max RSS KB): Atlas from a warm cache (one untimed
-#    preview first cooks the graph and the noise into it), its render-only
-#    time from its "rendered ... in" line; vdb_render including the read of
-#    the 512x512x64 grid, its ray-tracing time from its -v output.
-# 3. Writes docs/images/render_vdb_ground.png and render_atlas_ground_cmp.png
-#    and prints a Markdown table: one row per run plus the medians.
+#    the same run, both reading the same density.vdb, interleaved (atlas
+#    --noise none, atlas with its default noise up-rez, vdb_render, ... ROUNDS
+#    times, default 3), each whole process timed by /usr/bin/time -f
+#    '%e %U %S %M' (wall s, user and system CPU s, max RSS KB). `atlas preview
+#    density.vdb --noise none` is the like-for-like row (vdb_render does no
+#    up-rez); the default row adds the Nubis noise set (noise/nubis_set 128^3,
+#    from a warm cache: one untimed run first cooks it). Atlas's render-only
+#    time is from its "rendered ... in" line, vdb_render's ray-tracing time
+#    from its -v output; both include reading the 512x512x64 grid.
+# 3. Writes docs/images/render_vdb_ground.png and render_atlas_density_cmp.png
+#    (the like-for-like Atlas run) and prints a Markdown table: one row per run
+#    plus the medians, and `atlas --help`'s own cost (process start: shared
+#    libraries) for scale.
 #
 # Camera translation: Atlas --camera P,L --fov V (vertical degrees) ->
 # vdb_render -translate P -lookat L -up 0,0,1 -fov H with H the horizontal
@@ -69,25 +74,32 @@ awk '
 "$ATLAS" cook "$WORK/cloudscape_vdb.yaml" --out "$WORK/out" --output density.vdb --cache "$CACHE" --quiet >/dev/null
 "$ATLAS" info "$WORK/out/density.vdb" >&2
 
-# 2. Both renderers, same camera and sun, whole processes timed, interleaved.
-ATLAS_CMD=("$ATLAS" preview "$ROOT/graphs/cloudscape.yaml" --cache "$CACHE" --size ${W}x${H}
-  --camera $CAM_POS,$CAM_AT --fov $VFOV --sun $SUN_AZ,$SUN_EL -o "$OUT_DIR/render_atlas_ground_cmp.png")
+# 2. Both renderers, same density file, camera and sun, whole processes timed, interleaved.
+ATLAS_CMD=("$ATLAS" preview "$WORK/out/density.vdb" --cache "$CACHE" --size ${W}x${H}
+  --camera $CAM_POS,$CAM_AT --fov $VFOV --sun $SUN_AZ,$SUN_EL)
 VDB_CMD=(vdb_render "$WORK/out/density.vdb" "$WORK/vdb.exr" -name density -res ${W}x${H}
   -translate $CAM_POS -lookat $CAM_AT -up 0,0,1 -fov $HFOV
   -light $LIGHT,1,0.95,0.88 -scatter 0.30,0.30,0.30 -absorb 0.02,0.02,0.02 -gain 0.2 -step 1 -shadowstep 3 -v)
-"${ATLAS_CMD[@]}" --quiet >/dev/null 2>&1   # warm the cache (graph, noise set): not timed
+"${ATLAS_CMD[@]}" -o "$WORK/warm.png" --quiet >/dev/null 2>&1   # warm the cache (noise set): not timed
+/usr/bin/time -f '%e %U %S %M' -o "$WORK/t_help" "$ATLAS" --help >/dev/null 2>&1 || true
 ROWS=()
+atlas_run() { # $1 = none | auto, $2 = output picture, $3 = tag
+  /usr/bin/time -f '%e %U %S %M' -o "$WORK/t_$3" "${ATLAS_CMD[@]}" --noise "$1" -o "$2" >/dev/null 2>"$WORK/log_$3"
+}
 for r in $(seq 1 "$ROUNDS"); do
-  /usr/bin/time -f '%e %U %S %M' -o "$WORK/t_atlas" "${ATLAS_CMD[@]}" >/dev/null 2>"$WORK/log_atlas"
+  atlas_run none "$OUT_DIR/render_atlas_density_cmp.png" none
+  atlas_run auto "$WORK/atlas_auto.png" auto
   /usr/bin/time -f "%e %U %S %M" -o "$WORK/t_vdb" "${VDB_CMD[@]}" >"$WORK/log_vdb" 2>&1
-  A_RENDER=$(sed -n 's/.*rendered [0-9x]*[^)]*) in \([0-9.]*\) s.*/\1/p' "$WORK/log_atlas" | tail -1)
+  N_RENDER=$(sed -n 's/.*rendered [0-9x]*[^)]*) in \([0-9.]*\) s.*/\1/p' "$WORK/log_none" | tail -1)
+  A_RENDER=$(sed -n 's/.*rendered [0-9x]*[^)]*) in \([0-9.]*\) s.*/\1/p' "$WORK/log_auto" | tail -1)
   V_RENDER=$(awk '/ray-tracing/ {f = 1; next} f && /completed in/ {print $(NF - 1); exit}' "$WORK/log_vdb")
-  read -r AW AU AS AM < "$WORK/t_atlas"
+  read -r NW NU NS NM < "$WORK/t_none"
+  read -r AW AU AS AM < "$WORK/t_auto"
   read -r VW VU VS VM < "$WORK/t_vdb"
-  ROWS+=("$r $AW $AU $AS $AM ${A_RENDER:-?} $VW $VU $VS $VM ${V_RENDER:-?}")
-  echo "round $r: atlas ${AW}s wall ${AU}+${AS}s CPU ${AM}KB (render ${A_RENDER:-?} s); vdb_render ${VW}s wall ${VU}+${VS}s CPU ${VM}KB (ray-tracing ${V_RENDER:-?} s)" >&2
+  ROWS+=("$r $NW $NU $NS $NM ${N_RENDER:-?} $AW $AU $AS $AM ${A_RENDER:-?} $VW $VU $VS $VM ${V_RENDER:-?}")
+  echo "round $r: atlas --noise none ${NW}s wall ${NU}+${NS}s CPU ${NM}KB (render ${N_RENDER:-?} s); default noise ${AW}s ${AU}+${AS}s ${AM}KB (render ${A_RENDER:-?} s); vdb_render ${VW}s wall ${VU}+${VS}s CPU ${VM}KB (ray-tracing ${V_RENDER:-?} s)" >&2
 done
-cat "$WORK/log_atlas" >&2
+cat "$WORK/log_none" "$WORK/log_auto" >&2
 # vdb_render's EXR has straight colour plus alpha: composite over the same
 # uniform sky Atlas uses (0.30, 0.45, 0.75) and tone-map like Atlas' PNG
 # (x * 1.5, Reinhard, sRGB) so the two pictures are comparable.
@@ -97,16 +109,19 @@ oiiotool "$WORK/vdb.exr" --ch R,G,B,A --unpremult --premult \
 
 echo "load average after the runs: $(cat /proc/loadavg)"
 echo
-echo "| round | atlas wall | atlas user + sys CPU | atlas max RSS | atlas render only (wall) | vdb_render wall | vdb_render user + sys CPU | vdb_render max RSS | vdb_render ray-tracing (wall) |"
-echo "|---|---|---|---|---|---|---|---|---|"
+read -r HW HU HS HM < "$WORK/t_help"
+echo "| round | atlas (--noise none) wall | user + sys CPU | max RSS | render only | atlas (default noise) wall | user + sys CPU | max RSS | render only | vdb_render wall | user + sys CPU | max RSS | ray-tracing |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for row in "${ROWS[@]}"; do
   set -- $row
-  echo "| $1 | $2 s | $3 + $4 s | $(( $5 / 1024 )) MB | $6 s | $7 s | $8 + $9 s | $(( ${10} / 1024 )) MB | ${11} s |"
+  echo "| $1 | $2 s | $3 + $4 s | $(( $5 / 1024 )) MB | $6 s | $7 s | $8 + $9 s | $(( ${10} / 1024 )) MB | ${11} s | ${12} s | ${13} + ${14} s | $(( ${15} / 1024 )) MB | ${16} s |"
 done
 printf '%s\n' "${ROWS[@]}" | $PY -c '
 import sys, statistics as st
 rows = [l.split() for l in sys.stdin if l.strip()]
 col = lambda i: st.median(float(r[i]) for r in rows)
-print(f"| median | {col(1):.2f} s | {col(2):.2f} + {col(3):.2f} s | {col(4)/1024:.0f} MB | - | {col(6):.2f} s | {col(7):.2f} + {col(8):.2f} s | {col(9)/1024:.0f} MB | - |")'
+cells = lambda b: f"{col(b):.2f} s | {col(b + 1):.2f} + {col(b + 2):.2f} s | {col(b + 3)/1024:.0f} MB | -"
+print(f"| median | {cells(1)} | {cells(6)} | {cells(11)} |")'
 echo
-echo "atlas: fast mode, quality 1, NVDF set from the disk cache, default noise up-rez; pictures render_atlas_ground_cmp.png, render_vdb_ground.png"
+echo "atlas --help alone (process start, ~260 shared libraries): ${HW} s wall, ${HU} + ${HS} s CPU, $(( HM / 1024 )) MB max RSS"
+echo "atlas: density.vdb read as a plain density grid (render::load_scene), fast mode, quality 1; pictures render_atlas_density_cmp.png (--noise none), render_vdb_ground.png"

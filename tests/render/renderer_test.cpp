@@ -255,8 +255,8 @@ TEST(Render, ReportListsOnlyWhatRan) {
 #include <random>
 
 TEST(RenderLoadScene, DensityGridGetsTheSameDensityAndASafeSdf) {
-    const Vec3i res{{24, 20, 12}};
-    Field3D d(res, 1, Box3d{{{-100, 50, 0}}, {{92, 210, 96}}}, {"density"});
+    const Vec3i res{{48, 40, 24}};
+    Field3D d(res, 1, Box3d{{{-100, 50, 0}}, {{284, 370, 192}}}, {"density"});
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(0, 1);
     // Two blobs and a few stray voxels.
@@ -265,7 +265,7 @@ TEST(RenderLoadScene, DensityGridGetsTheSameDensityAndASafeSdf) {
             for (int x = 0; x < res[0]; ++x) {
                 const double a = std::hypot(x - 6.0, y - 5.0, z - 4.0), b = std::hypot(x - 17.0, y - 13.0, z - 7.0);
                 double v = std::max(0.0, 1 - a / 4) + 0.5 * std::max(0.0, 1 - b / 3);
-                if (u(rng) < 0.003) v = u(rng);
+                if (u(rng) < 0.0003) v = u(rng);
                 d.at(0, x, y, z) = static_cast<float>(v);
             }
     const auto path = std::filesystem::temp_directory_path() / "atlas_load_scene_density.vdb";

@@ -70,11 +70,14 @@ void edt_line(const double* f, int n, double w, double* out, int* v, double* z) 
 // vdb_render draws) as an NVDF set the sampler reads as the same density:
 // density_scene's mapping (profile D^(1/0.6) / S, detail type 0, density
 // scale S = max(1, max D^(1/0.6))), and an SDF that lets the march skip empty
-// space: -min voxel inside the cells next to a non-zero voxel (so wherever
-// the density is non-zero every corner is "inside" and the picture is
-// density_scene's), elsewhere the Euclidean distance between voxel centres to
-// the nearest non-zero voxel less 4 voxel diagonals' worth (4 max voxel): a
-// lower bound on the distance from any point of the cell to non-zero density.
+// space. The distance is an exact Euclidean transform over blocks of B^3
+// voxels (block centres, to the nearest block holding a non-zero voxel),
+// less B voxel diagonals: a lower bound L on the distance from a voxel centre
+// to the nearest non-zero voxel centre. The SDF is L - 4 max voxel, clamped to
+// at most -min voxel: a point of a cell with a non-zero corner is inside at
+// every corner (so wherever the density is non-zero the picture is
+// density_scene's), and the interpolated SDF elsewhere stays under the
+// distance to the nearest cell with a non-zero corner.
 Field3DPtr set_from_density(const Field3D& density) {
     float dmax = 0;
     for (float d : density.channel(0)) {
@@ -90,43 +93,53 @@ Field3DPtr set_from_density(const Field3D& density) {
     auto d = density.channel(0);
     auto p = set->channel(0), sc = set->channel(2), sd = set->channel(3);
     const size_t nx = size_t(r[0]), ny = size_t(r[1]), nz = size_t(r[2]), sxy = nx * ny;
-    // Profile and scale; sd = squared distance seed (0 occupied, inf empty).
-    tbb::parallel_for(size_t(0), nz, [&](size_t z) {
-        for (size_t i = z * sxy; i < (z + 1) * sxy; ++i) {
-            p[i] = static_cast<float>(std::pow(double(d[i]), 1.0 / 0.6) / S);
-            sc[i] = static_cast<float>(S);
-            sd[i] = d[i] > 0 ? 0.0f : std::numeric_limits<float>::infinity();
-        }
+    constexpr int B = 2;
+    const Vec3i cr{{(r[0] + B - 1) / B, (r[1] + B - 1) / B, (r[2] + B - 1) / B}};
+    const size_t cx = size_t(cr[0]), cy = size_t(cr[1]), cz = size_t(cr[2]), cxy = cx * cy;
+    std::vector<double> cd(cx * cy * cz, std::numeric_limits<double>::infinity());
+    // Profile and scale; block occupancy (a coarse z row belongs to one task).
+    tbb::parallel_for(size_t(0), cz, [&](size_t bz) {
+        for (size_t z = bz * B; z < std::min(nz, (bz + 1) * B); ++z)
+            for (size_t y = 0; y < ny; ++y)
+                for (size_t x = 0; x < nx; ++x) {
+                    const size_t i = z * sxy + y * nx + x;
+                    const float v = d[i];
+                    p[i] = v > 0 ? static_cast<float>(std::pow(double(v), 1.0 / 0.6) / S) : 0.0f;
+                    sc[i] = static_cast<float>(S);
+                    if (v > 0) cd[bz * cxy + (y / B) * cx + x / B] = 0;
+                }
     });
-    // Separable squared EDT, one axis at a time, lines in parallel.
+    // Separable squared EDT over the blocks, one axis at a time, lines in parallel.
     auto pass = [&](int axis) {
-        const size_t n = size_t(r[axis]);
-        const size_t stride = axis == 0 ? 1 : (axis == 1 ? nx : sxy);
-        const size_t lines = (nx * ny * nz) / n;
+        const size_t n = size_t(cr[axis]);
+        const size_t stride = axis == 0 ? 1 : (axis == 1 ? cx : cxy);
+        const size_t lines = (cx * cy * cz) / n;
         tbb::parallel_for(tbb::blocked_range<size_t>(0, lines), [&](const tbb::blocked_range<size_t>& range) {
-            std::vector<double> f(n), out(n), z(n + 1);
+            std::vector<double> f(n), out(n), zz(n + 1);
             std::vector<int> v(n);
             for (size_t l = range.begin(); l < range.end(); ++l) {
                 size_t base;
-                if (axis == 0) base = l * nx;
-                else if (axis == 1) base = (l / nx) * sxy + (l % nx);
+                if (axis == 0) base = l * cx;
+                else if (axis == 1) base = (l / cx) * cxy + (l % cx);
                 else base = l;
-                for (size_t i = 0; i < n; ++i) f[i] = sd[base + i * stride];
-                edt_line(f.data(), int(n), vox[axis], out.data(), v.data(), z.data());
-                for (size_t i = 0; i < n; ++i) sd[base + i * stride] = static_cast<float>(out[i]);
+                for (size_t i = 0; i < n; ++i) f[i] = cd[base + i * stride];
+                edt_line(f.data(), int(n), B * vox[axis], out.data(), v.data(), zz.data());
+                for (size_t i = 0; i < n; ++i) cd[base + i * stride] = out[i];
             }
         });
     };
     for (int a = 0; a < 3; ++a) pass(a);
     const float inside = -static_cast<float>(vmin);
-    const double margin = 4.0 * vmax;
+    const double margin = B * std::sqrt(vox[0] * vox[0] + vox[1] * vox[1] + vox[2] * vox[2]) + 4.0 * vmax;
     tbb::parallel_for(size_t(0), nz, [&](size_t z) {
-        for (size_t i = z * sxy; i < (z + 1) * sxy; ++i) {
-            const double dist = std::sqrt(double(sd[i]));
-            // Within one voxel per axis of a non-zero voxel: inside.
-            sd[i] = !std::isfinite(dist) ? static_cast<float>(1e30)
-                    : dist - margin < double(inside) ? inside
-                                                      : static_cast<float>(dist - margin);
+        for (size_t y = 0; y < ny; ++y) {
+            const double* row = &cd[(z / B) * cxy + (y / B) * cx];
+            for (size_t x = 0; x < nx; ++x) {
+                const double dist = std::sqrt(row[x / B]);
+                sd[z * sxy + y * nx + x] = !std::isfinite(dist)    ? static_cast<float>(1e30)
+                                           : dist - margin < inside ? inside
+                                                                    : static_cast<float>(dist - margin);
+            }
         }
     });
     return set;
