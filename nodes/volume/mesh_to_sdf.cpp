@@ -44,5 +44,5 @@ void cook(CookContext& ctx) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "volume/mesh_to_sdf", .version = 2, .declare = declare, .cook = cook});
+    registry.add({.name = "volume/mesh_to_sdf", .version = 3, .declare = declare, .cook = cook});
 }

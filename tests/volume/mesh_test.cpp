@@ -567,3 +567,78 @@ TEST(MeshSdf, OpenVdbMatchesBruteForce) {
         EXPECT_LE(e.far, 0.5);
     }
 }
+
+// The whole-grid pass (detail::mesh_signed_distance: the two-pass min-plus EDT and the
+// fused six-ray vote) against its definitions, on a non-cubic grid with non-cubic voxels:
+// with no exact band, |sdf| is the distance to the nearest crossing of the mesh with a grid
+// line through voxel centres (brute force over crossings found here by an independent
+// ray-triangle test), and the sign is that of mesh_winding_field (the separate six-ray
+// vote with its fast-winding-number fallback), also on a mesh with a hole.
+TEST(MeshSdf, WholeGridPassMatchesBruteForceCrossingsAndVote) {
+    const Vec3i res{{19, 23, 17}};
+    const Box3d box{{{0.3, -0.2, 0.1}}, {{0.3 + 19 * 1.1, -0.2 + 23 * 0.9, 0.1 + 17 * 1.3}}};
+    Mesh closed = uv_sphere({{10.7, 10.1, 11.2}}, 6.3, 14, 28);
+    Mesh holed = closed;
+    holed.triangles.erase(holed.triangles.begin() + 60, holed.triangles.begin() + 66);
+    MeshSdfOptions no_band;
+    no_band.exact_band_voxels = 0;
+    const Vec3d h{{1.1, 0.9, 1.3}};
+    for (const Mesh* m : {&closed, &holed}) {
+        // Crossings: every grid line (voxel-centre coordinates on two axes) against every
+        // triangle, inclusive of edges (a superset of the top-left rule's hits).
+        std::vector<std::pair<int, Vec3d>> crossings; // (axis of the line, point)
+        for (int a = 0; a < 3; ++a) {
+            const int b = a == 0 ? 1 : 0, c = a == 2 ? 1 : 2;
+            for (int j = 0; j < res[c]; ++j)
+                for (int i = 0; i < res[b]; ++i) {
+                    const double pb = box.min[b] + (i + 0.5) * h[b], pc = box.min[c] + (j + 0.5) * h[c];
+                    for (const auto& t : m->triangles) {
+                        Vec3d v[3];
+                        for (int k = 0; k < 3; ++k)
+                            for (int e = 0; e < 3; ++e) v[k][e] = m->vertices[t[size_t(k)]][e];
+                        // Barycentrics of (pb, pc) in the triangle's projection on (b, c).
+                        const double d = (v[1][b] - v[0][b]) * (v[2][c] - v[0][c]) - (v[2][b] - v[0][b]) * (v[1][c] - v[0][c]);
+                        if (d == 0) continue;
+                        const double l1 = ((pb - v[0][b]) * (v[2][c] - v[0][c]) - (v[2][b] - v[0][b]) * (pc - v[0][c])) / d;
+                        const double l2 = ((v[1][b] - v[0][b]) * (pc - v[0][c]) - (pb - v[0][b]) * (v[1][c] - v[0][c])) / d;
+                        const double l0 = 1 - l1 - l2;
+                        if (l0 < -1e-12 || l1 < -1e-12 || l2 < -1e-12) continue;
+                        Vec3d p;
+                        p[a] = l0 * v[0][a] + l1 * v[1][a] + l2 * v[2][a];
+                        p[b] = pb, p[c] = pc;
+                        crossings.push_back({a, p});
+                    }
+                }
+        }
+        ASSERT_GT(crossings.size(), 500u);
+        const Field3D s = mesh_to_sdf(*m, res, box, no_band);
+        const Field3D w = mesh_winding_field(*m, res, box);
+        double worst = 0, worst_two_families = 0;
+        int sign_diff = 0;
+        for (int z = 0; z < res[2]; ++z)
+            for (int y = 0; y < res[1]; ++y)
+                for (int x = 0; x < res[0]; ++x) {
+                    const Vec3d p = s.voxel_center(x, y, z);
+                    double all = std::numeric_limits<double>::infinity(), two = all;
+                    for (const auto& [a, q] : crossings) {
+                        const double d2 = dot(p - q, p - q);
+                        all = std::min(all, d2);
+                        if (a != 2) two = std::min(two, d2);
+                    }
+                    const double got = std::abs(s.at(0, x, y, z));
+                    worst = std::max(worst, std::abs(got - std::sqrt(all)));
+                    worst_two_families = std::max(worst_two_families, std::abs(got - std::sqrt(two)));
+                    sign_diff += (s.at(0, x, y, z) < 0) != (w.at(0, x, y, z) > 0.5f);
+                }
+        EXPECT_LT(worst, 1e-4);               // exact with respect to the crossings (float)
+        EXPECT_GT(worst_two_families, 0.05);  // negative control: the z family matters
+        EXPECT_EQ(sign_diff, 0);
+    }
+    // Same bytes on one thread, both methods (cubic voxels for OpenVDB), with the hole.
+    const Box3d cube{{{0, 0, 0}}, {{24, 24, 24}}};
+    const Field3D e_many = mesh_to_sdf(holed, {{24, 24, 24}}, cube);
+    const Field3D o_many = mesh_to_sdf_openvdb(holed, {{24, 24, 24}}, cube);
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_TRUE(mesh_to_sdf(holed, {{24, 24, 24}}, cube) == e_many);
+    EXPECT_TRUE(mesh_to_sdf_openvdb(holed, {{24, 24, 24}}, cube) == o_many);
+}

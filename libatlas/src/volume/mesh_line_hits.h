@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -88,6 +89,16 @@ double straddling_squared_distance(const Mesh& mesh, const UnionSurface& us, uin
 // change across them are interior to the union (a surface crossing inside
 // another part): not distance seeds. Returns the t of the kept hits of line l.
 void union_boundary_hits(const AxisHits& ah, uint32_t l, std::vector<double>& out);
+
+// The whole grid (res voxels, x fastest) of signed distances, in `out`, for both mesh SDF
+// methods: the exact EDT to the seeds (union-boundary crossings with the grid lines),
+// lowered by the exact band, signed by the six-ray vote (inside: all six counts >= 1;
+// where they differ, the fast winding number > 0.5). `band(sq)` is called once with `out`
+// holding squared distances (m^2, +inf where none) that are upper bounds: it lowers them
+// (min) with its exact ones, and may run in parallel. Distance `far` where there is no seed.
+// Returns the number of voxels whose six counts disagreed. Same bytes for any thread count.
+uint64_t mesh_signed_distance(const MeshLineHits& hits, const UnionSurface& us, const Mesh& mesh, Vec3i res, Box3d bounds,
+                              float far, float* out, const std::function<void(float* sq)>& band);
 
 // Other axes of `a` in increasing order.
 inline void other_axes(int a, int& b, int& c) {

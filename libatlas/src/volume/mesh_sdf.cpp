@@ -3,12 +3,13 @@
 #include "atlas/core/memory.h"
 #include "atlas/volume/mesh_io.h"
 #include "atlas/volume/mesh_voxelize.h"
-#include "edt_core.h"
 #include "mesh_line_hits.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -107,31 +108,22 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
     if (!std::isfinite(o.far_distance) || std::abs(o.far_distance) > kMaxMeshCoordinate)
         throw Error("mesh_to_sdf: far_distance must be finite and within 1e18 m");
     const uint64_t count = uint64_t(res[0]) * res[1] * res[2];
-    if (budget) budget->check(field_bytes(count, 5), "mesh_to_sdf: output, winding, band and two EDT grids");
-    const detail::MeshLineHits hits = detail::mesh_line_hits(m, res, bounds);
-    // Overlapping parts: distances go to the union's surface only.
-    const detail::UnionSurface us = detail::union_surface(m);
+    if (budget) budget->check(field_bytes(count, 3), "mesh_to_sdf: output, EDT grid and ray counts");
+    // The grid-line crossings and (overlapping parts: distances go to the union's surface
+    // only) the union's surface, side by side: the latter's box intersection is serial.
+    validate_mesh(m, "mesh voxelisation");
+    detail::MeshLineHits hits;
+    detail::UnionSurface us;
+    tbb::parallel_invoke([&] { hits = detail::mesh_line_hits(m, res, bounds); }, [&] { us = detail::union_surface(m); });
     Field3D out(res, 1, bounds, {"sdf"}, budget);
     const Vec3d h = out.voxel_size();
-    const size_t stride[3] = {1, size_t(res[0]), size_t(res[0]) * size_t(res[1])};
 
-    // Far field: exact EDT to the crossing points on the grid lines.
-    auto seeds = [&](int a, size_t base, int, std::vector<double>& s) {
-        int b, c;
-        detail::other_axes(a, b, c);
-        const size_t ib = (base / stride[b]) % size_t(res[b]), ic = (base / stride[c]) % size_t(res[c]);
-        const uint32_t l = uint32_t(ib) + uint32_t(ic) * uint32_t(res[b]);
-        const auto& ah = hits.axis[a];
-        if (us.trivial()) s.assign(ah.t.begin() + ah.offsets[l], ah.t.begin() + ah.offsets[l + 1]);
-        else detail::union_boundary_hits(ah, l, s);
-    };
-    std::vector<float> d2 = detail::squared_distance_to_line_seeds(res, h, seeds);
-
-    // Near field: exact distances to the union's surface within the band.
-    // Triangles wholly on the surface: point-triangle distance (serial over
-    // triangles; min is order-independent). Buried triangles: none.
-    // Straddling triangles: the nearest point of their unburied part, which
-    // is the triangle's closest point if unburied, else on an edge, a corner
+    // Near field: exact distances to the union's surface within the band, lowering
+    // the whole-grid EDT's squared distances (detail::mesh_signed_distance).
+    // Triangles wholly on the surface: point-triangle distance (parallel over
+    // triangles, an atomic min per voxel: the min is order-independent). Buried
+    // triangles: none. Straddling triangles: the nearest point of their unburied part,
+    // which is the triangle's closest point if unburied, else on an edge, a corner
     // or an intersection segment (parallel per triangle, merged in order).
     const double vmin = std::min({h[0], h[1], h[2]});
     const double band = o.exact_band_voxels * vmin;
@@ -173,28 +165,62 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
         return !empty;
     };
     std::vector<uint32_t> straddling;
-    if (band > 0) {
-        for (uint32_t ti = 0; ti < m.triangles.size(); ++ti) {
-            if (!us.trivial() && us.state[ti] != detail::UnionSurface::kSurface) {
-                if (us.state[ti] == detail::UnionSurface::kStraddling) straddling.push_back(ti);
-                continue;
-            }
+    if (band > 0 && !us.trivial())
+        for (uint32_t ti = 0; ti < m.triangles.size(); ++ti)
+            if (us.state[ti] == detail::UnionSurface::kStraddling) straddling.push_back(ti);
+    // Field3D::voxel_center's arithmetic, inline.
+    auto centre_of = [&](int x, int y, int z) {
+        return Vec3d{{bounds.min[0] + (x + 0.5) * h[0], bounds.min[1] + (y + 0.5) * h[1], bounds.min[2] + (z + 0.5) * h[2]}};
+    };
+    auto exact_band = [&](float* d2) {
+        if (!(band > 0)) return;
+        // Triangles in z-order of their centres (voxel units, z, y, x ascending in
+        // 16-voxel bricks), so that neighbours touch the same cache lines of the grid.
+        std::vector<std::pair<uint64_t, uint32_t>> order(m.triangles.size());
+        tbb::parallel_for(size_t(0), m.triangles.size(), [&](size_t ti) {
             const auto& t = m.triangles[ti];
-            const Vec3d a = to_d(m.vertices[t[0]]), b = to_d(m.vertices[t[1]]), c = to_d(m.vertices[t[2]]);
-            int lo[3], hi[3];
-            if (!voxel_range(a, b, c, lo, hi, needs_wide[ti] ? wide : band)) continue;
-            for (int z = lo[2]; z <= hi[2]; ++z)
-                for (int y = lo[1]; y <= hi[1]; ++y)
-                    for (int x = lo[0]; x <= hi[0]; ++x) {
-                        const Vec3d p = out.voxel_center(x, y, z);
-                        const Vec3d q = closest_on_triangle(p, a, b, c) - p;
-                        const float e = float(dot(q, q));
-                        float& cur = d2[out.index(x, y, z)];
-                        if (e < cur) cur = e;
-                    }
-        }
-    }
-    if (!straddling.empty()) {
+            uint64_t key = 0;
+            for (int k = 2; k >= 0; --k) {
+                const double c = (double(m.vertices[t[0]][k]) + m.vertices[t[1]][k] + m.vertices[t[2]][k]) / 3.0;
+                const double v = std::clamp((c - bounds.min[k]) / h[k], 0.0, double(res[k]));
+                key = key << 21 | (uint64_t(v) >> 4);
+            }
+            order[ti] = {key, uint32_t(ti)};
+        });
+        std::sort(order.begin(), order.end());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t oi = r.begin(); oi < r.end(); ++oi) {
+                const uint32_t ti = order[oi].second;
+                if (!us.trivial() && us.state[ti] != detail::UnionSurface::kSurface) continue;
+                const auto& t = m.triangles[ti];
+                const Vec3d a = to_d(m.vertices[t[0]]), b = to_d(m.vertices[t[1]]), c = to_d(m.vertices[t[2]]);
+                int lo[3], hi[3];
+                if (!voxel_range(a, b, c, lo, hi, needs_wide[ti] ? wide : band)) continue;
+                // The distance to the triangle's plane is a lower bound of the distance to it:
+                // where its square is already above the voxel's value (an upper bound: the
+                // EDT's), the triangle cannot lower it (with a margin for rounding, so the
+                // result is that of the full loop).
+                const Vec3d nrm = cross(b - a, c - a);
+                const double nn = dot(nrm, nrm);
+                const bool planar = nn > 0 && std::isfinite(nn);
+                const Vec3d u = planar ? nrm / std::sqrt(nn) : Vec3d{{0, 0, 0}};
+                for (int z = lo[2]; z <= hi[2]; ++z)
+                    for (int y = lo[1]; y <= hi[1]; ++y)
+                        for (int x = lo[0]; x <= hi[0]; ++x) {
+                            const Vec3d p = centre_of(x, y, z);
+                            std::atomic_ref<float> cur(d2[out.index(x, y, z)]);
+                            float now = cur.load(std::memory_order_relaxed);
+                            if (planar) {
+                                const double pd = dot(p - a, u);
+                                if (pd * pd * (1 - 1e-6) >= double(now)) continue;
+                            }
+                            const Vec3d q = closest_on_triangle(p, a, b, c) - p;
+                            const float e = float(dot(q, q));
+                            while (e < now && !cur.compare_exchange_weak(now, e, std::memory_order_relaxed)) {}
+                        }
+            }
+        });
+        if (straddling.empty()) return;
         std::vector<std::vector<std::pair<size_t, float>>> found(straddling.size());
         tbb::parallel_for(size_t(0), straddling.size(), [&](size_t si) {
             const uint32_t ti = straddling[si];
@@ -211,17 +237,10 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
         });
         for (const auto& f : found)
             for (const auto& [i, e] : f) d2[i] = std::min(d2[i], e);
-    }
-    uint64_t fallback = 0;
-    const std::vector<float> vote = detail::ray_winding_vote(hits, res, m, bounds, &fallback);
+    };
+    // Far field: exact EDT to the crossing points on the grid lines; sign from the vote.
     const float far = float(o.far_distance > 0 ? o.far_distance : diagonal(bounds));
-    auto sdf = out.channel(0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(count), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-            const float d = std::isinf(d2[i]) ? far : std::sqrt(d2[i]);
-            sdf[i] = vote[i] > 0.5f ? -d : d;
-        }
-    });
+    const uint64_t fallback = detail::mesh_signed_distance(hits, us, m, res, bounds, far, out.channel(0).data(), exact_band);
     if (stats) {
         stats->line_hits = hits.total;
         stats->winding_fallback_voxels = fallback;

@@ -4,12 +4,13 @@
 #include "atlas/core/memory.h"
 #include "atlas/volume/mesh_io.h"
 #include "atlas/volume/mesh_voxelize.h"
-#include "edt_core.h"
 #include "mesh_line_hits.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tree/LeafManager.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 
@@ -22,7 +23,10 @@ Field3D mesh_to_sdf_openvdb(const Mesh& m, Vec3i res, Box3d bounds, const Memory
     const auto t0 = std::chrono::steady_clock::now();
     validate_mesh(m, "mesh_to_sdf_openvdb");
     if (budget) budget->check(field_bytes(uint64_t(res[0]) * res[1] * res[2], 6), "mesh_to_sdf_openvdb: grids");
-    const detail::MeshLineHits hits = detail::mesh_line_hits(m, res, bounds);
+    // The grid-line crossings and the union's surface (below), side by side.
+    detail::MeshLineHits hits;
+    detail::UnionSurface us;
+    tbb::parallel_invoke([&] { hits = detail::mesh_line_hits(m, res, bounds); }, [&] { us = detail::union_surface(m); });
     Field3D out(res, 1, bounds, {"sdf"}, budget);
     const Vec3d h = out.voxel_size();
     if (std::abs(h[0] - h[1]) > 1e-9 * h[0] || std::abs(h[0] - h[2]) > 1e-9 * h[0])
@@ -37,7 +41,6 @@ Field3D mesh_to_sdf_openvdb(const Mesh& m, Vec3i res, Box3d bounds, const Memory
     // Buried ones are left out; straddling ones (partly buried: OpenVDB would measure
     // to their buried part too, short by up to a triangle's size near the seams) are
     // measured here, to their unburied part, and merged into OpenVDB's band.
-    const detail::UnionSurface us = detail::union_surface(m);
     std::vector<openvdb::Vec3I> tris;
     std::vector<uint32_t> straddling;
     tris.reserve(m.triangles.size());
@@ -53,61 +56,64 @@ Field3D mesh_to_sdf_openvdb(const Mesh& m, Vec3i res, Box3d bounds, const Memory
     auto grid = tris.empty() ? openvdb::FloatGrid::create(float(bandwidth * h[0]))
                              : openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xf, pts, tris, quads, bandwidth);
     grid->setTransform(xf);
-    if (!straddling.empty()) {
-        // Exact distances to the straddling triangles' unburied parts within the band
-        // (parallel per triangle, merged in triangle order: the min is order-free).
-        const double bw = bandwidth * h[0];
-        std::vector<std::vector<std::pair<openvdb::Coord, float>>> found(straddling.size());
-        tbb::parallel_for(size_t(0), straddling.size(), [&](size_t si) {
-            const auto& t = m.triangles[straddling[si]];
-            int lo[3], hi[3];
-            for (int k = 0; k < 3; ++k) {
-                const double mn = std::min({double(m.vertices[t[0]][k]), double(m.vertices[t[1]][k]), double(m.vertices[t[2]][k])}) - bw;
-                const double mx = std::max({double(m.vertices[t[0]][k]), double(m.vertices[t[1]][k]), double(m.vertices[t[2]][k])}) + bw;
-                lo[k] = std::max(0, int(std::ceil((mn - bounds.min[k]) / h[k] - 0.5)));
-                hi[k] = std::min(res[k] - 1, int(std::floor((mx - bounds.min[k]) / h[k] - 0.5)));
-                if (lo[k] > hi[k]) return;
-            }
-            for (int z = lo[2]; z <= hi[2]; ++z)
-                for (int y = lo[1]; y <= hi[1]; ++y)
-                    for (int x = lo[0]; x <= hi[0]; ++x) {
-                        const double d2 = detail::straddling_squared_distance(m, us, straddling[si], out.voxel_center(x, y, z));
-                        if (d2 < bw * bw) found[si].push_back({openvdb::Coord(x, y, z), float(std::sqrt(d2))});
-                    }
-        });
-        auto acc = grid->getAccessor();
-        for (const auto& f : found)
-            for (const auto& [c, d] : f)
-                if (!acc.isValueOn(c) || d < acc.getValue(c)) acc.setValue(c, d);
-    }
-    // Beyond OpenVDB's band: the exact EDT to the mesh's (union-boundary) crossings with
-    // the grid lines, as `method: edt` (OpenVDB's first-order fast sweeping, maskSdf,
-    // over-estimated by up to 0.69 voxel on the CGAL bunny). Both are distances to
-    // surface points, never short, so the smaller is the better.
-    const size_t stride[3] = {1, size_t(res[0]), size_t(res[0]) * size_t(res[1])};
-    auto seeds = [&](int a, size_t base, int, std::vector<double>& sd) {
-        int b, c;
-        detail::other_axes(a, b, c);
-        const size_t ib = (base / stride[b]) % size_t(res[b]), ic = (base / stride[c]) % size_t(res[c]);
-        const uint32_t l = uint32_t(ib) + uint32_t(ic) * uint32_t(res[b]);
-        const auto& ah = hits.axis[a];
-        if (us.trivial()) sd.assign(ah.t.begin() + ah.offsets[l], ah.t.begin() + ah.offsets[l + 1]);
-        else detail::union_boundary_hits(ah, l, sd);
-    };
-    const std::vector<float> d2 = detail::squared_distance_to_line_seeds(res, h, seeds);
-    uint64_t fallback = 0;
-    const std::vector<float> vote = detail::ray_winding_vote(hits, res, m, bounds, &fallback);
+    // Straddling triangles: exact distances to their unburied parts within the band
+    // (parallel per triangle, merged in triangle order: the min is order-free).
+    const double bw = bandwidth * h[0];
+    std::vector<std::vector<std::pair<size_t, float>>> found(straddling.size());
+    tbb::parallel_for(size_t(0), straddling.size(), [&](size_t si) {
+        const auto& t = m.triangles[straddling[si]];
+        int lo[3], hi[3];
+        for (int k = 0; k < 3; ++k) {
+            const double mn = std::min({double(m.vertices[t[0]][k]), double(m.vertices[t[1]][k]), double(m.vertices[t[2]][k])}) - bw;
+            const double mx = std::max({double(m.vertices[t[0]][k]), double(m.vertices[t[1]][k]), double(m.vertices[t[2]][k])}) + bw;
+            lo[k] = std::max(0, int(std::ceil((mn - bounds.min[k]) / h[k] - 0.5)));
+            hi[k] = std::min(res[k] - 1, int(std::floor((mx - bounds.min[k]) / h[k] - 0.5)));
+            if (lo[k] > hi[k]) return;
+        }
+        for (int z = lo[2]; z <= hi[2]; ++z)
+            for (int y = lo[1]; y <= hi[1]; ++y)
+                for (int x = lo[0]; x <= hi[0]; ++x) {
+                    const double d2 = detail::straddling_squared_distance(m, us, straddling[si], out.voxel_center(x, y, z));
+                    if (d2 < bw * bw) found[si].push_back({out.index(x, y, z), float(d2)});
+                }
+    });
+    // OpenVDB's band and the straddling triangles lower the exact EDT to the mesh's
+    // (union-boundary) crossings with the grid lines, as `method: edt` (OpenVDB's
+    // first-order fast sweeping, maskSdf, over-estimated by up to 0.69 voxel on the
+    // CGAL bunny). Both are distances to surface points, never short, so the smaller
+    // is the better. Sign from the ray winding vote.
     const openvdb::CoordBBox box(openvdb::Coord(0, 0, 0), openvdb::Coord(res[0] - 1, res[1] - 1, res[2] - 1));
-    auto s = out.channel(0);
-    const float far = float(length(bounds.size()));
-    for (size_t i = 0; i < s.size(); ++i) s[i] = std::isinf(d2[i]) ? far : std::sqrt(d2[i]);
-    for (auto it = grid->cbeginValueOn(); it; ++it) {
-        const openvdb::Coord c = it.getCoord();
-        if (!box.isInside(c)) continue; // beyond the grid
-        float& v = s[out.index(c.x(), c.y(), c.z())];
-        v = std::min(v, std::abs(*it));
-    }
-    for (size_t i = 0; i < s.size(); ++i) s[i] = vote[i] > 0.5f ? -s[i] : s[i];
+    auto merge_band = [&](float* sq) {
+        // Leaf by leaf in parallel: each voxel belongs to one leaf.
+        using Leaves = openvdb::tree::LeafManager<const openvdb::FloatTree>;
+        using LeafRange = Leaves::LeafRange;
+        Leaves leaves(grid->constTree());
+        tbb::parallel_for(leaves.leafRange(), [&](const LeafRange& r) {
+            for (auto leaf = r.begin(); leaf; ++leaf)
+                for (auto it = leaf->cbeginValueOn(); it; ++it) {
+                    const openvdb::Coord c = it.getCoord();
+                    if (!box.isInside(c)) continue; // beyond the grid
+                    const float v = std::abs(*it);
+                    float& e = sq[out.index(c.x(), c.y(), c.z())];
+                    e = std::min(e, v * v);
+                }
+        });
+        // Active tiles (none in a narrow band in practice), serially.
+        for (auto it = grid->cbeginValueOn(); it; ++it) {
+            if (it.isVoxelValue()) continue;
+            openvdb::CoordBBox tb;
+            it.getBoundingBox(tb);
+            tb.intersect(box);
+            const float v = std::abs(*it);
+            for (auto c = tb.begin(); c; ++c) {
+                float& e = sq[out.index((*c).x(), (*c).y(), (*c).z())];
+                e = std::min(e, v * v);
+            }
+        }
+        for (const auto& f : found)
+            for (const auto& [i, e] : f) sq[i] = std::min(sq[i], e);
+    };
+    const uint64_t fallback = detail::mesh_signed_distance(hits, us, m, res, bounds, float(length(bounds.size())), out.channel(0).data(), merge_band);
     if (stats) {
         stats->line_hits = hits.total;
         stats->winding_fallback_voxels = fallback;

@@ -197,10 +197,19 @@ UnionSurface union_surface(const Mesh& m) {
         pairs.push_back({std::min(s, t), std::max(s, t)});
     });
     std::sort(pairs.begin(), pairs.end());
+    // The exact tests in parallel (one flag per pair), the crossings then in pair order.
+    std::vector<uint8_t> crosses(pairs.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+            const auto [s, t] = pairs[i];
+            crosses[i] = !tri[s].is_degenerate() && !tri[t].is_degenerate() && CGAL::do_intersect(tri[s], tri[t]);
+        }
+    });
     std::vector<std::vector<std::array<Vec3d, 2>>> segs;
     std::vector<uint8_t> hit(n, 0);
-    for (const auto& [s, t] : pairs) {
-        if (tri[s].is_degenerate() || tri[t].is_degenerate() || !CGAL::do_intersect(tri[s], tri[t])) continue;
+    for (size_t pi = 0; pi < pairs.size(); ++pi) {
+        if (!crosses[pi]) continue;
+        const auto [s, t] = pairs[pi];
         if (segs.empty()) segs.resize(n);
         hit[s] = hit[t] = 1;
         const auto r = CGAL::intersection(tri[s], tri[t]);
