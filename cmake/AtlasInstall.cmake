@@ -84,6 +84,8 @@ else()
 endif()
 install(EXPORT AtlasTargets NAMESPACE Atlas:: DESTINATION "${ATLAS_INSTALL_CMAKEDIR}" COMPONENT development)
 install(TARGETS atlas RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}" COMPONENT runtime)
+# The OpenImageIO module (libatlas/CMakeLists.txt), found beside the program as ../lib/atlas/.
+install(TARGETS atlas_oiio LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}/atlas" COMPONENT runtime)
 
 # Where Debian's FindOpenVDB.cmake lives (it is a find module, not a config).
 find_file(ATLAS_FIND_OPENVDB_MODULE FindOpenVDB.cmake PATHS ${CMAKE_MODULE_PATH} NO_DEFAULT_PATH)
