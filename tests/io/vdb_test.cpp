@@ -262,3 +262,42 @@ TEST(Vdb, RotatedOrFlippedTransformsAreRejected) {
     write_grids_directly(dir / "flip.vdb", {a});
     expect_error_containing([&] { read_vdb(dir / "flip.vdb"); }, {"flip.vdb", "axis-aligned"});
 }
+
+// read_vdb densifies a float grid by visiting its tiles and leaves only; every
+// voxel must be what OpenVDB's own copyToDense gives over the same box:
+// leaf voxels active or not, tiles at both internal levels (active and
+// inactive), a non-zero background, -0 values. A foreign file (no atlas box
+// metadata): the box is the active voxels' union, which here cuts through a
+// tile and a leaf.
+#include <openvdb/tools/Dense.h>
+
+TEST(Vdb, SparseDensifyMatchesCopyToDense) {
+    TempDir dir;
+    openvdb::initialize();
+    auto g = openvdb::FloatGrid::create(0.25f);
+    g->setName("density");
+    auto& t = g->tree();
+    t.setValue(openvdb::Coord(1, 2, 3), 1.5f);
+    t.setValue(openvdb::Coord(2, 2, 3), -0.0f);
+    t.setValueOff(openvdb::Coord(3, 2, 3), 7.0f);   // inactive voxel value in a leaf
+    t.setValue(openvdb::Coord(300, -40, 17), 2.0f); // a far leaf: the box spans empty background
+    t.addTile(1, openvdb::Coord(128, 0, 0), 3.0f, true);   // a 128^3 tile, active
+    t.addTile(1, openvdb::Coord(0, 128, 0), 4.0f, false);  // inactive tile: its value still counts
+    t.addTile(2, openvdb::Coord(-4096, -4096, -4096), -0.0f, false);
+    t.setValue(openvdb::Coord(100, 200, -5), 0.5f);
+    write_grids_directly(dir / "sparse.vdb", {g});
+    const Field3D f = read_vdb(dir / "sparse.vdb");
+    const openvdb::CoordBBox box = g->evalActiveVoxelBoundingBox();
+    ASSERT_EQ(f.resolution(), (Vec3i{{box.dim().x(), box.dim().y(), box.dim().z()}}));
+    std::vector<float> ref(size_t(box.volume()));
+    openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, ref.data());
+    openvdb::tools::copyToDense(*g, dense);
+    size_t tile_voxels = 0, background = 0;
+    for (size_t i = 0; i < ref.size(); ++i) {
+        ASSERT_EQ(std::memcmp(&ref[i], &f.channel(0)[i], sizeof(float)), 0) << i << ": " << ref[i] << " vs " << f.channel(0)[i];
+        tile_voxels += ref[i] == 3.0f || ref[i] == 4.0f;
+        background += ref[i] == 0.25f;
+    }
+    EXPECT_GT(tile_voxels, 0u); // the box does reach the tiles ...
+    EXPECT_GT(background, 0u);  // ... and the background
+}

@@ -273,6 +273,11 @@ TEST(RenderLoadScene, DensityGridGetsTheSameDensityAndASafeSdf) {
     const CloudScene s = load_scene({path});
     std::filesystem::remove(path);
     const CloudScene ref = density_scene(d);
+    // The profile alone is stored; detail type and density scale are uniform.
+    EXPECT_EQ(s.modeling->channels(), 1);
+    ASSERT_TRUE(s.uniform_detail_type && s.uniform_density_scale);
+    EXPECT_EQ(*s.uniform_detail_type, 0.0f);
+    EXPECT_EQ(*s.uniform_density_scale, ref.modeling->channel(2)[0]);
     const Field3D a = sample_density(s, res), b = sample_density(ref, res);
     for (size_t i = 0; i < a.voxel_count(); ++i) ASSERT_NEAR(a.channel(0)[i], b.channel(0)[i], 1e-6f) << i;
     // SDF bound, brute force over the non-zero voxels.
@@ -304,4 +309,51 @@ TEST(RenderLoadScene, DensityGridGetsTheSameDensityAndASafeSdf) {
         }
     }
     EXPECT_GT(skipping, 400); // the SDF does let the march skip
+}
+
+// Uniform modeling channels (CloudScene::uniform_detail_type / _density_scale,
+// as load_scene makes for a density grid) render the very bytes of the same
+// values stored in every voxel, with and without noise; a different uniform
+// scale (negative control) changes the picture, and a profile-only field
+// without uniform values is refused.
+TEST(RenderScene, UniformChannelsRenderLikeStoredOnes) {
+    for (bool noise : {false, true}) {
+        CloudScene stored = sphere_scene(24, 240, 80, 0.0, 2.5);
+        {
+            // One corner voxel far outside the sphere (never read: its cells
+            // are outside) differs, so the stored channels are interpolated,
+            // not found uniform by the sampler's own scan.
+            auto m = std::make_shared<Field3D>(*stored.modeling);
+            m->at(1, 0, 0, 0) = 1e-3f;
+            m->at(2, 0, 0, 0) = 2.0f;
+            stored.modeling = m;
+        }
+        if (noise) {
+            stored.noise = make_noise(16);
+            stored.noise_tile = 96;
+        }
+        auto profile = std::make_shared<Field3D>(stored.modeling->resolution(), 1, stored.modeling->bounds(),
+                                                 std::vector<std::string>{"dimensional_profile"});
+        const auto src = stored.modeling->channel(0);
+        std::copy(src.begin(), src.end(), profile->channel(0).begin());
+        CloudScene uniform = stored;
+        uniform.modeling = profile;
+        uniform.uniform_detail_type = 0.0f;
+        uniform.uniform_density_scale = 2.5f;
+        RenderSettings s = preview_settings(stored.modeling->bounds(), 40, 30);
+        s.light_grid = {{12, 12, 12}};
+        const auto a = render_clouds(stored, s), b = render_clouds(uniform, s);
+        for (int c = 0; c < 4; ++c)
+            for (size_t i = 0; i < a.image.channel(c).size(); ++i) ASSERT_EQ(a.image.channel(c)[i], b.image.channel(c)[i]) << c << " " << i;
+        EXPECT_EQ(a.report.density_samples, b.report.density_samples);
+        CloudScene other = uniform;
+        other.uniform_density_scale = 0.5f * *uniform.uniform_density_scale;
+        const auto o = render_clouds(other, s);
+        double diff = 0;
+        for (size_t i = 0; i < a.image.channel(0).size(); ++i) diff += std::fabs(a.image.channel(0)[i] - o.image.channel(0)[i]);
+        EXPECT_GT(diff, 1e-3);
+        CloudScene bare = uniform;
+        bare.uniform_density_scale.reset();
+        EXPECT_THROW(validate_scene(bare), Error);
+    }
 }

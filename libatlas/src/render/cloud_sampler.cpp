@@ -21,10 +21,11 @@ CloudSampler::CloudSampler(const CloudScene& scene) {
     const Field3D& m = *scene.modeling;
     const Field3D& s = *scene.sdf;
     int cp = channel_or(m, "dimensional_profile", 0);
-    int ct = channel_or(m, "detail_type", 1);
-    int cs = channel_or(m, "density_scale", 2);
+    int ct = scene.uniform_detail_type ? -1 : channel_or(m, "detail_type", 1);
+    int cs = scene.uniform_density_scale ? -1 : channel_or(m, "density_scale", 2);
     int cd = channel_or(s, "sdf", 0);
-    grid_.ch = {m.channel(cp).data(), m.channel(ct).data(), m.channel(cs).data(), s.channel(cd).data()};
+    grid_.ch = {m.channel(cp).data(), ct >= 0 ? m.channel(ct).data() : nullptr, cs >= 0 ? m.channel(cs).data() : nullptr,
+                s.channel(cd).data()};
     grid_.nx = m.nx();
     grid_.ny = m.ny();
     grid_.nz = m.nz();
@@ -34,9 +35,28 @@ CloudSampler::CloudSampler(const CloudScene& scene) {
         grid_.min[a] = bounds_.min[a];
         grid_.inv_voxel[a] = 1.0 / voxel_[a];
     }
+    // Uniform channels (the scene's, or one finite value in every voxel) are
+    // not interpolated.
+    if (scene.uniform_detail_type) grid_.value[1] = *scene.uniform_detail_type;
+    if (scene.uniform_density_scale) grid_.value[2] = *scene.uniform_density_scale;
+    for (size_t c = 0; c < 4; ++c) {
+        const float* p = grid_.ch[c];
+        if (!p) {
+            grid_.uniform[c] = true;
+            continue;
+        }
+        const size_t n = m.voxel_count();
+        const float v0 = p[0];
+        grid_.uniform[c] = std::isfinite(v0) && std::all_of(p, p + n, [v0](float v) { return v == v0; });
+        grid_.value[c] = v0;
+    }
     // Billowy branch only when some voxel asks for it.
-    auto type = m.channel(ct);
-    billowy_ = std::any_of(type.begin(), type.end(), [](float v) { return v > 0.0f; });
+    if (grid_.uniform[1]) {
+        billowy_ = grid_.value[1] > 0.0f;
+    } else {
+        auto type = m.channel(ct);
+        billowy_ = std::any_of(type.begin(), type.end(), [](float v) { return v > 0.0f; });
+    }
     if (scene.noise) {
         const Field3D& n = *scene.noise;
         for (int c = 0; c < 4; ++c) noise_.ch[size_t(c)] = n.channel(std::min(c, n.channels() - 1)).data();
@@ -49,28 +69,42 @@ CloudSampler::CloudSampler(const CloudScene& scene) {
     }
 }
 
-VoxelSample CloudSampler::voxel(double x, double y, double z) const {
+CloudSampler::Cell CloudSampler::cell(double x, double y, double z) const {
     int x0, x1, y0, y1, z0, z1;
-    float tx, ty, tz;
-    detail::axis_clamp((x - grid_.min[0]) * grid_.inv_voxel[0], grid_.nx, x0, x1, tx);
-    detail::axis_clamp((y - grid_.min[1]) * grid_.inv_voxel[1], grid_.ny, y0, y1, ty);
-    detail::axis_clamp((z - grid_.min[2]) * grid_.inv_voxel[2], grid_.nz, z0, z1, tz);
+    Cell k;
+    detail::axis_clamp((x - grid_.min[0]) * grid_.inv_voxel[0], grid_.nx, x0, x1, k.tx);
+    detail::axis_clamp((y - grid_.min[1]) * grid_.inv_voxel[1], grid_.ny, y0, y1, k.ty);
+    detail::axis_clamp((z - grid_.min[2]) * grid_.inv_voxel[2], grid_.nz, z0, z1, k.tz);
     const size_t sx = 1, sy = size_t(grid_.nx), sz = size_t(grid_.nx) * size_t(grid_.ny);
-    const size_t i000 = size_t(z0) * sz + size_t(y0) * sy + size_t(x0) * sx;
-    const size_t dx = size_t(x1 - x0), dy = size_t(y1 - y0) * sy, dz = size_t(z1 - z0) * sz;
-    float out[4];
-    for (int c = 0; c < 4; ++c) {
-        const float* p = grid_.ch[size_t(c)];
-        float a = p[i000] + (p[i000 + dx] - p[i000]) * tx;
-        float b = p[i000 + dy] + (p[i000 + dy + dx] - p[i000 + dy]) * tx;
-        float cc = p[i000 + dz] + (p[i000 + dz + dx] - p[i000 + dz]) * tx;
-        float d = p[i000 + dz + dy] + (p[i000 + dz + dy + dx] - p[i000 + dz + dy]) * tx;
-        float ab = a + (b - a) * ty;
-        float cd = cc + (d - cc) * ty;
-        out[c] = ab + (cd - ab) * tz;
-    }
-    return {out[0], out[1], out[2], out[3]};
+    k.i000 = size_t(z0) * sz + size_t(y0) * sy + size_t(x0) * sx;
+    k.dx = size_t(x1 - x0);
+    k.dy = size_t(y1 - y0) * sy;
+    k.dz = size_t(z1 - z0) * sz;
+    return k;
 }
+
+float CloudSampler::channel(int c, const Cell& k) const {
+    if (grid_.uniform[size_t(c)]) return grid_.value[size_t(c)];
+    const float* p = grid_.ch[size_t(c)];
+    const size_t i000 = k.i000, dx = k.dx, dy = k.dy, dz = k.dz;
+    const float tx = k.tx, ty = k.ty, tz = k.tz;
+    float a = p[i000] + (p[i000 + dx] - p[i000]) * tx;
+    float b = p[i000 + dy] + (p[i000 + dy + dx] - p[i000 + dy]) * tx;
+    float cc = p[i000 + dz] + (p[i000 + dz + dx] - p[i000 + dz]) * tx;
+    float d = p[i000 + dz + dy] + (p[i000 + dz + dy + dx] - p[i000 + dz + dy]) * tx;
+    float ab = a + (b - a) * ty;
+    float cd = cc + (d - cc) * ty;
+    return ab + (cd - ab) * tz;
+}
+
+VoxelSample CloudSampler::voxel(double x, double y, double z) const {
+    const Cell k = cell(x, y, z);
+    const float sdf = channel(3, k);
+    if (!(sdf < 0)) return {0, 0, 0, sdf};
+    return {channel(0, k), channel(1, k), channel(2, k), sdf};
+}
+
+float CloudSampler::sdf(double x, double y, double z) const { return channel(3, cell(x, y, z)); }
 
 std::array<float, 4> CloudSampler::noise(double x, double y, double z) const {
     int x0, x1, y0, y1, z0, z1;

@@ -12,6 +12,11 @@ namespace atlas::render::detail {
 struct Grid4 {
     // dimensional profile, detail type, density scale, sdf
     std::array<const float*, 4> ch{};
+    // A channel whose voxels all hold one finite value (a plain density
+    // grid's detail type 0 and density scale S) is not interpolated: its
+    // trilinear blend is that value exactly.
+    std::array<bool, 4> uniform{};
+    std::array<float, 4> value{};
     int nx = 0, ny = 0, nz = 0;
     double min[3]{}, inv_voxel[3]{};
 };
@@ -31,7 +36,12 @@ public:
     // Throws via validate_scene.
     explicit CloudSampler(const CloudScene& scene);
 
+    // Trilinear sample of the four channels. Outside the cloud (sdf >= 0 or
+    // NaN) only the sdf is looked up and the other fields are 0: no caller
+    // reads them there (density() returns 0, the march skips the sample).
     VoxelSample voxel(double x, double y, double z) const;
+    // The sdf alone (the march's empty-space test): voxel(x, y, z).sdf.
+    float sdf(double x, double y, double z) const;
     // Up-rezzed density (>= 0, finite) from a voxel sample; camera_distance
     // drives the near-camera twice-folded noise (pass a large value to skip).
     float density(const VoxelSample& v, double x, double y, double z, double camera_distance) const;
@@ -47,6 +57,12 @@ public:
     Vec3d voxel_size() const { return voxel_; }
 
 private:
+    struct Cell {
+        size_t i000, dx, dy, dz;
+        float tx, ty, tz;
+    };
+    Cell cell(double x, double y, double z) const;
+    float channel(int c, const Cell& k) const;
     std::array<float, 4> noise(double x, double y, double z) const;
     Grid4 grid_;
     NoiseGrid noise_;

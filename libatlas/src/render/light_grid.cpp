@@ -46,6 +46,49 @@ LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_
         }
     });
     // 3. Toward the sun: march the coarse density from each voxel centre.
+    //    A sample whose trilinear cell has eight zero corners adds exactly 0,
+    //    so it is skipped after a one-byte test (most of a sparse cloud's
+    //    grid is empty; same bytes as sampling it).
+    std::vector<unsigned char> occupied(n, 0);
+    tbb::parallel_for(0, res_[2], [&](int z) {
+        const int z1 = std::min(z + 1, res_[2] - 1);
+        for (int y = 0; y < res_[1]; ++y) {
+            const int y1 = std::min(y + 1, res_[1] - 1);
+            for (int x = 0; x < res_[0]; ++x) {
+                const int x1 = std::min(x + 1, res_[0] - 1);
+                bool any = false;
+                for (int zz : {z, z1})
+                    for (int yy : {y, y1})
+                        for (int xx : {x, x1}) any = any || dens[size_t(zz) * slab + size_t(yy) * row + size_t(xx)] != 0.0f;
+                occupied[size_t(z) * slab + size_t(y) * row + size_t(x)] = any ? 1 : 0;
+            }
+        }
+    });
+    // The occupied cells' index box: along a ray each cell index moves one
+    // way, so once one leaves the box toward the sun, nothing follows.
+    int lo[3] = {res_[0], res_[1], res_[2]}, hi[3] = {-1, -1, -1};
+    for (int z = 0; z < res_[2]; ++z)
+        for (int y = 0; y < res_[1]; ++y)
+            for (int x = 0; x < res_[0]; ++x)
+                if (occupied[size_t(z) * slab + size_t(y) * row + size_t(x)]) {
+                    const int c[3] = {x, y, z};
+                    for (int a = 0; a < 3; ++a) {
+                        lo[a] = std::min(lo[a], c[a]);
+                        hi[a] = std::max(hi[a], c[a]);
+                    }
+                }
+    // 1 = the sample's cell is occupied, 0 = not, -1 = neither is any later one.
+    auto cell_occupied = [&](const Vec3d& q) {
+        size_t i = 0;
+        const size_t stride[3] = {1, row, slab};
+        for (int a = 0; a < 3; ++a) {
+            const double v = std::clamp((q[a] - bounds_.min[a]) / voxel_[a] - 0.5, 0.0, double(res_[a] - 1));
+            const int k = std::min(static_cast<int>(v), res_[a] - 1);
+            if ((sun_dir[a] > 0 && k > hi[a]) || (sun_dir[a] < 0 && k < lo[a])) return -1;
+            i += size_t(k) * stride[a];
+        }
+        return occupied[i] != 0 ? 1 : 0;
+    };
     sun_.assign(n, 0.0f);
     const double step = 0.75 * std::min({voxel_[0], voxel_[1], voxel_[2]});
     tbb::parallel_for(0, res_[2], [&](int z) {
@@ -59,7 +102,9 @@ LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_
                 for (int s = 0; s < steps; ++s) {
                     const double t0 = s * step, dt = std::min(step, len - t0);
                     const Vec3d q = p + sun_dir * (t0 + 0.5 * dt);
-                    acc += sample(dens, q[0], q[1], q[2]) * dt;
+                    const int o = cell_occupied(q);
+                    if (o < 0) break;
+                    if (o) acc += sample(dens, q[0], q[1], q[2]) * dt;
                 }
                 sun_[size_t(z) * slab + size_t(y) * row + size_t(x)] = static_cast<float>(acc);
             }

@@ -182,7 +182,7 @@ struct Integrator {
                 dt = base_step * (1 + t / grow);
                 // Sphere tracing: skip the SDF's empty ball when it is longer than the step.
                 const Vec3d p = o + dir * t;
-                const float sdf = cloud.voxel(p[0], p[1], p[2]).sdf;
+                const float sdf = cloud.sdf(p[0], p[1], p[2]);
                 if (sdf > dt) {
                     t += sdf;
                     continue;

@@ -35,9 +35,16 @@ CloudScene scene_from_nvdf_set(Field3DPtr vdb_set, Field3DPtr noise, double nois
 void validate_scene(const CloudScene& s) {
     if (!s.modeling) throw Error("render: scene.modeling is missing (expected the modeling NVDF)");
     if (!s.sdf) throw Error("render: scene.sdf is missing (expected the SDF in metres)");
-    if (s.modeling->channels() < 3)
-        throw Error("render: scene.modeling has " + std::to_string(s.modeling->channels()) +
+    // Each channel the sampler reads from the field: by name, else its index.
+    const Field3D& m = *s.modeling;
+    auto present = [&](const char* name, int index) { return m.find_channel(name) >= 0 || index < m.channels(); };
+    const bool type_ok = s.uniform_detail_type || present("detail_type", 1);
+    const bool scale_ok = s.uniform_density_scale || present("density_scale", 2);
+    if (!present("dimensional_profile", 0) || !type_ok || !scale_ok)
+        throw Error("render: scene.modeling has " + std::to_string(m.channels()) +
                     " channels, expected 3 (dimensional_profile, detail_type, density_scale)");
+    if (s.uniform_detail_type && !std::isfinite(*s.uniform_detail_type)) throw Error("render: uniform_detail_type must be finite");
+    if (s.uniform_density_scale && !std::isfinite(*s.uniform_density_scale)) throw Error("render: uniform_density_scale must be finite");
     if (s.sdf->resolution() != s.modeling->resolution() || !(s.sdf->bounds() == s.modeling->bounds()))
         throw Error("render: scene.sdf must have the modeling NVDF's resolution and bounds");
     if (s.noise && !(std::isfinite(s.noise_tile) && s.noise_tile > 0))

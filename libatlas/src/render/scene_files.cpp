@@ -67,48 +67,68 @@ void edt_line(const double* f, int n, double w, double* out, int* v, double* z) 
 }
 
 // A plain density grid (one channel, e.g. the float grid "density" that
-// vdb_render draws) as an NVDF set the sampler reads as the same density:
+// vdb_render draws) as a scene the sampler reads as the same density:
 // density_scene's mapping (profile D^(1/0.6) / S, detail type 0, density
-// scale S = max(1, max D^(1/0.6))), and an SDF that lets the march skip empty
-// space. The distance is an exact Euclidean transform over blocks of B^3
-// voxels (block centres, to the nearest block holding a non-zero voxel),
-// less B voxel diagonals: a lower bound L on the distance from a voxel centre
-// to the nearest non-zero voxel centre. The SDF is L - 4 max voxel, clamped to
-// at most -min voxel: a point of a cell with a non-zero corner is inside at
-// every corner (so wherever the density is non-zero the picture is
-// density_scene's), and the interpolated SDF elsewhere stays under the
-// distance to the nearest cell with a non-zero corner.
-Field3DPtr set_from_density(const Field3D& density) {
-    float dmax = 0;
-    for (float d : density.channel(0)) {
-        if (!(d >= 0) || !std::isfinite(d)) throw Error("render: a density grid needs finite densities >= 0");
-        dmax = std::max(dmax, d);
-    }
-    const double S = std::max(1.0, std::pow(double(dmax), 1.0 / 0.6));
+// scale S = max(1, max D^(1/0.6))), the last two uniform (no channels of
+// their own), the profile written over the grid's own storage, and an SDF
+// that lets the march skip empty space. The distance is an exact Euclidean
+// transform over blocks of B^3 voxels (block centres, to the nearest block
+// holding a non-zero voxel), less B voxel diagonals: a lower bound L on the
+// distance from a voxel centre to the nearest non-zero voxel centre. The SDF
+// is L - 4 max voxel, clamped to at most -min voxel: a point of a cell with a
+// non-zero corner is inside at every corner (so wherever the density is
+// non-zero the picture is density_scene's), and the interpolated SDF
+// elsewhere stays under the distance to the nearest cell with a non-zero
+// corner. Peak memory: the grid plus one SDF channel (was the grid plus a
+// 4-channel set, 4.9 times the grid).
+CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
+    Field3D& density = *grid;
     const Vec3i r = density.resolution();
-    auto set = std::make_shared<Field3D>(r, 4, density.bounds(),
-                                         std::vector<std::string>{"dimensional_profile", "detail_type", "density_scale", "sdf"});
+    auto sdf = std::make_shared<Field3D>(r, 1, density.bounds(), std::vector<std::string>{"sdf"});
     const Vec3d vox = density.voxel_size();
     const double vmin = std::min({vox[0], vox[1], vox[2]}), vmax = std::max({vox[0], vox[1], vox[2]});
-    auto d = density.channel(0);
-    auto p = set->channel(0), sc = set->channel(2), sd = set->channel(3);
+    auto p = density.channel(0), sd = sdf->channel(0);
     const size_t nx = size_t(r[0]), ny = size_t(r[1]), nz = size_t(r[2]), sxy = nx * ny;
     constexpr int B = 2;
     const Vec3i cr{{(r[0] + B - 1) / B, (r[1] + B - 1) / B, (r[2] + B - 1) / B}};
     const size_t cx = size_t(cr[0]), cy = size_t(cr[1]), cz = size_t(cr[2]), cxy = cx * cy;
     std::vector<double> cd(cx * cy * cz, std::numeric_limits<double>::infinity());
-    // Profile and scale; block occupancy (a coarse z row belongs to one task).
+    // 1. Check, maximum, block occupancy (a coarse z row belongs to one task).
+    std::vector<float> row_max(cz, 0.0f);
     tbb::parallel_for(size_t(0), cz, [&](size_t bz) {
+        float m = 0;
         for (size_t z = bz * B; z < std::min(nz, (bz + 1) * B); ++z)
             for (size_t y = 0; y < ny; ++y)
                 for (size_t x = 0; x < nx; ++x) {
                     const size_t i = z * sxy + y * nx + x;
-                    const float v = d[i];
-                    p[i] = v > 0 ? static_cast<float>(std::pow(double(v), 1.0 / 0.6) / S) : 0.0f;
-                    sc[i] = static_cast<float>(S);
-                    if (v > 0) cd[bz * cxy + (y / B) * cx + x / B] = 0;
+                    const float v = p[i];
+                    if (!(v >= 0) || !std::isfinite(v)) throw Error("render: a density grid needs finite densities >= 0");
+                    if (v > 0) {
+                        cd[bz * cxy + (y / B) * cx + x / B] = 0;
+                        m = std::max(m, v);
+                    } else if (std::signbit(v)) {
+                        p[i] = 0.0f; // -0: the profile is +0 where the density is 0
+                    }
                 }
+        row_max[bz] = m;
     });
+    const float dmax = *std::max_element(row_max.begin(), row_max.end());
+    const double S = std::max(1.0, std::pow(double(dmax), 1.0 / 0.6));
+    // 2. The profile in place, in the occupied blocks only (elsewhere it is the grid's 0).
+    tbb::parallel_for(size_t(0), cz, [&](size_t bz) {
+        for (size_t by = 0; by < cy; ++by)
+            for (size_t bx = 0; bx < cx; ++bx) {
+                if (cd[bz * cxy + by * cx + bx] != 0) continue;
+                for (size_t z = bz * B; z < std::min(nz, (bz + 1) * B); ++z)
+                    for (size_t y = by * B; y < std::min(ny, (by + 1) * B); ++y)
+                        for (size_t x = bx * B; x < std::min(nx, (bx + 1) * B); ++x) {
+                            const size_t i = z * sxy + y * nx + x;
+                            const float v = p[i];
+                            if (v > 0) p[i] = static_cast<float>(std::pow(double(v), 1.0 / 0.6) / S);
+                        }
+            }
+    });
+    density.set_channel_names({"dimensional_profile"});
     // Separable squared EDT over the blocks, one axis at a time, lines in parallel.
     auto pass = [&](int axis) {
         const size_t n = size_t(cr[axis]);
@@ -131,18 +151,31 @@ Field3DPtr set_from_density(const Field3D& density) {
     for (int a = 0; a < 3; ++a) pass(a);
     const float inside = -static_cast<float>(vmin);
     const double margin = B * std::sqrt(vox[0] * vox[0] + vox[1] * vox[1] + vox[2] * vox[2]) + 4.0 * vmax;
-    tbb::parallel_for(size_t(0), nz, [&](size_t z) {
-        for (size_t y = 0; y < ny; ++y) {
-            const double* row = &cd[(z / B) * cxy + (y / B) * cx];
-            for (size_t x = 0; x < nx; ++x) {
-                const double dist = std::sqrt(row[x / B]);
-                sd[z * sxy + y * nx + x] = !std::isfinite(dist)    ? static_cast<float>(1e30)
-                                           : dist - margin < inside ? inside
-                                                                    : static_cast<float>(dist - margin);
-            }
+    // One value per block, then broadcast to its voxels.
+    std::vector<float> block(cd.size());
+    tbb::parallel_for(size_t(0), cz, [&](size_t bz) {
+        for (size_t i = bz * cxy; i < (bz + 1) * cxy; ++i) {
+            const double dist = std::sqrt(cd[i]);
+            block[i] = !std::isfinite(dist)    ? static_cast<float>(1e30)
+                       : dist - margin < inside ? inside
+                                                : static_cast<float>(dist - margin);
         }
     });
-    return set;
+    std::vector<double>().swap(cd);
+    tbb::parallel_for(size_t(0), nz, [&](size_t z) {
+        for (size_t y = 0; y < ny; ++y) {
+            const float* row = &block[(z / B) * cxy + (y / B) * cx];
+            float* out = &sd[z * sxy + y * nx];
+            for (size_t x = 0; x < nx; ++x) out[x] = row[x / B];
+        }
+    });
+    CloudScene s;
+    s.modeling = std::move(grid);
+    s.sdf = std::move(sdf);
+    s.uniform_detail_type = 0.0f;
+    s.uniform_density_scale = static_cast<float>(S);
+    validate_scene(s);
+    return s;
 }
 
 } // namespace
@@ -154,9 +187,15 @@ CloudScene load_scene(const std::vector<std::filesystem::path>& files, double vo
     Field3DPtr first = read(files[0]);
     if (files.size() == 1) {
         try {
-            // A plain density grid (set_from_density); the grid itself is
-            // released once the set is built.
-            if (first->find_channel("dimensional_profile") < 0 && first->channels() == 1) first = set_from_density(*first);
+            // A plain density grid (density_grid_scene): the profile goes over
+            // the grid's own storage when nothing else holds the grid (read
+            // just now: nothing does), else over a copy.
+            if (first->find_channel("dimensional_profile") < 0 && first->channels() == 1) {
+                std::shared_ptr<Field3D> grid =
+                    first.use_count() == 1 ? std::const_pointer_cast<Field3D>(first) : std::make_shared<Field3D>(*first);
+                first.reset();
+                return density_grid_scene(std::move(grid));
+            }
             return scene_from_nvdf_set(std::move(first));
         } catch (const Error& e) {
             throw Error(files[0].string() + ": " + e.what());

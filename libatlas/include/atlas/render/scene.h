@@ -9,6 +9,7 @@
 
 #include "atlas/core/field.h"
 
+#include <optional>
 #include <string>
 
 namespace atlas::render {
@@ -22,11 +23,19 @@ namespace atlas::render {
 //             frequency wispy, b, a = low/high frequency billowy) in [0, 1],
 //             tiling every noise_tile metres; fewer channels repeat the
 //             last one. Null: no up-rez (density = dimensional profile).
+//   uniform_detail_type, uniform_density_scale
+//             when set (finite), that modeling channel is this value
+//             everywhere and the field need not hold it (then modeling
+//             may be the profile alone): a plain density grid's detail
+//             type 0 and density scale S (load_scene) cost no 67 MB
+//             channel of one value each at 512x512x64.
 struct CloudScene {
     Field3DPtr modeling;
     Field3DPtr sdf;
     Field3DPtr noise;
     double noise_tile = 256; // metres per noise period, > 0
+    std::optional<float> uniform_detail_type;
+    std::optional<float> uniform_density_scale;
 };
 
 // A scene from one 4-channel "vdb_set" field (volume/nvdf's output, or
@@ -34,8 +43,9 @@ struct CloudScene {
 // density_scale, sdf. Throws atlas::Error naming a missing channel.
 CloudScene scene_from_nvdf_set(Field3DPtr vdb_set, Field3DPtr noise = nullptr, double noise_tile = 256);
 
-// Checks the scene (non-null fields, matching grids, >= 3 modeling
-// channels, finite noise_tile > 0); throws atlas::Error naming the problem.
+// Checks the scene (non-null fields, matching grids, the modeling channels
+// that are not uniform present, finite uniform values, finite noise_tile >
+// 0); throws atlas::Error naming the problem.
 void validate_scene(const CloudScene& scene);
 
 // Pinhole camera. fov_deg is the vertical field of view in degrees (0, 180);
@@ -71,7 +81,8 @@ namespace atlas::render {
 //              reads): density_scene's mapping (the sampled density is the
 //              grid's) with an SDF for empty-space skipping (-min voxel in
 //              the cells next to non-zero voxels, elsewhere a lower bound on
-//              the distance to them)
+//              the distance to them); modeling is the profile alone (the
+//              grid's own storage), detail type and density scale uniform
 //   two files  the modeling NVDF (named channels, else the first three:
 //              a TGA slice stack STEM.001.tga is R, G, B), then the SDF:
 //              channel "sdf" in metres, or encoded field data ("field_data",
