@@ -23,6 +23,9 @@
 #    (the like-for-like Atlas run) and prints a Markdown table: one row per run
 #    plus the medians, and `atlas --help`'s own cost (process start: shared
 #    libraries) for scale.
+# ATLAS_BASE=/path/to/older/atlas adds that binary's `--noise none` run to
+#    every round (interleaved, same file and camera), for before/after figures
+#    under the same load, and says whether its picture has the same bytes.
 #
 # Camera translation: Atlas --camera P,L --fov V (vertical degrees) ->
 # vdb_render -translate P -lookat L -up 0,0,1 -fov H with H the horizontal
@@ -82,7 +85,14 @@ VDB_CMD=(vdb_render "$WORK/out/density.vdb" "$WORK/vdb.exr" -name density -res $
   -light $LIGHT,1,0.95,0.88 -scatter 0.30,0.30,0.30 -absorb 0.02,0.02,0.02 -gain 0.2 -step 1 -shadowstep 3 -v)
 "${ATLAS_CMD[@]}" -o "$WORK/warm.png" --quiet >/dev/null 2>&1   # warm the cache (noise set): not timed
 /usr/bin/time -f '%e %U %S %M' -o "$WORK/t_help" "$ATLAS" --help >/dev/null 2>&1 || true
+ATLAS_BASE=${ATLAS_BASE:-}
+if [ -n "$ATLAS_BASE" ]; then
+  BASE_CMD=("$ATLAS_BASE" "${ATLAS_CMD[@]:1}")
+  "${BASE_CMD[@]}" -o "$WORK/warm_base.png" --quiet >/dev/null 2>&1
+  /usr/bin/time -f '%e %U %S %M' -o "$WORK/t_help_base" "$ATLAS_BASE" --help >/dev/null 2>&1 || true
+fi
 ROWS=()
+BASE_ROWS=()
 atlas_run() { # $1 = none | auto, $2 = output picture, $3 = tag
   /usr/bin/time -f '%e %U %S %M' -o "$WORK/t_$3" "${ATLAS_CMD[@]}" --noise "$1" -o "$2" >/dev/null 2>"$WORK/log_$3"
 }
@@ -90,6 +100,11 @@ for r in $(seq 1 "$ROUNDS"); do
   atlas_run none "$OUT_DIR/render_atlas_density_cmp.png" none
   atlas_run auto "$WORK/atlas_auto.png" auto
   /usr/bin/time -f "%e %U %S %M" -o "$WORK/t_vdb" "${VDB_CMD[@]}" >"$WORK/log_vdb" 2>&1
+  if [ -n "$ATLAS_BASE" ]; then
+    /usr/bin/time -f '%e %U %S %M' -o "$WORK/t_base" "${BASE_CMD[@]}" --noise none -o "$WORK/atlas_base.png" >/dev/null 2>&1
+    BASE_ROWS+=("$r $(cat "$WORK/t_base")")
+    echo "round $r: baseline atlas --noise none $(cat "$WORK/t_base") (wall s, user s, sys s, max RSS KB)" >&2
+  fi
   N_RENDER=$(sed -n 's/.*rendered [0-9x]*[^)]*) in \([0-9.]*\) s.*/\1/p' "$WORK/log_none" | tail -1)
   A_RENDER=$(sed -n 's/.*rendered [0-9x]*[^)]*) in \([0-9.]*\) s.*/\1/p' "$WORK/log_auto" | tail -1)
   V_RENDER=$(awk '/ray-tracing/ {f = 1; next} f && /completed in/ {print $(NF - 1); exit}' "$WORK/log_vdb")
@@ -123,5 +138,19 @@ col = lambda i: st.median(float(r[i]) for r in rows)
 cells = lambda b: f"{col(b):.2f} s | {col(b + 1):.2f} + {col(b + 2):.2f} s | {col(b + 3)/1024:.0f} MB | -"
 print(f"| median | {cells(1)} | {cells(6)} | {cells(11)} |")'
 echo
-echo "atlas --help alone (process start, ~260 shared libraries): ${HW} s wall, ${HU} + ${HS} s CPU, $(( HM / 1024 )) MB max RSS"
+echo "atlas --help alone (process start, $(ldd "$ATLAS" | wc -l) shared libraries): ${HW} s wall, ${HU} + ${HS} s CPU, $(( HM / 1024 )) MB max RSS"
+if [ -n "$ATLAS_BASE" ]; then
+  echo
+  echo "| baseline (--noise none) | wall | user + sys CPU | max RSS |"
+  echo "|---|---|---|---|"
+  printf '%s\n' "${BASE_ROWS[@]}" | $PY -c '
+import sys, statistics as st
+rows = [l.split() for l in sys.stdin if l.strip()]
+for r in rows: print(f"| {r[0]} | {float(r[1]):.2f} s | {float(r[2]):.2f} + {float(r[3]):.2f} s | {int(r[4])//1024} MB |")
+col = lambda i: st.median(float(r[i]) for r in rows)
+print(f"| median | {col(1):.2f} s | {col(2):.2f} + {col(3):.2f} s | {col(4)/1024:.0f} MB |")'
+  read -r BW BU BS BM < "$WORK/t_help_base"
+  echo "baseline $ATLAS_BASE --help ($(ldd "$ATLAS_BASE" | wc -l) shared libraries): ${BW} s wall, ${BU} + ${BS} s CPU, $(( BM / 1024 )) MB max RSS"
+  if cmp -s "$WORK/atlas_base.png" "$OUT_DIR/render_atlas_density_cmp.png"; then echo "baseline picture: the same bytes"; else echo "baseline picture: DIFFERENT bytes"; fi
+fi
 echo "atlas: density.vdb read as a plain density grid (render::load_scene), fast mode, quality 1; pictures render_atlas_density_cmp.png (--noise none), render_vdb_ground.png"
