@@ -3,6 +3,7 @@
 #include "atlas/compress/compress_options.h"
 #include "atlas/compress/texture.h"
 #include "atlas/graph/graph.h"
+#include "atlas/render/preview_options.h"
 #include "atlas/render/renderer.h"
 
 #include <sstream>
@@ -14,7 +15,14 @@ namespace {
 template <class T>
 std::vector<OptionDecl> with_schema_flags(std::vector<OptionDecl> head, std::span<const TextOption<T>> schema, std::vector<OptionDecl> tail) {
     for (const TextOption<T>& o : schema)
-        if (o.cli_flag) head.push_back({o.cli_flag, o.metavar, schema_flag_doc(o)});
+        if (o.cli_flag) head.push_back({o.cli_flag, o.metavar, schema_flag_doc(o), o.repeatable});
+    head.insert(head.end(), tail.begin(), tail.end());
+    return head;
+}
+// The preview's: `head`, its schema flags, the spellings that set several options, `tail`.
+std::vector<OptionDecl> with_preview_flags(std::vector<OptionDecl> head, std::vector<OptionDecl> tail) {
+    head = with_schema_flags(std::move(head), render::preview_options(), {});
+    for (const auto& sp : render::preview_cli_spellings()) head.push_back({sp.cli_flag, sp.metavar, sp.doc});
     head.insert(head.end(), tail.begin(), tail.end());
     return head;
 }
@@ -22,7 +30,7 @@ std::vector<OptionDecl> with_schema_flags(std::vector<OptionDecl> head, std::spa
 
 std::string schema_flag_doc(const TextOptionSpec& o) {
     const bool names = o.kind == OptionKind::Choice || o.kind == OptionKind::List;
-    return o.doc + (names && !o.words.empty() ? ": " + o.expected() : "");
+    return o.doc + (names && !o.words.empty() ? ": " + o.expected() : "") + (o.default_text.empty() ? "" : " (default " + o.default_text + ")");
 }
 
 const std::vector<Command>& commands() {
@@ -56,7 +64,7 @@ const std::vector<Command>& commands() {
         {"nodes", "[TYPE] [--markdown]", "list node types, or show one node's ports and parameters",
          {{"--markdown", "", "print the whole reference as Markdown (docs/nodes.md)"}},
          run_nodes},
-        {"options", "[--markdown]", "list every output format's options and the compress options (atlas compress flags = dds options)",
+        {"options", "[--markdown]", "list every output format's options, the compress options (atlas compress flags = dds options) and the preview options (atlas preview flags = render/preview parameters)",
          {{"--markdown", "", "print the reference as Markdown (docs/options.md)"}},
          run_options},
         {"compress", "IN -o OUT.dds --format FORMAT [options]",
@@ -77,46 +85,26 @@ const std::vector<Command>& commands() {
         {"info", "FILE...", "describe EXR, VDB, image or TGA-slice files: size, channels, value statistics", {}, run_info},
         {"preview", "(GRAPH | FILES...) -o OUT.png [options]",
          "render what a graph writes (NDF set: 2.5D cloud layer over a curved Earth; NVDF set: voxel clouds; both: composited) or NVDF files",
-         {{"--out", "OUT.png", "output picture (also -o): PNG tone-mapped, .exr linear radiance + transmittance"},
-          {"--size", "WxH", "image size (default 960x540)"},
-          {"--camera", "X,Y,Z,LX,LY,LZ", "camera position and look-at point in metres (default: framing the volume)"},
-          {"--fov", "DEG", "vertical field of view (default 50)"},
-          {"--sun", "AZ,EL", "sun azimuth and elevation in degrees (default 60,35; 230,20 for a 2.5D layer)"},
-          {"--sun-colour", "R,G,B", "sun radiance, linear (default 1,0.95,0.88; 2.6,2.45,2.25 for a 2.5D layer)"},
-          {"--quality", "Q", "fast mode step scale (default 1; 2 = half-length steps)"},
-          {"--extinction", "PER_M", "extinction per metre at density 1 (default 0.04)"},
-          {"--exposure", "E", "PNG tone map exposure (default 1.5)"},
+         with_preview_flags({{"--out", "OUT.png", "output picture (also -o): PNG tone-mapped, .exr linear radiance + transmittance"}}, {
           {"--noise", "FILE|auto|none", "voxel up-rez noise: a 4-channel volume file, auto (default: noise/nubis_set 128^3 cooked through the cache) or none"},
-          {"--noise-tile", "M", "metres per noise period (default 256)"},
           {"--voxel", "M", "voxel size in metres for files without bounds (TGA stacks)"},
-          {"--reference", "", "render the reference mode instead of the fast mode"},
           {"--sweep", "", "print fast-mode time and RMSE vs the reference per quality as CSV; -o writes the reference"},
           {"--turntable", "N", "N frames around the volume: OUT_000.png .."},
-          {"--light", "X,Y,Z,R,G,B,I[,RADIUS]", "a point light (metres, linear colour, intensity, optional reach in m); repeatable", true},
-          {"--sky", "ZR,ZG,ZB,HR,HG,HB", "sky gradient: zenith and horizon colours, linear (default: uniform 0.30,0.45,0.75)"},
           {"--cache", "DIR", "on-disk cache of node results when previewing a graph (as atlas cook)"},
           {"--no-cache", "", "do not use ATLAS_CACHE_DIR"},
           {"--jobs", "N", "worker threads (default: all cores); the picture does not depend on it"},
           {"--mode", "layer|voxel", "override the mode picked from the graph's outputs (default: NDF set -> layer, NVDF -> voxel, both -> composited)"},
-          {"--view", "ground|aerial|orbit[:AZ,EL]", "camera preset framing the clouds (default: ground for a layer, orbit:30,20 for voxels)"},
           {"--set", "NODE.PARAM=VALUE", "override a parameter before cooking (as atlas cook); repeatable", true},
-          {"--time", "S", "2.5D: seconds of wind scroll (map and noise)"},
-          {"--wind", "X,Y", "2.5D: wind velocity in m/s (default 8,0)"},
-          {"--earth-radius", "M", "2.5D: Earth radius in metres (default 6360000)"},
           {"--watch", "", "after the preview, re-cook and re-render whenever the graph or a file it reads changes (prints each step's time)"},
           {"--watch-max", "N", "with --watch: stop after N re-renders"},
           {"--frames", "N", "a time sequence OUT_000.png ..: frame i at --time + i x --time-step (wind scroll) with flash index --flash + i"},
           {"--time-step", "S", "seconds between --frames (default 60)"},
           {"--slice", "K", "2.5D: draw time slice K of the graph's ndf/forecast maps (--frames steps one slice per frame)"},
-          {"--lightning", "COUNT[,I[,RADIUS]]", "2.5D: COUNT flashes placed by the set's superstorm_coverage (else precipitation, coverage), intensity I (default 5e6), reach (default 4000 m)"},
-          {"--flash", "N", "flash index of --lightning (default 0): the same index gives the same flash positions"},
-          {"--edge", "wrap|clamp|empty", "2.5D: the map beyond its bounds (default: empty for a superstorm set, else wrap)"},
-          {"--envelope", "on|off|auto", "2.5D: skip empty space with a cone map over the cloud tops (the graph's ndf/cone_map if it writes one); auto (default) = on above the lowest cloud base"},
           {"--artistic", "on|off", "off: the physical lighting a path tracer computes (no powder, octave multiple scattering; docs/render.md \"Reference: Cycles\")"},
           {"--ms-octaves", "N[,A,B,C]", "with --artistic off: octaves of multiple scattering (0 = single scattering; default " + std::to_string(render::kPhysicalMsOctaves) + "), optionally their energy, extinction and anisotropy factors"},
           {"--light-grid", "NX,NY,NZ", "voxel light grid resolution (default 128,128,32, capped at the volume's)"},
           {"--export-scene", "DIR", "also write DIR/density.vdb and DIR/scene.json for scripts/cycles_reference.py (Blender Cycles)"},
-          {"--quiet", "", "no progress bar or summary"}},
+          {"--quiet", "", "no progress bar or summary"}}),
          run_preview},
     };
     return table;

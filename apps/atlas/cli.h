@@ -58,14 +58,22 @@ std::string general_help();
 std::string schema_flag_doc(const TextOptionSpec& o);
 
 // Sets `out` from the flags of `cmd` that schema options declare (a Flag option's
-// flag takes no value and means true); throws UsageError
-// "--flag expects <expected>, got '<text>'". Other flags are left to the caller.
+// flag takes no value and means true; a repeatable one's values are joined with ';');
+// throws UsageError "--flag expects <expected>, got '<text>'" (a Text option adds why).
+// Other flags are left to the caller.
 template <class T>
 void read_schema_flags(const Args& a, std::span<const TextOption<T>> schema, T& out, const std::string& cmd) {
     for (const TextOption<T>& o : schema) {
         if (!o.cli_flag || !a.has(o.cli_flag)) continue;
-        const std::string text = o.kind == OptionKind::Flag ? "true" : a.get(o.cli_flag);
-        if (!set_text_option(o, text, out)) throw UsageError{std::string(o.cli_flag) + " expects " + o.expected() + ", got '" + text + "'", cmd};
+        std::string text = o.kind == OptionKind::Flag ? "true" : a.get(o.cli_flag);
+        if (o.repeatable) {
+            text.clear();
+            for (const std::string& v : a.all(o.cli_flag)) text += (text.empty() ? "" : ";") + v;
+        }
+        if (!set_text_option(o, text, out)) {
+            const std::string why = o.kind == OptionKind::Text && o.check_text ? ": " + o.check_text(text) : "";
+            throw UsageError{std::string(o.cli_flag) + " expects " + o.expected() + ", got '" + text + "'" + why, cmd};
+        }
     }
 }
 

@@ -3,6 +3,7 @@
 
 #include "atlas/graph/graph.h"
 #include "atlas/graph/node_docs.h"
+#include "atlas/render/preview_options.h"
 
 #include <iostream>
 
@@ -31,7 +32,7 @@ int run_nodes(const Args& a) {
 // The Markdown is readable as text too: one generator, no second copy to drift.
 int run_options(const Args& a) {
     if (!a.positional.empty()) throw UsageError{"expected no arguments", "options"};
-    std::cout << options_reference_markdown();
+    std::cout << options_reference_markdown() << render::preview_options_markdown();
     return 0;
 }
 

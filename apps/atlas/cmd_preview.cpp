@@ -13,6 +13,7 @@
 #include "atlas/render/image_out.h"
 #include "atlas/render/layer.h"
 #include "atlas/render/preview.h"
+#include "atlas/render/preview_options.h"
 #include "atlas/render/renderer.h"
 #include "atlas/render/sweep.h"
 
@@ -235,29 +236,6 @@ Field3DPtr cook_voxel_noise(int jobs, const std::optional<std::filesystem::path>
     return std::get<Field3DPtr>(s.get("nubis_noise", "out", o));
 }
 
-// The box around the voxels that hold cloud (SDF < 0), or the whole bounds.
-Box3d cloud_bounds(const render::CloudScene& scene) {
-    const Field3D& sdf = *scene.sdf;
-    const int c = std::max(0, sdf.find_channel("sdf"));
-    Vec3i lo{{sdf.nx(), sdf.ny(), sdf.nz()}}, hi{{-1, -1, -1}};
-    for (int z = 0; z < sdf.nz(); ++z)
-        for (int y = 0; y < sdf.ny(); ++y)
-            for (int x = 0; x < sdf.nx(); ++x)
-                if (sdf.at(c, x, y, z) < 0) {
-                    lo = {{std::min(lo[0], x), std::min(lo[1], y), std::min(lo[2], z)}};
-                    hi = {{std::max(hi[0], x), std::max(hi[1], y), std::max(hi[2], z)}};
-                }
-    const Box3d b = sdf.bounds();
-    if (hi[0] < 0) return b;
-    const Vec3d v = sdf.voxel_size();
-    Box3d r;
-    for (int a = 0; a < 3; ++a) {
-        r.min[a] = b.min[a] + lo[a] * v[a];
-        r.max[a] = b.min[a] + (hi[a] + 1) * v[a];
-    }
-    return r;
-}
-
 // Writes into `staged` (a temporary path); the caller moves it into place.
 void write_picture(const Field2D& image, const std::filesystem::path& staged, double exposure) {
     auto ext = staged.extension().string();
@@ -308,44 +286,32 @@ void apply_physics_options(const Args& a, render::RenderSettings& s) {
 
 namespace {
 
-// --view ground|aerial|orbit[:AZ,EL]
-struct View {
-    std::string kind = "auto";
-    double az = 30, el = 20;
-};
-View parse_view(const Args& a) {
-    View v;
-    if (!a.has("--view")) return v;
-    std::string t = a.get("--view");
-    auto colon = t.find(':');
-    v.kind = t.substr(0, colon);
-    if (v.kind != "ground" && v.kind != "aerial" && v.kind != "orbit")
-        throw UsageError{"--view expects ground, aerial or orbit[:AZ,EL], got '" + t + "'", "preview"};
-    if (colon != std::string::npos) {
-        if (v.kind != "orbit") throw UsageError{"--view: only orbit takes angles (orbit:AZ,EL), got '" + t + "'", "preview"};
-        auto n = numbers(t.substr(colon + 1), 2, "--view orbit");
-        v.az = n[0];
-        v.el = n[1];
+// The preview's render flags: the schema's (render::preview_options) and the
+// spellings that set several of its options (--sun AZ,EL, --camera, --view, ...),
+// parsed by the schema as the render/preview node's parameters are.
+render::PreviewOptions read_preview_flags(const Args& a) {
+    render::PreviewOptions o;
+    const auto schema = render::preview_options();
+    read_schema_flags(a, schema, o, "preview");
+    for (const render::OptionSpelling& sp : render::preview_cli_spellings()) {
+        if (!a.has(sp.cli_flag)) continue;
+        const std::string text = a.get(sp.cli_flag);
+        std::vector<std::pair<std::string, std::string>> parts;
+        if (!sp.expand(text, parts)) throw UsageError{std::string(sp.cli_flag) + " expects " + sp.metavar + ", got '" + text + "'", "preview"};
+        for (const auto& [name, value] : parts) {
+            const TextOption<render::PreviewOptions>* opt = find_option(schema, name);
+            if (!opt || !set_text_option(*opt, value, o))
+                throw UsageError{std::string(sp.cli_flag) + " expects " + sp.metavar + " with " + name + " " + (opt ? opt->expected() : "?") + ", got '" +
+                                     text + "'",
+                                 "preview"};
+        }
     }
-    return v;
-}
-
-render::Camera voxel_camera(const render::CloudScene& scene, const View& v, double aspect) {
-    const Box3d b = cloud_bounds(scene);
-    if (v.kind == "ground" || v.kind == "auto") {
-        // From the ground at the south edge of the clouds, 2 m up (or under the
-        // lowest base when the clouds float high), pitched up so the bases and
-        // the lit flanks fill the frame: how cumulus is seen and photographed.
-        render::Camera c;
-        c.fov_deg = 60;
-        const Vec3d size = b.max - b.min;
-        const double ground = scene.modeling->bounds().min[2];
-        c.position = {{0.5 * (b.min[0] + b.max[0]), b.min[1] - 0.1 * size[1], std::max(ground + 2.0, b.min[2] - 0.25 * size[2])}};
-        c.look_at = {{0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), b.max[2] + 0.25 * size[2]}};
-        return c;
+    try {
+        render::check_preview_options(o);
+    } catch (const Error& e) {
+        throw UsageError{e.what(), "preview"};
     }
-    if (v.kind == "aerial") return render::framing_camera(b, aspect, 30, 55);
-    return render::framing_camera(b, aspect, v.az, v.el);
+    return o;
 }
 
 } // namespace
@@ -360,17 +326,10 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
         jobs = static_cast<int>(numbers(a.get("--jobs"), 1, "--jobs")[0]);
         if (jobs < 1 || jobs > 1024) throw UsageError{"--jobs expects a number of threads >= 1", "preview"};
     }
-    int w = 960, h = 540;
-    if (a.has("--size")) {
-        std::string s = a.get("--size");
-        auto x = s.find('x');
-        if (x == std::string::npos) throw UsageError{"--size expects WxH, e.g. 960x540, got '" + s + "'", "preview"};
-        w = static_cast<int>(numbers(s.substr(0, x), 1, "--size")[0]);
-        h = static_cast<int>(numbers(s.substr(x + 1), 1, "--size")[0]);
-    }
+    const render::PreviewOptions po = read_preview_flags(a);
+    const int w = po.size[0], h = po.size[1];
     std::string mode = a.has("--mode") ? a.get("--mode") : "auto";
     if (mode != "auto" && mode != "layer" && mode != "voxel") throw UsageError{"--mode expects layer or voxel, got '" + mode + "'", "preview"};
-    const View view = parse_view(a);
     const bool quiet = a.has("--quiet");
     ProgressBar bar(!quiet);
     ProgressSink sink = bar.sink();
@@ -446,103 +405,29 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
         // cooked through the same cache as the graph.
         if (noise_opt == "auto") noise = cook_voxel_noise(jobs, cache_dir, sink, quiet);
         scene.noise = noise;
-        if (a.has("--noise-tile")) scene.noise_tile = numbers(a.get("--noise-tile"), 1, "--noise-tile")[0];
-        render::validate_scene(scene);
     }
-    if (have_layer) {
-        if (a.has("--time")) layer.time = numbers(a.get("--time"), 1, "--time")[0];
-        if (a.has("--earth-radius")) layer.earth_radius = numbers(a.get("--earth-radius"), 1, "--earth-radius")[0];
-        if (a.has("--wind")) {
-            auto v = numbers(a.get("--wind"), 2, "--wind");
-            layer.wind = {{v[0], v[1]}};
-        }
-        // (edge: layer_preview_scene's choice, Empty for a storm, else Wrap)
-        if (a.has("--edge")) {
-            const std::string e = a.get("--edge");
-            if (e == "wrap") layer.edge = render::MapEdge::Wrap;
-            else if (e == "clamp") layer.edge = render::MapEdge::Clamp;
-            else if (e == "empty") layer.edge = render::MapEdge::Empty;
-            else throw UsageError{"--edge expects wrap, clamp or empty, got '" + e + "'", "preview"};
-        }
-        render::validate_layer_scene(layer);
-    }
-
-    const Box3d bounds = have_voxel ? scene.modeling->bounds() : Box3d{{{0, 0, 0}}, {{1, 1, 1}}};
-    render::RenderSettings s = render::preview_settings(bounds, w, h);
-    const double aspect = double(w) / h;
-    if (have_layer) {
-        const auto kind = view.kind == "aerial" ? render::LayerView::Aerial
-                          : view.kind == "orbit" ? render::LayerView::Orbit
-                                                 : render::LayerView::Ground;
-        // The library's 2.5D daylight look and camera preset (the node's too).
-        s = render::layer_preview_settings(layer, w, h, kind, view.az, view.el);
-    } else if (have_voxel && (view.kind != "auto" || (a.positional.size() == 1 && is_graph(a.positional[0])))) {
-        s.camera = voxel_camera(scene, view, aspect);
-    }
-    s.threads = jobs;
-    // A graph's voxel clouds get the 2.5D mode's daylight (render::apply_voxel_daylight).
-    if (have_voxel && !have_layer && a.positional.size() == 1 && is_graph(a.positional[0])) render::apply_voxel_daylight(s);
-    if (a.has("--camera")) {
-        auto v = numbers(a.get("--camera"), 6, "--camera");
-        s.camera.position = {{v[0], v[1], v[2]}};
-        s.camera.look_at = {{v[3], v[4], v[5]}};
-    }
-    if (have_layer) {
-        // Envelope skipping pays off looking down on the layer (a ground view
-        // starts under the clouds, where the cone map over the tops cannot
-        // help): auto = on when the camera is above the lowest cloud base.
-        std::string env = a.has("--envelope") ? a.get("--envelope") : "auto";
-        if (env != "on" && env != "off" && env != "auto") throw UsageError{"--envelope expects on, off or auto, got '" + env + "'", "preview"};
-        if (env == "auto") {
-            const int cmin = layer.ndf->find_channel("min_height");
-            float lowest = std::numeric_limits<float>::infinity();
-            for (float v : layer.ndf->channel(cmin)) lowest = std::min(lowest, v);
-            env = s.camera.position[2] > lowest ? "on" : "off";
-        }
-        if (env == "off") layer.envelope = {};
-        if (env == "on" && !layer.envelope.cone_map && layer.ndf->width() > 2) {
-            const auto t = std::chrono::steady_clock::now();
-            layer.envelope.cone_map = render::cloud_top_cone_map(*layer.ndf);
-            if (!quiet)
-                std::fprintf(stderr, "envelope: cone map over the cloud tops (%dx%d) in %.2f s\n", layer.ndf->width(), layer.ndf->height(),
-                             std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count());
-        }
-    }
-    if (a.has("--fov")) s.camera.fov_deg = numbers(a.get("--fov"), 1, "--fov")[0];
-    if (a.has("--sun")) {
-        auto v = numbers(a.get("--sun"), 2, "--sun");
-        s.sun_direction = render::sun_direction(v[0], v[1]);
-    }
-    if (a.has("--sun-colour")) {
-        auto v = numbers(a.get("--sun-colour"), 3, "--sun-colour");
-        s.sun_colour = {{float(v[0]), float(v[1]), float(v[2])}};
-    }
-    if (a.has("--quality")) s.quality = numbers(a.get("--quality"), 1, "--quality")[0];
-    if (a.has("--extinction")) s.extinction = numbers(a.get("--extinction"), 1, "--extinction")[0];
-    if (a.has("--reference")) s.mode = render::RenderMode::Reference;
-    if (a.has("--sky")) {
-        auto v = numbers(a.get("--sky"), 6, "--sky");
-        s.sky_colour = {{float(v[0]), float(v[1]), float(v[2])}};
-        s.sky_horizon = Vec3f{{float(v[3]), float(v[4]), float(v[5])}};
-    }
-    for (const auto& l : a.all("--light")) {
-        try {
-            for (const auto& p : render::parse_point_lights(l)) s.lights.push_back(p);
-        } catch (const Error& e) {
-            throw UsageError{std::string("--light: ") + e.what(), "preview"};
-        }
-    }
-    const double exposure = a.has("--exposure") ? numbers(a.get("--exposure"), 1, "--exposure")[0] : 1.5;
+    if (po.lightning && !have_layer) throw UsageError{"--lightning places flashes over a 2.5D layer; this preview has no NDF set", "preview"};
+    // The library entry the render/preview node calls: the options applied to the
+    // scenes, the settings of the render calls (render/preview.h).
+    const bool from_graph = a.positional.size() == 1 && is_graph(a.positional[0]);
+    render::PreviewJob job = render::prepare_preview(have_voxel ? std::optional<render::CloudScene>(scene) : std::nullopt,
+                                                     have_layer ? std::optional<render::LayerScene>(layer) : std::nullopt, po,
+                                                     from_graph ? render::PreviewLook::Graph : render::PreviewLook::Fields, nullptr, jobs);
+    if (!quiet)
+        for (const std::string& note : job.notes) std::fprintf(stderr, "%s\n", note.c_str());
+    render::RenderSettings& s = job.settings;
+    const Box3d bounds = have_voxel ? job.voxel->modeling->bounds() : Box3d{{{0, 0, 0}}, {{1, 1, 1}}};
+    const double exposure = job.exposure;
     apply_physics_options(a, s); // --artistic, --ms-octaves, --light-grid
     if (a.has("--export-scene")) {
         if (have_voxel && have_layer) throw UsageError{"--export-scene exports a voxel or a 2.5D scene, not both at once (use --mode)", "preview"};
-        const std::string note = have_layer ? export_layer_scene(a.get("--export-scene"), layer, s) : export_scene(a.get("--export-scene"), scene, s);
+        const std::string note = have_layer ? export_layer_scene(a.get("--export-scene"), *job.layer, s) : export_scene(a.get("--export-scene"), *job.voxel, s);
         if (!quiet) std::fprintf(stderr, "%s\n", note.c_str());
     }
 
     if (a.has("--sweep")) {
         if (!have_voxel) throw UsageError{"--sweep measures the voxel renderer; the graph has no volume/nvdf output", "preview"};
-        auto r = render::quality_sweep(scene, s, {0.25, 0.5, 1, 2, 4}, &sink);
+        auto r = render::quality_sweep(*job.voxel, s, {0.25, 0.5, 1, 2, 4}, &sink);
         bar.finish();
         // stdout: the table (data); a CSV-friendly layout.
         std::printf("quality,seconds,rmse_radiance,rmse_transmittance\n");
@@ -552,40 +437,7 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
         return 0;
     }
 
-    // Lightning over the layer: flashes placed by the set's storm (or rain) channel.
-    int flash0 = a.has("--flash") ? static_cast<int>(numbers(a.get("--flash"), 1, "--flash")[0]) : 0;
-    if (a.has("--lightning")) {
-        if (!have_layer) throw UsageError{"--lightning places flashes over a 2.5D layer; this preview has no NDF set", "preview"};
-        const std::string t = a.get("--lightning");
-        const size_t n = std::count(t.begin(), t.end(), ',') + 1;
-        if (n > 3) throw UsageError{"--lightning expects COUNT[,INTENSITY[,RADIUS]], got '" + t + "'", "preview"};
-        auto v = numbers(t, n, "--lightning");
-        const Field2D& set = *layer.ndf;
-        int ch = -1;
-        for (const char* name : {"superstorm_coverage", "precipitation", "coverage"}) {
-            const int c = set.find_channel(name);
-            if (c < 0) continue;
-            auto d = set.channel(c);
-            if (std::any_of(d.begin(), d.end(), [](float x) { return x > 0; })) {
-                ch = c;
-                break;
-            }
-        }
-        if (ch < 0) throw Error("--lightning: the NDF set has no storm, rain or coverage to place flashes in");
-        // Heights: 20-60 % up the columns that can flash (in-cloud flashes).
-        const int cmn = set.find_channel("min_height"), cmx = set.find_channel("max_height");
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (int y = 0; y < set.height(); ++y)
-            for (int x = 0; x < set.width(); ++x)
-                if (set.at(ch, x, y) > 0) lo = std::min(lo, double(set.at(cmn, x, y))), hi = std::max(hi, double(set.at(cmx, x, y)));
-        render::LightField f;
-        f.probability = render::layer_flash_probability(set, ch, lo + 0.2 * (hi - lo), lo + 0.6 * (hi - lo) + 1e-3);
-        f.count = static_cast<int>(v[0]);
-        f.intensity = n > 1 ? v[1] : 5e6;
-        f.radius = n > 2 ? v[2] : 4000;
-        f.flash = flash0;
-        s.light_fields.push_back(f);
-    }
+    const int flash0 = int(po.flash_index);
     const std::filesystem::path out = a.get("--out");
     if (a.has("--turntable") && a.has("--frames")) throw UsageError{"--turntable and --frames contradict each other", "preview"};
     const bool sequence = a.has("--frames");
@@ -593,35 +445,31 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
     const int frames = a.has(frames_opt) ? static_cast<int>(numbers(a.get(frames_opt), 1, frames_opt)[0]) : 0;
     if (a.has(frames_opt) && (frames < 1 || frames > 3600)) throw UsageError{std::string(frames_opt) + " expects 1..3600 frames", "preview"};
     const double time_step = a.has("--time-step") ? numbers(a.get("--time-step"), 1, "--time-step")[0] : 60.0;
-    const double time0 = layer.time;
+    const double time0 = have_layer ? job.layer->time : 0.0;
     auto t0 = std::chrono::steady_clock::now();
     std::string features;
     // One frame: the layer, the voxel set, or the voxel set composited over the layer.
-    auto render_frame = [&](const render::RenderSettings& fs) {
-        std::optional<Field2D> img;
+    auto render_frame = [&]() {
+        render::PreviewFrame f = render::render_preview(job, &sink);
         features.clear();
-        if (have_layer) {
-            auto r = render::render_layer(layer, fs, &sink);
+        if (f.layer_report) {
+            const render::LayerReport& r = *f.layer_report;
             features += " [2.5D:";
-            for (const auto& f : r.report.active_features()) features += " " + f;
+            for (const auto& x : r.active_features()) features += " " + x;
             char buf[128];
-            std::snprintf(buf, sizeof buf, "; %.2f s, %llu cheap + %llu full samples, %llu skips]", r.report.seconds,
-                          (unsigned long long)r.report.cheap_samples, (unsigned long long)r.report.full_samples,
-                          (unsigned long long)r.report.skipped_steps);
+            std::snprintf(buf, sizeof buf, "; %.2f s, %llu cheap + %llu full samples, %llu skips]", r.seconds, (unsigned long long)r.cheap_samples,
+                          (unsigned long long)r.full_samples, (unsigned long long)r.skipped_steps);
             features += buf;
-            img = std::move(r.image);
         }
-        if (have_voxel) {
-            auto r = render::render_clouds(scene, fs, &sink);
+        if (f.voxel_report) {
             features += have_layer ? " [voxel:" : "";
-            for (const auto& f : r.report.active_features()) features += " " + f;
+            for (const auto& x : f.voxel_report->active_features()) features += " " + x;
             if (have_layer) features += "]";
-            img = img ? render::composite_over(r.image, *img, fs) : std::move(r.image);
         }
-        return std::move(*img);
+        return std::move(f.image);
     };
     if (frames == 0) {
-        Field2D image = render_frame(s);
+        Field2D image = render_frame();
         write_picture_atomic(image, out, exposure);
         bar.finish();
         std::cout << out.string() << "\n";
@@ -633,19 +481,22 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
             if (sequence) {
                 // A time sequence: the wind scroll advances, each frame a new flash,
                 // and a forecast its next time slice (the envelope follows the slice).
-                layer.time = time0 + i * time_step;
-                if (forecast) {
-                    layer.ndf = render::weather_map_as_set(forecast_slice(*forecast, (slice0 + i) % forecast->nz()));
-                    if (layer.envelope.cone_map) layer.envelope.cone_map = render::cloud_top_cone_map(*layer.ndf);
+                if (have_layer) {
+                    render::LayerScene& layer_now = *job.layer;
+                    layer_now.time = time0 + i * time_step;
+                    if (forecast) {
+                        layer_now.ndf = render::weather_map_as_set(forecast_slice(*forecast, (slice0 + i) % forecast->nz()));
+                        if (layer_now.envelope.cone_map) layer_now.envelope.cone_map = render::cloud_top_cone_map(*layer_now.ndf);
+                    }
                 }
                 for (auto& f : s.light_fields) f.flash = flash0 + i;
             } else if (have_layer) {
-                s.camera = render::layer_camera(layer, render::LayerView::Orbit, double(w) / h, 30 + 360.0 * i / frames, view.el);
+                s.camera = render::layer_camera(*job.layer, render::LayerView::Orbit, double(w) / h, 30 + 360.0 * i / frames, po.elevation);
             } else {
-                s.camera = render::framing_camera(have_voxel && is_graph(a.positional[0]) ? cloud_bounds(scene) : bounds, double(w) / h,
+                s.camera = render::framing_camera(have_voxel && is_graph(a.positional[0]) ? render::cloud_bounds(*job.voxel) : bounds, double(w) / h,
                                                   30 + 360.0 * i / frames);
             }
-            Field2D image = render_frame(s);
+            Field2D image = render_frame();
             char suffix[32];
             std::snprintf(suffix, sizeof suffix, "_%03d", i);
             const std::filesystem::path name = out.stem().string() + suffix + out.extension().string();

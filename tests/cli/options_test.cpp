@@ -3,12 +3,16 @@
 //  - compress: `atlas compress` flags (the program, run as a script runs it) and a
 //    graph's dds output options (checked as a graph load checks them);
 //  - sounding: the sim/sounding node's parameters and Sounding::validate();
-//  - grid parameters: one declaration for every node that has them.
+//  - grid parameters: one declaration for every node that has them;
+//  - preview: `atlas preview` flags (the program) and the render/preview node's
+//    parameters (checked as a graph load checks them), values and defaults.
 #include "atlas/compress/compress_options.h"
 #include "atlas/core/files.h"
 #include "atlas/graph/node.h"
 #include "atlas/graph/node_docs.h"
+#include "atlas/graph/option_params.h"
 #include "atlas/io/writers.h"
+#include "atlas/render/preview_options.h"
 #include "atlas/sim/sounding_options.h"
 
 #include "../support/cli_run.h"
@@ -52,6 +56,7 @@ std::vector<std::string> probes(const TextOptionSpec& o) {
         v.insert(v.end(), {"0,1", "1,0", "0,inf", "0,1,2", num(o.min) + ",0", "0," + num(o.max), "0," + num(std::nextafter(o.max, INFINITY) * 1.01)});
         break;
     case OptionKind::Flag: break;
+    case OptionKind::Text: v.insert(v.end(), {"x", ";"}); break;
     }
     if (!o.words.empty()) v.insert(v.end(), {o.words.front(), o.words.back(), o.words.back() + "x"});
     return v;
@@ -74,7 +79,7 @@ CliRun run(const std::string& args) {
 }
 
 TEST(OptionsSchema, DocsOptionsMdIsUpToDate) {
-    const std::string expected = options_reference_markdown();
+    const std::string expected = options_reference_markdown() + render::preview_options_markdown();
     std::string actual;
     ASSERT_NO_THROW(actual = read_file_bytes(std::string(ATLAS_SOURCE_DIR) + "/docs/options.md"));
     EXPECT_TRUE(actual == expected) << "docs/options.md is stale: regenerate it with 'build/bin/atlas options --markdown > docs/options.md'";
@@ -208,6 +213,165 @@ TEST(OptionsSchema, GridParametersAreDeclaredAlike) {
         }
     }
     EXPECT_GE(nodes, 20);
+}
+
+// ---------------------------------------------------------------------------
+// Preview: `atlas preview`'s flags and the render/preview node's parameters.
+
+// How the CLI spells an option without a flag of its own: the flag and a template
+// whose "{}" is the option's text (the other parts valid).
+const std::map<std::string, std::string> kPreviewSpelled = {
+    {"view", "--view={}"},
+    {"azimuth", "--view=orbit:{},20"},
+    {"elevation", "--view=orbit:30,{}"},
+    {"position", "--camera={},1,2,3"},
+    {"look_at", "--camera=1,2,3,{}"},
+    {"sun_azimuth", "--sun={},20"},
+    {"sun_elevation", "--sun=30,{}"},
+    {"sky_colour", "--sky={},0.5,0.5,0.5"},
+    {"sky_horizon", "--sky=0.5,0.5,0.5,{}"},
+    {"flash_count", "--lightning={}"},
+    {"flash_intensity", "--lightning=2,{}"},
+    {"flash_radius", "--lightning=2,1,{}"},
+};
+// Options the CLI sets only to one value (camera manual by --camera, mode reference by
+// --reference, lightning by --lightning) or not at all (the node's flash_probability
+// lights): probed on the node side only.
+const std::vector<std::string> kPreviewNodeOnly = {"camera", "mode", "lightning", "flash_seed", "flash_colour"};
+
+struct Probe {
+    std::string text; // as the CLI takes it
+    ParamValue node;  // as a graph file gives it
+};
+
+// Probes of a numeric option: one component at and past the bounds, NaN, Inf, a
+// non-integer, malformed text; the other components at a valid value.
+std::vector<Probe> preview_probes(const TextOptionSpec& o) {
+    std::vector<Probe> v;
+    const ParamType type = text_option_param_type(o);
+    const bool numeric = o.kind == OptionKind::Number || o.kind == OptionKind::Integer;
+    if (numeric && type != ParamType::String) {
+        const bool integer = o.kind == OptionKind::Integer;
+        const double ok = std::clamp(1.0, o.min, o.max);
+        std::vector<double> xs{ok, NAN, INFINITY, 2.7};
+        for (double b : {o.min, o.max})
+            if (std::isfinite(b)) xs.insert(xs.end(), {b, integer ? b + (b == o.min ? -1 : 1) : std::nextafter(b, b == o.min ? -INFINITY : INFINITY)});
+        for (double x : xs) {
+            std::vector<double> comps(size_t(o.count), ok);
+            comps[0] = x;
+            std::string text;
+            for (double c : comps) text += (text.empty() ? "" : std::string(1, o.separator)) + num(c);
+            ParamValue node;
+            if (o.count > 1) node = comps;
+            else if (integer && std::isfinite(x) && x == std::floor(x)) node = int64_t(x);
+            else node = x; // a graph gives a non-integer as a float, which an int parameter refuses
+            v.push_back({text, node});
+        }
+        v.push_back({"abc", std::string("abc")});
+        return v;
+    }
+    for (const std::string& t : probes(o)) v.push_back({t, t});
+    if (o.kind == OptionKind::Flag) v.insert(v.end(), {{"true", true}, {"false", false}});
+    if (numeric) // a string parameter with words and numbers
+        for (const std::string& t : {std::string("1,1,1"), std::string("-1,1,1"), std::string("1,1"), std::string("1e7,1,1"), std::string("nan,1,1")})
+            v.push_back({t, t});
+    if (o.kind == OptionKind::Text) v.push_back({"1,2,3,1,1,1,100; 4 5 6 1 1 1 2e3 50", std::string("1,2,3,1,1,1,100; 4 5 6 1 1 1 2e3 50")});
+    return v;
+}
+
+std::string replace_braces(std::string t, const std::string& text) { return t.replace(t.find("{}"), 2, text); }
+
+// `atlas preview` refuses a flag's value with status 2 before it reads its input;
+// an accepted value gets as far as the missing input file (status 1).
+bool preview_cli_accepts(const std::string& flag_and_value, std::string* err = nullptr) {
+    CliRun r = run("preview /nonexistent/atlas_options_test.vdb --noise none --quiet '" + flag_and_value + "' -o x.png");
+    if (err) *err = r.err;
+    EXPECT_TRUE(r.status == 1 || r.status == 2) << flag_and_value << ": status " << r.status << " " << r.err;
+    return r.status != 2;
+}
+
+TEST(OptionsSchema, PreviewFlagsAndNodeParametersAcceptTheSameValues) {
+    const NodeDeclaration d = declaration_of("render/preview");
+    const auto schema = render::preview_options();
+    int runs = 0;
+    for (const auto& o : schema) {
+        const ParamDecl* p = d.find_param(o.name);
+        ASSERT_TRUE(p) << o.name;
+        EXPECT_EQ(p->type, text_option_param_type(o)) << o.name;
+        EXPECT_EQ(p->unit, o.unit) << o.name;
+        EXPECT_EQ(p->doc, o.doc) << o.name;
+        const bool node_only = std::find(kPreviewNodeOnly.begin(), kPreviewNodeOnly.end(), o.name) != kPreviewNodeOnly.end();
+        const auto spelled = kPreviewSpelled.find(o.name);
+        // Every option is a flag, spelled by one, or listed as node-only: a new option needs a decision here.
+        EXPECT_EQ(int(o.cli_flag != nullptr) + int(spelled != kPreviewSpelled.end()) + int(node_only), 1) << o.name;
+        int node_yes = 0, node_no = 0;
+        for (const Probe& pr : preview_probes(o)) {
+            const bool node = p->check(pr.node).empty();
+            (node ? node_yes : node_no)++;
+            // The node's value, read back through the schema, is what the CLI's text gives.
+            if (node && !node_only) {
+                render::PreviewOptions from_node, from_cli;
+                EXPECT_TRUE(set_text_option(o, text_option_text(o, pr.node), from_node)) << o.name << " " << pr.text;
+                EXPECT_TRUE(set_text_option(o, pr.text, from_cli)) << o.name << " " << pr.text;
+                EXPECT_TRUE(from_node == from_cli) << o.name << " " << pr.text;
+            }
+            if (node_only) continue;
+            // Spelled options: the spelling's other parts are numbers, so words go through own flags only.
+            if (spelled != kPreviewSpelled.end() && o.kind == OptionKind::Number && !o.words.empty() && pr.text.find_first_of("0123456789") == std::string::npos)
+                continue;
+            const std::string arg = o.cli_flag ? std::string(o.cli_flag) + "=" + pr.text : replace_braces(spelled->second, pr.text);
+            std::string err;
+            const bool cli = preview_cli_accepts(arg, &err);
+            ++runs;
+            EXPECT_EQ(cli, node) << arg << ": CLI " << (cli ? "accepts" : "refuses") << " (" << err << "), node parameter '" << o.name << "' "
+                                 << (node ? "accepts" : "refuses: " + p->check(pr.node));
+            if (!cli && o.cli_flag) {
+                EXPECT_NE(err.find(std::string(o.cli_flag) + " expects " + o.expected()), std::string::npos) << err;
+            }
+        }
+        // The probes are not vacuous: each option takes some and refuses some.
+        EXPECT_GT(node_yes, 0) << o.name;
+        EXPECT_GT(node_no, 0) << o.name;
+    }
+    EXPECT_GT(runs, 150);
+}
+
+TEST(OptionsSchema, PreviewDefaultsAreOneAndTheNodesPresetIsNamed) {
+    const NodeDeclaration d = declaration_of("render/preview");
+    // The struct's initializers are the schema's default texts.
+    render::PreviewOptions from_texts;
+    for (const auto& o : render::preview_options()) {
+        if (o.default_text.empty()) continue;
+        EXPECT_TRUE(set_text_option(o, o.default_text, from_texts)) << o.name << " default '" << o.default_text << "'";
+    }
+    EXPECT_TRUE(from_texts == render::PreviewOptions{});
+    // The node's defaults are the CLI's, except the named preset (size 480x270).
+    int presets = 0;
+    for (const auto& o : render::preview_options()) {
+        const ParamDecl* p = d.find_param(o.name);
+        ASSERT_TRUE(p) << o.name;
+        std::string cli_default = o.default_text;
+        for (const auto& [name, text] : render::preview_node_defaults())
+            if (name == std::string(o.name)) cli_default = text, ++presets;
+        render::PreviewOptions node, cli;
+        ASSERT_TRUE(set_text_option(o, text_option_text(o, p->default_value), node)) << o.name;
+        ASSERT_TRUE(set_text_option(o, cli_default, cli)) << o.name;
+        EXPECT_TRUE(node == cli) << o.name << ": node default " << format_param_value(p->default_value) << ", CLI '" << cli_default << "'";
+    }
+    EXPECT_EQ(presets, 1);
+    EXPECT_EQ(std::get<std::vector<double>>(d.find_param("size")->default_value), (std::vector<double>{480, 270}));
+    // A negative control: a different default is seen as different.
+    render::PreviewOptions a, b;
+    ASSERT_TRUE(set_text_option(*find_option(render::preview_options(), "fov"), "40", b));
+    EXPECT_FALSE(a == b);
+    // The spellings' help names every option they set; --sun's default is the library's preview sun.
+    CliRun help = run("preview --help");
+    for (const auto& sp : render::preview_cli_spellings()) EXPECT_NE(help.out.find(std::string("  ") + sp.cli_flag), std::string::npos) << sp.cli_flag;
+    for (const auto& o : render::preview_options())
+        if (o.cli_flag) {
+            EXPECT_NE(help.out.find(std::string("  ") + o.cli_flag + " "), std::string::npos) << o.cli_flag;
+        }
+    EXPECT_NE(help.out.find("default 230,25"), std::string::npos) << help.out;
 }
 
 } // namespace

@@ -73,8 +73,8 @@ TEST(RenderPreviewNode, NeedsAnNvdfSet) {
 TEST(RenderPreviewNode, LightsSkyAndFlashParamsReachTheRenderer) {
     auto set = nvdf_set();
     const std::vector<double> size{20, 12};
-    const std::vector<double> horizon{0.9, 0.8, 0.6};
-    auto out = cook({{"size", size}, {"lights", std::string("50 50 50 1 0.5 0.2 2e4; 10 20 30 0 0 1 1e3 40")}, {"sky_horizon", horizon}},
+    // sky_horizon takes 'auto' (the look's) or three numbers, as atlas preview's --sky.
+    auto out = cook({{"size", size}, {"lights", std::string("50 50 50 1 0.5 0.2 2e4; 10 20 30 0 0 1 1e3 40")}, {"sky_horizon", std::string("0.9,0.8,0.6")}},
                     {{"nvdf", set}});
     auto image = std::get<Field2DPtr>(out.at("image"));
     // The same through the library.
@@ -93,6 +93,12 @@ TEST(RenderPreviewNode, LightsSkyAndFlashParamsReachTheRenderer) {
     auto plain = std::get<Field2DPtr>(cook({{"size", size}}, {{"nvdf", set}}).at("image"));
     EXPECT_FALSE(*flash == *plain);
     EXPECT_THROW(cook({{"lights", std::string("1 2 3")}}, {{"nvdf", set}}), Error);
+    // The graph's load-time check refuses what the schema refuses.
+    NodeDeclaration d;
+    builtin_nodes().find("render/preview")->declare(d);
+    EXPECT_NE(d.find_param("sky_horizon")->check(std::string("0.9,0.8")), "");
+    EXPECT_EQ(d.find_param("sky_horizon")->check(std::string("auto")), "");
+    EXPECT_NE(d.find_param("lights")->check(std::string("1 2 3")), "");
 }
 
 TEST(RenderPreviewNode, TheSunDefaultIsThePreviewSunOfTheLibrary) {
@@ -125,7 +131,12 @@ TEST(RenderPreviewNode, RendersAnNdfSetIn25DAsTheLibraryEntryDoes) {
     in.ndf = m;
     const render::LayerScene layer = render::layer_preview_scene(in);
     render::RenderSettings s = render::layer_preview_settings(layer, 24, 14, render::LayerView::Orbit, 30, 20);
-    auto r = render::render_layer(layer, s);
+    // Envelope auto (atlas preview's rule, which the node now shares): on above the
+    // lowest cloud base (1500 m), the cone map over the cloud tops.
+    ASSERT_GT(s.camera.position[2], 1500);
+    render::LayerScene with_envelope = layer;
+    with_envelope.envelope.cone_map = render::cloud_top_cone_map(*layer.ndf);
+    auto r = render::render_layer(with_envelope, s);
     EXPECT_TRUE(r.image == *image);
     float min_t = 1;
     for (float v : image->channel(3)) min_t = std::min(min_t, v);

@@ -86,6 +86,17 @@ std::string yaml_to_param(const YAML::Node& n, const ParamDecl& decl, ParamValue
         out = v;
         return "";
     }
+    if (decl.type == ParamType::String && decl.check_text && n.IsSequence()) {
+        // A schema text option that takes numbers (sky_colour: [0.1, 0.2, 0.5]): its
+        // comma-separated text, checked by the schema.
+        std::string text;
+        for (const auto& e : n) {
+            if (!e.IsScalar()) return "expected numbers in the list";
+            text += (text.empty() ? "" : ",") + e.Scalar();
+        }
+        out = text;
+        return "";
+    }
     if (!n.IsScalar()) return "expected a single " + std::string(param_type_name(decl.type)) + " value";
     const std::string& s = n.Scalar();
     switch (decl.type) {

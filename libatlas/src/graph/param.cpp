@@ -91,7 +91,8 @@ std::string ParamDecl::check(const ParamValue& v) const {
         return std::holds_alternative<bool>(v) ? "" : "expected true or false";
     case ParamType::String:
     case ParamType::Path:
-        return std::holds_alternative<std::string>(v) ? "" : "expected a string";
+        if (!std::holds_alternative<std::string>(v)) return "expected a string";
+        return type == ParamType::String && check_text ? check_text(std::get<std::string>(v)) : "";
     case ParamType::Enum: {
         if (!std::holds_alternative<std::string>(v)) return "expected one of the names listed for it";
         const auto& s = std::get<std::string>(v);

@@ -7,8 +7,11 @@
 #include "atlas/ndf/vertical_profile.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 namespace atlas::render {
@@ -166,6 +169,188 @@ std::vector<PointLight> parse_point_lights(const std::string& text) {
         lights.push_back(l);
     }
     return lights;
+}
+
+
+Box3d cloud_bounds(const CloudScene& scene) {
+    const Field3D& sdf = *scene.sdf;
+    const int c = std::max(0, sdf.find_channel("sdf"));
+    Vec3i lo{{sdf.nx(), sdf.ny(), sdf.nz()}}, hi{{-1, -1, -1}};
+    for (int z = 0; z < sdf.nz(); ++z)
+        for (int y = 0; y < sdf.ny(); ++y)
+            for (int x = 0; x < sdf.nx(); ++x)
+                if (sdf.at(c, x, y, z) < 0) {
+                    lo = {{std::min(lo[0], x), std::min(lo[1], y), std::min(lo[2], z)}};
+                    hi = {{std::max(hi[0], x), std::max(hi[1], y), std::max(hi[2], z)}};
+                }
+    const Box3d b = sdf.bounds();
+    if (hi[0] < 0) return b;
+    const Vec3d v = sdf.voxel_size();
+    Box3d r;
+    for (int a = 0; a < 3; ++a) {
+        r.min[a] = b.min[a] + lo[a] * v[a];
+        r.max[a] = b.min[a] + (hi[a] + 1) * v[a];
+    }
+    return r;
+}
+
+namespace {
+
+// The voxel view presets (ground, aerial, orbit) over the clouds' box.
+Camera voxel_camera(const CloudScene& scene, PreviewView view, double aspect, double azimuth, double elevation) {
+    const Box3d b = cloud_bounds(scene);
+    if (view == PreviewView::Ground || view == PreviewView::Auto) {
+        // From the ground at the south edge of the clouds, 2 m up (or under the
+        // lowest base when the clouds float high), pitched up so the bases and
+        // the lit flanks fill the frame: how cumulus is seen and photographed.
+        Camera c;
+        c.fov_deg = 60;
+        const Vec3d size = b.max - b.min;
+        const double ground = scene.modeling->bounds().min[2];
+        c.position = {{0.5 * (b.min[0] + b.max[0]), b.min[1] - 0.1 * size[1], std::max(ground + 2.0, b.min[2] - 0.25 * size[2])}};
+        c.look_at = {{0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), b.max[2] + 0.25 * size[2]}};
+        return c;
+    }
+    if (view == PreviewView::Aerial) return framing_camera(b, aspect, 30, 55);
+    return framing_camera(b, aspect, azimuth, elevation);
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// Lightning over the layer: flashes placed by the set's storm (or rain, or coverage) channel,
+// 20-60 % up the columns that can flash (in-cloud flashes).
+Field3DPtr layer_lightning_probability(const Field2D& set) {
+    int ch = -1;
+    for (const char* name : {"superstorm_coverage", "precipitation", "coverage"}) {
+        const int c = set.find_channel(name);
+        if (c < 0) continue;
+        auto d = set.channel(c);
+        if (std::any_of(d.begin(), d.end(), [](float x) { return x > 0; })) {
+            ch = c;
+            break;
+        }
+    }
+    if (ch < 0) throw Error("lightning: the NDF set has no storm, rain or coverage to place flashes in");
+    const int cmn = set.find_channel("min_height"), cmx = set.find_channel("max_height");
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int y = 0; y < set.height(); ++y)
+        for (int x = 0; x < set.width(); ++x)
+            if (set.at(ch, x, y) > 0) lo = std::min(lo, double(set.at(cmn, x, y))), hi = std::max(hi, double(set.at(cmx, x, y)));
+    return layer_flash_probability(set, ch, lo + 0.2 * (hi - lo), lo + 0.6 * (hi - lo) + 1e-3);
+}
+
+} // namespace
+
+PreviewJob prepare_preview(std::optional<CloudScene> voxel, std::optional<LayerScene> layer, const PreviewOptions& o, PreviewLook look,
+                           Field3DPtr flash_probability, int threads) {
+    check_preview_options(o);
+    if (!voxel && !layer) throw Error("preview: nothing to draw (no voxel scene and no 2.5D layer)");
+    PreviewJob job;
+    if (voxel) {
+        voxel->noise_tile = o.noise_tile;
+        validate_scene(*voxel);
+    }
+    if (layer) {
+        layer->time = o.time;
+        layer->earth_radius = o.earth_radius;
+        layer->wind = o.wind;
+        if (o.edge) layer->edge = *o.edge; // else layer_preview_scene's choice: Empty for a storm, else Wrap
+        validate_layer_scene(*layer);
+    }
+    const int w = o.size[0], h = o.size[1];
+    const Box3d bounds = voxel ? voxel->modeling->bounds() : Box3d{{{0, 0, 0}}, {{1, 1, 1}}};
+    RenderSettings s = preview_settings(bounds, w, h);
+    const double aspect = double(w) / h;
+    if (layer) {
+        const LayerView kind = o.view == PreviewView::Aerial   ? LayerView::Aerial
+                               : o.view == PreviewView::Orbit  ? LayerView::Orbit
+                               : o.view == PreviewView::Ground ? LayerView::Ground
+                               : look == PreviewLook::Graph    ? LayerView::Ground
+                                                               : LayerView::Orbit;
+        // The 2.5D daylight look and camera preset.
+        s = layer_preview_settings(*layer, w, h, kind, o.azimuth, o.elevation);
+    } else if (o.view != PreviewView::Auto || look == PreviewLook::Graph) {
+        s.camera = voxel_camera(*voxel, o.view, aspect, o.azimuth, o.elevation);
+    } else {
+        s.camera = framing_camera(bounds, aspect, o.azimuth, o.elevation);
+    }
+    s.threads = threads;
+    // A graph's voxel clouds get the 2.5D mode's daylight.
+    if (voxel && !layer && look == PreviewLook::Graph) apply_voxel_daylight(s);
+    if (o.manual_camera) {
+        s.camera.position = o.position;
+        s.camera.look_at = o.look_at;
+    }
+    if (layer) {
+        // Envelope skipping pays off looking down on the layer (a ground view
+        // starts under the clouds, where the cone map over the tops cannot
+        // help): auto = on when the camera is above the lowest cloud base.
+        PreviewEnvelope env = o.envelope;
+        if (env == PreviewEnvelope::Auto) {
+            const int cmin = layer->ndf->find_channel("min_height");
+            float lowest = std::numeric_limits<float>::infinity();
+            for (float v : layer->ndf->channel(cmin)) lowest = std::min(lowest, v);
+            env = s.camera.position[2] > lowest ? PreviewEnvelope::On : PreviewEnvelope::Off;
+        }
+        if (env == PreviewEnvelope::Off) layer->envelope = {};
+        if (env == PreviewEnvelope::On && !layer->envelope.cone_map && layer->ndf->width() > 2) {
+            const auto t = std::chrono::steady_clock::now();
+            layer->envelope.cone_map = cloud_top_cone_map(*layer->ndf);
+            char buf[128];
+            std::snprintf(buf, sizeof buf, "envelope: cone map over the cloud tops (%dx%d) in %.2f s", layer->ndf->width(), layer->ndf->height(),
+                          seconds_since(t));
+            job.notes.push_back(buf);
+        }
+    }
+    if (o.fov > 0) s.camera.fov_deg = o.fov;
+    s.sun_direction = sun_direction(o.sun_azimuth, o.sun_elevation);
+    if (o.sun_colour) s.sun_colour = *o.sun_colour;
+    s.quality = o.quality;
+    s.extinction = o.extinction;
+    s.mode = o.mode;
+    if (o.sky_colour) s.sky_colour = *o.sky_colour;
+    if (o.sky_horizon) s.sky_horizon = *o.sky_horizon;
+    s.lights.insert(s.lights.end(), o.lights.begin(), o.lights.end());
+    if (o.lightning && !flash_probability) {
+        if (!layer) throw Error("lightning places flashes over a 2.5D layer; this preview has no NDF set");
+        flash_probability = layer_lightning_probability(*layer->ndf);
+    }
+    if (flash_probability) {
+        LightField f;
+        f.probability = flash_probability;
+        f.colour = o.flash_colour;
+        f.intensity = o.flash_intensity;
+        f.radius = o.flash_radius;
+        f.seed = uint32_t(o.flash_seed);
+        f.flash = int32_t(o.flash_index);
+        f.count = int(o.flash_count);
+        s.light_fields.push_back(f);
+    }
+    job.voxel = std::move(voxel);
+    job.layer = std::move(layer);
+    job.settings = std::move(s);
+    job.exposure = o.exposure;
+    return job;
+}
+
+PreviewFrame render_preview(const PreviewJob& job, const ProgressSink* progress) {
+    if (!job.voxel && !job.layer) throw Error("preview: nothing to draw (no voxel scene and no 2.5D layer)");
+    std::optional<Field2D> image;
+    std::optional<LayerReport> layer_report;
+    std::optional<RenderReport> voxel_report;
+    if (job.layer) {
+        LayerResult r = render_layer(*job.layer, job.settings, progress);
+        layer_report = r.report;
+        image = std::move(r.image);
+    }
+    if (job.voxel) {
+        RenderResult r = render_clouds(*job.voxel, job.settings, progress);
+        voxel_report = r.report;
+        image = image ? composite_over(r.image, *image, job.settings) : std::move(r.image);
+    }
+    return PreviewFrame{std::move(*image), std::move(layer_report), std::move(voxel_report)};
 }
 
 } // namespace atlas::render

@@ -69,17 +69,22 @@ const NumberOption<T>* find_option(std::span<const NumberOption<T>> schema, std:
 // front end parses through parse_text_option, so they accept the same values.
 
 enum class OptionKind {
-    Number,  // a finite decimal number in [min, max] (a leading '+' and surrounding blanks allowed)
-    Integer, // a whole decimal number in [min, max], or one of `words`
+    Number,  // a finite decimal number in [min, max] (a leading '+' and surrounding blanks allowed),
+             // or one of `words`; with count > 1, `count` of them separated by `separator`
+    Integer, // a whole decimal number in [min, max], or one of `words`; with count > 1, `count`
+             // of them separated by `separator` (no words)
     Flag,    // true/1/yes/on or false/0/no/off; a CLI flag takes no value and means true
     Choice,  // one of `words`
     List,    // comma-separated non-empty items, each one of `words` (any name when `words` is empty)
     Range,   // "lo,hi": two finite numbers in [min, max] with hi > lo
+    Text,    // free text that `check_text` accepts (e.g. a list of point lights)
 };
 
 // What parse_text_option made of an option's text.
 struct OptionValue {
-    double number = 0;              // Number; Integer when no word was given
+    double number = 0;              // Number; Integer when no word was given (the first of `numbers`)
+    std::vector<double> numbers;    // Number, Integer: the `count` numbers (empty when a word was given)
+    std::string text;               // Text: the text as given
     std::string word;               // Choice; Integer when one of its words was given
     std::vector<std::string> items; // List
     double lo = 0, hi = 0;          // Range
@@ -95,6 +100,18 @@ struct TextOptionSpec {
     double min = -std::numeric_limits<double>::infinity(); // Number, Integer, Range: inclusive
     double max = std::numeric_limits<double>::infinity();
     std::vector<std::string> words; // see OptionKind
+    // Number, Integer: how many numbers the value has, and what separates them in text.
+    int count = 1;
+    char separator = ',';
+    // The value when the option is not given, as text this option parses ("" when the
+    // struct's own default applies and is described in `doc`); node parameters declared
+    // from the schema take it as their default.
+    std::string default_text;
+    // Text: "" when the text is a valid value, else why not; `metavar` says its form.
+    std::string (*check_text)(std::string_view text) = nullptr;
+    // A CLI flag that may be given more than once; its values are joined with ';'.
+    bool repeatable = false;
+    const char* unit = "";
 
     // What a value must be ("an integer in [1, 16] or 'full'"), for messages and docs.
     std::string expected() const;
@@ -116,6 +133,7 @@ inline bool parse_finite(std::string_view text, double& out) {
     return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(out);
 }
 inline std::string number_text(double v) {
+    if (v == std::floor(v) && std::fabs(v) < 1e15) return std::to_string(static_cast<long long>(v)); // integers whole: 4294967295
     std::ostringstream os;
     os.precision(9);
     os << v;
@@ -145,8 +163,15 @@ inline std::string TextOptionSpec::expected() const {
                                          : "") +
                                (as_float ? " (a 32-bit float)" : "");
     switch (kind) {
-    case OptionKind::Number: return "a finite number" + bounds;
-    case OptionKind::Integer: return "an integer" + bounds + (words.empty() ? "" : " or " + detail::quoted_words(words, " or "));
+    case OptionKind::Number:
+    case OptionKind::Integer: {
+        const bool integer = kind == OptionKind::Integer;
+        const std::string n = count > 1 ? std::to_string(count) + (integer ? " integers" : " finite numbers") + bounds + " separated by '" +
+                                              std::string(1, separator) + "'"
+                                        : (integer ? "an integer" : "a finite number") + bounds;
+        return n + (words.empty() ? "" : " or " + detail::quoted_words(words, " or "));
+    }
+    case OptionKind::Text: return std::string("text of the form ") + metavar;
     case OptionKind::Flag: return "true or false";
     case OptionKind::Choice: return detail::quoted_words(words, " or ");
     case OptionKind::List:
@@ -161,18 +186,38 @@ inline std::string TextOptionSpec::expected() const {
 inline bool parse_text_option(const TextOptionSpec& o, std::string_view text, OptionValue& out) {
     const std::string_view s = detail::trim_blanks(text);
     switch (o.kind) {
-    case OptionKind::Number: return detail::parse_finite(s, out.number) && out.number >= o.min && out.number <= o.max;
+    case OptionKind::Number:
     case OptionKind::Integer: {
+        out.numbers.clear();
         if (detail::is_word(o.words, s)) {
             out.word = std::string(s);
             return true;
         }
-        long long n = 0;
-        const auto r = std::from_chars(s.data(), s.data() + s.size(), n);
-        if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size() || double(n) < o.min || double(n) > o.max) return false;
-        out.number = double(n);
+        out.word.clear();
+        size_t start = 0;
+        for (int i = 0; i < o.count; ++i) {
+            const size_t sep = i + 1 < o.count ? s.find(o.separator, start) : s.size();
+            if (sep == std::string_view::npos) return false;
+            const std::string_view part = detail::trim_blanks(s.substr(start, sep - start));
+            double v = 0;
+            if (o.kind == OptionKind::Number) {
+                if (!detail::parse_finite(part, v)) return false;
+            } else {
+                long long n = 0;
+                const auto r = std::from_chars(part.data(), part.data() + part.size(), n);
+                if (part.empty() || r.ec != std::errc() || r.ptr != part.data() + part.size()) return false;
+                v = double(n);
+            }
+            if (v < o.min || v > o.max) return false;
+            out.numbers.push_back(v);
+            start = sep + 1;
+        }
+        out.number = out.numbers.front();
         return true;
     }
+    case OptionKind::Text:
+        out.text = std::string(text);
+        return !o.check_text || o.check_text(text).empty();
     case OptionKind::Flag:
         out.flag = s == "true" || s == "1" || s == "yes" || s == "on";
         return out.flag || s == "false" || s == "0" || s == "no" || s == "off";

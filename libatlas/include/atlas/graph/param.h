@@ -4,6 +4,7 @@
 #include "atlas/core/math.h"
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <variant>
@@ -44,6 +45,9 @@ struct ParamDecl {
     std::string unit;               // "m", "1/m", "cells", "" for none
     std::string doc;                // one line
     std::vector<std::string> choices; // Enum only
+    // String only: "" when the text is a valid value, else why not (a text option of a
+    // library schema, atlas/graph/option_params.h); checked with the type.
+    std::function<std::string(const std::string&)> check_text;
 
     // Fluent setters for declarations.
     ParamDecl& range(double lo, double hi) { min = lo; max = hi; return *this; }

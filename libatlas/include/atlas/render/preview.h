@@ -10,8 +10,10 @@
 #include "atlas/core/field.h"
 #include "atlas/render/layer.h"
 #include "atlas/render/lights.h"
+#include "atlas/render/preview_options.h"
 #include "atlas/render/renderer.h"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -82,5 +84,49 @@ void apply_voxel_daylight(RenderSettings& s);
 // commas and/or spaces. Empty items are skipped. Throws atlas::Error quoting
 // the bad item (syntax only: the renderer checks the values, validate_light).
 std::vector<PointLight> parse_point_lights(const std::string& text);
+
+// ---------------------------------------------------------------------------
+// The one library entry of a preview, for `atlas preview` and the render/preview
+// node alike: options (PreviewOptions, atlas/render/preview_options.h) in, the
+// render calls' settings out, then the picture.
+
+// Whose clouds: a graph's (`atlas preview GRAPH`: voxel clouds get the 2.5D
+// daylight look, the auto view is the ground view) or given fields (`atlas preview
+// FILES`, the render/preview node: the plain look, the auto view orbits, framing the
+// whole volume).
+enum class PreviewLook { Fields, Graph };
+
+// A preview ready to render: the scenes with the options applied and the settings
+// of every render call.
+struct PreviewJob {
+    std::optional<CloudScene> voxel; // voxel clouds (over the layer when both are set)
+    std::optional<LayerScene> layer; // the 2.5D layer
+    RenderSettings settings;
+    double exposure = 1.5;           // PNG tone map (tone_map)
+    std::vector<std::string> notes;  // work done on the way, for a log ("envelope: cone map ...")
+};
+
+// Applies the options to the scenes (noise_tile; time, wind, earth_radius, edge and
+// the envelope of the layer) and builds the settings, in this order: the view preset
+// (layer_preview_settings for a layer; the voxel presets of PreviewView), the look,
+// the manual camera, fov, sun, sky, march, lights, the physical model, flash lights
+// (from `flash_probability`, else with `lightning` placed over the layer's set).
+// threads: RenderSettings::threads. Throws atlas::Error on invalid options or
+// scenes, or when neither scene is given.
+PreviewJob prepare_preview(std::optional<CloudScene> voxel, std::optional<LayerScene> layer, const PreviewOptions& options, PreviewLook look,
+                           Field3DPtr flash_probability = nullptr, int threads = 0);
+
+// One picture of the job: the layer, the voxel clouds, or the clouds composited
+// over the layer (composite_over); the reports of the calls that ran.
+struct PreviewFrame {
+    Field2D image; // r, g, b linear radiance, transmittance
+    std::optional<LayerReport> layer_report;
+    std::optional<RenderReport> voxel_report;
+};
+PreviewFrame render_preview(const PreviewJob& job, const ProgressSink* progress = nullptr);
+
+// The box around the voxels that hold cloud (SDF < 0), or the whole bounds when none
+// does: what the voxel view presets frame.
+Box3d cloud_bounds(const CloudScene& scene);
 
 } // namespace atlas::render
