@@ -30,7 +30,8 @@ std::vector<OptionDecl> with_preview_flags(std::vector<OptionDecl> head, std::ve
 
 std::string schema_flag_doc(const TextOptionSpec& o) {
     const bool names = o.kind == OptionKind::Choice || o.kind == OptionKind::List;
-    return o.doc + (names && !o.words.empty() ? ": " + o.expected() : "") + (o.default_text.empty() ? "" : " (default " + o.default_text + ")");
+    return o.doc + (names && !o.words.empty() ? ": " + o.expected() : "") + (o.default_text.empty() ? "" : " (default " + o.default_text + ")") +
+           (o.repeatable ? "; repeatable" : "");
 }
 
 const std::vector<Command>& commands() {
