@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 namespace atlas::volume::detail {
 namespace {
@@ -150,8 +151,9 @@ uint64_t mesh_signed_distance(const MeshLineHits& hits, const UnionSurface& us, 
     for (int a = 0; a < 3; ++a) h[a] = (bounds.max[a] - bounds.min[a]) / res[a];
     const double h2[3] = {h[0] * h[0], h[1] * h[1], h[2] * h[2]};
     const Seeds seeds[3] = {line_seeds(hits.axis[0], us), line_seeds(hits.axis[1], us), line_seeds(hits.axis[2], us)};
-    std::vector<float> work(count);
-    std::vector<int16_t> cnt(count);
+    // Every value is written by pass 1 before pass 2 reads it: no zero fill.
+    const std::unique_ptr<float[]> work(new float[count]);
+    const std::unique_ptr<int16_t[]> cnt(new int16_t[count]);
 
     // Pass 1: per z-slab.
     tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
@@ -162,7 +164,7 @@ uint64_t mesh_signed_distance(const MeshLineHits& hits, const UnionSurface& us, 
         std::vector<int> cb(size_t(nx), 0), ct(size_t(nx), 0);
         Scratch sc;
         for (int z = r.begin(); z < r.end(); ++z) {
-            float* W = work.data() + size_t(z) * sxy;
+            float* W = work.get() + size_t(z) * sxy;
             float* C = out + size_t(z) * sxy;
             // Family x: S_x along rows, then E_y down the columns.
             bool any_x = false;
@@ -267,7 +269,7 @@ uint64_t mesh_signed_distance(const MeshLineHits& hits, const UnionSurface& us, 
                 }
                 std::copy(A.begin(), A.end(), C);
             } else std::fill(C, C + sxy, kInf);
-            std::copy(K.begin(), K.end(), cnt.data() + size_t(z) * sxy);
+            std::copy(K.begin(), K.end(), cnt.get() + size_t(z) * sxy);
         }
     });
 
