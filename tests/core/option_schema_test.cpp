@@ -106,5 +106,70 @@ TEST(OptionSchema, ChoiceListFlagAndRange) {
     EXPECT_FALSE(parse_text_option(bounded, "0,11", v));
 }
 
+// Vectors (count > 1): each part read as the scalar kind reads it, split at the
+// separator by hand here (an independent reader: std::string::find + strtod).
+TEST(OptionSchema, VectorsTakeCountPartsEachAsTheScalarKind) {
+    TextOptionSpec three{"v", nullptr, "X,Y,Z", OptionKind::Number, "", -1, 1};
+    three.count = 3;
+    TextOptionSpec size{"s", nullptr, "WxH", OptionKind::Integer, "", 1, 8192};
+    size.count = 2;
+    size.separator = 'x';
+    TextOptionSpec colour = three;
+    colour.words = {"auto"};
+    auto reference = [](const TextOptionSpec& o, const std::string& text, std::vector<double>& out) {
+        out.clear();
+        size_t start = 0;
+        for (int i = 0; i < o.count; ++i) {
+            const size_t at = i + 1 < o.count ? text.find(o.separator, start) : text.size();
+            if (at == std::string::npos) return false;
+            const std::string part = trimmed(text.substr(start, at - start));
+            double x = 0;
+            if (o.kind == OptionKind::Number) {
+                if (!reference_number(part, o.min, o.max, x)) return false;
+            } else {
+                if (part.empty() || part.find_first_not_of("+-0123456789") != std::string::npos || part[0] == '+') return false;
+                char* end = nullptr;
+                x = double(std::strtoll(part.c_str(), &end, 10));
+                if (*end != '\0' || x < o.min || x > o.max) return false;
+            }
+            out.push_back(x);
+            start = at + 1;
+        }
+        return true;
+    };
+    const std::vector<std::string> texts{"0,0,0", " 1 , -1 ,0.5", "1,2,0", "0,0", "0,0,0,0", "0,,0", ",0,0", "0,0,", "nan,0,0", "0,0,inf",
+                                         "1x1", "8192x8192", "8193x1", "0x5", "2.5x3", "-1x2", "12x", "x12", "12x34x56", " 640 x 480 ", "auto",
+                                         "autox", "1e0,0,0", "+1,0,0"};
+    for (const TextOptionSpec* o : {&three, &size}) {
+        for (const std::string& t : texts) {
+            OptionValue v;
+            std::vector<double> want;
+            const bool ok = reference(*o, t, want);
+            EXPECT_EQ(parse_text_option(*o, t, v), ok) << o->name << " '" << t << "'";
+            if (ok) {
+                EXPECT_EQ(v.numbers, want) << t;
+                EXPECT_EQ(v.number, want[0]) << t;
+            }
+        }
+    }
+    OptionValue v;
+    EXPECT_TRUE(parse_text_option(colour, "auto", v));
+    EXPECT_EQ(v.word, "auto");
+    EXPECT_TRUE(v.numbers.empty());
+    EXPECT_TRUE(parse_text_option(colour, "0.5,0.5,0.5", v));
+    EXPECT_TRUE(v.word.empty());
+    EXPECT_EQ(v.numbers.size(), 3u);
+    EXPECT_FALSE(parse_text_option(three, "auto", v));
+    EXPECT_EQ(three.expected(), "3 finite numbers in [-1, 1] separated by ','");
+    EXPECT_EQ(size.expected(), "2 integers in [1, 8192] separated by 'x'");
+    EXPECT_EQ(colour.expected(), "3 finite numbers in [-1, 1] separated by ',' or 'auto'");
+    // Text: whatever check_text accepts, kept as given.
+    TextOptionSpec text{"t", nullptr, "A;B", OptionKind::Text, ""};
+    text.check_text = [](std::string_view s) { return s.find('!') == std::string_view::npos ? std::string() : std::string("no '!'"); };
+    EXPECT_TRUE(parse_text_option(text, " a; b ", v));
+    EXPECT_EQ(v.text, " a; b ");
+    EXPECT_FALSE(parse_text_option(text, "a!", v));
+}
+
 } // namespace
 } // namespace atlas

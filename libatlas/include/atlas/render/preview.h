@@ -109,7 +109,8 @@ struct PreviewJob {
 // Applies the options to the scenes (noise_tile; time, wind, earth_radius, edge and
 // the envelope of the layer) and builds the settings, in this order: the view preset
 // (layer_preview_settings for a layer; the voxel presets of PreviewView), the look,
-// the manual camera, fov, sun, sky, march, lights, the physical model, flash lights
+// the manual camera, the layer's envelope (auto: on when the camera is above the lowest
+// cloud base), fov, sun, sky, march, lights, flash lights
 // (from `flash_probability`, else with `lightning` placed over the layer's set).
 // threads: RenderSettings::threads. Throws atlas::Error on invalid options or
 // scenes, or when neither scene is given.
