@@ -83,8 +83,9 @@ Field3D mesh_to_sdf(const Mesh& mesh, Vec3i res, Box3d bounds, const MeshSdfOpti
 Field3D density_from_sdf(const Field3D& sdf, int channel = 0);
 
 // OpenVDB pipeline, for comparison: meshToUnsignedDistanceField in a 3-voxel
-// band, signed by the ray-winding vote, extended over the whole grid by
-// OpenVDB fast sweeping (tools::maskSdf; first order). Cubic voxels only.
+// band (straddling triangles of overlapping parts measured to their unburied
+// part), extended over the whole grid by the same exact EDT to the grid-line
+// crossings as mesh_to_sdf, signed by the ray-winding vote. Cubic voxels only.
 Field3D mesh_to_sdf_openvdb(const Mesh& mesh, Vec3i res, Box3d bounds, const MemoryBudget* budget = nullptr,
                             MeshSdfStats* stats = nullptr);
 
