@@ -7,7 +7,8 @@
 # Per scene: atlas preview --artistic off --export-scene (the scene for Cycles), then
 #   - Cycles with --ref-spp samples (default 512) and 128 volume bounces: the reference;
 #   - the preview at its defaults (--artistic off and on), across --quality (march steps)
-#     and --light-grid (the sun's light grid) and single scattering (--ms-octaves 0);
+#     and --light-grid (the sun's light grid), the octaves without the diffusion term
+#     (--ms-diffusion off) and single scattering (--ms-octaves 0);
 #   - Cycles at 1, 4, 16, 64 samples (another seed): its error and time.
 # Writes OUT/results.csv, OUT/table.md and docs/images/cycles_error_vs_time.png (matplotlib).
 # --smoke: one scene, 64x36, 8 reference samples, no plot (CI: checks the pipeline runs).
@@ -94,6 +95,9 @@ for entry in "${SCENES[@]}"; do
       t=$(atlas "$d/g$g.exr" $args --artistic off --light-grid $g --export-scene "$d/scene_g")
       row "$name" atlas "artistic off; light grid ${g//,/x}" "$t" "$d/g$g.exr" "$ref"
     done
+    # shellcheck disable=SC2086
+    t=$(atlas "$d/octaves.exr" $args --artistic off --ms-diffusion off --export-scene "$d/scene_oct")
+    row "$name" atlas "artistic off; octaves only (no diffusion)" "$t" "$d/octaves.exr" "$ref"
     # shellcheck disable=SC2086
     t=$(atlas "$d/ss.exr" $args --artistic off --ms-octaves 0 --export-scene "$d/scene_ss")
     row "$name" atlas "artistic off; single scattering" "$t" "$d/ss.exr" "$ref"

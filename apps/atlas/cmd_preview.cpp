@@ -248,7 +248,7 @@ void write_picture_atomic(const Field2D& image, const std::filesystem::path& pat
     write_file_atomic(path, [&](const std::filesystem::path& tmp) { write_picture(image, tmp, exposure); });
 }
 
-// --artistic on|off, --ms-octaves N, --light-grid NX,NY,NZ (docs/render.md, "Reference: Cycles").
+// --artistic on|off, --ms-octaves N, --ms-diffusion on|off[,SWEEPS], --light-grid NX,NY,NZ (docs/render.md, "Reference: Cycles").
 void apply_physics_options(const Args& a, render::RenderSettings& s) {
     if (a.has("--artistic")) {
         const std::string v = a.get("--artistic");
@@ -256,6 +256,7 @@ void apply_physics_options(const Args& a, render::RenderSettings& s) {
         if (v == "off") {
             s.artistic = false;
             s.ms_octaves = render::kPhysicalMsOctaves;
+            s.ms_diffusion = true; // docs/render.md, "Multiple scattering by diffusion"
             s.multiple_scattering = 1;
             s.ambient_strength = 1;
             // One Henyey-Greenstein lobe with the dual lobe's mean cosine
@@ -275,6 +276,15 @@ void apply_physics_options(const Args& a, render::RenderSettings& s) {
         s.ms_octaves = static_cast<int>(v[0]);
         if (four) s.ms_energy = v[1], s.ms_extinction = v[2], s.ms_anisotropy = v[3];
         if (commas == 4) s.ms_scatter_power = v[4];
+    }
+    if (a.has("--ms-diffusion")) {
+        if (s.artistic) throw UsageError{"--ms-diffusion sets the physical model's multiple scattering; it needs --artistic off", "preview"};
+        const std::string t = a.get("--ms-diffusion");
+        const auto comma = t.find(',');
+        const std::string v = t.substr(0, comma);
+        if (v != "on" && v != "off") throw UsageError{"--ms-diffusion expects on or off[,SWEEPS], got '" + t + "'", "preview"};
+        s.ms_diffusion = v == "on";
+        if (comma != std::string::npos) s.ms_diffusion_sweeps = static_cast<int>(numbers(t.substr(comma + 1), 1, "--ms-diffusion")[0]);
     }
     if (a.has("--light-grid")) {
         auto v = numbers(a.get("--light-grid"), 3, "--light-grid");

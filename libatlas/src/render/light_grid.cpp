@@ -18,12 +18,13 @@ double exit_distance(const Box3d& b, const Vec3d& p, const Vec3d& d) {
     return std::isfinite(t1) ? std::max(0.0, t1) : 0.0;
 }
 
-LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_(res), bounds_(cloud.bounds()) {
+LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_(res), bounds_(cloud.bounds()), sun_dir_(sun_dir) {
     for (int a = 0; a < 3; ++a) voxel_[a] = bounds_.size()[a] / res_[a];
     const size_t n = size_t(res_[0]) * size_t(res_[1]) * size_t(res_[2]);
     const size_t row = size_t(res_[0]), slab = row * size_t(res_[1]);
     // 1. The cloud's density at the grid's voxel centres (no near-camera detail).
-    std::vector<float> dens(n);
+    dens_.assign(n, 0.0f);
+    std::vector<float>& dens = dens_;
     tbb::parallel_for(0, res_[2], [&](int z) {
         for (int y = 0; y < res_[1]; ++y)
             for (int x = 0; x < res_[0]; ++x) {

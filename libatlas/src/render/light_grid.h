@@ -17,13 +17,22 @@ public:
     float sun(double x, double y, double z) const { return sample(sun_, x, y, z); }
     float sky(double x, double y, double z) const { return sample(sky_, x, y, z); }
     double voxel_min() const { return std::min({voxel_[0], voxel_[1], voxel_[2]}); }
+    // The grid itself (x fastest): density at the voxel centres and the
+    // summed density toward the sun from them (the diffusion term's input).
+    Vec3i resolution() const { return res_; }
+    const Vec3d& voxel() const { return voxel_; }
+    const Box3d& bounds() const { return bounds_; }
+    const std::vector<float>& density() const { return dens_; }
+    const std::vector<float>& sun_depths() const { return sun_; }
+    const Vec3d& sun_direction() const { return sun_dir_; }
 
 private:
     float sample(const std::vector<float>& g, double x, double y, double z) const;
     Vec3i res_;
     Box3d bounds_;
     Vec3d voxel_;
-    std::vector<float> sun_, sky_;
+    Vec3d sun_dir_;
+    std::vector<float> dens_, sun_, sky_;
 };
 
 // Length of the ray p + t*d (t >= 0) inside box b (0 when it misses).

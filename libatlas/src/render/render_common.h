@@ -97,8 +97,11 @@ inline SunTerms sun_terms(const RenderSettings& s, double cos_theta) {
 //   dp          the sample's profile (in-scatter probability), [0, 1]
 //   ms_relax    Beer relaxation deep inside (0.05 deep .. 0.25 at the surface)
 //   sky_tau     optical depth toward the sky
+//   diffusion   the diffusion term's in-scattered weight at the sample
+//               (DiffusionGrid::radiance; physical mode with ms_diffusion),
+//               < 0 without it
 inline void shade(const RenderSettings& s, const SunTerms& st, double tau, double dp, double ms_relax, double sky_tau, double& sun_w,
-                  double& sky_w) {
+                  double& sky_w, double diffusion = -1) {
     if (!s.artistic) {
         // The physical model (docs/render.md, "Reference: Cycles"): single
         // scattering of the sun plus the octave series; st.ms_phase[n] holds
@@ -114,7 +117,14 @@ inline void shade(const RenderSettings& s, const SunTerms& st, double tau, doubl
         // event along the two paths we know, toward the sun and the zenith.
         const double q = -std::expm1(-(tau + sky_tau));
         const double again = s.ms_scatter_power == 1 ? q : std::pow(q, s.ms_scatter_power);
-        sun_w = direct + s.multiple_scattering * ms * again;
+        // With the diffusion term: the larger of the octaves and its P1
+        // in-scattered radiance (docs/render.md, "Multiple scattering by
+        // diffusion"): each falls short outside its regime (the octaves
+        // around thick media, diffusion in wisps a few mean free paths
+        // across), neither was measured above Cycles where the other holds.
+        double multi = ms * again;
+        if (diffusion >= 0) multi = std::max(multi, diffusion);
+        sun_w = direct + s.multiple_scattering * multi;
         sky_w = s.ambient_strength * (s.ms_octaves > 0 ? 1.0 : std::exp(-sky_tau));
         return;
     }

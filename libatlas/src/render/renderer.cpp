@@ -1,5 +1,6 @@
 #include "atlas/render/renderer.h"
 
+#include "diffusion.h"
 #include "light_grid.h"
 #include "render_common.h"
 
@@ -24,6 +25,7 @@ std::vector<std::string> RenderReport::active_features() const {
     f.push_back("dual_hg");
     f.push_back("ambient");
     f.push_back(physical ? "ms_octaves" : "multiple_scattering");
+    if (diffusion) f.push_back("ms_diffusion");
     if (point_lights) f.push_back("point_lights");
     if (sky_gradient) f.push_back("sky_gradient");
     return f;
@@ -64,6 +66,7 @@ void check_settings(const RenderSettings& s) {
     if (s.light_samples < 1 || s.light_samples > 64) bad("light_samples must be 1..64");
     if (s.ms_octaves < 0 || s.ms_octaves > 16) bad("ms_octaves must be 0..16");
     if (!(s.ms_scatter_power >= 0 && s.ms_scatter_power <= 8)) bad("ms_scatter_power must be in [0, 8]");
+    if (s.ms_diffusion_sweeps < 1 || s.ms_diffusion_sweeps > 4096) bad("ms_diffusion_sweeps must be 1..4096");
     for (double v : {s.ms_energy, s.ms_extinction, s.ms_anisotropy})
         if (!(v >= 0 && v <= 1)) bad("ms_energy, ms_extinction and ms_anisotropy must be in [0, 1]");
     for (size_t i = 0; i < s.lights.size(); ++i) validate_light(s.lights[i], "lights[" + std::to_string(i) + "]");
@@ -95,6 +98,7 @@ std::optional<std::pair<double, double>> clip_ray(const Box3d& b, const Vec3d& o
 struct Integrator {
     const detail::CloudSampler& cloud;
     const detail::LightGrid* grid; // null in reference mode
+    const detail::DiffusionGrid* diffusion; // null without ms_diffusion
     const RenderSettings& s;
     Vec3d sun;       // unit, toward the sun
     double base_step; // metres at the camera
@@ -205,7 +209,7 @@ struct Integrator {
                     light_depths(p, sun_sum, sky_sum);
                     double sun_w, sky_w;
                     detail::shade(s, st, ext * sun_sum, detail::saturate(v.profile), remap(v.sdf, -128.0, 0.0, 0.05, 0.25), ext * sky_sum,
-                                  sun_w, sky_w);
+                                  sun_w, sky_w, diffusion ? diffusion->radiance(p[0], p[1], p[2], dir * -1.0) : -1.0);
                     // Energy-conserving step integral: (1 - exp(-sigma dt)) of the
                     // light is scattered toward the eye (albedo 1).
                     const double absorbed = -std::expm1(-sigma * dt);
@@ -267,15 +271,28 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     // The light grid never needs to be finer than the volume itself.
     Vec3i grid_res = settings.light_grid;
     for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], scene.modeling->resolution()[a]);
-    if (fast) detail::run_in_arena(settings.threads, [&] { grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun); });
+    // The diffusion term needs the grid in reference mode too (its source is
+    // the grid's sun transmittance); the march there still uses marched light.
+    const bool diffuse = !settings.artistic && settings.ms_diffusion && settings.ms_octaves > 0 && settings.multiple_scattering > 0;
+    std::unique_ptr<detail::DiffusionGrid> diffusion;
+    if (fast || diffuse)
+        detail::run_in_arena(settings.threads, [&] {
+            grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun);
+            if (diffuse) {
+                const double g = settings.hg_forward_weight * settings.hg_forward + (1 - settings.hg_forward_weight) * settings.hg_back;
+                diffusion = std::make_unique<detail::DiffusionGrid>(*grid, settings.extinction, g, settings.ms_diffusion_sweeps);
+            }
+        });
+    report.diffusion = diffusion != nullptr;
 
     Integrator in{cloud,
-                  grid.get(),
+                  fast ? grid.get() : nullptr,
+                  diffusion.get(),
                   settings,
                   sun,
                   0.5 * vmin / settings.quality,
                   128 * vmin, // the step doubles every 128 voxels of distance
-                  grid ? 0.5 * grid->voxel_min() : 0.0,
+                  fast ? 0.5 * grid->voxel_min() : 0.0,
                   settings.reference_step > 0 ? settings.reference_step : 0.25 * vmin,
                   report.near_camera_detail,
                   {sky.ambient[0], sky.ambient[1], sky.ambient[2]},

@@ -100,6 +100,20 @@ struct RenderSettings {
     int ms_octaves = 0;
     double ms_energy = 0.5, ms_extinction = 0.5, ms_anisotropy = 0.5; // each in [0, 1]
     double ms_scatter_power = 1;
+    // Physical mode: multiple scattering in optically thick media by the
+    // diffusion approximation on the light grid (docs/render.md, "Multiple
+    // scattering by diffusion"): the fluence of the once-scattered sun light,
+    // -div(D grad phi) = sigma_s T_sun E, D = 1 / (3 sigma_t (1 - g)),
+    // Marshak boundaries, ms_diffusion_sweeps red-black SOR sweeps per level
+    // of a coarse-to-fine cascade (1..4096). Per sample the multiply
+    // scattered sun light is the larger of the octaves' and the diffusion's
+    // P1 in-scattered radiance sigma_s (phi + 3 g F . w) / (4 pi)
+    // (F = -D grad phi, w toward the eye); multiple_scattering scales it.
+    // Needs ms_octaves > 0 and multiple_scattering > 0; ignored with
+    // artistic = true. false: the octaves alone (the bytes of the renderer
+    // before it existed). The CLI's --artistic off turns it on.
+    bool ms_diffusion = false;
+    int ms_diffusion_sweeps = 32;
 };
 
 // Which parts of the method ran (features the scene does not need are left
@@ -114,6 +128,7 @@ struct RenderReport {
     int point_light_count = 0;     // lights integrated (after resolving light fields)
     bool sky_gradient = false;     // sky_horizon set
     bool physical = false;         // artistic = false: the physical model (no powder, octave multiple scattering)
+    bool diffusion = false;        // physical model with ms_diffusion: the diffusion term ran
     uint64_t density_samples = 0;  // view-ray density evaluations
     // "noise_uprez billowy ..." - the active features, space separated.
     std::vector<std::string> active_features() const;

@@ -1,0 +1,342 @@
+#include "diffusion.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace atlas::render::detail {
+
+namespace {
+
+struct Level {
+    Vec3i n;
+    Vec3d h;
+    std::vector<float> sig; // sigma_t per metre
+    std::vector<float> q;   // source per metre (per E)
+    std::vector<float> phi;
+    std::vector<float> leak; // the Marshak faces' area factor (staircase correction)
+    size_t idx(int x, int y, int z) const { return (size_t(z) * size_t(n[1]) + size_t(y)) * size_t(n[0]) + size_t(x); }
+    size_t size() const { return size_t(n[0]) * size_t(n[1]) * size_t(n[2]); }
+    double hmin() const { return std::min({h[0], h[1], h[2]}); }
+};
+
+// Successive over-relaxation factor of the red-black sweeps.
+constexpr double kOmega = 1.8;
+// The Marshak boundary's resistance: phi = 0 at 2D beyond the face.
+constexpr double kMarshak = 2.0;
+
+// One colour's sweep: every voxel with (x + y + z) % 2 == colour reads only
+// voxels of the other colour, so z slabs run in parallel with the same bytes.
+void sweep(Level& L, double reduce, int colour) {
+    const double min_sig = kDiffusionMinTau / L.hmin();
+    tbb::parallel_for(0, L.n[2], [&](int z) {
+        for (int y = 0; y < L.n[1]; ++y) {
+            for (int x = (y + z + colour) & 1; x < L.n[0]; x += 2) {
+                const size_t i = L.idx(x, y, z);
+                const double si = L.sig[i];
+                if (si < min_sig) continue;
+                double num = L.q[i], den = 0;
+                const int c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a) {
+                    const double ri = 1.5 * reduce * si * L.h[a];
+                    const double inv_h = 1.0 / L.h[a];
+                    for (int side = -1; side <= 1; side += 2) {
+                        int cc[3] = {c[0], c[1], c[2]};
+                        cc[a] += side;
+                        if (cc[a] >= 0 && cc[a] < L.n[a]) {
+                            const size_t j = L.idx(cc[0], cc[1], cc[2]);
+                            const double sj = L.sig[j];
+                            if (sj >= min_sig) {
+                                const double k = inv_h / (ri + 1.5 * reduce * sj * L.h[a]);
+                                num += k * L.phi[j];
+                                den += k;
+                                continue;
+                            }
+                        }
+                        den += L.leak[i] * inv_h / (ri + kMarshak);
+                    }
+                }
+                const double old = L.phi[i];
+                L.phi[i] = static_cast<float>(std::max(0.0, old + kOmega * (num / den - old)));
+            }
+        }
+    });
+}
+
+// Outside-medium voxels next to the medium take the mean of their medium
+// neighbours' Marshak surface values 2 phi / (r + 2), so that lookups just
+// outside the medium see the surface, not 0 (measured on the calibration
+// shapes: the same as extrapolating through the surface value, 0.069 against
+// 0.070 mean error). Reads medium voxels only.
+void fill_outside(Level& L, double reduce) {
+    const double min_sig = kDiffusionMinTau / L.hmin();
+    tbb::parallel_for(0, L.n[2], [&](int z) {
+        for (int y = 0; y < L.n[1]; ++y)
+            for (int x = 0; x < L.n[0]; ++x) {
+                const size_t i = L.idx(x, y, z);
+                if (L.sig[i] >= min_sig) continue;
+                double acc = 0;
+                int cnt = 0;
+                const int c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a)
+                    for (int side = -1; side <= 1; side += 2) {
+                        int cc[3] = {c[0], c[1], c[2]};
+                        cc[a] += side;
+                        if (cc[a] < 0 || cc[a] >= L.n[a]) continue;
+                        const size_t j = L.idx(cc[0], cc[1], cc[2]);
+                        if (L.sig[j] < min_sig) continue;
+                        const double rj = 1.5 * reduce * L.sig[j] * L.h[a];
+                        acc += 2 * L.phi[j] / (rj + kMarshak);
+                        ++cnt;
+                    }
+                L.phi[i] = cnt ? static_cast<float>(acc / cnt) : 0.0f;
+            }
+    });
+}
+
+// A smooth surface of unit normal n drawn in voxel faces has |nx| + |ny| +
+// |nz| times its area on the axis faces (1.5x on average over a sphere), so
+// the Marshak leak through a boundary voxel's faces is scaled by 1 / that
+// sum, n from the density gradient (central differences, 0 beyond the grid).
+// Axis-aligned faces (a box) keep factor 1; so does a voxel with no gradient.
+void leak_factors(Level& L) {
+    L.leak.assign(L.size(), 1.0f);
+    auto sig = [&](int x, int y, int z) {
+        if (x < 0 || y < 0 || z < 0 || x >= L.n[0] || y >= L.n[1] || z >= L.n[2]) return 0.0;
+        return double(L.sig[L.idx(x, y, z)]);
+    };
+    tbb::parallel_for(0, L.n[2], [&](int z) {
+        for (int y = 0; y < L.n[1]; ++y)
+            for (int x = 0; x < L.n[0]; ++x) {
+                const double g[3] = {(sig(x + 1, y, z) - sig(x - 1, y, z)) / L.h[0], (sig(x, y + 1, z) - sig(x, y - 1, z)) / L.h[1],
+                                     (sig(x, y, z + 1) - sig(x, y, z - 1)) / L.h[2]};
+                const double l2 = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]), l1 = std::fabs(g[0]) + std::fabs(g[1]) + std::fabs(g[2]);
+                if (l1 > 0) L.leak[L.idx(x, y, z)] = static_cast<float>(l2 / l1);
+            }
+    });
+}
+
+Level coarsen(const Level& f, const Vec3d& size) {
+    Level c;
+    for (int a = 0; a < 3; ++a) {
+        c.n[a] = std::max(1, (f.n[a] + 1) / 2);
+        c.h[a] = size[a] / c.n[a];
+    }
+    c.sig.assign(c.size(), 0.0f);
+    c.q.assign(c.size(), 0.0f);
+    c.phi.assign(c.size(), 0.0f);
+    tbb::parallel_for(0, c.n[2], [&](int z) {
+        for (int y = 0; y < c.n[1]; ++y)
+            for (int x = 0; x < c.n[0]; ++x) {
+                double s = 0, q = 0;
+                int cnt = 0;
+                for (int dz = 0; dz < 2; ++dz)
+                    for (int dy = 0; dy < 2; ++dy)
+                        for (int dx = 0; dx < 2; ++dx) {
+                            const int fx = 2 * x + dx, fy = 2 * y + dy, fz = 2 * z + dz;
+                            if (fx >= f.n[0] || fy >= f.n[1] || fz >= f.n[2]) continue;
+                            const size_t j = f.idx(fx, fy, fz);
+                            s += f.sig[j];
+                            q += f.q[j];
+                            ++cnt;
+                        }
+                const size_t i = c.idx(x, y, z);
+                c.sig[i] = static_cast<float>(s / cnt);
+                c.q[i] = static_cast<float>(q / cnt);
+            }
+    });
+    leak_factors(c);
+    return c;
+}
+
+void prolong(const Level& c, Level& f) {
+    tbb::parallel_for(0, f.n[2], [&](int z) {
+        for (int y = 0; y < f.n[1]; ++y)
+            for (int x = 0; x < f.n[0]; ++x)
+                f.phi[f.idx(x, y, z)] = c.phi[c.idx(std::min(x / 2, c.n[0] - 1), std::min(y / 2, c.n[1] - 1), std::min(z / 2, c.n[2] - 1))];
+    });
+}
+
+void solve(Level& L, double reduce, int sweeps) {
+    for (int s = 0; s < sweeps; ++s) {
+        sweep(L, reduce, 0);
+        sweep(L, reduce, 1);
+    }
+    fill_outside(L, reduce);
+}
+
+} // namespace
+
+DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g, int sweeps)
+    : res_(grid.resolution()), bounds_(grid.bounds()), voxel_(grid.voxel()) {
+    const double reduce = 1 - g;
+    const Vec3d size = bounds_.size();
+    std::vector<Level> levels(1);
+    levels.reserve(16);
+    Level& fine = levels[0];
+    fine.n = res_;
+    fine.h = voxel_;
+    const size_t n = fine.size();
+    fine.sig.resize(n);
+    fine.q.resize(n);
+    fine.phi.assign(n, 0.0f);
+    // The sun's mean chord through a voxel: volume / projected area.
+    const Vec3d& sun = grid.sun_direction();
+    const double chord = 1.0 / (std::fabs(sun[0]) / voxel_[0] + std::fabs(sun[1]) / voxel_[1] + std::fabs(sun[2]) / voxel_[2]);
+    const auto& dens = grid.density();
+    const auto& depth = grid.sun_depths();
+    const double vol = voxel_[0] * voxel_[1] * voxel_[2];
+    const double min_sig = kDiffusionMinTau / fine.hmin();
+    double src = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const double sig = extinction * dens[i];
+        fine.sig[i] = static_cast<float>(sig);
+        // The source averaged over the chord: sigma x mean of T over it,
+        // T = e^-tau at the centre, e^(-tau +- x) at the chord's ends.
+        const double tau = extinction * depth[i], x = 0.5 * sig * chord;
+        double q = sig * std::exp(-tau);
+        if (x > 1e-6) q = sig * (std::exp(-std::max(0.0, tau - x)) - std::exp(-(tau + x))) / (2 * x);
+        fine.q[i] = sig >= min_sig ? static_cast<float>(q) : 0.0f;
+        src += fine.q[i] * vol;
+    }
+    source_total_ = src;
+    leak_factors(fine);
+    while (std::max({levels.back().n[0], levels.back().n[1], levels.back().n[2]}) > 4) levels.push_back(coarsen(levels.back(), size));
+    // Cascade: the coarsest level solved with 4x the sweeps, each finer one
+    // started from the coarser solution.
+    for (size_t l = levels.size(); l-- > 0;) {
+        if (l + 1 < levels.size()) prolong(levels[l + 1], levels[l]);
+        solve(levels[l], reduce, l + 1 == levels.size() ? 4 * sweeps : sweeps);
+    }
+    const Level& top = levels[0]; // (push_back above moved the levels)
+    phi_ = top.phi;
+    // Outflow through the medium's boundary faces (the conservation check).
+    double out = 0;
+    for (int z = 0; z < res_[2]; ++z)
+        for (int y = 0; y < res_[1]; ++y)
+            for (int x = 0; x < res_[0]; ++x) {
+                const size_t i = top.idx(x, y, z);
+                const double si = top.sig[i];
+                if (si < min_sig) continue;
+                const int c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a) {
+                    const double area = vol / voxel_[a];
+                    for (int side = -1; side <= 1; side += 2) {
+                        int cc[3] = {c[0], c[1], c[2]};
+                        cc[a] += side;
+                        const bool inside = cc[a] >= 0 && cc[a] < res_[a] && top.sig[top.idx(cc[0], cc[1], cc[2])] >= min_sig;
+                        if (!inside) out += top.leak[i] * area * phi_[i] / (1.5 * reduce * si * voxel_[a] + kMarshak);
+                    }
+                }
+            }
+    outflow_total_ = out;
+    // The diffuse flux F = -D grad phi per voxel (per E): the mean of the
+    // face fluxes on each axis (Marshak phi / (r + 2) outward at the medium's
+    // faces); outside voxels next to the medium take their medium
+    // neighbours' mean, others 0.
+    flux_.assign(3 * n, 0.0f);
+    tbb::parallel_for(0, res_[2], [&](int z) {
+        for (int y = 0; y < res_[1]; ++y)
+            for (int x = 0; x < res_[0]; ++x) {
+                const size_t i = top.idx(x, y, z);
+                const double si = top.sig[i];
+                if (si < min_sig) continue;
+                const int c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a) {
+                    const double ri = 1.5 * reduce * si * voxel_[a];
+                    double f = 0;
+                    for (int side = -1; side <= 1; side += 2) {
+                        int cc[3] = {c[0], c[1], c[2]};
+                        cc[a] += side;
+                        double face; // flux toward +axis through this face
+                        if (cc[a] >= 0 && cc[a] < res_[a] && top.sig[top.idx(cc[0], cc[1], cc[2])] >= min_sig) {
+                            const size_t j = top.idx(cc[0], cc[1], cc[2]);
+                            face = side * (phi_[i] - phi_[j]) / (ri + 1.5 * reduce * top.sig[j] * voxel_[a]);
+                        } else {
+                            face = side * phi_[i] / (ri + kMarshak);
+                        }
+                        f += 0.5 * face;
+                    }
+                    flux_[3 * i + size_t(a)] = static_cast<float>(f);
+                }
+            }
+    });
+    tbb::parallel_for(0, res_[2], [&](int z) {
+        for (int y = 0; y < res_[1]; ++y)
+            for (int x = 0; x < res_[0]; ++x) {
+                const size_t i = top.idx(x, y, z);
+                if (top.sig[i] >= min_sig) continue;
+                double acc[3] = {0, 0, 0};
+                int cnt = 0;
+                const int c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a)
+                    for (int side = -1; side <= 1; side += 2) {
+                        int cc[3] = {c[0], c[1], c[2]};
+                        cc[a] += side;
+                        if (cc[a] < 0 || cc[a] >= res_[a]) continue;
+                        const size_t j = top.idx(cc[0], cc[1], cc[2]);
+                        if (top.sig[j] < min_sig) continue;
+                        // flux_ of medium voxels is final here: this pass writes outside voxels only
+                        for (int b = 0; b < 3; ++b) acc[b] += flux_[3 * j + size_t(b)];
+                        ++cnt;
+                    }
+                if (cnt)
+                    for (int b = 0; b < 3; ++b) flux_[3 * i + size_t(b)] = static_cast<float>(acc[b] / cnt);
+            }
+    });
+    g_ = g;
+}
+
+double DiffusionGrid::radiance(double x, double y, double z, const Vec3d& toward_eye) const {
+    double w[8];
+    size_t idx[8];
+    corners(x, y, z, idx, w);
+    double phi = 0, f[3] = {0, 0, 0};
+    for (int k = 0; k < 8; ++k) {
+        phi += w[k] * phi_[idx[k]];
+        for (int b = 0; b < 3; ++b) f[b] += w[k] * flux_[3 * idx[k] + size_t(b)];
+    }
+    phi = std::max(0.0, phi);
+    return std::max(0.0, phi + 3 * g_ * (f[0] * toward_eye[0] + f[1] * toward_eye[1] + f[2] * toward_eye[2]));
+}
+
+void DiffusionGrid::corners(double x, double y, double z, size_t idx[8], double w[8]) const {
+    const double u[3] = {(x - bounds_.min[0]) / voxel_[0] - 0.5, (y - bounds_.min[1]) / voxel_[1] - 0.5, (z - bounds_.min[2]) / voxel_[2] - 0.5};
+    int i0[3], i1[3];
+    double t[3];
+    for (int a = 0; a < 3; ++a) {
+        const double v = std::clamp(u[a], 0.0, double(res_[a] - 1));
+        i0[a] = std::min(static_cast<int>(v), res_[a] - 1);
+        i1[a] = std::min(i0[a] + 1, res_[a] - 1);
+        t[a] = v - i0[a];
+    }
+    const size_t row = size_t(res_[0]), slab = row * size_t(res_[1]);
+    for (int k = 0; k < 8; ++k) {
+        const int xx = k & 1 ? i1[0] : i0[0], yy = k & 2 ? i1[1] : i0[1], zz = k & 4 ? i1[2] : i0[2];
+        idx[k] = size_t(zz) * slab + size_t(yy) * row + size_t(xx);
+        w[k] = (k & 1 ? t[0] : 1 - t[0]) * (k & 2 ? t[1] : 1 - t[1]) * (k & 4 ? t[2] : 1 - t[2]);
+    }
+}
+
+float DiffusionGrid::fluence(double x, double y, double z) const {
+    const double u[3] = {(x - bounds_.min[0]) / voxel_[0] - 0.5, (y - bounds_.min[1]) / voxel_[1] - 0.5, (z - bounds_.min[2]) / voxel_[2] - 0.5};
+    int i0[3], i1[3];
+    float t[3];
+    for (int a = 0; a < 3; ++a) {
+        const double v = std::clamp(u[a], 0.0, double(res_[a] - 1));
+        i0[a] = std::min(static_cast<int>(v), res_[a] - 1);
+        i1[a] = std::min(i0[a] + 1, res_[a] - 1);
+        t[a] = static_cast<float>(v - i0[a]);
+    }
+    const size_t row = size_t(res_[0]), slab = row * size_t(res_[1]);
+    auto at = [&](int xx, int yy, int zz) { return phi_[size_t(zz) * slab + size_t(yy) * row + size_t(xx)]; };
+    const float c00 = at(i0[0], i0[1], i0[2]) + (at(i1[0], i0[1], i0[2]) - at(i0[0], i0[1], i0[2])) * t[0];
+    const float c10 = at(i0[0], i1[1], i0[2]) + (at(i1[0], i1[1], i0[2]) - at(i0[0], i1[1], i0[2])) * t[0];
+    const float c01 = at(i0[0], i0[1], i1[2]) + (at(i1[0], i0[1], i1[2]) - at(i0[0], i0[1], i1[2])) * t[0];
+    const float c11 = at(i0[0], i1[1], i1[2]) + (at(i1[0], i1[1], i1[2]) - at(i0[0], i1[1], i1[2])) * t[0];
+    const float c0 = c00 + (c10 - c00) * t[1], c1 = c01 + (c11 - c01) * t[1];
+    return std::max(0.0f, c0 + (c1 - c0) * t[2]);
+}
+
+} // namespace atlas::render::detail
