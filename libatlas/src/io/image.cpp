@@ -45,9 +45,11 @@ std::vector<std::string> module_candidates() {
     std::error_code ec;
     const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
     if (!ec) dirs.push_back(exe.parent_path());
-    for (const auto& d : dirs)
+    for (size_t i = 0; i < dirs.size(); ++i) {
+        if (i > 0 && dirs[i] == dirs[0]) continue; // the program holds the io code
         for (const char* rel : {"libatlas_oiio.so", "../lib/atlas/libatlas_oiio.so", "atlas/libatlas_oiio.so", "../lib/libatlas_oiio.so"})
-            c.push_back((d / rel).string());
+            c.push_back((dirs[i] / rel).string());
+    }
 #ifdef ATLAS_OIIO_MODULE_INSTALL_PATH
     c.emplace_back(ATLAS_OIIO_MODULE_INSTALL_PATH);
 #endif
@@ -65,7 +67,10 @@ const AtlasOiioApi& oiio(const std::string& where) {
         std::string tried;
         for (const auto& path : module_candidates()) {
             std::error_code ec;
-            if (!fs::exists(path, ec)) continue;
+            if (!fs::exists(path, ec)) {
+                tried += "\n  " + path + ": no such file";
+                continue;
+            }
             void* h = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
             if (!h) {
                 tried += "\n  " + path + ": " + dlerror();
@@ -81,7 +86,7 @@ const AtlasOiioApi& oiio(const std::string& where) {
             dlclose(h);
         }
         failure = "OpenImageIO is needed for this image, but its module libatlas_oiio.so was not found or did not load (set "
-                  "ATLAS_OIIO_MODULE to its path)" + tried;
+                  "ATLAS_OIIO_MODULE to its path); tried:" + tried;
     });
     if (!api) throw Error(where + failure);
     return *api;
