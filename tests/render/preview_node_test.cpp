@@ -99,6 +99,12 @@ TEST(RenderPreviewNode, LightsSkyAndFlashParamsReachTheRenderer) {
     EXPECT_NE(d.find_param("sky_horizon")->check(std::string("0.9,0.8")), "");
     EXPECT_EQ(d.find_param("sky_horizon")->check(std::string("auto")), "");
     EXPECT_NE(d.find_param("lights")->check(std::string("1 2 3")), "");
+    // A host (or a graph's [r, g, b] list) may give the numbers as a list: the same value.
+    const std::vector<double> horizon{0.9, 0.8, 0.6};
+    EXPECT_EQ(d.find_param("sky_horizon")->check(horizon), "");
+    EXPECT_NE(d.find_param("sky_horizon")->check(std::vector<double>{0.9, 0.8}), "");
+    auto listed = cook({{"size", size}, {"lights", std::string("50 50 50 1 0.5 0.2 2e4; 10 20 30 0 0 1 1e3 40")}, {"sky_horizon", horizon}}, {{"nvdf", set}});
+    EXPECT_TRUE(*std::get<Field2DPtr>(listed.at("image")) == *image);
 }
 
 TEST(RenderPreviewNode, TheSunDefaultIsThePreviewSunOfTheLibrary) {

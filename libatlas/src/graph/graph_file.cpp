@@ -86,7 +86,7 @@ std::string yaml_to_param(const YAML::Node& n, const ParamDecl& decl, ParamValue
         out = v;
         return "";
     }
-    if (decl.type == ParamType::String && decl.check_text && n.IsSequence()) {
+    if (decl.type == ParamType::String && decl.check_value && n.IsSequence()) {
         // A schema text option that takes numbers (sky_colour: [0.1, 0.2, 0.5]): its
         // comma-separated text, checked by the schema.
         std::string text;

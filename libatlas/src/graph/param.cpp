@@ -91,8 +91,10 @@ std::string ParamDecl::check(const ParamValue& v) const {
         return std::holds_alternative<bool>(v) ? "" : "expected true or false";
     case ParamType::String:
     case ParamType::Path:
+        if (type == ParamType::String && check_value && (std::holds_alternative<std::string>(v) || std::holds_alternative<std::vector<double>>(v)))
+            return check_value(v);
         if (!std::holds_alternative<std::string>(v)) return "expected a string";
-        return type == ParamType::String && check_text ? check_text(std::get<std::string>(v)) : "";
+        return "";
     case ParamType::Enum: {
         if (!std::holds_alternative<std::string>(v)) return "expected one of the names listed for it";
         const auto& s = std::get<std::string>(v);

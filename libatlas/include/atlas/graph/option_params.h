@@ -148,7 +148,8 @@ void declare_text_options(NodeDeclaration& d, std::span<const TextOption<T>> sch
         default: {
             p = &d.param_string(o.name, def);
             const TextOptionSpec spec = o;
-            p->check_text = [spec](const std::string& text) {
+            p->check_value = [spec](const ParamValue& given) {
+                const std::string text = text_option_text(spec, given);
                 OptionValue v;
                 return parse_text_option(spec, text, v) ? std::string() : "expected " + spec.expected() + ", got '" + text + "'";
             };

@@ -45,9 +45,10 @@ struct ParamDecl {
     std::string unit;               // "m", "1/m", "cells", "" for none
     std::string doc;                // one line
     std::vector<std::string> choices; // Enum only
-    // String only: "" when the text is a valid value, else why not (a text option of a
-    // library schema, atlas/graph/option_params.h); checked with the type.
-    std::function<std::string(const std::string&)> check_text;
+    // String only: "" when the value is valid, else why not (a text option of a library
+    // schema, atlas/graph/option_params.h). It gets the text, or a list of numbers a
+    // host or graph gave for an option that takes numbers ([0.1, 0.2, 0.5]).
+    std::function<std::string(const ParamValue&)> check_value;
 
     // Fluent setters for declarations.
     ParamDecl& range(double lo, double hi) { min = lo; max = hi; return *this; }
