@@ -248,50 +248,6 @@ void write_picture_atomic(const Field2D& image, const std::filesystem::path& pat
     write_file_atomic(path, [&](const std::filesystem::path& tmp) { write_picture(image, tmp, exposure); });
 }
 
-// --artistic on|off, --ms-octaves N, --ms-diffusion on|off[,SWEEPS], --light-grid NX,NY,NZ (docs/render.md, "Reference: Cycles").
-void apply_physics_options(const Args& a, render::RenderSettings& s) {
-    if (a.has("--artistic")) {
-        const std::string v = a.get("--artistic");
-        if (v != "on" && v != "off") throw UsageError{"--artistic expects on or off, got '" + v + "'", "preview"};
-        if (v == "off") {
-            s.artistic = false;
-            s.ms_octaves = render::kPhysicalMsOctaves;
-            s.ms_diffusion = true; // docs/render.md, "Multiple scattering by diffusion"
-            s.multiple_scattering = 1;
-            s.ambient_strength = 1;
-            // One Henyey-Greenstein lobe with the dual lobe's mean cosine
-            // (0.33 for the defaults): what a path tracer's volume offers
-            // (Cycles 3.4 does not weight two scatter closures by their
-            // densities), and what multiple scattering depends on.
-            s.hg_forward = s.hg_forward_weight * s.hg_forward + (1 - s.hg_forward_weight) * s.hg_back;
-            s.hg_forward_weight = 1;
-        }
-    }
-    if (a.has("--ms-octaves")) {
-        if (s.artistic) throw UsageError{"--ms-octaves sets the physical model's multiple scattering; it needs --artistic off", "preview"};
-        const std::string t = a.get("--ms-octaves");
-        const auto commas = std::count(t.begin(), t.end(), ',');
-        const bool four = commas == 3 || commas == 4;
-        auto v = numbers(t, four ? size_t(commas + 1) : 1, "--ms-octaves");
-        s.ms_octaves = static_cast<int>(v[0]);
-        if (four) s.ms_energy = v[1], s.ms_extinction = v[2], s.ms_anisotropy = v[3];
-        if (commas == 4) s.ms_scatter_power = v[4];
-    }
-    if (a.has("--ms-diffusion")) {
-        if (s.artistic) throw UsageError{"--ms-diffusion sets the physical model's multiple scattering; it needs --artistic off", "preview"};
-        const std::string t = a.get("--ms-diffusion");
-        const auto comma = t.find(',');
-        const std::string v = t.substr(0, comma);
-        if (v != "on" && v != "off") throw UsageError{"--ms-diffusion expects on or off[,SWEEPS], got '" + t + "'", "preview"};
-        s.ms_diffusion = v == "on";
-        if (comma != std::string::npos) s.ms_diffusion_sweeps = static_cast<int>(numbers(t.substr(comma + 1), 1, "--ms-diffusion")[0]);
-    }
-    if (a.has("--light-grid")) {
-        auto v = numbers(a.get("--light-grid"), 3, "--light-grid");
-        s.light_grid = {{int(v[0]), int(v[1]), int(v[2])}};
-    }
-}
-
 } // namespace
 
 namespace {
@@ -428,7 +384,6 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
     render::RenderSettings& s = job.settings;
     const Box3d bounds = have_voxel ? job.voxel->modeling->bounds() : Box3d{{{0, 0, 0}}, {{1, 1, 1}}};
     const double exposure = job.exposure;
-    apply_physics_options(a, s); // --artistic, --ms-octaves, --light-grid
     if (a.has("--export-scene")) {
         if (have_voxel && have_layer) throw UsageError{"--export-scene exports a voxel or a 2.5D scene, not both at once (use --mode)", "preview"};
         const std::string note = have_layer ? export_layer_scene(a.get("--export-scene"), *job.layer, s) : export_scene(a.get("--export-scene"), *job.voxel, s);

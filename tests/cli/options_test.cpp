@@ -238,6 +238,9 @@ const std::map<std::string, std::string> kPreviewSpelled = {
 // --reference, lightning by --lightning) or not at all (the node's flash_probability
 // lights): probed on the node side only.
 const std::vector<std::string> kPreviewNodeOnly = {"camera", "mode", "lightning", "flash_seed", "flash_colour"};
+// Options that need another one to mean anything: the flags the CLI probe adds (the
+// node checks each parameter alone when the graph loads).
+const std::map<std::string, std::string> kPreviewContext = {{"ms_octaves", "--artistic=off"}, {"ms_diffusion", "--artistic=off"}};
 
 struct Probe {
     std::string text; // as the CLI takes it
@@ -283,8 +286,8 @@ std::string replace_braces(std::string t, const std::string& text) { return t.re
 
 // `atlas preview` refuses a flag's value with status 2 before it reads its input;
 // an accepted value gets as far as the missing input file (status 1).
-bool preview_cli_accepts(const std::string& flag_and_value, std::string* err = nullptr) {
-    CliRun r = run("preview /nonexistent/atlas_options_test.vdb --noise none --quiet '" + flag_and_value + "' -o x.png");
+bool preview_cli_accepts(const std::string& flag_and_value, std::string* err = nullptr, const std::string& context = "") {
+    CliRun r = run("preview /nonexistent/atlas_options_test.vdb --noise none --quiet " + context + " '" + flag_and_value + "' -o x.png");
     if (err) *err = r.err;
     EXPECT_TRUE(r.status == 1 || r.status == 2) << flag_and_value << ": status " << r.status << " " << r.err;
     return r.status != 2;
@@ -321,7 +324,8 @@ TEST(OptionsSchema, PreviewFlagsAndNodeParametersAcceptTheSameValues) {
                 continue;
             const std::string arg = o.cli_flag ? std::string(o.cli_flag) + "=" + pr.text : replace_braces(spelled->second, pr.text);
             std::string err;
-            const bool cli = preview_cli_accepts(arg, &err);
+            const auto context = kPreviewContext.find(o.name);
+            const bool cli = preview_cli_accepts(arg, &err, context == kPreviewContext.end() ? "" : context->second);
             ++runs;
             EXPECT_EQ(cli, node) << arg << ": CLI " << (cli ? "accepts" : "refuses") << " (" << err << "), node parameter '" << o.name << "' "
                                  << (node ? "accepts" : "refuses: " + p->check(pr.node));
@@ -372,6 +376,14 @@ TEST(OptionsSchema, PreviewDefaultsAreOneAndTheNodesPresetIsNamed) {
             EXPECT_NE(help.out.find(std::string("  ") + o.cli_flag + " "), std::string::npos) << o.cli_flag;
         }
     EXPECT_NE(help.out.find("default 230,25"), std::string::npos) << help.out;
+    // The physical model's options need artistic off, in both front ends.
+    EXPECT_EQ(run("preview /nonexistent/x.vdb --noise none --ms-octaves 4 -o x.png").status, 2);
+    EXPECT_EQ(run("preview /nonexistent/x.vdb --noise none --artistic off --ms-octaves 4 -o x.png").status, 1);
+    render::PreviewOptions physical;
+    ASSERT_TRUE(set_text_option(*find_option(render::preview_options(), "ms_diffusion"), "off,8", physical));
+    EXPECT_THROW(render::check_preview_options(physical), Error);
+    ASSERT_TRUE(set_text_option(*find_option(render::preview_options(), "artistic"), "off", physical));
+    EXPECT_NO_THROW(render::check_preview_options(physical));
 }
 
 } // namespace

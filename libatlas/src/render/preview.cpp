@@ -313,6 +313,28 @@ PreviewJob prepare_preview(std::optional<CloudScene> voxel, std::optional<LayerS
     if (o.sky_colour) s.sky_colour = *o.sky_colour;
     if (o.sky_horizon) s.sky_horizon = *o.sky_horizon;
     s.lights.insert(s.lights.end(), o.lights.begin(), o.lights.end());
+    if (!o.artistic) {
+        s.artistic = false;
+        s.ms_octaves = kPhysicalMsOctaves;
+        s.ms_diffusion = true; // docs/render.md, "Multiple scattering by diffusion"
+        s.multiple_scattering = 1;
+        s.ambient_strength = 1;
+        // One Henyey-Greenstein lobe with the dual lobe's mean cosine
+        // (0.33 for the defaults): what a path tracer's volume offers
+        // (Cycles 3.4 does not weight two scatter closures by their
+        // densities), and what multiple scattering depends on.
+        s.hg_forward = s.hg_forward_weight * s.hg_forward + (1 - s.hg_forward_weight) * s.hg_back;
+        s.hg_forward_weight = 1;
+    }
+    if (!o.ms_octaves.empty()) {
+        const std::vector<double>& v = o.ms_octaves;
+        s.ms_octaves = static_cast<int>(v[0]);
+        if (v.size() >= 4) s.ms_energy = v[1], s.ms_extinction = v[2], s.ms_anisotropy = v[3];
+        if (v.size() == 5) s.ms_scatter_power = v[4];
+    }
+    if (o.ms_diffusion) s.ms_diffusion = *o.ms_diffusion;
+    if (o.ms_diffusion_sweeps) s.ms_diffusion_sweeps = *o.ms_diffusion_sweeps;
+    s.light_grid = o.light_grid;
     if (o.lightning && !flash_probability) {
         if (!layer) throw Error("lightning places flashes over a 2.5D layer; this preview has no NDF set");
         flash_probability = layer_lightning_probability(*layer->ndf);

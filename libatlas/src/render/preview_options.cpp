@@ -23,7 +23,9 @@ bool PreviewOptions::operator==(const PreviewOptions& o) const {
            sun_elevation == o.sun_elevation && sun_colour == o.sun_colour && sky_colour == o.sky_colour && sky_horizon == o.sky_horizon &&
            same_lights(lights, o.lights) && lightning == o.lightning && flash_seed == o.flash_seed && flash_index == o.flash_index &&
            flash_count == o.flash_count && flash_colour == o.flash_colour && flash_intensity == o.flash_intensity && flash_radius == o.flash_radius &&
-           mode == o.mode && quality == o.quality && extinction == o.extinction && noise_tile == o.noise_tile && time == o.time && wind == o.wind && earth_radius == o.earth_radius &&
+           mode == o.mode && quality == o.quality && extinction == o.extinction && noise_tile == o.noise_tile && artistic == o.artistic &&
+           ms_octaves == o.ms_octaves && ms_diffusion == o.ms_diffusion && ms_diffusion_sweeps == o.ms_diffusion_sweeps && light_grid == o.light_grid &&
+           time == o.time && wind == o.wind && earth_radius == o.earth_radius &&
            edge == o.edge && envelope == o.envelope;
 }
 
@@ -40,6 +42,51 @@ std::string check_lights(std::string_view text) {
     } catch (const Error& e) {
         return e.what();
     }
+}
+
+// "N[,A,B,C[,P]]": octaves 0..16, energy, extinction, anisotropy in [0, 1], power in [0, 8].
+bool ms_octave_numbers(std::string_view text, std::vector<double>& v) {
+    const TextOptionSpec one{"ms_octaves", nullptr, "", K::Number, ""};
+    v.clear();
+    size_t start = 0;
+    while (true) {
+        const size_t comma = text.find(',', start);
+        V x;
+        if (!parse_text_option(one, text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start), x)) return false;
+        v.push_back(x.number);
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+    }
+    if (v.size() != 1 && v.size() != 4 && v.size() != 5) return false;
+    if (v[0] != std::floor(v[0]) || v[0] < 0 || v[0] > 16) return false;
+    for (size_t i = 1; i < 4 && i < v.size(); ++i)
+        if (v[i] < 0 || v[i] > 1) return false;
+    return v.size() < 5 || (v[4] >= 0 && v[4] <= 8);
+}
+std::string check_ms_octaves(std::string_view text) {
+    std::vector<double> v;
+    if (detail::trim_blanks(text).empty() || ms_octave_numbers(text, v)) return "";
+    return "octaves N 0..16, energy A, extinction B and anisotropy C in [0, 1], scatter power P in [0, 8]";
+}
+// "on|off[,SWEEPS]": SWEEPS 1..4096.
+bool ms_diffusion_parts(std::string_view text, bool& on, std::optional<int>& sweeps) {
+    const size_t comma = text.find(',');
+    const std::string_view word = detail::trim_blanks(text.substr(0, comma));
+    if (word != "on" && word != "off") return false;
+    on = word == "on";
+    sweeps.reset();
+    if (comma == std::string_view::npos) return true;
+    const TextOptionSpec n{"sweeps", nullptr, "", K::Integer, "", 1, 4096};
+    V x;
+    if (!parse_text_option(n, text.substr(comma + 1), x)) return false;
+    sweeps = int(x.number);
+    return true;
+}
+std::string check_ms_diffusion(std::string_view text) {
+    bool on = false;
+    std::optional<int> sweeps;
+    if (detail::trim_blanks(text).empty() || ms_diffusion_parts(text, on, sweeps)) return "";
+    return "on or off, optionally ',SWEEPS' with SWEEPS 1..4096";
 }
 
 Vec3f vec3f(const V& v) { return {{float(v.numbers[0]), float(v.numbers[1]), float(v.numbers[2])}}; }
@@ -145,6 +192,35 @@ std::vector<TextOption<P>> make_preview_options() {
             [](P& p, const V& v) { p.exposure = v.number; }),
         opt({"noise_tile", "--noise-tile", "M", K::Number, "voxel up-rez: metres per noise period", 1e-3, 1e9}, "256", "m",
             [](P& p, const V& v) { p.noise_tile = v.number; }),
+        opt({"artistic", "--artistic", "on|off", K::Choice,
+             "off: the physical lighting a path tracer computes (no powder, octave and diffusion multiple scattering; docs/render.md \"Reference: "
+             "Cycles\")",
+             -inf, inf, {"on", "off"}},
+            "on", "", [](P& p, const V& v) { p.artistic = v.word == "on"; }),
+        [] {
+            TextOption<P> o{{"ms_octaves", "--ms-octaves", "N[,A,B,C[,P]]", K::Text,
+                             "with artistic off: octaves of multiple scattering (0 = single scattering; empty: " + std::to_string(kPhysicalMsOctaves) +
+                                 "), optionally their energy, extinction and anisotropy factors and scatter power"}};
+            o.check_text = check_ms_octaves;
+            o.apply = [](P& p, const V& v) {
+                if (!ms_octave_numbers(v.text, p.ms_octaves)) p.ms_octaves.clear();
+            };
+            return o;
+        }(),
+        [] {
+            TextOption<P> o{{"ms_diffusion", "--ms-diffusion", "on|off[,SWEEPS]", K::Text,
+                             "with artistic off: multiple scattering in thick media by diffusion on the light grid (docs/render.md \"Multiple "
+                             "scattering by diffusion\"; empty: on), optionally its SOR sweeps per level (default 32)"}};
+            o.check_text = check_ms_diffusion;
+            o.apply = [](P& p, const V& v) {
+                bool on = false;
+                if (ms_diffusion_parts(v.text, on, p.ms_diffusion_sweeps)) p.ms_diffusion = on;
+                else p.ms_diffusion.reset(), p.ms_diffusion_sweeps.reset();
+            };
+            return o;
+        }(),
+        opt(vec({"light_grid", "--light-grid", "NX,NY,NZ", K::Integer, "voxel light grid resolution (capped at the volume's)", 1, 1024}, 3),
+            "128,128,32", "voxels", [](P& p, const V& v) { p.light_grid = {{int(v.numbers[0]), int(v.numbers[1]), int(v.numbers[2])}}; }),
         opt({"time", "--time", "S", K::Number, "2.5D: seconds of wind scroll (map and noise) and vortex-ring turn", -1e9, 1e9}, "0", "s",
             [](P& p, const V& v) { p.time = v.number; }),
         opt(vec({"wind", "--wind", "X,Y", K::Number, "2.5D: wind velocity (at most 1000 m/s)", -1000, 1000}, 2), "8,0", "m/s",
@@ -298,6 +374,8 @@ std::string preview_options_markdown() {
 
 void check_preview_options(const PreviewOptions& o) {
     if (!(o.size[0] >= 1 && o.size[1] >= 1)) throw Error("preview: size must be at least 1x1 pixels");
+    if (o.artistic && !o.ms_octaves.empty()) throw Error("ms_octaves sets the physical model's multiple scattering; it needs artistic off");
+    if (o.artistic && o.ms_diffusion) throw Error("ms_diffusion sets the physical model's multiple scattering; it needs artistic off");
 }
 
 } // namespace atlas::render

@@ -110,7 +110,8 @@ struct PreviewJob {
 // the envelope of the layer) and builds the settings, in this order: the view preset
 // (layer_preview_settings for a layer; the voxel presets of PreviewView), the look,
 // the manual camera, the layer's envelope (auto: on when the camera is above the lowest
-// cloud base), fov, sun, sky, march, lights, flash lights
+// cloud base), fov, sun, sky, march, lights, the physical model (artistic off,
+// ms_octaves, ms_diffusion, light_grid), flash lights
 // (from `flash_probability`, else with `lightning` placed over the layer's set).
 // threads: RenderSettings::threads. Throws atlas::Error on invalid options or
 // scenes, or when neither scene is given.

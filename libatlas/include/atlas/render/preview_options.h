@@ -48,6 +48,13 @@ struct PreviewOptions {
     double flash_intensity = 1e5, flash_radius = 0;
     RenderMode mode = RenderMode::Fast;
     double quality = 1, extinction = 0.04, noise_tile = 256;
+    // The physical model (docs/render.md, "Reference: Cycles"): artistic false turns
+    // it on, with kPhysicalMsOctaves octaves and the diffusion term unless given.
+    bool artistic = true;
+    std::vector<double> ms_octaves;   // empty, or N [, energy, extinction, anisotropy [, scatter power]]
+    std::optional<bool> ms_diffusion; // unset: on under artistic off
+    std::optional<int> ms_diffusion_sweeps;
+    Vec3i light_grid{{128, 128, 32}};
     // 2.5D
     double time = 0;
     Vec2d wind{{8, 0}};
@@ -83,8 +90,9 @@ std::span<const std::pair<const char*, const char*>> preview_node_defaults();
 // sets it), what it accepts, its defaults, unit and doc.
 std::string preview_options_markdown();
 
-// Throws atlas::Error for options no front end should let through (a size below
-// 1x1: a host filling PreviewOptions itself).
+// Throws atlas::Error for options that contradict each other (ms_octaves or
+// ms_diffusion without artistic off) or that no front end lets through (a size
+// below 1x1: a host filling PreviewOptions itself).
 void check_preview_options(const PreviewOptions& o);
 
 } // namespace atlas::render
