@@ -50,6 +50,9 @@ function(atlas_test name)
   target_compile_definitions(${name} PRIVATE
     ATLAS_SOURCE_DIR="${PROJECT_SOURCE_DIR}" ATLAS_BINARY_DIR="${PROJECT_BINARY_DIR}")
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS unit)
+  # Every suite is listed, so scripts/test.sh can build and run them all under sanitizers
+  # (target unit_suites, tests/CMakeLists.txt).
+  set_property(GLOBAL APPEND PROPERTY ATLAS_TEST_SUITES ${name})
 endfunction()
 
 # atlas_benchmark(NAME SOURCES... LIBS ...): a Google Benchmark program. Each
