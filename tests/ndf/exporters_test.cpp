@@ -23,7 +23,7 @@ using namespace atlas;
 using namespace atlas::ndf;
 
 namespace {
-// A set with hashed random channels; heights straddle the layer, one NaN.
+// A set with hashed random channels; heights straddle the layer, one NaN (sets of 2x2 and more).
 Field2D random_set(Vec2i res, Box2d box) {
     Field2D s = make_ndf_set(res, box, 0, 1, nullptr);
     for (int c = 0; c < ChannelCount; ++c)
@@ -32,7 +32,7 @@ Field2D random_set(Vec2i res, Box2d box) {
                 const float u = float(hash_coords(77 + uint32_t(c), x, y, 0) >> 8) / float(1 << 24);
                 s.at(c, x, y) = (c == MinHeight || c == MaxHeight) ? -2000.0f + 14000.0f * u : u;
             }
-    s.at(MaxHeight, 1, 1) = std::numeric_limits<float>::quiet_NaN();
+    if (res[0] > 1 && res[1] > 1) s.at(MaxHeight, 1, 1) = std::numeric_limits<float>::quiet_NaN(); // (1, 1) exists
     return s;
 }
 float in_layer_ref(double h, double lo, double hi) {

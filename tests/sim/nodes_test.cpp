@@ -656,7 +656,9 @@ outputs:
     expect_same(*vel, sim.velocity_field(), "velocity");
     // The cold bubble is there: T' reached about -5 K at its centre initially.
     double min_tp = 0;
-    for (float t : sim.theta_perturbation().channel(0)) min_tp = std::min(min_tp, double(t));
+    // theta_perturbation() returns a field by value: keep it alive while its channel is read.
+    const auto tp_field = sim.theta_perturbation();
+    for (float t : tp_field.channel(0)) min_tp = std::min(min_tp, double(t));
     EXPECT_LT(min_tp, -4.0);
 }
 
