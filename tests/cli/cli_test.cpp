@@ -635,17 +635,21 @@ TEST(CliHostile, TruncatedVdbFailsFast) {
     }
 }
 
+// ASan's shadow memory and free-quarantine count in the kernel's RSS, so an RSS
+// bound means nothing in a sanitizer build (the Release suite checks it).
+#if defined(__SANITIZE_ADDRESS__)
+#define SKIP_RSS_BOUNDS_UNDER_ASAN() GTEST_SKIP() << "RSS bound not meaningful under AddressSanitizer"
+#else
+#define SKIP_RSS_BOUNDS_UNDER_ASAN() (void)0
+#endif
+
 // --memory-budget holds the live total (issue 17 item 6): values held, the
 // in-memory cache and new fields together. Five 8 MB fields, each under the
 // budget, exceed 32 MiB together: the cook either stays under the budget (peak
 // RSS over the same program's baseline, measured by the kernel) or refuses
 // cleanly, naming the node.
 TEST(CliBudget, LiveTotalStaysUnderTheBudgetOrIsRefusedByName) {
-#if defined(__SANITIZE_ADDRESS__)
-    // ASan's shadow memory and free-quarantine count in the kernel's RSS, so the
-    // budget's RSS bound means nothing there (the Release suite checks it).
-    GTEST_SKIP() << "RSS bound not meaningful under AddressSanitizer";
-#endif
+    SKIP_RSS_BOUNDS_UNDER_ASAN();
     const fs::path d = fresh_dir("budget");
     auto g = write_graph("budget.yaml",
                          "atlas: 1\nnodes:\n"
@@ -694,11 +698,7 @@ TEST(CliBudget, LiveTotalStaysUnderTheBudgetOrIsRefusedByName) {
 // fields it cooks, the kernel-measured peak over the program's baseline stays
 // under the budget plus a slack, and the bytes equal an unbudgeted cook.
 TEST(CliBudget, RunningNodesScratchCountsAgainstTheBudget) {
-#if defined(__SANITIZE_ADDRESS__)
-    // ASan's shadow memory and free-quarantine count in the kernel's RSS, so the
-    // budget's RSS bound means nothing there (the Release suite checks it).
-    GTEST_SKIP() << "RSS bound not meaningful under AddressSanitizer";
-#endif
+    SKIP_RSS_BOUNDS_UNDER_ASAN();
     const fs::path d = fresh_dir("scratch");
     auto g = write_graph("scratch.yaml",
                          "atlas: 1\nnodes:\n"
