@@ -13,10 +13,14 @@
 // out of the loop (TBB cancels the remaining blocks).
 #pragma once
 
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 namespace atlas {
@@ -63,6 +67,28 @@ T parallel_reduce_blocks(size_t n, size_t block, T init, Fn&& fn, Combine&& comb
     T acc = init;
     for (const T& p : partial) acc = combine(acc, p);
     return acc;
+}
+
+// Runs a and b, possibly at the same time on two threads; returns when both are done.
+// Two independent computations (each writing only its own result) stay deterministic.
+template <typename A, typename B>
+void parallel_invoke(A&& a, B&& b) {
+    tbb::parallel_invoke(std::forward<A>(a), std::forward<B>(b));
+}
+
+// Threads a loop may use when nothing limits it (the machine's hardware concurrency).
+inline int hardware_threads() { return int(tbb::info::default_concurrency()); }
+
+// Runs fn() with the loops inside it limited to `threads` worker threads (<= 0: no
+// limit). The limit changes which thread runs a block, never the blocks themselves.
+template <typename Fn>
+void with_thread_limit(int threads, Fn&& fn) {
+    if (threads <= 0) {
+        fn();
+        return;
+    }
+    tbb::task_arena arena(threads);
+    arena.execute(fn);
 }
 
 } // namespace atlas
