@@ -1,8 +1,7 @@
 // field/resample: a 3D field onto a new resolution and bounds, trilinearly.
 #include "atlas/core/field_math.h"
 #include "atlas/graph/node.h"
-
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -68,7 +67,7 @@ Value resample_window(CookContext& ctx, const TileWindow& win, Vec3i res) {
         ctx.check_memory(field_bytes(uint64_t(w) * h * res[2], src.channels()), "the resampled field");
         auto out = std::make_shared<Field3D>(Vec3i{{w, h, res[2]}}, src.channels(), src.bounds(), src.channel_names(), &ctx.budget());
         const double lz = src.bounds().min[2], szo = src.bounds().size()[2] / res[2], szs = src.voxel_size()[2];
-        tbb::parallel_for(0, res[2], [&](int z) {
+        parallel_for_index(res[2], [&](int z) {
             const Taps tz = taps(((lz + (z + 0.5) * szo) - lz) / szs, src.nz(), 0, src.nz());
             for (int y = 0; y < h; ++y) {
                 const Taps ty = taps(coord(win.y0 + y, uy_lo, sy), g[1], win.y0, h);
@@ -89,7 +88,7 @@ Value resample_window(CookContext& ctx, const TileWindow& win, Vec3i res) {
     auto src = ctx.input_field2d("in");
     const int w = src->width(), h = src->height();
     auto out = std::make_shared<Field2D>(Vec2i{{w, h}}, src->channels(), src->bounds(), src->channel_names(), &ctx.budget());
-    tbb::parallel_for(0, h, [&](int y) {
+    parallel_for_index(h, [&](int y) {
         const Taps ty = taps(coord(win.y0 + y, uy_lo, sy), g[1], win.y0, h);
         for (int x = 0; x < w; ++x) {
             const Taps tx = taps(coord(win.x0 + x, ux_lo, sx), g[0], win.x0, w);

@@ -1,8 +1,7 @@
 // ndf/warp: domain warp of a map by another map.
 #include "atlas/ndf/operators.h"
 #include "ndf/ndf_params.h"
-
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -69,7 +68,7 @@ Field2D warp_window(const Field2D& in, const Field2D& warp, double amount, WrapM
         const int base = int(fl);
         return Taps{std::clamp(fix(base, n) - origin, 0, local - 1), std::clamp(fix(base + 1, n) - origin, 0, local - 1), t};
     };
-    tbb::parallel_for(0, h, [&](int y) { // rows are independent: the same bytes for any thread count
+    parallel_for_index(h, [&](int y) { // rows are independent: the same bytes for any thread count
         const double py = lo[1] + (y0 + y + 0.5) * s[1];
         for (int x = 0; x < w; ++x) {
             const size_t i = in.index(x, y);

@@ -5,7 +5,6 @@
 #include "atlas/core/files.h"
 
 #include <cstring>
-#include <fstream>
 
 namespace atlas::compress {
 

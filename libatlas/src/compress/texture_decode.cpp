@@ -4,10 +4,10 @@
 #include "atlas/compress/bc6h.h"
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
+#include "atlas/core/parallel.h"
 #include "half.h"
 #include "texture_internal.h"
 
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -243,7 +243,7 @@ CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* mani
     };
     const std::vector<Decoder> models = decoders_in(decoders);
     std::vector<ModelResult> results(models.size());
-    tbb::parallel_for(size_t(0), models.size(), [&](size_t k) {
+    parallel_for_each(models.size(), 1, [&](size_t k) {
         const Decoder d = models[k];
         DecoderStats& st = results[k].st;
         std::vector<double>& sq = results[k].sq;

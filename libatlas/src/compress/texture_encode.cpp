@@ -6,17 +6,15 @@
 #include "atlas/compress/bc6h.h"
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
+#include "atlas/core/parallel.h"
 #include "half.h"
 #include "mips.h"
 #include "texture_internal.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 
 namespace atlas::compress {
@@ -70,8 +68,8 @@ void encode_plain(const LevelData& L, int layer, DxgiFormat f, bool one_sided, u
     const size_t n = size_t(L.w) * size_t(L.h) * size_t(L.d);
     const int unit = format_unit_bytes(f);
     const auto& P = L.planes[size_t(layer)];
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) {
+    parallel_blocks(n, 4096, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i != i1; ++i) {
             uint8_t* p = out + i * size_t(unit);
             float dec[4] = {0, 0, 0, 0};
             auto put16 = [&](int k, uint16_t v) { p[2 * k] = uint8_t(v); p[2 * k + 1] = uint8_t(v >> 8); };
@@ -124,9 +122,9 @@ void encode_bc(const LevelData& L, int layer, Format fmt, const BlockOptions& bo
     const size_t nblocks = size_t(bw) * size_t(bh) * size_t(L.d);
     const bool bc6h = fmt == Format::Bc6hUf16 || fmt == Format::Bc6hSf16;
     const size_t unit = bc6h ? 16 : 8;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nblocks, 64), [&](const tbb::blocked_range<size_t>& r) {
+    parallel_blocks(nblocks, 64, [&](size_t b0, size_t b1) {
         if (progress) progress->poll();
-        for (size_t b = r.begin(); b != r.end(); ++b) {
+        for (size_t b = b0; b != b1; ++b) {
             const int bx = int(b % size_t(bw)), by = int((b / size_t(bw)) % size_t(bh)), z = int(b / (size_t(bw) * size_t(bh)));
             float src[48];
             const int ch = (fmt == Format::Bc1 || bc6h) ? 3 : 1;

@@ -5,13 +5,12 @@
 #include "graph_walk.h"
 
 #include "atlas/core/files.h"
+#include "atlas/core/parallel.h"
 #include "atlas/io/writers.h"
 #include "../core/file_limits.h"
 #include "output_records.h"
 #include "value_cache.h"
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -194,7 +193,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     CookResult& result = last_;
     result.checked = opt.checked;
     const Graph& g = graph();
-    const int jobs = opt.jobs > 0 ? opt.jobs : int(tbb::info::default_concurrency());
+    const int jobs = opt.jobs > 0 ? opt.jobs : hardware_threads();
     // One budget per session: the live total of this cook's fields and values
     // and of the in-memory cache; before refusing it drops cache entries.
     const MemoryBudget budget(opt.memory_budget);
@@ -443,13 +442,13 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     std::set<std::string> target_nodes;
     for (const auto& t : targets) target_nodes.insert(t.first);
     std::map<std::string, uint64_t> released_bytes;
-    tbb::task_arena arena(jobs);
+    ThreadLimit arena(jobs);
     for (const auto& level : levels) {
         std::vector<std::exception_ptr> errors(level.size());
         std::vector<NodeReport> reports(level.size());
         std::vector<std::shared_ptr<const NodeOutputs>> produced(level.size());
-        arena.execute([&] {
-            tbb::parallel_for(size_t(0), level.size(), size_t(1), [&](size_t i) {
+        arena.run([&] {
+            parallel_for_each(level.size(), 1, [&](size_t i) {
                 const GraphNode& n = *level[i];
                 const NodeState& s = state.at(n.name);
                 try {

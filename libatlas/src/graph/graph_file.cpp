@@ -4,6 +4,7 @@
 #include "atlas/core/files.h"
 #include "atlas/io/writers.h"
 #include "atlas/io/yaml_document.h"
+#include "graph_walk.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -41,8 +42,8 @@ struct Parser {
 };
 
 bool parse_bool(const std::string& s, bool& out) {
-    if (s == "true" || s == "yes" || s == "on") { out = true; return true; }
-    if (s == "false" || s == "no" || s == "off") { out = false; return true; }
+    if (s == "true" || s == "yes" || s == "on" || s == "1") { out = true; return true; }
+    if (s == "false" || s == "no" || s == "off" || s == "0") { out = false; return true; }
     return false;
 }
 
@@ -206,6 +207,8 @@ void check_output_request(PortType produced, const std::string& format, const st
 }
 
 } // namespace
+
+std::string detail::param_from_yaml(const YAML::Node& n, const ParamDecl& decl, ParamValue& out) { return yaml_to_param(n, decl, out); }
 
 std::string closest_match(const std::string& word, const std::vector<std::string>& candidates) {
     auto distance = [](const std::string& a, const std::string& b) {

@@ -1,5 +1,6 @@
 // Graph validation (connections, types, cycles) and parameter overrides.
 #include "atlas/graph/graph.h"
+#include "graph_walk.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -142,35 +143,22 @@ void set_param_text(Graph& graph, const NodeRegistry& registry, const std::strin
     } catch (const Error& e) {
         throw Error(origin + ": " + e.what());
     }
-    // Parse the text as a YAML flow value so '--set a.b=[1,2,3]' works.
-    YAML::Node n;
-    try {
-        n = YAML::Load(value_text);
-    } catch (const YAML::Exception& e) {
-        throw Error(origin + ": cannot read value '" + value_text + "': " + e.msg);
-    }
+    // A string parameter takes the text as it is; any other value, and a schema text
+    // option given as a list ('--set p.sky_colour=[1,2,3]'), is read as a YAML flow value
+    // by the graph file's own converter, so both front ends accept the same values.
     ParamValue v;
     std::string err;
-    const int comps = param_components(d->type);
-    if (comps > 1) {
-        if (!n.IsSequence()) err = "expected a list of " + std::to_string(comps) + " numbers, e.g. [1, 2" + (comps == 3 ? ", 3]" : "]");
-        else {
-            std::vector<double> xs;
-            for (const auto& e : n) {
-                try { xs.push_back(std::stod(e.Scalar())); } catch (...) { err = "expected numbers in the list"; }
-            }
-            v = xs;
-        }
-    } else if (d->type == ParamType::Float) {
-        try { size_t used; v = std::stod(value_text, &used); if (used != value_text.size()) err = "expected a number"; } catch (...) { err = "expected a number"; }
-    } else if (d->type == ParamType::Int) {
-        try { size_t used; v = int64_t(std::stoll(value_text, &used)); if (used != value_text.size()) err = "expected an integer"; } catch (...) { err = "expected an integer"; }
-    } else if (d->type == ParamType::Bool) {
-        if (value_text == "true" || value_text == "1" || value_text == "yes" || value_text == "on") v = true;
-        else if (value_text == "false" || value_text == "0" || value_text == "no" || value_text == "off") v = false;
-        else err = "expected true or false";
-    } else {
+    const bool list = !value_text.empty() && value_text.front() == '[';
+    if (d->type == ParamType::String && !(d->check_value && list)) {
         v = value_text;
+    } else {
+        YAML::Node n;
+        try {
+            n = YAML::Load(value_text);
+        } catch (const YAML::Exception& e) {
+            throw Error(origin + ": cannot read value '" + value_text + "': " + e.msg);
+        }
+        err = detail::param_from_yaml(n, *d, v);
     }
     if (err.empty()) err = d->check(v);
     if (!err.empty())

@@ -9,7 +9,16 @@
 #include <string>
 #include <vector>
 
+namespace YAML {
+class Node;
+}
+
 namespace atlas::detail {
+
+// A parameter value from YAML, as a graph file gives it (a list for float2/float3/
+// int2/int3 and for a schema text option that takes numbers, else one scalar): the one
+// converter of graph files and --set. Returns "" or what was expected.
+std::string param_from_yaml(const YAML::Node& n, const ParamDecl& decl, ParamValue& out);
 
 // Topological order (inputs first) of every node, following file order.
 inline std::vector<const GraphNode*> topological_order(const Graph& g) {

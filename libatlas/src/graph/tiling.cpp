@@ -4,12 +4,12 @@
 #include "graph_walk.h"
 
 #include "atlas/core/files.h"
+#include "atlas/core/parallel.h"
 #include "atlas/core/hash.h"
 #include "atlas/io/writers.h"
 #include "value_cache.h"
 
 #include <nlohmann/json.hpp>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -429,7 +429,7 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
 
     result = TiledCookResult{};
     result.tiles = tiles;
-    result.jobs = opt.jobs > 0 ? opt.jobs : int(tbb::info::default_concurrency());
+    result.jobs = opt.jobs > 0 ? opt.jobs : hardware_threads();
     const auto hashes = session.node_hashes();
 
     std::vector<Vec2i> selection;
@@ -527,7 +527,7 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
             throw Error(o->where.str() + ": --tiles " + tile_name(tiles) + ": output '" + o->file +
                         "' is BC-compressed in 4x4 blocks, and tiles of " + xy_text(tile_size) + " texels are not block-aligned");
 
-    tbb::task_arena arena(opt.jobs > 0 ? opt.jobs : int(tbb::info::default_concurrency()));
+    ThreadLimit arena(opt.jobs);
     const int total_tiles = int(selection.size());
     int tiles_finished = int(selection.size() - to_cook.size());
 
@@ -580,7 +580,7 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
                     value_peak = std::max(value_peak, distinct_bytes(alive));
                 }
                 try {
-                    arena.execute([&] { type.cook(ctx); });
+                    arena.run([&] { type.cook(ctx); });
                 } catch (const CancelledError&) {
                     throw;
                 } catch (const std::exception& e) {

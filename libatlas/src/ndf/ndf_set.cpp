@@ -6,7 +6,6 @@
 
 #include "atlas/core/parallel.h"
 
-#include <tbb/parallel_for.h>
 
 #include <cmath>
 

@@ -4,8 +4,7 @@
 
 #include "atlas/core/error.h"
 #include "atlas/noise/value_noise.h"
-
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <cmath>
 #include <limits>
@@ -52,7 +51,7 @@ Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const M
     Field2D out = set;
     if (s.blend == 0) return out;
     const Vec3i period{{1 << 16, 1 << 16, 1}};
-    tbb::parallel_for(0, set.height(), [&](int y) {
+    parallel_for_index(set.height(), [&](int y) {
         for (int x = 0; x < set.width(); ++x) {
             const Vec2d d = set.texel_center(x, y) - s.center;
             const double r = length(d);
@@ -94,7 +93,7 @@ Field2D superstorm_anvil(const Field2D& set, const SuperstormStencil& s, const F
         if (cl >= 0) std::copy(previous->channel(cl).begin(), previous->channel(cl).end(), out.channel(1).begin());
     }
     if (s.blend == 0 || s.anvil == 0) return out;
-    tbb::parallel_for(0, set.height(), [&](int y) {
+    parallel_for_index(set.height(), [&](int y) {
         for (int x = 0; x < set.width(); ++x) {
             const double r = length(set.texel_center(x, y) - s.center);
             if (!(r < s.radius)) continue;
@@ -168,7 +167,7 @@ Field2D vortex_ring_map(Vec2i res, Box2d bounds, Vec2d center, const std::vector
                         const MemoryBudget* budget) {
     if (rings.empty()) throw Error("vortex rings: at least one ring");
     Field2D f(res, 2, bounds, {"ring_index", "ring_blend"}, budget);
-    tbb::parallel_for(0, res[1], [&](int y) {
+    parallel_for_index(res[1], [&](int y) {
         for (int x = 0; x < res[0]; ++x) {
             const double r = length(f.texel_center(x, y) - center);
             float idx = -1, blend = 0;

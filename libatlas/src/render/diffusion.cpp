@@ -1,6 +1,5 @@
 #include "diffusion.h"
-
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -30,7 +29,7 @@ constexpr double kMarshak = 2.0;
 // voxels of the other colour, so z slabs run in parallel with the same bytes.
 void sweep(Level& L, double reduce, int colour) {
     const double min_sig = kDiffusionMinTau / L.hmin();
-    tbb::parallel_for(0, L.n[2], [&](int z) {
+    parallel_for_index(L.n[2], [&](int z) {
         for (int y = 0; y < L.n[1]; ++y) {
             for (int x = (y + z + colour) & 1; x < L.n[0]; x += 2) {
                 const size_t i = L.idx(x, y, z);
@@ -71,7 +70,7 @@ void sweep(Level& L, double reduce, int colour) {
 // 0.070 mean error). Reads medium voxels only.
 void fill_outside(Level& L, double reduce) {
     const double min_sig = kDiffusionMinTau / L.hmin();
-    tbb::parallel_for(0, L.n[2], [&](int z) {
+    parallel_for_index(L.n[2], [&](int z) {
         for (int y = 0; y < L.n[1]; ++y)
             for (int x = 0; x < L.n[0]; ++x) {
                 const size_t i = L.idx(x, y, z);
@@ -106,7 +105,7 @@ void leak_factors(Level& L) {
         if (x < 0 || y < 0 || z < 0 || x >= L.n[0] || y >= L.n[1] || z >= L.n[2]) return 0.0;
         return double(L.sig[L.idx(x, y, z)]);
     };
-    tbb::parallel_for(0, L.n[2], [&](int z) {
+    parallel_for_index(L.n[2], [&](int z) {
         for (int y = 0; y < L.n[1]; ++y)
             for (int x = 0; x < L.n[0]; ++x) {
                 const double g[3] = {(sig(x + 1, y, z) - sig(x - 1, y, z)) / L.h[0], (sig(x, y + 1, z) - sig(x, y - 1, z)) / L.h[1],
@@ -126,7 +125,7 @@ Level coarsen(const Level& f, const Vec3d& size) {
     c.sig.assign(c.size(), 0.0f);
     c.q.assign(c.size(), 0.0f);
     c.phi.assign(c.size(), 0.0f);
-    tbb::parallel_for(0, c.n[2], [&](int z) {
+    parallel_for_index(c.n[2], [&](int z) {
         for (int y = 0; y < c.n[1]; ++y)
             for (int x = 0; x < c.n[0]; ++x) {
                 double s = 0, q = 0;
@@ -151,7 +150,7 @@ Level coarsen(const Level& f, const Vec3d& size) {
 }
 
 void prolong(const Level& c, Level& f) {
-    tbb::parallel_for(0, f.n[2], [&](int z) {
+    parallel_for_index(f.n[2], [&](int z) {
         for (int y = 0; y < f.n[1]; ++y)
             for (int x = 0; x < f.n[0]; ++x)
                 f.phi[f.idx(x, y, z)] = c.phi[c.idx(std::min(x / 2, c.n[0] - 1), std::min(y / 2, c.n[1] - 1), std::min(z / 2, c.n[2] - 1))];
@@ -236,7 +235,7 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
     // faces); outside voxels next to the medium take their medium
     // neighbours' mean, others 0.
     flux_.assign(3 * n, 0.0f);
-    tbb::parallel_for(0, res_[2], [&](int z) {
+    parallel_for_index(res_[2], [&](int z) {
         for (int y = 0; y < res_[1]; ++y)
             for (int x = 0; x < res_[0]; ++x) {
                 const size_t i = top.idx(x, y, z);
@@ -262,7 +261,7 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
                 }
             }
     });
-    tbb::parallel_for(0, res_[2], [&](int z) {
+    parallel_for_index(res_[2], [&](int z) {
         for (int y = 0; y < res_[1]; ++y)
             for (int x = 0; x < res_[0]; ++x) {
                 const size_t i = top.idx(x, y, z);

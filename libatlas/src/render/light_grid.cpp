@@ -1,7 +1,5 @@
 #include "light_grid.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,7 +23,7 @@ LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_
     // 1. The cloud's density at the grid's voxel centres (no near-camera detail).
     dens_.assign(n, 0.0f);
     std::vector<float>& dens = dens_;
-    tbb::parallel_for(0, res_[2], [&](int z) {
+    parallel_for_index(res_[2], [&](int z) {
         for (int y = 0; y < res_[1]; ++y)
             for (int x = 0; x < res_[0]; ++x) {
                 const double px = bounds_.min[0] + (x + 0.5) * voxel_[0];
@@ -36,7 +34,7 @@ LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_
     });
     // 2. Toward the sky: a running sum down each column (midpoint rule).
     sky_.assign(n, 0.0f);
-    tbb::parallel_for(0, res_[1], [&](int y) {
+    parallel_for_index(res_[1], [&](int y) {
         for (int x = 0; x < res_[0]; ++x) {
             double acc = 0;
             for (int z = res_[2] - 1; z >= 0; --z) {
@@ -51,7 +49,7 @@ LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_
     //    so it is skipped after a one-byte test (most of a sparse cloud's
     //    grid is empty; same bytes as sampling it).
     std::vector<unsigned char> occupied(n, 0);
-    tbb::parallel_for(0, res_[2], [&](int z) {
+    parallel_for_index(res_[2], [&](int z) {
         const int z1 = std::min(z + 1, res_[2] - 1);
         for (int y = 0; y < res_[1]; ++y) {
             const int y1 = std::min(y + 1, res_[1] - 1);
@@ -92,7 +90,7 @@ LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_
     };
     sun_.assign(n, 0.0f);
     const double step = 0.75 * std::min({voxel_[0], voxel_[1], voxel_[2]});
-    tbb::parallel_for(0, res_[2], [&](int z) {
+    parallel_for_index(res_[2], [&](int z) {
         for (int y = 0; y < res_[1]; ++y)
             for (int x = 0; x < res_[0]; ++x) {
                 const Vec3d p{{bounds_.min[0] + (x + 0.5) * voxel_[0], bounds_.min[1] + (y + 0.5) * voxel_[1],

@@ -8,12 +8,10 @@
 
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
+#include "atlas/core/parallel.h"
 #include "atlas/core/progress.h"
 #include "atlas/render/renderer.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -202,20 +200,9 @@ struct Pinhole {
     }
 };
 
-// Runs f in an arena of `threads` threads (0 = TBB default).
-template <class F>
-void run_in_arena(int threads, F&& f) {
-    if (threads > 0) {
-        tbb::task_arena arena(threads);
-        arena.execute(f);
-    } else {
-        f();
-    }
-}
-
 constexpr int kTile = 16;
 
-// The deterministic tile loop: fixed 16x16 tiles over TBB; pixel(x, y,
+// The deterministic tile loop: fixed 16x16 tiles, one block each; pixel(x, y,
 // jitter, samples) is called once per pixel with jitter =
 // hash_to_unit(hash_coords(seed, x, y)) and must depend only on its
 // arguments. Returns the summed per-tile sample counts (fixed order).
@@ -228,9 +215,9 @@ uint64_t for_each_pixel(const RenderSettings& s, const ProgressSink* progress, c
     std::vector<uint64_t> tile_samples(size_t(tiles), 0);
     std::atomic<int> done{0};
     std::atomic<bool> cancelled{false};
-    run_in_arena(s.threads, [&] {
-        tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
-            for (int ti = r.begin(); ti != r.end(); ++ti) {
+    with_thread_limit(s.threads, [&] {
+        parallel_blocks(size_t(tiles), 1, [&](size_t t0, size_t t1) {
+            for (int ti = int(t0); ti != int(t1); ++ti) {
                 if (cancelled.load(std::memory_order_relaxed)) return;
                 if (progress && progress->cancelled()) {
                     cancelled = true;

@@ -3,13 +3,12 @@
 #include "diffusion.h"
 #include "light_grid.h"
 #include "render_common.h"
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
-
-#include <tbb/parallel_for.h>
 
 namespace atlas::render {
 
@@ -276,7 +275,7 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     const bool diffuse = !settings.artistic && settings.ms_diffusion && settings.ms_octaves > 0 && settings.multiple_scattering > 0;
     std::unique_ptr<detail::DiffusionGrid> diffusion;
     if (fast || diffuse)
-        detail::run_in_arena(settings.threads, [&] {
+        with_thread_limit(settings.threads, [&] {
             grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun);
             if (diffuse) {
                 const double g = settings.hg_forward_weight * settings.hg_forward + (1 - settings.hg_forward_weight) * settings.hg_back;
@@ -341,7 +340,7 @@ Field3D sample_density(const CloudScene& scene, Vec3i res) {
     const Box3d b = cloud.bounds();
     Field3D out(res, 1, b, {"density"});
     const Vec3d v = out.voxel_size();
-    tbb::parallel_for(0, res[2], [&](int z) {
+    parallel_for_index(res[2], [&](int z) {
         for (int y = 0; y < res[1]; ++y)
             for (int x = 0; x < res[0]; ++x)
                 out.at(0, x, y, z) =

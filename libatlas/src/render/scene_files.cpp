@@ -1,9 +1,8 @@
 #include "atlas/render/scene.h"
 
 #include "atlas/core/error.h"
+#include "atlas/core/parallel.h"
 #include "atlas/io/readers.h"
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -95,7 +94,8 @@ CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
     std::vector<double> cd(cx * cy * cz, std::numeric_limits<double>::infinity());
     // 1. Check, maximum, block occupancy (a coarse z row belongs to one task).
     std::vector<float> row_max(cz, 0.0f);
-    tbb::parallel_for(size_t(0), cz, [&](size_t bz) {
+    parallel_for_index(int(cz), [&](int bzi) {
+        const size_t bz = size_t(bzi);
         float m = 0;
         for (size_t z = bz * B; z < std::min(nz, (bz + 1) * B); ++z)
             for (size_t y = 0; y < ny; ++y)
@@ -115,7 +115,8 @@ CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
     const float dmax = *std::max_element(row_max.begin(), row_max.end());
     const double S = std::max(1.0, std::pow(double(dmax), 1.0 / 0.6));
     // 2. The profile in place, in the occupied blocks only (elsewhere it is the grid's 0).
-    tbb::parallel_for(size_t(0), cz, [&](size_t bz) {
+    parallel_for_index(int(cz), [&](int bzi) {
+        const size_t bz = size_t(bzi);
         for (size_t by = 0; by < cy; ++by)
             for (size_t bx = 0; bx < cx; ++bx) {
                 if (cd[bz * cxy + by * cx + bx] != 0) continue;
@@ -134,10 +135,10 @@ CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
         const size_t n = size_t(cr[axis]);
         const size_t stride = axis == 0 ? 1 : (axis == 1 ? cx : cxy);
         const size_t lines = (cx * cy * cz) / n;
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, lines), [&](const tbb::blocked_range<size_t>& range) {
+        parallel_blocks(lines, 64, [&](size_t l0, size_t l1) {
             std::vector<double> f(n), out(n), zz(n + 1);
             std::vector<int> v(n);
-            for (size_t l = range.begin(); l < range.end(); ++l) {
+            for (size_t l = l0; l < l1; ++l) {
                 size_t base;
                 if (axis == 0) base = l * cx;
                 else if (axis == 1) base = (l / cx) * cxy + (l % cx);
@@ -153,7 +154,8 @@ CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
     const double margin = B * std::sqrt(vox[0] * vox[0] + vox[1] * vox[1] + vox[2] * vox[2]) + 4.0 * vmax;
     // One value per block, then broadcast to its voxels.
     std::vector<float> block(cd.size());
-    tbb::parallel_for(size_t(0), cz, [&](size_t bz) {
+    parallel_for_index(int(cz), [&](int bzi) {
+        const size_t bz = size_t(bzi);
         for (size_t i = bz * cxy; i < (bz + 1) * cxy; ++i) {
             const double dist = std::sqrt(cd[i]);
             block[i] = !std::isfinite(dist)    ? static_cast<float>(1e30)
@@ -162,7 +164,8 @@ CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
         }
     });
     std::vector<double>().swap(cd);
-    tbb::parallel_for(size_t(0), nz, [&](size_t z) {
+    parallel_for_index(int(nz), [&](int zi) {
+        const size_t z = size_t(zi);
         for (size_t y = 0; y < ny; ++y) {
             const float* row = &block[(z / B) * cxy + (y / B) * cx];
             float* out = &sd[z * sxy + y * nx];

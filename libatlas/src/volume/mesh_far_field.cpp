@@ -16,8 +16,7 @@
 // sign. Every slab, column and voxel is computed the same way on any thread count.
 #include "mesh_line_hits.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -129,8 +128,8 @@ Seeds line_seeds(const AxisHits& ah, const UnionSurface& us) {
     }
     const uint32_t lines = uint32_t(ah.offsets.size() - 1);
     std::vector<std::vector<double>> per(lines);
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, lines, 256), [&](const tbb::blocked_range<uint32_t>& r) {
-        for (uint32_t l = r.begin(); l < r.end(); ++l) union_boundary_hits(ah, l, per[l]);
+    parallel_blocks(lines, 256, [&](size_t l0, size_t l1) {
+        for (size_t l = l0; l < l1; ++l) union_boundary_hits(ah, uint32_t(l), per[l]);
     });
     s.off_store.assign(size_t(lines) + 1, 0);
     for (uint32_t l = 0; l < lines; ++l) s.off_store[l + 1] = s.off_store[l] + uint32_t(per[l].size());
@@ -156,121 +155,119 @@ uint64_t mesh_signed_distance(const MeshLineHits& hits, const UnionSurface& us, 
     const std::unique_ptr<int16_t[]> cnt(new int16_t[count]);
 
     // Pass 1: per z-slab.
-    tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
+    parallel_for_index(nz, [&](int z) {
         // The slab's buffers stay in the L2 cache; the grids get contiguous copies.
         std::vector<float> A(sxy), B(sxy), line(size_t(std::max(nx, ny)));
         std::vector<int16_t> K(sxy);
         std::vector<uint32_t> cj(size_t(nx), 0), ck(size_t(nx), 0);
         std::vector<int> cb(size_t(nx), 0), ct(size_t(nx), 0);
         Scratch sc;
-        for (int z = r.begin(); z < r.end(); ++z) {
-            float* W = work.get() + size_t(z) * sxy;
-            float* C = out + size_t(z) * sxy;
-            // Family x: S_x along rows, then E_y down the columns.
-            bool any_x = false;
-            for (int y = 0; y < ny; ++y) {
-                const uint32_t l = uint32_t(y) + uint32_t(z) * uint32_t(ny);
-                float* row = A.data() + size_t(y) * size_t(nx);
-                if (nearest_seed(seeds[0].t + seeds[0].off[l], seeds[0].off[l + 1] - seeds[0].off[l], row, 1, nx, h2[0])) any_x = true;
-                else std::fill(row, row + nx, kInf);
-                ray_counts<true>(hits.axis[0], l, nx, K.data() + size_t(y) * size_t(nx), 1);
+        float* W = work.get() + size_t(z) * sxy;
+        float* C = out + size_t(z) * sxy;
+        // Family x: S_x along rows, then E_y down the columns.
+        bool any_x = false;
+        for (int y = 0; y < ny; ++y) {
+            const uint32_t l = uint32_t(y) + uint32_t(z) * uint32_t(ny);
+            float* row = A.data() + size_t(y) * size_t(nx);
+            if (nearest_seed(seeds[0].t + seeds[0].off[l], seeds[0].off[l + 1] - seeds[0].off[l], row, 1, nx, h2[0])) any_x = true;
+            else std::fill(row, row + nx, kInf);
+            ray_counts<true>(hits.axis[0], l, nx, K.data() + size_t(y) * size_t(nx), 1);
+        }
+        if (any_x)
+            for (int x = 0; x < nx; ++x) {
+                float* col = A.data() + size_t(x);
+                if (envelope(col, size_t(nx), line.data(), 1, ny, h2[1], sc))
+                    for (int y = 0; y < ny; ++y) col[size_t(y) * size_t(nx)] = line[size_t(y)];
             }
-            if (any_x)
-                for (int x = 0; x < nx; ++x) {
-                    float* col = A.data() + size_t(x);
-                    if (envelope(col, size_t(nx), line.data(), 1, ny, h2[1], sc))
-                        for (int y = 0; y < ny; ++y) col[size_t(y) * size_t(nx)] = line[size_t(y)];
-                }
-            // Family y: S_y down the columns and their ray counts, computed row by row
-            // with a cursor per column (the same arithmetic as nearest_seed / ray_counts).
-            bool any_y = false;
-            {
-                const AxisHits& ah = hits.axis[1];
+        // Family y: S_y down the columns and their ray counts, computed row by row
+        // with a cursor per column (the same arithmetic as nearest_seed / ray_counts).
+        bool any_y = false;
+        {
+            const AxisHits& ah = hits.axis[1];
+            for (int x = 0; x < nx; ++x) {
+                const uint32_t l = uint32_t(x) + uint32_t(z) * uint32_t(nx);
+                cj[size_t(x)] = seeds[1].off[l];
+                ck[size_t(x)] = ah.offsets[l];
+                cb[size_t(x)] = 0;
+                int total = 0;
+                for (uint32_t k = ah.offsets[l]; k < ah.offsets[l + 1]; ++k) total += ah.sign[k];
+                ct[size_t(x)] = total;
+                any_y |= seeds[1].off[l + 1] > seeds[1].off[l];
+            }
+            const double* t = seeds[1].t;
+            for (int y = 0; y < ny; ++y) {
+                float* row = B.data() + size_t(y) * size_t(nx);
+                int16_t* krow = K.data() + size_t(y) * size_t(nx);
                 for (int x = 0; x < nx; ++x) {
                     const uint32_t l = uint32_t(x) + uint32_t(z) * uint32_t(nx);
-                    cj[size_t(x)] = seeds[1].off[l];
-                    ck[size_t(x)] = ah.offsets[l];
-                    cb[size_t(x)] = 0;
-                    int total = 0;
-                    for (uint32_t k = ah.offsets[l]; k < ah.offsets[l + 1]; ++k) total += ah.sign[k];
-                    ct[size_t(x)] = total;
-                    any_y |= seeds[1].off[l + 1] > seeds[1].off[l];
-                }
-                const double* t = seeds[1].t;
-                for (int y = 0; y < ny; ++y) {
-                    float* row = B.data() + size_t(y) * size_t(nx);
-                    int16_t* krow = K.data() + size_t(y) * size_t(nx);
-                    for (int x = 0; x < nx; ++x) {
-                        const uint32_t l = uint32_t(x) + uint32_t(z) * uint32_t(nx);
-                        const uint32_t end = seeds[1].off[l + 1];
-                        uint32_t& j = cj[size_t(x)];
-                        if (j == end) row[x] = kInf; // no seed on this line
-                        else {
-                            while (j + 1 < end && std::abs(y - t[j + 1]) <= std::abs(y - t[j])) ++j;
-                            const double e = y - t[j];
-                            row[x] = float(e * e * h2[1]);
-                        }
-                        const uint32_t k1 = ah.offsets[l + 1];
-                        uint32_t& k = ck[size_t(x)];
-                        int& below = cb[size_t(x)];
-                        while (k < k1 && ah.t[k] <= y) below += ah.sign[k++];
-                        const int16_t a = clamp16(below), b = clamp16(-(ct[size_t(x)] - below));
-                        int16_t& c = krow[x];
-                        if (c != a || c != b) c = kDisagree;
+                    const uint32_t end = seeds[1].off[l + 1];
+                    uint32_t& j = cj[size_t(x)];
+                    if (j == end) row[x] = kInf; // no seed on this line
+                    else {
+                        while (j + 1 < end && std::abs(y - t[j + 1]) <= std::abs(y - t[j])) ++j;
+                        const double e = y - t[j];
+                        row[x] = float(e * e * h2[1]);
                     }
+                    const uint32_t k1 = ah.offsets[l + 1];
+                    uint32_t& k = ck[size_t(x)];
+                    int& below = cb[size_t(x)];
+                    while (k < k1 && ah.t[k] <= y) below += ah.sign[k++];
+                    const int16_t a = clamp16(below), b = clamp16(-(ct[size_t(x)] - below));
+                    int16_t& c = krow[x];
+                    if (c != a || c != b) c = kDisagree;
                 }
             }
-            if (any_y)
-                for (int y = 0; y < ny; ++y) {
-                    float* row = B.data() + size_t(y) * size_t(nx);
-                    if (envelope(row, 1, line.data(), 1, nx, h2[0], sc)) std::copy(line.begin(), line.begin() + nx, row);
-                }
-            if (any_x && any_y)
-                for (size_t i = 0; i < sxy; ++i) W[i] = std::min(A[i], B[i]);
-            else if (any_x) std::copy(A.begin(), A.end(), W);
-            else if (any_y) std::copy(B.begin(), B.end(), W);
-            else std::fill(W, W + sxy, kInf);
-            // Family z: S_z at this z for every z-line, then E_x along rows, E_y down the columns.
-            const Seeds& sz = seeds[2];
-            bool any_z = false;
-            for (int y = 0; y < ny; ++y)
-                for (int x = 0; x < nx; ++x) {
-                    const uint32_t l = uint32_t(x) + uint32_t(y) * uint32_t(nx);
-                    const double* t0 = sz.t + sz.off[l];
-                    const double* t1 = sz.t + sz.off[l + 1];
-                    float& a = A[size_t(y) * size_t(nx) + size_t(x)];
-                    if (t0 == t1) {
-                        a = kInf;
-                        continue;
-                    }
-                    any_z = true;
-                    const double* it = std::lower_bound(t0, t1, double(z));
-                    double e = std::numeric_limits<double>::infinity();
-                    if (it != t1) e = *it - z;
-                    if (it != t0 && z - *(it - 1) < e) e = z - *(it - 1);
-                    a = float(e * e * h2[2]);
-                }
-            bool any_c = false;
-            if (any_z) {
-                for (int y = 0; y < ny; ++y) {
-                    float* row = A.data() + size_t(y) * size_t(nx);
-                    if (!envelope(row, 1, B.data() + size_t(y) * size_t(nx), 1, nx, h2[0], sc))
-                        std::fill(B.data() + size_t(y) * size_t(nx), B.data() + size_t(y + 1) * size_t(nx), kInf);
-                    else any_c = true;
-                }
-            }
-            if (any_c) {
-                for (int x = 0; x < nx; ++x) {
-                    float* col = A.data() + size_t(x);
-                    if (envelope(B.data() + size_t(x), size_t(nx), line.data(), 1, ny, h2[1], sc))
-                        for (int y = 0; y < ny; ++y) col[size_t(y) * size_t(nx)] = line[size_t(y)];
-                    else
-                        for (int y = 0; y < ny; ++y) col[size_t(y) * size_t(nx)] = kInf;
-                }
-                std::copy(A.begin(), A.end(), C);
-            } else std::fill(C, C + sxy, kInf);
-            std::copy(K.begin(), K.end(), cnt.get() + size_t(z) * sxy);
         }
+        if (any_y)
+            for (int y = 0; y < ny; ++y) {
+                float* row = B.data() + size_t(y) * size_t(nx);
+                if (envelope(row, 1, line.data(), 1, nx, h2[0], sc)) std::copy(line.begin(), line.begin() + nx, row);
+            }
+        if (any_x && any_y)
+            for (size_t i = 0; i < sxy; ++i) W[i] = std::min(A[i], B[i]);
+        else if (any_x) std::copy(A.begin(), A.end(), W);
+        else if (any_y) std::copy(B.begin(), B.end(), W);
+        else std::fill(W, W + sxy, kInf);
+        // Family z: S_z at this z for every z-line, then E_x along rows, E_y down the columns.
+        const Seeds& sz = seeds[2];
+        bool any_z = false;
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const uint32_t l = uint32_t(x) + uint32_t(y) * uint32_t(nx);
+                const double* t0 = sz.t + sz.off[l];
+                const double* t1 = sz.t + sz.off[l + 1];
+                float& a = A[size_t(y) * size_t(nx) + size_t(x)];
+                if (t0 == t1) {
+                    a = kInf;
+                    continue;
+                }
+                any_z = true;
+                const double* it = std::lower_bound(t0, t1, double(z));
+                double e = std::numeric_limits<double>::infinity();
+                if (it != t1) e = *it - z;
+                if (it != t0 && z - *(it - 1) < e) e = z - *(it - 1);
+                a = float(e * e * h2[2]);
+            }
+        bool any_c = false;
+        if (any_z) {
+            for (int y = 0; y < ny; ++y) {
+                float* row = A.data() + size_t(y) * size_t(nx);
+                if (!envelope(row, 1, B.data() + size_t(y) * size_t(nx), 1, nx, h2[0], sc))
+                    std::fill(B.data() + size_t(y) * size_t(nx), B.data() + size_t(y + 1) * size_t(nx), kInf);
+                else any_c = true;
+            }
+        }
+        if (any_c) {
+            for (int x = 0; x < nx; ++x) {
+                float* col = A.data() + size_t(x);
+                if (envelope(B.data() + size_t(x), size_t(nx), line.data(), 1, ny, h2[1], sc))
+                    for (int y = 0; y < ny; ++y) col[size_t(y) * size_t(nx)] = line[size_t(y)];
+                else
+                    for (int y = 0; y < ny; ++y) col[size_t(y) * size_t(nx)] = kInf;
+            }
+            std::copy(A.begin(), A.end(), C);
+        } else std::fill(C, C + sxy, kInf);
+        std::copy(K.begin(), K.end(), cnt.get() + size_t(z) * sxy);
     });
 
     // The exact band lowers the squared distances (the family-z EDT is an upper bound).
@@ -279,42 +276,41 @@ uint64_t mesh_signed_distance(const MeshLineHits& hits, const UnionSurface& us, 
     // Pass 2: per y, 16 z-columns at a time.
     constexpr int kBlock = 16;
     std::vector<std::vector<size_t>> disagree(static_cast<size_t>(ny));
-    tbb::parallel_for(tbb::blocked_range<int>(0, ny, 1), [&](const tbb::blocked_range<int>& r) {
+    parallel_for_index(ny, [&](int y) {
         std::vector<float> bw(size_t(nz) * kBlock), bs(size_t(nz) * kBlock), line(static_cast<size_t>(nz));
         std::vector<int16_t> bk(size_t(nz) * kBlock);
         Scratch sc;
-        for (int y = r.begin(); y < r.end(); ++y)
-            for (int x0 = 0; x0 < nx; x0 += kBlock) {
-                const int w = std::min(kBlock, nx - x0);
-                const size_t base = size_t(y) * size_t(nx) + size_t(x0);
-                for (int z = 0; z < nz; ++z) {
-                    const size_t o = base + size_t(z) * sxy;
-                    for (int k = 0; k < w; ++k) {
-                        bw[size_t(z) * kBlock + size_t(k)] = work[o + size_t(k)];
-                        bs[size_t(z) * kBlock + size_t(k)] = out[o + size_t(k)];
-                        bk[size_t(z) * kBlock + size_t(k)] = cnt[o + size_t(k)];
-                    }
-                }
+        for (int x0 = 0; x0 < nx; x0 += kBlock) {
+            const int w = std::min(kBlock, nx - x0);
+            const size_t base = size_t(y) * size_t(nx) + size_t(x0);
+            for (int z = 0; z < nz; ++z) {
+                const size_t o = base + size_t(z) * sxy;
                 for (int k = 0; k < w; ++k) {
-                    float* s = bs.data() + size_t(k);
-                    if (envelope(bw.data() + size_t(k), kBlock, line.data(), 1, nz, h2[2], sc))
-                        for (int z = 0; z < nz; ++z) s[size_t(z) * kBlock] = std::min(s[size_t(z) * kBlock], line[size_t(z)]);
-                    const uint32_t l = uint32_t(x0 + k) + uint32_t(y) * uint32_t(nx);
-                    int16_t* kk = bk.data() + size_t(k);
-                    ray_counts<false>(hits.axis[2], l, nz, kk, kBlock);
-                    for (int z = 0; z < nz; ++z) {
-                        const float d2 = s[size_t(z) * kBlock];
-                        const float d = d2 == kInf ? far : std::sqrt(d2);
-                        const int16_t c = kk[size_t(z) * kBlock];
-                        if (c == kDisagree) disagree[size_t(y)].push_back(base + size_t(k) + size_t(z) * sxy);
-                        s[size_t(z) * kBlock] = c != kDisagree && c >= 1 ? -d : d;
-                    }
-                }
-                for (int z = 0; z < nz; ++z) {
-                    const size_t o = base + size_t(z) * sxy;
-                    for (int k = 0; k < w; ++k) out[o + size_t(k)] = bs[size_t(z) * kBlock + size_t(k)];
+                    bw[size_t(z) * kBlock + size_t(k)] = work[o + size_t(k)];
+                    bs[size_t(z) * kBlock + size_t(k)] = out[o + size_t(k)];
+                    bk[size_t(z) * kBlock + size_t(k)] = cnt[o + size_t(k)];
                 }
             }
+            for (int k = 0; k < w; ++k) {
+                float* s = bs.data() + size_t(k);
+                if (envelope(bw.data() + size_t(k), kBlock, line.data(), 1, nz, h2[2], sc))
+                    for (int z = 0; z < nz; ++z) s[size_t(z) * kBlock] = std::min(s[size_t(z) * kBlock], line[size_t(z)]);
+                const uint32_t l = uint32_t(x0 + k) + uint32_t(y) * uint32_t(nx);
+                int16_t* kk = bk.data() + size_t(k);
+                ray_counts<false>(hits.axis[2], l, nz, kk, kBlock);
+                for (int z = 0; z < nz; ++z) {
+                    const float d2 = s[size_t(z) * kBlock];
+                    const float d = d2 == kInf ? far : std::sqrt(d2);
+                    const int16_t c = kk[size_t(z) * kBlock];
+                    if (c == kDisagree) disagree[size_t(y)].push_back(base + size_t(k) + size_t(z) * sxy);
+                    s[size_t(z) * kBlock] = c != kDisagree && c >= 1 ? -d : d;
+                }
+            }
+            for (int z = 0; z < nz; ++z) {
+                const size_t o = base + size_t(z) * sxy;
+                for (int k = 0; k < w; ++k) out[o + size_t(k)] = bs[size_t(z) * kBlock + size_t(k)];
+            }
+        }
     });
 
     // Where the six counts disagree (holes, flipped faces): the fast generalized winding number.
@@ -322,8 +318,8 @@ uint64_t mesh_signed_distance(const MeshLineHits& hits, const UnionSurface& us, 
     for (const auto& d : disagree) todo.insert(todo.end(), d.begin(), d.end());
     if (!todo.empty()) {
         const FastWindingNumber wn(mesh);
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t k = r.begin(); k < r.end(); ++k) {
+        parallel_blocks(todo.size(), 64, [&](size_t k0, size_t k1) {
+            for (size_t k = k0; k < k1; ++k) {
                 const size_t v = todo[k];
                 const size_t x = v % size_t(nx), y = (v / size_t(nx)) % size_t(ny), z = v / sxy;
                 const Vec3d p{{bounds.min[0] + (double(x) + 0.5) * h[0], bounds.min[1] + (double(y) + 0.5) * h[1],

@@ -1,12 +1,10 @@
 // Mesh/grid-line crossings and the six-ray winding vote.
 #include "mesh_line_hits.h"
 
-#include "atlas/core/parallel.h"
 #include "atlas/core/error.h"
+#include "atlas/core/parallel.h"
 #include "atlas/volume/mesh_io.h"
 #include "atlas/volume/mesh_voxelize.h"
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -54,8 +52,8 @@ AxisHits hits_along(const Mesh& m, const std::vector<Vec3d>& pv, Vec3i res, int 
         uint32_t tri;
     };
     std::vector<std::vector<Hit>> per_line(lines);
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, lines, 256), [&](const tbb::blocked_range<uint32_t>& r) {
-        for (uint32_t l = r.begin(); l < r.end(); ++l) {
+    parallel_blocks(lines, 256, [&](size_t l0, size_t l1) {
+        for (uint32_t l = uint32_t(l0); l < l1; ++l) {
             const double qb = double(l % uint32_t(res[b])), qc = double(l / uint32_t(res[b]));
             auto& out = per_line[l];
             for (uint32_t k = cand_off[l]; k < cand_off[l + 1]; ++k) {
@@ -173,8 +171,8 @@ std::vector<float> ray_winding_vote(const MeshLineHits& hits, Vec3i res, const M
     Vec3d h;
     for (int a = 0; a < 3; ++a) h[a] = (bounds.max[a] - bounds.min[a]) / res[a];
     const FastWindingNumber wn(mesh);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t k = r.begin(); k < r.end(); ++k) {
+    parallel_blocks(todo.size(), 64, [&](size_t k0, size_t k1) {
+        for (size_t k = k0; k < k1; ++k) {
             const size_t v = todo[k];
             const size_t x = v % stride[1], y = (v / stride[1]) % size_t(res[1]), z = v / stride[2];
             const Vec3d p{{bounds.min[0] + (double(x) + 0.5) * h[0], bounds.min[1] + (double(y) + 0.5) * h[1],

@@ -1,12 +1,10 @@
 // Mesh inside test and signed distance over a grid.
 #include "atlas/core/error.h"
 #include "atlas/core/memory.h"
+#include "atlas/core/parallel.h"
 #include "atlas/volume/mesh_io.h"
 #include "atlas/volume/mesh_voxelize.h"
 #include "mesh_line_hits.h"
-
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <atomic>
@@ -114,7 +112,7 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
     validate_mesh(m, "mesh voxelisation");
     detail::MeshLineHits hits;
     detail::UnionSurface us;
-    tbb::parallel_invoke([&] { hits = detail::mesh_line_hits(m, res, bounds); }, [&] { us = detail::union_surface(m); });
+    parallel_invoke([&] { hits = detail::mesh_line_hits(m, res, bounds); }, [&] { us = detail::union_surface(m); });
     Field3D out(res, 1, bounds, {"sdf"}, budget);
     const Vec3d h = out.voxel_size();
 
@@ -177,7 +175,7 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
         // Triangles in z-order of their centres (voxel units, z, y, x ascending in
         // 16-voxel bricks), so that neighbours touch the same cache lines of the grid.
         std::vector<std::pair<uint64_t, uint32_t>> order(m.triangles.size());
-        tbb::parallel_for(size_t(0), m.triangles.size(), [&](size_t ti) {
+        parallel_for_each(m.triangles.size(), 4096, [&](size_t ti) {
             const auto& t = m.triangles[ti];
             uint64_t key = 0;
             for (int k = 2; k >= 0; --k) {
@@ -188,8 +186,8 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
             order[ti] = {key, uint32_t(ti)};
         });
         std::sort(order.begin(), order.end());
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t oi = r.begin(); oi < r.end(); ++oi) {
+        parallel_blocks(order.size(), 256, [&](size_t o0, size_t o1) {
+            for (size_t oi = o0; oi < o1; ++oi) {
                 const uint32_t ti = order[oi].second;
                 if (!us.trivial() && us.state[ti] != detail::UnionSurface::kSurface) continue;
                 const auto& t = m.triangles[ti];
@@ -222,7 +220,7 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
         });
         if (straddling.empty()) return;
         std::vector<std::vector<std::pair<size_t, float>>> found(straddling.size());
-        tbb::parallel_for(size_t(0), straddling.size(), [&](size_t si) {
+        parallel_for_each(straddling.size(), 1, [&](size_t si) {
             const uint32_t ti = straddling[si];
             const auto& t = m.triangles[ti];
             const Vec3d v[3] = {to_d(m.vertices[t[0]]), to_d(m.vertices[t[1]]), to_d(m.vertices[t[2]])};

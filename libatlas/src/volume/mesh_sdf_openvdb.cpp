@@ -2,6 +2,7 @@
 // grid-line crossings beyond it, sign from the ray winding vote.
 #include "atlas/core/error.h"
 #include "atlas/core/memory.h"
+#include "atlas/core/parallel.h"
 #include "atlas/volume/mesh_io.h"
 #include "atlas/volume/mesh_voxelize.h"
 #include "mesh_line_hits.h"
@@ -9,8 +10,6 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tree/LeafManager.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 
@@ -26,7 +25,7 @@ Field3D mesh_to_sdf_openvdb(const Mesh& m, Vec3i res, Box3d bounds, const Memory
     // The grid-line crossings and the union's surface (below), side by side.
     detail::MeshLineHits hits;
     detail::UnionSurface us;
-    tbb::parallel_invoke([&] { hits = detail::mesh_line_hits(m, res, bounds); }, [&] { us = detail::union_surface(m); });
+    parallel_invoke([&] { hits = detail::mesh_line_hits(m, res, bounds); }, [&] { us = detail::union_surface(m); });
     Field3D out(res, 1, bounds, {"sdf"}, budget);
     const Vec3d h = out.voxel_size();
     if (std::abs(h[0] - h[1]) > 1e-9 * h[0] || std::abs(h[0] - h[2]) > 1e-9 * h[0])
@@ -60,7 +59,7 @@ Field3D mesh_to_sdf_openvdb(const Mesh& m, Vec3i res, Box3d bounds, const Memory
     // (parallel per triangle, merged in triangle order: the min is order-free).
     const double bw = bandwidth * h[0];
     std::vector<std::vector<std::pair<size_t, float>>> found(straddling.size());
-    tbb::parallel_for(size_t(0), straddling.size(), [&](size_t si) {
+    parallel_for_each(straddling.size(), 1, [&](size_t si) {
         const auto& t = m.triangles[straddling[si]];
         int lo[3], hi[3];
         for (int k = 0; k < 3; ++k) {
@@ -84,19 +83,17 @@ Field3D mesh_to_sdf_openvdb(const Mesh& m, Vec3i res, Box3d bounds, const Memory
     // is the better. Sign from the ray winding vote.
     const openvdb::CoordBBox box(openvdb::Coord(0, 0, 0), openvdb::Coord(res[0] - 1, res[1] - 1, res[2] - 1));
     auto merge_band = [&](float* sq) {
-        // Leaf by leaf in parallel: each voxel belongs to one leaf.
-        using Leaves = openvdb::tree::LeafManager<const openvdb::FloatTree>;
-        using LeafRange = Leaves::LeafRange;
-        Leaves leaves(grid->constTree());
-        tbb::parallel_for(leaves.leafRange(), [&](const LeafRange& r) {
-            for (auto leaf = r.begin(); leaf; ++leaf)
-                for (auto it = leaf->cbeginValueOn(); it; ++it) {
-                    const openvdb::Coord c = it.getCoord();
-                    if (!box.isInside(c)) continue; // beyond the grid
-                    const float v = std::abs(*it);
-                    float& e = sq[out.index(c.x(), c.y(), c.z())];
-                    e = std::min(e, v * v);
-                }
+        // Leaf by leaf in parallel (the manager's leaf array, by index): each voxel
+        // belongs to one leaf.
+        const openvdb::tree::LeafManager<const openvdb::FloatTree> leaves(grid->constTree());
+        parallel_for_each(leaves.leafCount(), 1, [&](size_t li) {
+            for (auto it = leaves.leaf(li).cbeginValueOn(); it; ++it) {
+                const openvdb::Coord c = it.getCoord();
+                if (!box.isInside(c)) continue; // beyond the grid
+                const float v = std::abs(*it);
+                float& e = sq[out.index(c.x(), c.y(), c.z())];
+                e = std::min(e, v * v);
+            }
         });
         // Active tiles (none in a narrow band in practice), serially.
         for (auto it = grid->cbeginValueOn(); it; ++it) {

@@ -2,14 +2,13 @@
 #include "mesh_line_hits.h"
 
 #include "atlas/core/error.h"
+#include "atlas/core/parallel.h"
 #include "atlas/volume/mesh_io.h"
 #include "atlas/volume/mesh_voxelize.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/box_intersection_d.h>
 #include <CGAL/intersections.h>
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -80,7 +79,7 @@ FastWindingNumber::FastWindingNumber(const Mesh& m, double beta) : beta_(beta) {
     }
     // Node moments from the triangles in their range (ranges nest, so this is
     // O(n log n) overall).
-    tbb::parallel_for(size_t(0), nodes_.size(), [&](size_t k) {
+    parallel_for_each(nodes_.size(), 1, [&](size_t k) {
         Node& nd = nodes_[k];
         Vec3d an{}, c{}, mean{};
         double area = 0;
@@ -199,8 +198,8 @@ UnionSurface union_surface(const Mesh& m) {
     std::sort(pairs.begin(), pairs.end());
     // The exact tests in parallel (one flag per pair), the crossings then in pair order.
     std::vector<uint8_t> crosses(pairs.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
+    parallel_blocks(pairs.size(), 1024, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
             const auto [s, t] = pairs[i];
             crosses[i] = !tri[s].is_degenerate() && !tri[t].is_degenerate() && CGAL::do_intersect(tri[s], tri[t]);
         }
@@ -263,7 +262,7 @@ UnionSurface union_surface(const Mesh& m) {
     for (uint32_t r = 0; r < n; ++r)
         if (rep[r] != UINT32_MAX) reps.push_back(r);
     std::vector<uint8_t> region_buried(n, 0);
-    tbb::parallel_for(size_t(0), reps.size(), [&](size_t i) { region_buried[reps[i]] = centre_buried(rep[reps[i]]); });
+    parallel_for_each(reps.size(), 1, [&](size_t i) { region_buried[reps[i]] = centre_buried(rep[reps[i]]); });
     std::vector<uint8_t> own(n, 0);
     for (uint32_t t = 0; t < n; ++t)
         if (!hit[t]) own[t] = region_buried[region[t]];
@@ -273,9 +272,9 @@ UnionSurface union_surface(const Mesh& m) {
     }
     us.segments = std::move(segs);
     us.corner_buried.assign(n, {0, 0, 0});
-    tbb::parallel_for(uint32_t(0), n, [&](uint32_t t) {
+    parallel_for_each(n, 1, [&](size_t t) {
         if (us.state[t] != UnionSurface::kStraddling) return;
-        for (int k = 0; k < 3; ++k) us.corner_buried[t][size_t(k)] = us.point_buried(m, t, to_d(m.vertices[m.triangles[t][size_t(k)]]));
+        for (int k = 0; k < 3; ++k) us.corner_buried[t][size_t(k)] = us.point_buried(m, uint32_t(t), to_d(m.vertices[m.triangles[t][size_t(k)]]));
     });
     return us;
 }
@@ -308,7 +307,7 @@ std::vector<double> fast_winding_numbers(const Mesh& m, const std::vector<Vec3d>
     validate_mesh(m, "fast_winding_numbers");
     const detail::FastWindingNumber wn(m);
     std::vector<double> out(points.size());
-    tbb::parallel_for(size_t(0), points.size(), [&](size_t i) { out[i] = wn(points[i]); });
+    parallel_for_each(points.size(), 1, [&](size_t i) { out[i] = wn(points[i]); });
     return out;
 }
 

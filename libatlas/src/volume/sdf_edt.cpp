@@ -7,13 +7,12 @@
 // parabolas along the two other axes (integer sites). The squared distance to
 // all crossings is the minimum over the three families.
 #include "atlas/core/memory.h"
+#include "atlas/core/parallel.h"
 #include "atlas/core/progress.h"
 #include "atlas/volume/sdf.h"
 #include "line_passes.h"
 #include "edt_core.h"
 #include "surface_crossings.h"
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
@@ -97,8 +96,8 @@ std::vector<float> squared_distance_to_line_seeds(Vec3i res, Vec3d h, const Line
                 envelope(f, w, n, hb2, v, z);
             });
         }
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t i = r.begin(); i < r.end(); ++i) best[i] = std::min(best[i], work[i]);
+        parallel_blocks(count, size_t(1) << 16, [&](size_t i0, size_t i1) {
+            for (size_t i = i0; i < i1; ++i) best[i] = std::min(best[i], work[i]);
         });
     }
     if (seed_count) *seed_count = crossings.load();
@@ -144,8 +143,8 @@ Field3D sdf_from_density_edt(const Field3D& density, const SdfOptions& o, const 
     const bool clip = o.max_distance > 0;
     const float far = clip ? float(o.max_distance) : float(detail::far_value(density, o));
     auto sdf = out.channel(0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
+    parallel_blocks(count, size_t(1) << 16, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
             const bool in = detail::is_inside(dens[i], iso);
             float d = best[i] == kInf ? far : std::sqrt(best[i]);
             if (clip) d = std::min(d, far);

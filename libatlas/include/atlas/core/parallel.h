@@ -79,16 +79,31 @@ void parallel_invoke(A&& a, B&& b) {
 // Threads a loop may use when nothing limits it (the machine's hardware concurrency).
 inline int hardware_threads() { return int(tbb::info::default_concurrency()); }
 
-// Runs fn() with the loops inside it limited to `threads` worker threads (<= 0: no
-// limit). The limit changes which thread runs a block, never the blocks themselves.
+// A limit on the worker threads of the loops run through it (<= 0: no limit), kept
+// for several runs (a cook's levels or tiles). The limit changes which thread runs a
+// block, never the blocks themselves.
+class ThreadLimit {
+public:
+    explicit ThreadLimit(int threads) : threads_(threads > 0 ? threads : hardware_threads()), arena_(threads_) {}
+    int threads() const { return threads_; }
+    template <typename Fn>
+    void run(Fn&& fn) {
+        arena_.execute(fn);
+    }
+
+private:
+    int threads_;
+    tbb::task_arena arena_;
+};
+
+// Runs fn() with the loops inside it limited to `threads` worker threads (<= 0: no limit).
 template <typename Fn>
 void with_thread_limit(int threads, Fn&& fn) {
     if (threads <= 0) {
         fn();
         return;
     }
-    tbb::task_arena arena(threads);
-    arena.execute(fn);
+    ThreadLimit(threads).run(fn);
 }
 
 } // namespace atlas
