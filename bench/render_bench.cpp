@@ -5,6 +5,7 @@
 // nvdf/cloudscape.vdb, cooked with `atlas cook`), else a synthetic cloudscape
 // of metaball-like spheres over the same 4096 x 4096 x 512 m domain.
 // Smoke variants are tiny and only prove the code runs.
+#include "atlas/io/readers.h"
 #include "atlas/noise/value_noise.h"
 #include "atlas/render/renderer.h"
 #include "atlas/render/sweep.h"
@@ -60,7 +61,7 @@ CloudScene synthetic_cloudscape(Vec3i res) {
 const CloudScene& scene() {
     static const CloudScene s = [] {
         CloudScene c;
-        if (const char* f = std::getenv("ATLAS_RENDER_BENCH_SCENE"); f && *f) c = load_scene({f});
+        if (const char* f = std::getenv("ATLAS_RENDER_BENCH_SCENE"); f && *f) c = scene_from_fields({{io::as_field3d(io::read_field_file(f)), f}});
         else c = synthetic_cloudscape({{512, 512, 64}});
         c.noise = bench_noise(64);
         c.noise_tile = 256;

@@ -1,7 +1,8 @@
 // Volume benchmarks: whole-grid SDF (exact EDT vs OpenVDB fast sweeping) and
 // mesh to SDF. Error columns: the fast-sweeping result against the EDT (exact
 // with respect to the crossing points), in voxels.
-#include "atlas/volume/mesh_io.h"
+#include "atlas/io/geometry_files.h"
+#include "atlas/volume/mesh_repair.h"
 #include "atlas/volume/mesh_primitives.h"
 #include "atlas/volume/mesh_voxelize.h"
 #include "atlas/volume/sdf.h"
@@ -90,7 +91,7 @@ Mesh bumpy_sphere(int triangles) {
 void run_mesh_sdf(benchmark::State& state, int triangles, int res, bool openvdb) {
     const Mesh m = bumpy_sphere(triangles);
     if (const char* dir = std::getenv("ATLAS_BENCH_MESH_DIR"))
-        write_mesh(std::filesystem::path(dir) / ("bench_mesh_" + std::to_string(m.triangles.size()) + ".obj"), m);
+        io::write_mesh(std::filesystem::path(dir) / ("bench_mesh_" + std::to_string(m.triangles.size()) + ".obj"), m);
     const Box3d box{{{0, 0, 0}}, {{256, 256, 256}}};
     const Vec3i r{{res, res, res}};
     MeshSdfStats st;
@@ -128,7 +129,7 @@ const Mesh& armadillo() {
             if (std::system(cmd.c_str()) != 0) return Mesh{};
             file = dir / "data/meshes/armadillo.off";
         }
-        return read_mesh(file);
+        return repair_polygon_soup(io::read_polygon_soup(file));
     }();
     return m;
 }

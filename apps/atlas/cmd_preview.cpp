@@ -8,6 +8,8 @@
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
 #include "atlas/graph/evaluator.h"
+#include "atlas/io/exr.h"
+#include "atlas/io/image.h"
 #include "atlas/io/readers.h"
 #include "atlas/ndf/cone_map.h"
 #include "atlas/render/image_out.h"
@@ -239,8 +241,13 @@ Field3DPtr cook_voxel_noise(int jobs, const std::optional<std::filesystem::path>
 // Writes into `staged` (a temporary path); the caller moves it into place.
 void write_picture(const Field2D& image, const std::filesystem::path& staged, double exposure) {
     auto ext = staged.extension().string();
-    if (ext == ".exr") render::write_preview_exr(image, staged);
-    else render::write_preview_png(image, staged, exposure);
+    if (ext == ".exr") {
+        io::ExrOptions o;
+        o.channel_meaning = render::kLinearImageMeaning;
+        io::write_exr(image, staged, o);
+    } else {
+        io::write_image(render::tone_map(image, exposure), staged);
+    }
 }
 
 // A picture written atomically: a failed render or write leaves no file.
@@ -362,8 +369,9 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
         }
     } else {
         if (mode == "layer") throw UsageError{"--mode layer needs a graph that writes an NDF set", "preview"};
-        std::vector<std::filesystem::path> files(a.positional.begin(), a.positional.end());
-        scene = render::load_scene(files, a.has("--voxel") ? numbers(a.get("--voxel"), 1, "--voxel")[0] : 0.0);
+        std::vector<render::SceneField> files;
+        for (const std::string& p : a.positional) files.push_back({io::as_field3d(io::read_field_file(p)), p});
+        scene = render::scene_from_fields(std::move(files), a.has("--voxel") ? numbers(a.get("--voxel"), 1, "--voxel")[0] : 0.0);
         have_voxel = true;
     }
     if (have_voxel) {

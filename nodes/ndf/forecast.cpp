@@ -1,7 +1,6 @@
 // ndf/forecast: cook an FC6 forecast into a sequence of weather maps.
-#include "atlas/ndf/forecast.h"
-#include "atlas/core/files.h"
 #include "ndf/ndf_params.h"
+#include "ndf/weather_files.h"
 
 namespace {
 using namespace atlas;
@@ -26,7 +25,7 @@ void declare(NodeDeclaration& d) {
 }
 
 void cook(CookContext& ctx) {
-    const ndf::Forecast f = ndf::load_forecast(ctx.get_path("forecast"));
+    const ndf::Forecast f = read_forecast_file(ctx.get_path("forecast"));
     ndf::WeatherMapSpec spec;
     const int slices = int(ctx.get_int("slices"));
     spec.resolution = ctx.get_int2("resolution");
@@ -48,7 +47,7 @@ void cook(CookContext& ctx) {
 void hash_extra(const NodeParams& p, Hasher& h) {
     const auto file = p.get_path("forecast");
     hash_file(h, file);
-    hash_file(h, ndf::forecast_presets_path(file));
+    hash_file(h, forecast_presets_file(file, read_file_bytes(file)));
 }
 } // namespace
 

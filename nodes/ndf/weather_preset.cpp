@@ -2,6 +2,7 @@
 #include "atlas/core/files.h"
 #include "atlas/ndf/forecast.h"
 #include "ndf/ndf_params.h"
+#include "ndf/weather_files.h"
 
 namespace {
 using namespace atlas;
@@ -24,7 +25,7 @@ void declare(NodeDeclaration& d) {
 }
 
 void cook(CookContext& ctx) {
-    const auto presets = ndf::load_presets(ctx.get_path("presets"));
+    const auto presets = read_presets_file(ctx.get_path("presets"));
     const std::string& to = ctx.get_string("blend_to");
     ndf::WeatherPreset p = presets[size_t(ndf::find_preset(presets, ctx.get_string("preset")))];
     if (!to.empty()) p = ndf::lerp_presets(p, presets[size_t(ndf::find_preset(presets, to))], ctx.get_float("blend"));

@@ -2,13 +2,13 @@
 #include "atlas/core/files.h"
 #include "atlas/core/hash.h"
 #include "atlas/graph/node.h"
-#include "atlas/volume/mesh_io.h"
+#include "volume/mesh_files.h"
 
 namespace {
 using namespace atlas;
 
 void declare(NodeDeclaration& d) {
-    d.doc("Reads OBJ, OFF, PLY or STL through CGAL and repairs it: duplicate vertices merged, degenerate and duplicate "
+    d.doc("Reads OBJ, OFF, PLY or STL (OBJ and OFF with errors at file:line, PLY and STL through CGAL) and repairs it: duplicate vertices merged, degenerate and duplicate "
           "triangles removed, orientation made consistent and outward.");
     d.output("out", PortType::Mesh, "the repaired mesh, metres");
     d.param_path("file").describe("mesh file, relative to the graph file");
@@ -16,7 +16,7 @@ void declare(NodeDeclaration& d) {
 
 void cook(CookContext& ctx) {
     volume::MeshRepairReport rep;
-    auto mesh = std::make_shared<Mesh>(volume::read_mesh(ctx.get_path("file"), &rep));
+    auto mesh = std::make_shared<Mesh>(volume_nodes::read_mesh_file(ctx.get_path("file"), &rep));
     ctx.metric("triangles", double(mesh->triangles.size()));
     ctx.metric("removed_degenerate", double(rep.removed_degenerate));
     ctx.metric("removed_duplicates", double(rep.removed_duplicates));

@@ -2,7 +2,7 @@
 #include "atlas/core/files.h"
 #include "atlas/core/hash.h"
 #include "atlas/graph/node.h"
-#include "atlas/volume/splat.h"
+#include "atlas/io/geometry_files.h"
 
 namespace {
 using namespace atlas;
@@ -14,7 +14,7 @@ void declare(NodeDeclaration& d) {
 }
 
 void cook(CookContext& ctx) {
-    auto pts = std::make_shared<Points>(volume::read_points(ctx.get_path("file")));
+    auto pts = std::make_shared<Points>(io::read_points(ctx.get_path("file")));
     ctx.metric("points", double(pts->positions.size()));
     ctx.set_output("out", PointsPtr(pts));
 }

@@ -9,6 +9,8 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+
+#include <filesystem>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -23,6 +25,7 @@
 #include <unistd.h>
 
 namespace atlas::compress {
+namespace fs = std::filesystem;
 using io::compress_to_dds;
 using io::read_dds;
 using io::read_dds_file;

@@ -6,6 +6,8 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +16,7 @@
 #include <unistd.h>
 
 namespace atlas::compress {
+namespace fs = std::filesystem;
 using io::compress_to_dds;
 using io::read_dds;
 using io::read_dds_file;

@@ -4,6 +4,8 @@
 #include "atlas/io/dds_file.h"
 
 #include <gtest/gtest.h>
+
+#include <filesystem>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -12,6 +14,7 @@
 #include <fstream>
 
 namespace atlas::compress {
+namespace fs = std::filesystem;
 using io::compress_to_dds;
 using io::read_dds;
 using io::read_dds_file;

@@ -1,7 +1,8 @@
 // libFuzzer: the mesh readers. The first byte picks the format (OBJ, OFF,
 // PLY, STL: the reader goes by extension), the rest is the file.
 #include "atlas/core/error.h"
-#include "atlas/volume/mesh_io.h"
+#include "atlas/io/geometry_files.h"
+#include "atlas/volume/mesh_repair.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -17,7 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size > 1 && std::fwrite(data + 1, 1, size - 1, f) != size - 1) std::abort();
     std::fclose(f);
     try {
-        atlas::volume::read_mesh(path);
+        atlas::volume::repair_polygon_soup(atlas::io::read_polygon_soup(path));
     } catch (const atlas::Error&) {
     }
     std::filesystem::remove(path);

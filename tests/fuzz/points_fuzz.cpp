@@ -1,7 +1,7 @@
 // libFuzzer: the point file readers. The first byte picks the format (PLY or
 // XYZ text), the rest is the file.
 #include "atlas/core/error.h"
-#include "atlas/volume/splat.h"
+#include "atlas/io/geometry_files.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -17,7 +17,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size > 1 && std::fwrite(data + 1, 1, size - 1, f) != size - 1) std::abort();
     std::fclose(f);
     try {
-        atlas::volume::read_points(path);
+        atlas::io::read_points(path);
     } catch (const atlas::Error&) {
     }
     std::filesystem::remove(path);

@@ -6,6 +6,7 @@
 #include "atlas/graph/evaluator.h"
 #include "atlas/graph/node.h"
 #include "atlas/ndf/ndf_set.h"
+#include "ndf/weather_files.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -137,7 +138,7 @@ TEST(Forecast, KeyedHourReproducesItsPresetExactly) {
             EXPECT_EQ(forecast_preset(f, int(r), k.hour - 240).cumulus_coverage, want.cumulus_coverage);
         }
     // The production forecast too.
-    const Forecast g = load_forecast(kGraphs / "fc6" / "forecast.yaml");
+    const Forecast g = ndf_nodes::read_forecast_file(kGraphs / "fc6" / "forecast.yaml");
     for (size_t r = 0; r < g.regions.size(); ++r)
         for (const auto& k : g.regions[r].keys)
             for (const auto& fi : preset_fields())

@@ -2,6 +2,7 @@
 #include "atlas/ndf/weather_preset.h"
 
 #include "atlas/core/error.h"
+#include "ndf/weather_files.h"
 
 #include <gtest/gtest.h>
 
@@ -135,12 +136,12 @@ TEST(WeatherPreset, LerpEndsExactMiddleLinearWindAsVector) {
 }
 
 TEST(WeatherPreset, ProductionPresetsParse) {
-    const auto p = load_presets(std::filesystem::path(ATLAS_SOURCE_DIR) / "graphs" / "fc6" / "presets.yaml");
+    const auto p = ndf_nodes::read_presets_file(std::filesystem::path(ATLAS_SOURCE_DIR) / "graphs" / "fc6" / "presets.yaml");
     EXPECT_GE(p.size(), 6u);
     for (const auto& x : p) EXPECT_NO_THROW(validate_preset(x)) << x.name;
     const WeatherPreset& broken = p[size_t(find_preset(p, "broken_clouds"))];
     EXPECT_EQ(broken.cumulus_coverage, 0.54); // the values the talk shows
     EXPECT_EQ(broken.cirrus_coverage, 0.45);
     EXPECT_EQ(broken.horizon_coverage, 0.95);
-    EXPECT_THROW(load_presets("/nonexistent/presets.yaml"), Error);
+    EXPECT_THROW(ndf_nodes::read_presets_file("/nonexistent/presets.yaml"), Error);
 }

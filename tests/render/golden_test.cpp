@@ -127,8 +127,10 @@ TEST(RenderOutput, PngAndExrRoundTrip) {
     auto r = render_clouds(scene, s);
     const auto dir = std::filesystem::temp_directory_path() / ("atlas_render_test_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
-    write_preview_png(r.image, dir / "p.png");
-    write_preview_exr(r.image, dir / "p.exr");
+    io::write_image(tone_map(r.image), dir / "p.png");
+    io::ExrOptions exr;
+    exr.channel_meaning = kLinearImageMeaning;
+    io::write_exr(r.image, dir / "p.exr", exr);
     Field2D png = io::read_image(dir / "p.png");
     EXPECT_EQ(png.width(), 20);
     EXPECT_EQ(png.channels(), 3);

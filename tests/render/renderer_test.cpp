@@ -245,10 +245,11 @@ TEST(Render, ReportListsOnlyWhatRan) {
 }
 
 // A plain density grid (one float grid "density", what vdb_render reads)
-// through load_scene: the sampled density is density_scene's (itself checked
+// through scene_from_fields: the sampled density is density_scene's (itself checked
 // against the grid above), and the empty-space SDF never claims more room
 // than there is: at random points its interpolated value stays under the
 // brute-force distance to the nearest non-zero voxel's cell.
+#include "atlas/io/readers.h"
 #include "atlas/io/vdb.h"
 
 #include <filesystem>
@@ -270,7 +271,7 @@ TEST(RenderLoadScene, DensityGridGetsTheSameDensityAndASafeSdf) {
             }
     const auto path = std::filesystem::temp_directory_path() / "atlas_load_scene_density.vdb";
     io::write_vdb(d, path);
-    const CloudScene s = load_scene({path});
+    const CloudScene s = scene_from_fields({{io::as_field3d(io::read_field_file(path)), path.string()}});
     std::filesystem::remove(path);
     const CloudScene ref = density_scene(d);
     // The profile alone is stored; detail type and density scale are uniform.
@@ -312,7 +313,7 @@ TEST(RenderLoadScene, DensityGridGetsTheSameDensityAndASafeSdf) {
 }
 
 // Uniform modeling channels (CloudScene::uniform_detail_type / _density_scale,
-// as load_scene makes for a density grid) render the very bytes of the same
+// as scene_from_fields makes for a density grid) render the very bytes of the same
 // values stored in every voxel, with and without noise; a different uniform
 // scale (negative control) changes the picture, and a profile-only field
 // without uniform values is refused.

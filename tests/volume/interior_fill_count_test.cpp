@@ -5,7 +5,9 @@
 // thickness (point-triangle distance over every triangle) and the spacing of
 // the samples (all pairs).
 #include "atlas/volume/interior_fill.h"
-#include "atlas/volume/mesh_io.h"
+#include "atlas/io/geometry_files.h"
+#include "atlas/volume/mesh_repair.h"
+#include "volume/mesh_files.h"
 #include "atlas/volume/mesh_primitives.h"
 #include "atlas/volume/mesh_voxelize.h"
 
@@ -116,8 +118,8 @@ TEST(InteriorFillCount, TorusAndSphereHonourTheTarget) {
 TEST(InteriorFillCount, CgalArmadilloAndElephantHonourTheTarget) {
     const auto armadillo = cgal_mesh("armadillo.off"), elephant = cgal_mesh("elephant.off");
     if (armadillo.empty() || elephant.empty()) GTEST_SKIP() << "libcgal-demo's data.tar.gz is not installed";
-    check_fill(read_mesh(elephant), 300, "elephant");
-    check_fill(read_mesh(armadillo), 2000, "armadillo", 20);
+    check_fill(volume_nodes::read_mesh_file(elephant), 300, "elephant");
+    check_fill(volume_nodes::read_mesh_file(armadillo), 2000, "armadillo", 20);
     std::error_code ec;
     std::filesystem::remove_all(armadillo.parent_path().parent_path().parent_path(), ec);
 }

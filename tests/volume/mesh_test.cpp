@@ -1,5 +1,7 @@
 #include "atlas/core/error.h"
-#include "atlas/volume/mesh_io.h"
+#include "atlas/io/geometry_files.h"
+#include "atlas/volume/mesh_repair.h"
+#include "volume/mesh_files.h"
 #include "atlas/volume/mesh_voxelize.h"
 #include "volume_test_util.h"
 
@@ -235,7 +237,7 @@ TEST(MeshErrors, EmptyAndNonFinite) {
     Mesh bad_index = box_mesh({{1, 1, 1}}, {{2, 2, 2}});
     bad_index.triangles[0][0] = 99;
     EXPECT_THROW(mesh_to_sdf(bad_index, {{4, 4, 4}}, grid_box(4)), Error);
-    EXPECT_THROW(read_mesh("/nonexistent/cloud.obj"), Error);
+    EXPECT_THROW(volume_nodes::read_mesh_file("/nonexistent/cloud.obj"), Error);
 }
 
 TEST(MeshIo, RoundTripEveryFormat) {
@@ -245,9 +247,9 @@ TEST(MeshIo, RoundTripEveryFormat) {
     const Field3D ref = mesh_winding_field(cube, {{8, 8, 8}}, grid_box(8));
     for (const char* ext : {"obj", "off", "ply", "stl"}) {
         const auto file = dir / (std::string("cube.") + ext);
-        write_mesh(file, cube);
+        io::write_mesh(file, cube);
         MeshRepairReport rep;
-        const Mesh back = read_mesh(file, &rep);
+        const Mesh back = volume_nodes::read_mesh_file(file, &rep);
         EXPECT_EQ(back.triangles.size(), 12u) << ext;
         EXPECT_EQ(back.vertices.size(), 8u) << ext; // STL's unshared corners are merged
         EXPECT_TRUE(mesh_winding_field(back, {{8, 8, 8}}, grid_box(8)) == ref) << ext;
@@ -255,7 +257,7 @@ TEST(MeshIo, RoundTripEveryFormat) {
     // A file with text that is not a mesh.
     const auto junk = dir / "junk.off";
     { std::FILE* f = std::fopen(junk.c_str(), "w"); std::fputs("OFF\n3 1 0\n0 0 0\n1 0 nan\n", f); std::fclose(f); }
-    EXPECT_THROW(read_mesh(junk), Error);
+    EXPECT_THROW(volume_nodes::read_mesh_file(junk), Error);
     std::filesystem::remove_all(dir);
 }
 
@@ -376,7 +378,7 @@ TEST(MeshWinding, FastWindingNumberMatchesExact) {
 // where the six rays disagree, and the inside test still matches the closed
 // bunny away from the surface.
 TEST(MeshSdf, OpenBunnyReportsWindingFallback) {
-    const Mesh closed = read_mesh(bunny_file());
+    const Mesh closed = volume_nodes::read_mesh_file(bunny_file());
     ASSERT_GT(closed.triangles.size(), 70000u);
     Mesh open = closed;
     const size_t step = open.triangles.size() / 171;
@@ -405,7 +407,7 @@ TEST(MeshIo, TextErrorsNameLineAndIndex) {
     const std::string verts = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
     auto obj = [&](const std::string& name, const std::string& text) {
         write_text(dir / name, text);
-        return error_of([&] { read_mesh(dir / name); });
+        return error_of([&] { volume_nodes::read_mesh_file(dir / name); });
     };
     auto has = [](const std::string& msg, std::initializer_list<const char*> parts) {
         for (const char* p : parts)
@@ -441,9 +443,9 @@ TEST(MeshIo, TextErrorsNameLineAndIndex) {
     EXPECT_TRUE(has(e, {"nan.off:4", "vertex 1", "not finite"})) << e;
     // Valid files with comments, relative indices, texture/normal references and colours still read.
     write_text(dir / "ok.obj", "# tetra\n" + verts + "vn 0 0 1\nvt 0 0\nf 1/1/1 3//1 2\nf -4 -3 -1\nf 1 4 3\nf 2 3 4\n");
-    EXPECT_EQ(read_mesh(dir / "ok.obj").triangles.size(), 4u);
+    EXPECT_EQ(volume_nodes::read_mesh_file(dir / "ok.obj").triangles.size(), 4u);
     write_text(dir / "ok.off", "OFF # tetra\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1 255 0 0\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
-    EXPECT_EQ(read_mesh(dir / "ok.off").triangles.size(), 4u);
+    EXPECT_EQ(volume_nodes::read_mesh_file(dir / "ok.off").triangles.size(), 4u);
     // In memory: a far vertex and far grid bounds are refused with the reason.
     Mesh far = box_mesh({{1, 1, 1}}, {{2, 2, 2}});
     far.vertices[5][2] = 1e30f;
@@ -519,7 +521,7 @@ TEST(MeshSdf, OpenVdbMatchesBruteForce) {
         (std::abs(ref) <= 1.5 * h ? e.band : e.far) = std::max(std::abs(ref) <= 1.5 * h ? e.band : e.far, d);
     };
     {
-        const Mesh bunny = read_mesh(bunny_file());
+        const Mesh bunny = volume_nodes::read_mesh_file(bunny_file());
         const Vec3i res{{32, 32, 32}};
         const Box3d box{{{-0.55, -0.55, -0.55}}, {{0.55, 0.55, 0.55}}};
         const Field3D s = mesh_to_sdf_openvdb(bunny, res, box);

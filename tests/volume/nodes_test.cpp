@@ -2,8 +2,9 @@
 #include "atlas/core/error.h"
 #include "atlas/graph/evaluator.h"
 #include "atlas/graph/node.h"
+#include "atlas/io/geometry_files.h"
 #include "atlas/volume/edit.h"
-#include "atlas/volume/mesh_io.h"
+#include "atlas/volume/mesh_repair.h"
 #include "atlas/volume/mesh_primitives.h"
 #include "atlas/volume/mesh_voxelize.h"
 #include "atlas/volume/nvdf.h"
@@ -144,7 +145,7 @@ TEST(VolumeNodes, ReadMeshNodeRepairs) {
     std::filesystem::create_directories(dir);
     Mesh m = volume::make_box_mesh({{4, 4, 4}}, {{2, 2, 2}});
     for (auto& t : m.triangles) std::swap(t[1], t[2]); // inside out
-    volume::write_mesh(dir / "box.off", m);
+    io::write_mesh(dir / "box.off", m);
     Session s(builtin_nodes());
     s.load_text("atlas: 1\nnodes:\n  m:\n    type: volume/read_mesh\n    params: {file: box.off}\n  f:\n    type: volume/mesh_to_sdf\n    inputs: {mesh: m}\n    params: {resolution: [8, 8, 8], bounds_max: [8, 8, 8]}\noutputs:\n  - {node: f, port: sdf, file: f.vdb}\n", "g.yaml", dir);
     CookOptions co;

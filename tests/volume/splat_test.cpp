@@ -1,4 +1,5 @@
 #include "atlas/core/error.h"
+#include "atlas/io/geometry_files.h"
 #include "atlas/volume/splat.h"
 
 #include <gtest/gtest.h>
@@ -97,7 +98,7 @@ TEST(PointsIo, ReadsXyzAndPly) {
         std::ofstream f(dir / "a.xyz");
         f << "# cloud\n1 2 3 4\n\n5 6 7 8 # tail\n";
     }
-    const Points x = read_points(dir / "a.xyz");
+    const Points x = io::read_points(dir / "a.xyz");
     ASSERT_EQ(x.positions.size(), 2u);
     EXPECT_EQ(x.positions[1][2], 7.0f);
     EXPECT_EQ(x.attributes.at("radius")[1], 8.0f);
@@ -106,7 +107,7 @@ TEST(PointsIo, ReadsXyzAndPly) {
         f << "1 2 3\n4 5 x\n";
     }
     try {
-        read_points(dir / "bad.xyz");
+        io::read_points(dir / "bad.xyz");
         FAIL();
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("bad.xyz:2"), std::string::npos) << e.what();
@@ -116,11 +117,11 @@ TEST(PointsIo, ReadsXyzAndPly) {
         f << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float radius\nend_header\n"
              "0 0 0 1.5\n1 0 0 2.5\n0 1 0 3.5\n";
     }
-    const Points p = read_points(dir / "a.ply");
+    const Points p = io::read_points(dir / "a.ply");
     ASSERT_EQ(p.positions.size(), 3u);
     EXPECT_EQ(p.positions[2][1], 1.0f);
     ASSERT_TRUE(p.attributes.count("radius"));
     EXPECT_EQ(p.attributes.at("radius")[1], 2.5f);
-    EXPECT_THROW(read_points(dir / "missing.ply"), Error);
+    EXPECT_THROW(io::read_points(dir / "missing.ply"), Error);
     std::filesystem::remove_all(dir);
 }

@@ -2,7 +2,6 @@
 #include "atlas/compress/dds.h"
 
 #include "atlas/core/error.h"
-#include "atlas/core/files.h"
 
 #include <cstring>
 

@@ -3,7 +3,6 @@
 #include "atlas/compress/bc4.h"
 #include "atlas/compress/bc6h.h"
 #include "atlas/core/error.h"
-#include "atlas/core/files.h"
 #include "atlas/core/parallel.h"
 #include "half.h"
 #include "texture_internal.h"
@@ -197,15 +196,14 @@ Field3D decode_texture(const DdsTexture& tex, const TextureManifest* manifest, D
 
 CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* manifest, const Field3D& source, DecoderSet decoders,
                               const std::vector<int>& channels, const std::string& what) {
-    const fs::path path(what);
     const int nz = tex.volume ? tex.depth : tex.array_size;
     if (source.nx() != tex.width || source.ny() != tex.height || source.nz() != nz)
-        throw Error(path.string() + ": texture is " + std::to_string(tex.width) + "x" + std::to_string(tex.height) + "x" +
+        throw Error(what + ": texture is " + std::to_string(tex.width) + "x" + std::to_string(tex.height) + "x" +
                     std::to_string(nz) + " but the source field is " + std::to_string(source.nx()) + "x" + std::to_string(source.ny()) +
                     "x" + std::to_string(source.nz()));
     const bool scalar = manifest && manifest->encoding == "bc1-scalar";
     CompressReport r;
-    r.file = path.string();
+    r.file = what;
     r.format = manifest ? manifest->encoding : dxgi_format_name(tex.format);
     r.width = tex.width;
     r.height = tex.height;

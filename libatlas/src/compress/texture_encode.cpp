@@ -1,11 +1,10 @@
 // Field -> DDS texture: mapping, validation, mips, parallel block encoding, bound
-// accounting, manifest, atomic write.
+// accounting, manifest (in memory; io writes the files).
 #include "atlas/compress/bc1.h"
 #include "atlas/compress/bc1_scalar.h"
 #include "atlas/compress/bc4.h"
 #include "atlas/compress/bc6h.h"
 #include "atlas/core/error.h"
-#include "atlas/core/files.h"
 #include "atlas/core/parallel.h"
 #include "half.h"
 #include "mips.h"

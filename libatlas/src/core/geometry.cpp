@@ -1,6 +1,10 @@
 #include "atlas/core/geometry.h"
 
+#include "atlas/core/error.h"
 #include "atlas/core/hash.h"
+
+#include <cmath>
+#include <cstdio>
 
 namespace atlas {
 
@@ -20,6 +24,28 @@ uint64_t Points::byte_size() const {
     uint64_t n = positions.size() * sizeof(Vec3f);
     for (const auto& kv : attributes) n += kv.second.size() * sizeof(float);
     return n;
+}
+
+void validate_polygon_soup(const PolygonSoup& soup, const std::string& who) {
+    for (size_t i = 0; i < soup.points.size(); ++i)
+        for (int a = 0; a < 3; ++a) {
+            const double v = soup.points[i][a];
+            if (!std::isfinite(v)) throw Error(who + ": vertex " + std::to_string(i) + " is not finite");
+            if (std::abs(v) > kMaxMeshCoordinate) {
+                char buf[32];
+                std::snprintf(buf, sizeof buf, "%.9g", v);
+                throw Error(who + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " + buf + ", outside the supported range +-1e18 m");
+            }
+        }
+    for (size_t f = 0; f < soup.polygons.size(); ++f) {
+        const auto& poly = soup.polygons[f];
+        if (poly.size() < 3)
+            throw Error(who + ": face " + std::to_string(f) + " has " + std::to_string(poly.size()) + " corners, expected at least 3");
+        for (size_t v : poly)
+            if (v >= soup.points.size())
+                throw Error(who + ": face " + std::to_string(f) + " uses vertex " + std::to_string(v) + " but there are " +
+                            std::to_string(soup.points.size()) + " vertices");
+    }
 }
 
 } // namespace atlas

@@ -2,7 +2,6 @@
 #include "atlas/ndf/forecast.h"
 
 #include "atlas/core/error.h"
-#include "atlas/core/files.h"
 #include "atlas/ndf/generators.h"
 #include "atlas/ndf/ndf_set.h"
 
@@ -210,18 +209,12 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
     return f;
 }
 
-std::filesystem::path forecast_presets_path(const std::filesystem::path& file) {
-    const std::string text = read_file_bytes(file);
-    const YAML::Node root = io::load_yaml(text, file.string());
+std::string forecast_presets_entry(const std::string& text, const std::string& filename) {
+    const YAML::Node root = io::load_yaml(text, filename);
     const YAML::Node n = root.IsMap() ? root["presets"] : YAML::Node();
     if (!n || !n.IsScalar() || n.Scalar().empty())
-        throw ParseError(n ? io::yaml_location(file.string(), n) : SourceLocation{file.string(), 1, 1}, "'presets' must name the presets file");
-    return file.parent_path() / n.Scalar();
-}
-
-Forecast load_forecast(const std::filesystem::path& file) {
-    const auto presets_file = forecast_presets_path(file);
-    return parse_forecast(read_file_bytes(file), file.string(), load_presets(presets_file));
+        throw ParseError(n ? io::yaml_location(filename, n) : SourceLocation{filename, 1, 1}, "'presets' must name the presets file");
+    return n.Scalar();
 }
 
 PresetBlend forecast_blend(const Forecast& f, int region, double hour) {

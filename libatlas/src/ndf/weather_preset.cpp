@@ -2,7 +2,6 @@
 #include "atlas/ndf/weather_preset.h"
 
 #include "atlas/core/error.h"
-#include "atlas/core/files.h"
 #include "atlas/io/yaml_document.h"
 
 #include <algorithm>
@@ -124,8 +123,6 @@ std::vector<WeatherPreset> parse_presets(const std::string& text, const std::str
     }
     return out;
 }
-
-std::vector<WeatherPreset> load_presets(const std::filesystem::path& file) { return parse_presets(read_file_bytes(file), file.string()); }
 
 int find_preset(const std::vector<WeatherPreset>& presets, const std::string& name) {
     for (size_t i = 0; i < presets.size(); ++i)

@@ -1,8 +1,6 @@
 #include "atlas/render/image_out.h"
 
 #include "atlas/core/error.h"
-#include "atlas/io/exr.h"
-#include "atlas/io/image.h"
 
 #include <cmath>
 #include <string>
@@ -27,16 +25,6 @@ Field2D tone_map(const Field2D& linear, double exposure) {
         }
     }
     return out;
-}
-
-void write_preview_png(const Field2D& image, const std::filesystem::path& path, double exposure) {
-    io::write_image(tone_map(image, exposure), path);
-}
-
-void write_preview_exr(const Field2D& image, const std::filesystem::path& path) {
-    io::ExrOptions o;
-    o.channel_meaning = "linear radiance r, g, b and view transmittance (atlas render)";
-    io::write_exr(image, path, o);
 }
 
 } // namespace atlas::render

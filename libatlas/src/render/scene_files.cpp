@@ -2,7 +2,6 @@
 
 #include "atlas/core/error.h"
 #include "atlas/core/parallel.h"
-#include "atlas/io/readers.h"
 
 #include <algorithm>
 #include <cmath>
@@ -183,16 +182,17 @@ CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
 
 } // namespace
 
-CloudScene load_scene(const std::vector<std::filesystem::path>& files, double voxel_size) {
+CloudScene scene_from_fields(std::vector<SceneField> files, double voxel_size) {
     if (!(voxel_size >= 0) || !std::isfinite(voxel_size)) throw Error("render: voxel size must be finite and >= 0 metres");
     if (files.empty() || files.size() > 2) throw Error("render: expected one NVDF set file, or a modeling file and an SDF file");
-    auto read = [&](const std::filesystem::path& p) { return rebound(io::as_field3d(io::read_field_file(p)), voxel_size); };
-    Field3DPtr first = read(files[0]);
+    for (const SceneField& f : files)
+        if (!f.field) throw Error("render: " + f.name + ": no field");
+    Field3DPtr first = rebound(std::move(files[0].field), voxel_size);
     if (files.size() == 1) {
         try {
             // A plain density grid (density_grid_scene): the profile goes over
-            // the grid's own storage when nothing else holds the grid (read
-            // just now: nothing does), else over a copy.
+            // the grid's own storage when nothing else holds the grid (a field
+            // the caller just read and moved in), else over a copy.
             if (first->find_channel("dimensional_profile") < 0 && first->channels() == 1) {
                 std::shared_ptr<Field3D> grid =
                     first.use_count() == 1 ? std::const_pointer_cast<Field3D>(first) : std::make_shared<Field3D>(*first);
@@ -201,11 +201,11 @@ CloudScene load_scene(const std::vector<std::filesystem::path>& files, double vo
             }
             return scene_from_nvdf_set(std::move(first));
         } catch (const Error& e) {
-            throw Error(files[0].string() + ": " + e.what());
+            throw Error(files[0].name + ": " + e.what());
         }
     }
-    Field3DPtr second = read(files[1]);
-    if (first->channels() < 3) throw Error(files[0].string() + ": the modeling NVDF needs 3 channels, got " + std::to_string(first->channels()));
+    Field3DPtr second = rebound(std::move(files[1].field), voxel_size);
+    if (first->channels() < 3) throw Error(files[0].name + ": the modeling NVDF needs 3 channels, got " + std::to_string(first->channels()));
     CloudScene s;
     s.modeling = first;
     int c = second->find_channel("sdf");
@@ -224,7 +224,7 @@ CloudScene load_scene(const std::vector<std::filesystem::path>& files, double vo
     try {
         validate_scene(s);
     } catch (const Error& e) {
-        throw Error(files[0].string() + ", " + files[1].string() + ": " + e.what());
+        throw Error(files[0].name + ", " + files[1].name + ": " + e.what());
     }
     return s;
 }

@@ -3,7 +3,7 @@
 
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"
-#include "atlas/volume/mesh_io.h"
+#include "atlas/volume/mesh_repair.h"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>

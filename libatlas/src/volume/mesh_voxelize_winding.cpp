@@ -3,7 +3,7 @@
 
 #include "atlas/core/error.h"
 #include "atlas/core/parallel.h"
-#include "atlas/volume/mesh_io.h"
+#include "atlas/volume/mesh_repair.h"
 #include "atlas/volume/mesh_voxelize.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>

@@ -16,15 +16,12 @@
 #include "atlas/core/progress.h"
 
 #include <array>
-#include <filesystem>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace atlas::compress {
-
-namespace fs = std::filesystem;
 
 // Bump whenever the encoder writes other bytes for the same field and options, so
 // cooked outputs and cached textures from an older encoder are not reused.

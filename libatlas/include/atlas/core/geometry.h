@@ -35,6 +35,23 @@ struct Points {
     uint64_t byte_size() const;
 };
 
+// Polygons as a mesh file holds them, before repair (volume::repair_polygon_soup
+// makes a Mesh of it): double positions, polygons of 3 or more 0-based corners.
+struct PolygonSoup {
+    std::vector<Vec3d> points;
+    std::vector<std::vector<size_t>> polygons;
+};
+
+// Largest |coordinate| (metres) of a mesh vertex or a grid bound that readers
+// and the mesh code accept. Distances then stay below ~3.5e18 m; beyond
+// ~1.8e19 m their squares overflow float.
+inline constexpr double kMaxMeshCoordinate = 1e18;
+
+// Throws atlas::Error starting "who: " when a point is NaN, infinite or beyond
+// +-kMaxMeshCoordinate (naming its index and coordinate), a polygon has fewer
+// than 3 corners, or a corner names a point that does not exist.
+void validate_polygon_soup(const PolygonSoup& soup, const std::string& who);
+
 using MeshPtr = std::shared_ptr<const Mesh>;
 using PointsPtr = std::shared_ptr<const Points>;
 

@@ -28,7 +28,6 @@
 #include "atlas/core/progress.h"
 #include "atlas/ndf/weather_preset.h"
 
-#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -62,14 +61,14 @@ void validate_forecast(const Forecast& f);
 // Parses a forecast file's text; presets come from `presets` (the caller
 // loaded them). Errors are atlas::ParseError at file:line:col naming the
 // field, e.g. "region 'east': key hour 12 is not after the previous key (30)".
-// The 'presets:' entry is not read here (load_forecast does that).
+// The 'presets:' entry is not read here (forecast_presets_entry gives it).
 Forecast parse_forecast(const std::string& text, const std::string& filename, std::vector<WeatherPreset> presets);
 
-// Reads a forecast file and the presets file its 'presets:' entry names
-// (relative to the forecast file's directory).
-Forecast load_forecast(const std::filesystem::path& file);
-// The presets file a forecast file names (resolved), for content hashing.
-std::filesystem::path forecast_presets_path(const std::filesystem::path& forecast_file);
+// The presets file a forecast's text names in its 'presets:' entry, as written
+// (a path relative to the forecast file's directory; the caller resolves and
+// reads it: files are read in io and the nodes, not here). ParseError at
+// file:line when the entry is missing or not a non-empty string.
+std::string forecast_presets_entry(const std::string& text, const std::string& filename);
 
 // Which two presets are blended at `hour` in `region`: weight is the share
 // of `to` (0 at a key). A single-key region gives {k, k, 0}.

@@ -17,7 +17,6 @@
 
 #include "atlas/core/math.h"
 
-#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -64,8 +63,6 @@ void validate_preset(const WeatherPreset& p);
 // presets, duplicate names, unknown fields (with "did you mean"), values
 // that are not numbers or out of range, min_height > max_height.
 std::vector<WeatherPreset> parse_presets(const std::string& text, const std::string& filename);
-// Reads and parses a presets file (atlas::Error when it cannot be read).
-std::vector<WeatherPreset> load_presets(const std::filesystem::path& file);
 
 // Index of the preset named `name`; throws atlas::Error listing the names.
 int find_preset(const std::vector<WeatherPreset>& presets, const std::string& name);

@@ -1,14 +1,14 @@
-// atlas/render/image_out.h - turning a rendered image into files.
+// atlas/render/image_out.h - turning a rendered image into pictures.
 //
 // The renderer's image (renderer.h) is linear radiance plus transmittance.
 // PNG previews are tone-mapped: x * exposure, then Reinhard x / (1 + x)
-// per channel, then the sRGB transfer curve; EXR keeps linear floats.
-// Pure functions; thread-safe for distinct files.
+// per channel, then the sRGB transfer curve; EXR keeps linear floats. The
+// files are written by io (io::write_image for the tone-mapped picture,
+// io::write_exr with kLinearImageMeaning for the linear one): render works on
+// memory. Pure functions; thread-safe.
 #pragma once
 
 #include "atlas/core/field.h"
-
-#include <filesystem>
 
 namespace atlas::render {
 
@@ -16,9 +16,7 @@ namespace atlas::render {
 // and bounds. exposure > 0 and finite, else atlas::Error.
 Field2D tone_map(const Field2D& linear, double exposure = 1.5);
 
-// Writes tone_map(image) as an 8-bit PNG (or any io::write_image format).
-void write_preview_png(const Field2D& image, const std::filesystem::path& path, double exposure = 1.5);
-// Writes the linear channels r, g, b, transmittance as 32-bit float EXR.
-void write_preview_exr(const Field2D& image, const std::filesystem::path& path);
+// What the channels of a linear preview EXR hold (its channel_meaning attribute).
+inline constexpr const char* kLinearImageMeaning = "linear radiance r, g, b and view transmittance (atlas render)";
 
 } // namespace atlas::render

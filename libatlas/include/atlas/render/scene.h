@@ -27,7 +27,7 @@ namespace atlas::render {
 //             when set (finite), that modeling channel is this value
 //             everywhere and the field need not hold it (then modeling
 //             may be the profile alone): a plain density grid's detail
-//             type 0 and density scale S (load_scene) cost no 67 MB
+//             type 0 and density scale S (scene_from_fields) cost no 67 MB
 //             channel of one value each at 512x512x64.
 struct CloudScene {
     Field3DPtr modeling;
@@ -69,12 +69,18 @@ Vec3d sun_direction(double azimuth_deg, double elevation_deg);
 
 } // namespace atlas::render
 
-#include <filesystem>
 #include <vector>
 
 namespace atlas::render {
 
-// A scene from files Atlas (or the Nubis pack) wrote, via io::read_field_file:
+// One field of a scene, and the name its errors carry (the file it came from).
+struct SceneField {
+    Field3DPtr field;
+    std::string name;
+};
+
+// A scene from fields Atlas (or the Nubis pack) wrote, as io::read_field_file
+// reads them (the caller reads the files: render works on memory):
 //   one file   a VDB or EXR with channels dimensional_profile, detail_type,
 //              density_scale, sdf (volume/nvdf's vdb_set), or a single
 //              density channel (e.g. a float grid "density", as vdb_render
@@ -89,7 +95,8 @@ namespace atlas::render {
 //              or a TGA stack's R) decoded d = v * 4352 - 256 metres.
 // voxel_size > 0 (metres) replaces the bounds of files that carry none
 // (images, TGA stacks: [0, n] per axis) with [0, n * voxel_size]; 0 keeps
-// the files' bounds. Throws atlas::Error naming the file and the problem.
-CloudScene load_scene(const std::vector<std::filesystem::path>& files, double voxel_size = 0);
+// the files' bounds. Throws atlas::Error naming the field and the problem.
+// A single density grid held by nothing else is used in place (no copy).
+CloudScene scene_from_fields(std::vector<SceneField> fields, double voxel_size = 0);
 
 } // namespace atlas::render

@@ -73,7 +73,7 @@ struct MeshSdfStats {
 // faces); beyond, never short, and over by < 0.5 voxel for closed surfaces
 // (measured 0.14 inside the grid, 0.12 leaving it), by up to 0.75 voxel
 // measured beyond open rims and where an open surface leaves the grid.
-// Vertices and bounds must lie within +-kMaxMeshCoordinate (mesh_io.h).
+// Vertices and bounds must lie within +-kMaxMeshCoordinate (atlas/core/geometry.h).
 Field3D mesh_to_sdf(const Mesh& mesh, Vec3i res, Box3d bounds, const MeshSdfOptions& options = {},
                     const MemoryBudget* budget = nullptr, MeshSdfStats* stats = nullptr);
 

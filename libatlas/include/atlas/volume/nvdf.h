@@ -13,7 +13,6 @@
 #include "atlas/core/field.h"
 #include "atlas/io/nubis_pack.h"
 
-#include <filesystem>
 #include <string>
 #include <vector>
 

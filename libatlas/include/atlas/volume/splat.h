@@ -14,7 +14,6 @@
 #include "atlas/core/field.h"
 #include "atlas/core/geometry.h"
 
-#include <filesystem>
 #include <string>
 
 namespace atlas {
@@ -45,10 +44,5 @@ struct SplatOptions {
 // a radius <= 0 or non-finite, an attribute of the wrong length.
 Field3D splat_points(const Points& points, Vec3i res, Box3d bounds, const SplatOptions& options,
                      const MemoryBudget* budget = nullptr);
-
-// Reads a point cloud: PLY (through CGAL; float properties such as "radius"
-// become attributes) or XYZ text ("x y z [radius [weight]]" per line, '#'
-// comments). Throws atlas::Error naming the file and line on bad input.
-Points read_points(const std::filesystem::path& file);
 
 } // namespace atlas::volume

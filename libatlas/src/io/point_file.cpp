@@ -1,6 +1,7 @@
-// Point cloud reading: PLY through CGAL, XYZ text by hand.
+// Point cloud files: PLY through CGAL (after its header is checked), XYZ text here.
+#include "atlas/io/geometry_files.h"
+
 #include "atlas/core/error.h"
-#include "atlas/volume/splat.h"
 #include "ply_header.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -13,10 +14,10 @@
 #include <fstream>
 #include <sstream>
 
-namespace atlas::volume {
+namespace atlas::io {
 namespace {
 
-Points read_xyz(const std::filesystem::path& file) {
+Points read_xyz(const fs::path& file) {
     std::ifstream in(file);
     if (!in) throw Error(file.string() + ": cannot open point file");
     Points pts;
@@ -52,7 +53,7 @@ Points read_xyz(const std::filesystem::path& file) {
     return pts;
 }
 
-Points read_ply(const std::filesystem::path& file) {
+Points read_ply(const fs::path& file) {
     using K = CGAL::Exact_predicates_inexact_constructions_kernel;
     CGAL::Point_set_3<K::Point_3> ps;
     std::ifstream in(file, std::ios::binary);
@@ -85,9 +86,9 @@ Points read_ply(const std::filesystem::path& file) {
 
 } // namespace
 
-Points read_points(const std::filesystem::path& file) {
-    if (!std::filesystem::exists(file)) throw Error(file.string() + ": no such point file");
-    if (!std::filesystem::is_regular_file(file))
+Points read_points(const fs::path& file) {
+    if (!fs::exists(file)) throw Error(file.string() + ": no such point file");
+    if (!fs::is_regular_file(file))
         throw Error(file.string() + ": cannot read points: not a regular file (a directory, device, FIFO or socket)");
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
@@ -99,4 +100,4 @@ Points read_points(const std::filesystem::path& file) {
     throw Error(file.string() + ": unknown point file type (expected .ply or .xyz)");
 }
 
-} // namespace atlas::volume
+} // namespace atlas::io

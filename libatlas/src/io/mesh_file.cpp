@@ -1,125 +1,34 @@
-// Mesh reading, validation and repair through CGAL.
-#include "atlas/volume/mesh_io.h"
+// Mesh files: OBJ and OFF parsed here (every error at file:line), PLY and STL
+// through CGAL::IO after their headers are checked; writing through CGAL::IO.
+#include "atlas/io/geometry_files.h"
 
 #include "atlas/core/error.h"
 #include "ply_header.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/IO/polygon_soup_io.h>
-#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
-#include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
 
 #include <algorithm>
-#include <charconv>
-#include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <array>
 #include <cctype>
+#include <charconv>
 #include <cmath>
-#include <map>
-#include <numeric>
+#include <cstring>
+#include <fstream>
 #include <string>
 #include <vector>
 
-namespace atlas::volume {
+namespace atlas::io {
 namespace {
 
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = K::Point_3;
 using Polygon = std::vector<std::size_t>;
-namespace PMP = CGAL::Polygon_mesh_processing;
-
-Vec3d to_d(const Point& p) { return {{p.x(), p.y(), p.z()}}; }
-
-std::string number(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.9g", v);
-    return buf;
-}
-
-uint32_t find_root(std::vector<uint32_t>& parent, uint32_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-}
-
-// Soup -> repaired triangle mesh (shared by repair_mesh and read_mesh).
-Mesh repair_soup(std::vector<Point> points, std::vector<Polygon> polygons, MeshRepairReport& rep) {
-    const size_t points_in = points.size();
-    // Fan-triangulate polygons with more than three corners.
-    std::vector<Polygon> tris;
-    tris.reserve(polygons.size());
-    for (const Polygon& p : polygons) {
-        if (p.size() > 3) ++rep.polygons_triangulated;
-        for (size_t i = 1; i + 1 < p.size(); ++i) tris.push_back({p[0], p[i], p[i + 1]});
-    }
-    const size_t tris_in = tris.size();
-    // Merges duplicate points, drops polygons with repeated corners and
-    // duplicate polygons (any orientation), removes unused points.
-    PMP::repair_polygon_soup(points, tris, CGAL::parameters::erase_all_duplicates(false).require_same_orientation(false));
-    rep.merged_vertices = points_in > points.size() ? points_in - points.size() : 0;
-    // Collinear (zero-area) triangles: area tiny against the triangle's own
-    // longest edge squared (scale-free, so one far vertex does not make every
-    // other triangle "degenerate").
-    const size_t before_area = tris.size();
-    std::erase_if(tris, [&](const Polygon& t) {
-        const Vec3d a = to_d(points[t[0]]), b = to_d(points[t[1]]), c = to_d(points[t[2]]);
-        const double e2 = std::max({dot(b - a, b - a), dot(c - b, c - b), dot(a - c, a - c)});
-        return length(cross(b - a, c - a)) * 0.5 <= 1e-12 * e2;
-    });
-    const size_t after = tris.size();
-    rep.removed_degenerate = before_area - after;
-    rep.removed_duplicates = tris_in > before_area ? tris_in - before_area : 0; // includes repeated-corner ones
-    if (tris.empty()) throw Error("mesh: no usable triangles remain after removing degenerate ones");
-
-    // Consistent orientation across shared edges. May duplicate non-manifold vertices.
-    std::vector<Polygon> oriented = tris;
-    PMP::orient_polygon_soup(points, oriented);
-    for (size_t i = 0; i < oriented.size() && i < tris.size(); ++i)
-        if (oriented[i] != tris[i]) ++rep.flipped_triangles;
-
-    // Components by shared (undirected) edges; flip those with negative volume.
-    std::vector<uint32_t> parent(oriented.size());
-    std::iota(parent.begin(), parent.end(), 0u);
-    std::map<std::pair<size_t, size_t>, uint32_t> edge_owner;
-    for (uint32_t t = 0; t < oriented.size(); ++t)
-        for (int e = 0; e < 3; ++e) {
-            size_t a = oriented[t][size_t(e)], b = oriented[t][size_t((e + 1) % 3)];
-            auto [it, fresh] = edge_owner.try_emplace({std::min(a, b), std::max(a, b)}, t);
-            if (!fresh) parent[find_root(parent, t)] = find_root(parent, it->second);
-        }
-    std::map<uint32_t, std::vector<uint32_t>> comps;
-    for (uint32_t t = 0; t < oriented.size(); ++t) comps[find_root(parent, t)].push_back(t);
-    rep.components = comps.size();
-    for (auto& [root, members] : comps) {
-        Vec3d centroid{};
-        for (uint32_t t : members)
-            for (size_t v : oriented[t]) centroid = centroid + to_d(points[v]);
-        centroid = centroid / double(members.size() * 3);
-        double vol = 0;
-        for (uint32_t t : members) {
-            const Vec3d a = to_d(points[oriented[t][0]]) - centroid, b = to_d(points[oriented[t][1]]) - centroid,
-                        c = to_d(points[oriented[t][2]]) - centroid;
-            vol += dot(a, cross(b, c));
-        }
-        if (vol < 0) {
-            for (uint32_t t : members) std::swap(oriented[t][1], oriented[t][2]);
-            rep.flipped_triangles += members.size();
-        }
-    }
-    Mesh out;
-    out.vertices.reserve(points.size());
-    for (const Point& p : points) out.vertices.push_back({{float(p.x()), float(p.y()), float(p.z())}});
-    out.triangles.reserve(oriented.size());
-    for (const Polygon& t : oriented) out.triangles.push_back({uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
-    return out;
-}
-
 
 // PLY and STL go to CGAL's readers, which trust their headers (a property
 // outside any element crashes the PLY reader; a count of 10^12 reserves
 // memory for it): the header is checked here first, against the file's size.
-uint64_t regular_file_size(const std::filesystem::path& file) {
+uint64_t regular_file_size(const fs::path& file) {
     std::error_code ec;
     const auto st = std::filesystem::status(file, ec);
     if (ec || !std::filesystem::is_regular_file(st))
@@ -129,7 +38,7 @@ uint64_t regular_file_size(const std::filesystem::path& file) {
 
 } // namespace
 
-void detail::check_ply_header(const std::filesystem::path& file, bool need_faces) {
+void detail::check_ply_header(const fs::path& file, bool need_faces) {
     const std::string f = file.string();
     const uint64_t size = regular_file_size(file);
     std::ifstream in(file, std::ios::binary);
@@ -226,7 +135,7 @@ void detail::check_ply_header(const std::filesystem::path& file, bool need_faces
 }
 
 namespace {
-void check_stl(const std::filesystem::path& file) {
+void check_stl(const fs::path& file) {
     const uint64_t size = regular_file_size(file);
     std::ifstream in(file, std::ios::binary);
     char head[84] = {};
@@ -253,7 +162,7 @@ struct TextReader {
     std::string line;
     size_t line_no = 0;
 
-    explicit TextReader(const std::filesystem::path& f) : file(f.string()), in(f) {
+    explicit TextReader(const fs::path& f) : file(f.string()), in(f) {
         if (!in) throw Error(file + ": cannot open mesh file");
     }
     // Next line split into tokens, '#' comments removed; false at the end.
@@ -299,7 +208,7 @@ struct TextReader {
     }
 };
 
-void read_obj(const std::filesystem::path& f, std::vector<Point>& points, std::vector<Polygon>& polys) {
+void read_obj(const fs::path& f, std::vector<Point>& points, std::vector<Polygon>& polys) {
     TextReader r(f);
     std::vector<std::string> tok;
     struct Pending {
@@ -363,7 +272,7 @@ void read_obj(const std::filesystem::path& f, std::vector<Point>& points, std::v
                         " vertices (1.." + std::to_string(points.size()) + "); truncated file?");
 }
 
-void read_off(const std::filesystem::path& f, std::vector<Point>& points, std::vector<Polygon>& polys) {
+void read_off(const fs::path& f, std::vector<Point>& points, std::vector<Polygon>& polys) {
     TextReader r(f);
     std::vector<std::string> tok;
     if (!r.next(tok)) throw Error(r.file + ": empty file, expected an OFF header");
@@ -410,40 +319,10 @@ void read_off(const std::filesystem::path& f, std::vector<Point>& points, std::v
 
 } // namespace
 
-void validate_mesh(const Mesh& m, const char* who) {
-    if (m.triangles.empty()) throw Error(std::string(who) + ": the mesh has no triangles");
-    for (size_t i = 0; i < m.vertices.size(); ++i)
-        for (int a = 0; a < 3; ++a)
-            if (!std::isfinite(m.vertices[i][a]))
-                throw Error(std::string(who) + ": vertex " + std::to_string(i) + " is not finite (" + std::to_string(m.vertices[i][a]) + ")");
-            else if (std::abs(m.vertices[i][a]) > kMaxMeshCoordinate)
-                throw Error(std::string(who) + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " + number(m.vertices[i][a]) +
-                            ", outside the supported range +-1e18 m");
-    for (size_t t = 0; t < m.triangles.size(); ++t)
-        for (uint32_t v : m.triangles[t])
-            if (v >= m.vertices.size())
-                throw Error(std::string(who) + ": triangle " + std::to_string(t) + " uses vertex " + std::to_string(v) + " but the mesh has " +
-                            std::to_string(m.vertices.size()));
-}
-
-Mesh repair_mesh(const Mesh& m, MeshRepairReport* report) {
-    validate_mesh(m, "repair_mesh");
-    std::vector<Point> points;
-    points.reserve(m.vertices.size());
-    for (const Vec3f& v : m.vertices) points.emplace_back(v[0], v[1], v[2]);
-    std::vector<Polygon> polys;
-    polys.reserve(m.triangles.size());
-    for (const auto& t : m.triangles) polys.push_back({t[0], t[1], t[2]});
-    MeshRepairReport rep;
-    Mesh out = repair_soup(std::move(points), std::move(polys), rep);
-    if (report) *report = rep;
-    return out;
-}
-
-Mesh read_mesh(const std::filesystem::path& file, MeshRepairReport* report) {
+PolygonSoup read_polygon_soup(const fs::path& file) {
     std::vector<Point> points;
     std::vector<Polygon> polys;
-    if (!std::filesystem::exists(file)) throw Error(file.string() + ": no such mesh file");
+    if (!fs::exists(file)) throw Error(file.string() + ": no such mesh file");
     regular_file_size(file); // a device or FIFO never ends: refused before reading
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
@@ -461,32 +340,15 @@ Mesh read_mesh(const std::filesystem::path& file, MeshRepairReport* report) {
         if (!ok) throw Error(file.string() + ": cannot read mesh (expected OBJ, OFF, PLY or STL)");
     }
     if (polys.empty()) throw Error(file.string() + ": the mesh has no faces");
-    for (size_t i = 0; i < points.size(); ++i)
-        for (int a = 0; a < 3; ++a) {
-            if (!std::isfinite(points[i][a])) throw Error(file.string() + ": vertex " + std::to_string(i) + " is not finite");
-            if (std::abs(points[i][a]) > kMaxMeshCoordinate)
-                throw Error(file.string() + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " + number(points[i][a]) +
-                            ", outside the supported range +-1e18 m");
-        }
-    for (size_t f = 0; f < polys.size(); ++f) {
-        if (polys[f].size() < 3) throw Error(file.string() + ": face " + std::to_string(f) + " has " + std::to_string(polys[f].size()) + " corners, expected at least 3");
-        for (size_t v : polys[f])
-            if (v >= points.size())
-                throw Error(file.string() + ": face " + std::to_string(f) + " uses vertex " + std::to_string(v) + " but the file has " +
-                            std::to_string(points.size()));
-    }
-    MeshRepairReport rep;
-    Mesh out;
-    try {
-        out = repair_soup(std::move(points), std::move(polys), rep);
-    } catch (const Error& e) {
-        throw Error(file.string() + ": " + e.what());
-    }
-    if (report) *report = rep;
-    return out;
+    PolygonSoup soup;
+    soup.points.reserve(points.size());
+    for (const Point& p : points) soup.points.push_back({{p.x(), p.y(), p.z()}});
+    soup.polygons = std::move(polys);
+    validate_polygon_soup(soup, file.string()); // CGAL's readers check neither values nor indices
+    return soup;
 }
 
-void write_mesh(const std::filesystem::path& file, const Mesh& m) {
+void write_mesh(const fs::path& file, const Mesh& m) {
     std::vector<Point> points;
     for (const Vec3f& v : m.vertices) points.emplace_back(v[0], v[1], v[2]);
     std::vector<Polygon> polys;
@@ -495,4 +357,4 @@ void write_mesh(const std::filesystem::path& file, const Mesh& m) {
         throw Error(file.string() + ": cannot write mesh");
 }
 
-} // namespace atlas::volume
+} // namespace atlas::io
