@@ -1,0 +1,99 @@
+"""Issue 13, item 4: the module layering the architecture page promises.
+
+- Only atlas/core/parallel.h calls TBB: every other file uses its helpers, whose
+  fixed blocks keep the bytes the same on any thread count.
+- The algorithm modules (noise, compress, volume, ndf, sim, render) work on memory:
+  no file streams, no std::filesystem, no core/files.h. Files are opened in io
+  (and by the nodes and the CLI that compose io with the algorithms).
+- Each module includes only the modules its CMake line links (libatlas/CMakeLists.txt).
+"""
+import os
+import pathlib
+import re
+
+ROOT = pathlib.Path(os.environ.get("ATLAS_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
+LIB = ROOT / "libatlas"
+ALGORITHM_MODULES = ["noise", "compress", "volume", "ndf", "sim", "render"]
+CPP = (".cpp", ".h", ".hpp", ".cc")
+
+
+def sources(*dirs):
+    for d in dirs:
+        for p in sorted((ROOT / d).rglob("*")):
+            if p.suffix in CPP and p.is_file():
+                yield p
+
+
+def module_files(module):
+    return list(sources(f"libatlas/src/{module}", f"libatlas/include/atlas/{module}"))
+
+
+def code_lines(path):
+    """Lines with // comments removed (a comment may name what it does not use)."""
+    for n, line in enumerate(path.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
+        yield n, line.split("//", 1)[0]
+
+
+def offences(paths, pattern):
+    rx = re.compile(pattern)
+    return [f"{os.path.relpath(p, ROOT)}:{n}: {line.strip()}" for p in paths for n, line in code_lines(p) if rx.search(line)]
+
+
+def test_only_core_parallel_calls_tbb():
+    allowed = LIB / "include/atlas/core/parallel.h"
+    files = [p for p in sources("libatlas", "nodes", "apps", "python", "plugins") if p != allowed]
+    assert len(files) > 100
+    bad = offences(files, r"#\s*include\s*<tbb/|\btbb::")
+    assert not bad, "TBB outside atlas/core/parallel.h:\n" + "\n".join(bad)
+
+
+def test_algorithm_modules_open_no_files():
+    pattern = r"#\s*include\s*<(fstream|filesystem)>|\bstd::(i|o)?fstream\b|\bstd::filesystem\b|\b(fopen|freopen|open)\s*\(|#\s*include\s*\"atlas/core/files\.h\""
+    for module in ALGORITHM_MODULES:
+        files = module_files(module)
+        assert files, module
+        bad = offences(files, pattern)
+        assert not bad, f"{module} opens files (they belong in io):\n" + "\n".join(bad)
+
+
+def test_the_checks_can_fail():
+    # Negative control: the patterns do catch what they look for.
+    fake = pathlib.Path("/tmp/atlas_layering_fake.cpp")
+    fake.write_text('#include <fstream>\nvoid f() { tbb::parallel_for(0, 1, [](int) {}); }\n')
+    try:
+        assert len(offences([fake], r"#\s*include\s*<(fstream|filesystem)>")) == 1
+        assert len(offences([fake], r"#\s*include\s*<tbb/|\btbb::")) == 1
+    finally:
+        fake.unlink()
+
+
+def link_lines():
+    deps = {}
+    for line in (LIB / "CMakeLists.txt").read_text().splitlines():
+        m = re.match(r"\s*atlas_module\((\w+)(.*)\)", line.split("#", 1)[0])
+        if m:
+            deps[m.group(1)] = set(re.findall(r"atlas::(\w+)", m.group(2)))
+    return deps
+
+
+def closure(deps, m, seen=None):
+    seen = set() if seen is None else seen
+    for d in deps.get(m, ()):
+        if d not in seen:
+            seen.add(d)
+            closure(deps, d, seen)
+    return seen
+
+
+def test_includes_follow_the_link_lines():
+    deps = link_lines()
+    assert {"core", "io", "render", "volume"} <= set(deps)
+    bad = []
+    for module in deps:
+        reach = closure(deps, module) | {module}
+        for p in module_files(module):
+            for n, line in code_lines(p):
+                m = re.search(r'#\s*include\s*"atlas/(\w+)/', line)
+                if m and m.group(1) in deps and m.group(1) not in reach:
+                    bad.append(f"{p.relative_to(ROOT)}:{n}: {module} includes atlas/{m.group(1)} but does not link it")
+    assert not bad, "\n".join(bad)
