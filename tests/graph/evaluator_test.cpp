@@ -524,6 +524,24 @@ TEST_F(Fixture, UnchangedOutputsAreNotRewrittenAndNothingCooks) {
     EXPECT_EQ(output_named(s4.cook(o), "sub/b.png").status, "written");
 }
 
+// .atlas-outputs.json records each file's mtime as Unix time, the value stat(2)
+// gives (the independent reader), not the file clock's own count.
+TEST_F(Fixture, OutputRecordsHoldUnixMtimes) {
+    Session s = session(kTwoOutputs);
+    s.cook(options());
+    const auto j = nlohmann::json::parse(slurp(dir / "out" / ".atlas-outputs.json"));
+    int files = 0;
+    for (const auto& [name, r] : j.at("outputs").items())
+        for (const auto& f : r.at("files")) {
+            struct stat st {};
+            ASSERT_EQ(::stat((dir / "out" / f.at("path").get<std::string>()).c_str(), &st), 0) << name;
+            const int64_t unix_ns = int64_t(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec;
+            EXPECT_EQ(f.at("mtime_ns").get<int64_t>(), unix_ns) << name;
+            ++files;
+        }
+    EXPECT_EQ(files, 2);
+}
+
 // The file on disk decides: a deleted, resized or edited output is written
 // again; a touched one with the same bytes is not (its mtime stays the touched one).
 TEST_F(Fixture, OutputChangedOnDiskIsWrittenAgain) {

@@ -41,7 +41,9 @@ int64_t file_mtime_ns(const std::filesystem::path& p) {
     std::error_code ec;
     const auto t = std::filesystem::last_write_time(p, ec);
     if (ec) return 0;
-    return int64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
+    // Unix time, as other tools read it (the file clock's own epoch is libstdc++'s, 2174).
+    const auto sys = std::chrono::file_clock::to_sys(t);
+    return int64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(sys.time_since_epoch()).count());
 }
 
 OutputRecords::OutputRecords(std::filesystem::path root) : root_(std::move(root)), records_(read_records(root_ / kFileName)) {}

@@ -22,7 +22,7 @@ namespace atlas {
 struct OutputFileRecord {
     std::string path; // relative to the root, generic form
     uint64_t bytes = 0;
-    int64_t mtime_ns = 0;
+    int64_t mtime_ns = 0; // last write time, nanoseconds since the Unix epoch
     std::string hash; // file_content_hash, hex
 };
 
