@@ -7,7 +7,6 @@
 #include "half.h"
 #include "texture_internal.h"
 
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>

@@ -10,7 +10,6 @@
 #include "mips.h"
 #include "texture_internal.h"
 
-
 #include <chrono>
 #include <cmath>
 #include <cstring>

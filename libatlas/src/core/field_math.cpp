@@ -3,7 +3,6 @@
 #include "atlas/core/error.h"
 #include "atlas/core/parallel.h"
 
-
 #include <algorithm>
 #include <cmath>
 

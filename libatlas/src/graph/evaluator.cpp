@@ -11,7 +11,6 @@
 #include "output_records.h"
 #include "value_cache.h"
 
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>

@@ -4,8 +4,8 @@
 #include "graph_walk.h"
 
 #include "atlas/core/files.h"
-#include "atlas/core/parallel.h"
 #include "atlas/core/hash.h"
+#include "atlas/core/parallel.h"
 #include "atlas/io/writers.h"
 #include "value_cache.h"
 

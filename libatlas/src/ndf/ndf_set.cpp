@@ -6,7 +6,6 @@
 
 #include "atlas/core/parallel.h"
 
-
 #include <cmath>
 
 namespace atlas::ndf {

@@ -12,7 +12,6 @@
 #include "atlas/core/progress.h"
 #include "atlas/render/renderer.h"
 
-
 #include <algorithm>
 #include <array>
 #include <atomic>
