@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <numbers>
 
@@ -170,6 +171,30 @@ TEST(LayerRender, NonFiniteChannelIsNamed) {
         EXPECT_NE(m.find("'coverage'"), std::string::npos) << m;
         EXPECT_NE(m.find("NaN"), std::string::npos) << m;
         EXPECT_NE(m.find("(3, 4)"), std::string::npos) << m;
+    }
+}
+
+// The scan is a bit test on the exponent: -Inf in the very last texel is
+// found, the largest and the subnormal floats are not mistaken for it.
+TEST(LayerRender, NonFiniteScanSeesLastTexelAndKeepsExtremeFinites) {
+    LayerScene s = scene_with(0.5, false);
+    Field2D extreme = *s.ndf;
+    const int w = extreme.width(), h = extreme.height();
+    extreme.at(ndf::Coverage, 0, 0) = std::numeric_limits<float>::max();
+    extreme.at(ndf::Coverage, 1, 0) = -std::numeric_limits<float>::max();
+    extreme.at(ndf::Coverage, 2, 0) = std::numeric_limits<float>::denorm_min();
+    s.ndf = std::make_shared<const Field2D>(extreme);
+    EXPECT_NO_THROW(validate_layer_scene(s));
+    const int last = extreme.channels() - 1;
+    extreme.at(last, w - 1, h - 1) = -std::numeric_limits<float>::infinity();
+    s.ndf = std::make_shared<const Field2D>(std::move(extreme));
+    try {
+        validate_layer_scene(s);
+        FAIL() << "-Inf in the last texel was not found";
+    } catch (const Error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("Inf"), std::string::npos) << m;
+        EXPECT_NE(m.find("(" + std::to_string(w - 1) + ", " + std::to_string(h - 1) + ")"), std::string::npos) << m;
     }
 }
 

@@ -10,6 +10,8 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace atlas::render {
@@ -40,10 +42,24 @@ std::vector<std::string> LayerReport::active_features() const {
 
 namespace {
 
+// True when some value in [p, p + n) is NaN or Inf (exponent bits all set):
+// a branch-free OR the compiler vectorises, so the whole-map scan every
+// preview frame makes costs a fraction of isfinite per texel.
+bool any_non_finite(const float* p, size_t n) {
+    uint32_t bad = 0;
+    for (size_t i = 0; i < n; ++i) {
+        uint32_t bits;
+        std::memcpy(&bits, p + i, sizeof bits);
+        bad |= uint32_t((bits & 0x7f800000u) == 0x7f800000u);
+    }
+    return bad != 0;
+}
+
 template <class F>
 void check_finite_impl(const F& f, const std::string& what, int nx, int ny) {
     for (int c = 0; c < f.channels(); ++c) {
         auto ch = f.channel(c);
+        if (!any_non_finite(ch.data(), ch.size())) continue;
         for (size_t i = 0; i < ch.size(); ++i) {
             if (std::isfinite(ch[i])) continue;
             const size_t plane = size_t(nx) * size_t(ny);
