@@ -26,17 +26,22 @@ uint64_t Points::byte_size() const {
     return n;
 }
 
+namespace {
+
+// One coordinate of vertex i: finite and within +-kMaxMeshCoordinate.
+void check_vertex_coordinate(double v, size_t i, int axis, const std::string& who) {
+    if (std::isfinite(v) && std::abs(v) <= kMaxMeshCoordinate) return;
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    throw Error(who + ": vertex " + std::to_string(i) + " has " + "xyz"[axis] + " = " + buf +
+                (std::isfinite(v) ? ", outside the supported range +-1e18 m" : ", which is not finite"));
+}
+
+} // namespace
+
 void validate_polygon_soup(const PolygonSoup& soup, const std::string& who) {
     for (size_t i = 0; i < soup.points.size(); ++i)
-        for (int a = 0; a < 3; ++a) {
-            const double v = soup.points[i][a];
-            if (!std::isfinite(v)) throw Error(who + ": vertex " + std::to_string(i) + " is not finite");
-            if (std::abs(v) > kMaxMeshCoordinate) {
-                char buf[32];
-                std::snprintf(buf, sizeof buf, "%.9g", v);
-                throw Error(who + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " + buf + ", outside the supported range +-1e18 m");
-            }
-        }
+        for (int a = 0; a < 3; ++a) check_vertex_coordinate(soup.points[i][a], i, a, who);
     for (size_t f = 0; f < soup.polygons.size(); ++f) {
         const auto& poly = soup.polygons[f];
         if (poly.size() < 3)
@@ -46,6 +51,17 @@ void validate_polygon_soup(const PolygonSoup& soup, const std::string& who) {
                 throw Error(who + ": face " + std::to_string(f) + " uses vertex " + std::to_string(v) + " but there are " +
                             std::to_string(soup.points.size()) + " vertices");
     }
+}
+
+void validate_mesh(const Mesh& m, const std::string& who) {
+    if (m.triangles.empty()) throw Error(who + ": the mesh has no triangles");
+    for (size_t i = 0; i < m.vertices.size(); ++i)
+        for (int a = 0; a < 3; ++a) check_vertex_coordinate(m.vertices[i][a], i, a, who);
+    for (size_t t = 0; t < m.triangles.size(); ++t)
+        for (uint32_t v : m.triangles[t])
+            if (v >= m.vertices.size())
+                throw Error(who + ": triangle " + std::to_string(t) + " uses vertex " + std::to_string(v) + " but the mesh has " +
+                            std::to_string(m.vertices.size()));
 }
 
 } // namespace atlas

@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <numeric>
 #include <string>
@@ -26,12 +25,6 @@ using Polygon = std::vector<std::size_t>;
 namespace PMP = CGAL::Polygon_mesh_processing;
 
 Vec3d to_d(const Point& p) { return {{p.x(), p.y(), p.z()}}; }
-
-std::string number(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.9g", v);
-    return buf;
-}
 
 uint32_t find_root(std::vector<uint32_t>& parent, uint32_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
@@ -111,22 +104,6 @@ Mesh repair_soup(std::vector<Point> points, std::vector<Polygon> polygons, MeshR
 }
 
 } // namespace
-
-void validate_mesh(const Mesh& m, const char* who) {
-    if (m.triangles.empty()) throw Error(std::string(who) + ": the mesh has no triangles");
-    for (size_t i = 0; i < m.vertices.size(); ++i)
-        for (int a = 0; a < 3; ++a)
-            if (!std::isfinite(m.vertices[i][a]))
-                throw Error(std::string(who) + ": vertex " + std::to_string(i) + " is not finite (" + std::to_string(m.vertices[i][a]) + ")");
-            else if (std::abs(m.vertices[i][a]) > kMaxMeshCoordinate)
-                throw Error(std::string(who) + ": vertex " + std::to_string(i) + " has " + "xyz"[a] + " = " + number(m.vertices[i][a]) +
-                            ", outside the supported range +-1e18 m");
-    for (size_t t = 0; t < m.triangles.size(); ++t)
-        for (uint32_t v : m.triangles[t])
-            if (v >= m.vertices.size())
-                throw Error(std::string(who) + ": triangle " + std::to_string(t) + " uses vertex " + std::to_string(v) + " but the mesh has " +
-                            std::to_string(m.vertices.size()));
-}
 
 Mesh repair_mesh(const Mesh& m, MeshRepairReport* report) {
     validate_mesh(m, "repair_mesh");

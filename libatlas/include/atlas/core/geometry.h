@@ -52,6 +52,10 @@ inline constexpr double kMaxMeshCoordinate = 1e18;
 // than 3 corners, or a corner names a point that does not exist.
 void validate_polygon_soup(const PolygonSoup& soup, const std::string& who);
 
+// The same for a triangle mesh, plus: throws when it has no triangles. Both
+// share one vertex check, so readers and the mesh algorithms word it alike.
+void validate_mesh(const Mesh& mesh, const std::string& who = "mesh");
+
 using MeshPtr = std::shared_ptr<const Mesh>;
 using PointsPtr = std::shared_ptr<const Points>;
 

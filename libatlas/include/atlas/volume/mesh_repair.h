@@ -23,10 +23,10 @@ struct MeshRepairReport {
 
 using atlas::kMaxMeshCoordinate; // core/geometry.h: the largest |coordinate| accepted
 
-// Throws atlas::Error (naming `who` and the problem) when the mesh has no
-// triangles, a vertex that is NaN or infinite or beyond +-kMaxMeshCoordinate
-// (naming its index and coordinate), or an index out of range.
-void validate_mesh(const Mesh& mesh, const char* who = "mesh");
+// validate_mesh lives beside validate_polygon_soup (core/geometry.h): no
+// triangles, a NaN, infinite or beyond +-kMaxMeshCoordinate vertex, or an
+// index out of range throws atlas::Error naming `who` and the problem.
+using atlas::validate_mesh;
 
 // Repair for voxelisation: merge duplicate vertices (exact positions), drop
 // degenerate triangles (repeated corners, or area below 1e-12 of the bounding
