@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
@@ -451,6 +452,11 @@ TEST(MeshIo, TextErrorsNameLineAndIndex) {
     far.vertices[5][2] = 1e30f;
     e = error_of([&] { mesh_to_sdf(far, {{4, 4, 4}}, grid_box(4)); });
     EXPECT_TRUE(has(e, {"vertex 5", "z = 1.00000002e+30", "supported range"})) << e;
+    // A NaN vertex in memory is worded as in a file (one check, core/geometry.cpp).
+    Mesh nan_mesh = box_mesh({{1, 1, 1}}, {{2, 2, 2}});
+    nan_mesh.vertices[2][0] = std::nanf("");
+    e = error_of([&] { mesh_to_sdf(nan_mesh, {{4, 4, 4}}, grid_box(4)); });
+    EXPECT_TRUE(has(e, {"vertex 2 has x = ", "nan", "not finite"})) << e;
     e = error_of([&] { mesh_to_sdf(box_mesh({{1, 1, 1}}, {{2, 2, 2}}), {{4, 4, 4}}, grid_box(1e19)); });
     EXPECT_TRUE(has(e, {"1e18"})) << e;
     // Within the range, distances near 1e18 m are finite and right (no float overflow).
