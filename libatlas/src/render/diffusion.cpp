@@ -15,6 +15,7 @@ struct Level {
     std::vector<float> q;   // source per metre (per E)
     std::vector<float> phi;
     std::vector<float> leak; // the Marshak faces' area factor (staircase correction)
+    std::vector<float> tb;   // the sun's transmittance averaged over the voxel (the source's q / sigma)
     size_t idx(int x, int y, int z) const { return (size_t(z) * size_t(n[1]) + size_t(y)) * size_t(n[0]) + size_t(x); }
     size_t size() const { return size_t(n[0]) * size_t(n[1]) * size_t(n[2]); }
     double hmin() const { return std::min({h[0], h[1], h[2]}); }
@@ -24,6 +25,22 @@ struct Level {
 constexpr double kOmega = 1.8;
 // The Marshak boundary's resistance: phi = 0 at 2D beyond the face.
 constexpr double kMarshak = 2.0;
+
+// The forward peak of the first-scattered light (P1 with an anisotropic
+// source): F = -D grad phi + 3 D Q1 with Q1 = g sigma Tbar (-sun), so a face
+// of normal n carries the extra flux ag Tbar (-sun . n), ag = g / (1 - g)
+// (sigma cancels). ag = 0: the isotropic source.
+struct ForwardFlux {
+    double ag = 0;
+    Vec3d sun{{0, 0, 1}};
+    // Outward through voxel i's face on axis a, side +-1, at transmittance t.
+    double out(double t, int a, int side) const { return ag * t * -sun[a] * side; }
+};
+
+// Outward flux through a Marshak face of a voxel of resistance r = 1.5 sigma'
+// h: phi = 0 at 2D beyond the face, F = D (phi - phi_s) / (h / 2) + G and
+// F = phi_s / 2 give F = (phi + r G) / (r + 2).
+inline double marshak_flux(double phi, double r, double g_out) { return (phi + r * g_out) / (r + kMarshak); }
 
 // One colour's sweep: every voxel with (x + y + z) % 2 == colour reads only
 // voxels of the other colour, so z slabs run in parallel with the same bytes.
@@ -68,7 +85,7 @@ void sweep(Level& L, double reduce, int colour) {
 // outside the medium see the surface, not 0 (measured on the calibration
 // shapes: the same as extrapolating through the surface value, 0.069 against
 // 0.070 mean error). Reads medium voxels only.
-void fill_outside(Level& L, double reduce) {
+void fill_outside(Level& L, double reduce, bool extrapolate, const ForwardFlux& ff) {
     const double min_sig = kDiffusionMinTau / L.hmin();
     parallel_for_index(L.n[2], [&](int z) {
         for (int y = 0; y < L.n[1]; ++y)
@@ -86,10 +103,11 @@ void fill_outside(Level& L, double reduce) {
                         const size_t j = L.idx(cc[0], cc[1], cc[2]);
                         if (L.sig[j] < min_sig) continue;
                         const double rj = 1.5 * reduce * L.sig[j] * L.h[a];
-                        acc += 2 * L.phi[j] / (rj + kMarshak);
+                        const double surface = 2 * marshak_flux(L.phi[j], rj, ff.out(L.tb[j], a, -side));
+                        acc += extrapolate ? 2 * surface - L.phi[j] : surface;
                         ++cnt;
                     }
-                L.phi[i] = cnt ? static_cast<float>(acc / cnt) : 0.0f;
+                L.phi[i] = cnt ? static_cast<float>(acc / cnt) : 0.0f; // may be < 0 extrapolated: lookups clamp
             }
     });
 }
@@ -124,11 +142,12 @@ Level coarsen(const Level& f, const Vec3d& size) {
     }
     c.sig.assign(c.size(), 0.0f);
     c.q.assign(c.size(), 0.0f);
+    c.tb.assign(c.size(), 0.0f);
     c.phi.assign(c.size(), 0.0f);
     parallel_for_index(c.n[2], [&](int z) {
         for (int y = 0; y < c.n[1]; ++y)
             for (int x = 0; x < c.n[0]; ++x) {
-                double s = 0, q = 0;
+                double s = 0, q = 0, t = 0;
                 int cnt = 0;
                 for (int dz = 0; dz < 2; ++dz)
                     for (int dy = 0; dy < 2; ++dy)
@@ -138,11 +157,13 @@ Level coarsen(const Level& f, const Vec3d& size) {
                             const size_t j = f.idx(fx, fy, fz);
                             s += f.sig[j];
                             q += f.q[j];
+                            t += f.tb[j];
                             ++cnt;
                         }
                 const size_t i = c.idx(x, y, z);
                 c.sig[i] = static_cast<float>(s / cnt);
                 c.q[i] = static_cast<float>(q / cnt);
+                c.tb[i] = static_cast<float>(t / cnt);
             }
     });
     leak_factors(c);
@@ -157,18 +178,49 @@ void prolong(const Level& c, Level& f) {
     });
 }
 
-void solve(Level& L, double reduce, int sweeps) {
+void solve(Level& L, double reduce, int sweeps, bool extrapolate, const ForwardFlux& ff) {
     for (int s = 0; s < sweeps; ++s) {
         sweep(L, reduce, 0);
         sweep(L, reduce, 1);
     }
-    fill_outside(L, reduce);
+    fill_outside(L, reduce, extrapolate, ff);
+}
+
+// The forward flux's divergence moved into the source (it does not depend
+// on phi): interior faces with the two voxels' mean Tbar, Marshak faces
+// through marshak_flux's r G / (r + 2). Writes each voxel's own q only.
+void add_forward_source(Level& L, double reduce, const ForwardFlux& ff) {
+    const double min_sig = kDiffusionMinTau / L.hmin();
+    std::vector<float> q = L.q;
+    parallel_for_index(L.n[2], [&](int z) {
+        for (int y = 0; y < L.n[1]; ++y)
+            for (int x = 0; x < L.n[0]; ++x) {
+                const size_t i = L.idx(x, y, z);
+                if (L.sig[i] < min_sig) continue;
+                double out = 0;
+                const int c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a)
+                    for (int side = -1; side <= 1; side += 2) {
+                        int cc[3] = {c[0], c[1], c[2]};
+                        cc[a] += side;
+                        if (cc[a] >= 0 && cc[a] < L.n[a] && L.sig[L.idx(cc[0], cc[1], cc[2])] >= min_sig) {
+                            out += ff.out(0.5 * (L.tb[i] + L.tb[L.idx(cc[0], cc[1], cc[2])]), a, side) / L.h[a];
+                        } else {
+                            const double r = 1.5 * reduce * L.sig[i] * L.h[a];
+                            out += L.leak[i] * r * ff.out(L.tb[i], a, side) / (r + kMarshak) / L.h[a];
+                        }
+                    }
+                q[i] = static_cast<float>(L.q[i] - out);
+            }
+    });
+    L.q = std::move(q);
 }
 
 } // namespace
 
-DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g, int sweeps)
+DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g, int sweeps, Voxels voxels, bool forward)
     : res_(grid.resolution()), bounds_(grid.bounds()), voxel_(grid.voxel()) {
+    const bool thick = voxels == Voxels::Thick;
     const double reduce = 1 - g;
     const Vec3d size = bounds_.size();
     std::vector<Level> levels(1);
@@ -179,6 +231,7 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
     const size_t n = fine.size();
     fine.sig.resize(n);
     fine.q.resize(n);
+    fine.tb.assign(n, 0.0f);
     fine.phi.assign(n, 0.0f);
     // The sun's mean chord through a voxel: volume / projected area.
     const Vec3d& sun = grid.sun_direction();
@@ -187,26 +240,59 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
     const auto& depth = grid.sun_depths();
     const double vol = voxel_[0] * voxel_[1] * voxel_[2];
     const double min_sig = kDiffusionMinTau / fine.hmin();
+    const size_t stride[3] = {1, size_t(res_[0]), size_t(res_[0]) * size_t(res_[1])};
     double src = 0;
     for (size_t i = 0; i < n; ++i) {
         const double sig = extinction * dens[i];
         fine.sig[i] = static_cast<float>(sig);
-        // The source averaged over the chord: sigma x mean of T over it,
-        // T = e^-tau at the centre, e^(-tau +- x) at the chord's ends.
-        const double tau = extinction * depth[i], x = 0.5 * sig * chord;
+        const double tau = extinction * depth[i];
         double q = sig * std::exp(-tau);
-        if (x > 1e-6) q = sig * (std::exp(-std::max(0.0, tau - x)) - std::exp(-(tau + x))) / (2 * x);
+        if (thick) {
+            // The mean of T over the voxel from the optical depth's gradient:
+            // T_c prod_a sinh(x_a) / x_a, x_a = |d tau / d a| h_a / 2, each
+            // gradient the steeper one-sided difference (at the sunlit
+            // surface the sun-side one crosses out of the medium).
+            const int c[3] = {int(i % stride[1]), int((i / stride[1]) % size_t(res_[1])), int(i / stride[2])};
+            double x[3], sum = 0;
+            for (int a = 0; a < 3; ++a) {
+                double grad = 0;
+                if (c[a] > 0) grad = std::max(grad, double(std::fabs(depth[i] - depth[i - stride[a]])));
+                if (c[a] + 1 < res_[a]) grad = std::max(grad, double(std::fabs(depth[i + stride[a]] - depth[i])));
+                x[a] = 0.5 * extinction * grad;
+                sum += x[a];
+            }
+            // The voxel's most sunward corner has a depth >= 0.
+            const double scale = sum > tau ? tau / sum : 1.0;
+            double f = 1;
+            for (int a = 0; a < 3; ++a) {
+                const double xa = x[a] * scale;
+                if (xa > 1e-6) f *= std::sinh(std::min(xa, 300.0)) / xa;
+            }
+            q = std::min(sig, q * f); // mean T <= 1
+        } else {
+            // The source averaged over the chord: sigma x mean of T over it,
+            // T = e^-tau at the centre, e^(-tau +- x) at the chord's ends.
+            const double x = 0.5 * sig * chord;
+            if (x > 1e-6) q = sig * (std::exp(-std::max(0.0, tau - x)) - std::exp(-(tau + x))) / (2 * x);
+        }
         fine.q[i] = sig >= min_sig ? static_cast<float>(q) : 0.0f;
+        fine.tb[i] = sig >= min_sig ? static_cast<float>(q / sig) : 0.0f;
         src += fine.q[i] * vol;
     }
     source_total_ = src;
     leak_factors(fine);
+    ForwardFlux ff;
+    if (forward) {
+        ff.ag = g / (1 - g);
+        ff.sun = sun;
+        add_forward_source(fine, reduce, ff);
+    }
     while (std::max({levels.back().n[0], levels.back().n[1], levels.back().n[2]}) > 4) levels.push_back(coarsen(levels.back(), size));
     // Cascade: the coarsest level solved with 4x the sweeps, each finer one
     // started from the coarser solution.
     for (size_t l = levels.size(); l-- > 0;) {
         if (l + 1 < levels.size()) prolong(levels[l + 1], levels[l]);
-        solve(levels[l], reduce, l + 1 == levels.size() ? 4 * sweeps : sweeps);
+        solve(levels[l], reduce, l + 1 == levels.size() ? 4 * sweeps : sweeps, thick, ff);
     }
     const Level& top = levels[0]; // (push_back above moved the levels)
     phi_ = top.phi;
@@ -225,15 +311,15 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
                         int cc[3] = {c[0], c[1], c[2]};
                         cc[a] += side;
                         const bool inside = cc[a] >= 0 && cc[a] < res_[a] && top.sig[top.idx(cc[0], cc[1], cc[2])] >= min_sig;
-                        if (!inside) out += top.leak[i] * area * phi_[i] / (1.5 * reduce * si * voxel_[a] + kMarshak);
+                        if (!inside) out += top.leak[i] * area * marshak_flux(phi_[i], 1.5 * reduce * si * voxel_[a], ff.out(top.tb[i], a, side));
                     }
                 }
             }
     outflow_total_ = out;
-    // The diffuse flux F = -D grad phi per voxel (per E): the mean of the
-    // face fluxes on each axis (Marshak phi / (r + 2) outward at the medium's
-    // faces); outside voxels next to the medium take their medium
-    // neighbours' mean, others 0.
+    // The diffuse flux F = -D grad phi (+ the forward flux) per voxel (per
+    // E): the mean of the face fluxes on each axis (marshak_flux outward at
+    // the medium's faces); outside voxels next to the medium take their
+    // medium neighbours' mean, others 0.
     flux_.assign(3 * n, 0.0f);
     parallel_for_index(res_[2], [&](int z) {
         for (int y = 0; y < res_[1]; ++y)
@@ -251,9 +337,10 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
                         double face; // flux toward +axis through this face
                         if (cc[a] >= 0 && cc[a] < res_[a] && top.sig[top.idx(cc[0], cc[1], cc[2])] >= min_sig) {
                             const size_t j = top.idx(cc[0], cc[1], cc[2]);
-                            face = side * (phi_[i] - phi_[j]) / (ri + 1.5 * reduce * top.sig[j] * voxel_[a]);
+                            face = side * ((phi_[i] - phi_[j]) / (ri + 1.5 * reduce * top.sig[j] * voxel_[a]) +
+                                           ff.out(0.5 * (top.tb[i] + top.tb[j]), a, side));
                         } else {
-                            face = side * phi_[i] / (ri + kMarshak);
+                            face = side * marshak_flux(phi_[i], ri, ff.out(top.tb[i], a, side));
                         }
                         f += 0.5 * face;
                     }

@@ -16,11 +16,14 @@ double exit_distance(const Box3d& b, const Vec3d& p, const Vec3d& d) {
     return std::isfinite(t1) ? std::max(0.0, t1) : 0.0;
 }
 
-LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_(res), bounds_(cloud.bounds()), sun_dir_(sun_dir) {
+LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir)
+    : LightGrid(cloud.bounds(), res, sun_dir, [&cloud](double x, double y, double z) { return cloud.density_at(x, y, z, 1e30); }) {}
+
+LightGrid::LightGrid(const Box3d& bounds, Vec3i res, Vec3d sun_dir, const DensityFn& density) : res_(res), bounds_(bounds), sun_dir_(sun_dir) {
     for (int a = 0; a < 3; ++a) voxel_[a] = bounds_.size()[a] / res_[a];
     const size_t n = size_t(res_[0]) * size_t(res_[1]) * size_t(res_[2]);
     const size_t row = size_t(res_[0]), slab = row * size_t(res_[1]);
-    // 1. The cloud's density at the grid's voxel centres (no near-camera detail).
+    // 1. The density at the grid's voxel centres (voxels: no near-camera detail).
     dens_.assign(n, 0.0f);
     std::vector<float>& dens = dens_;
     parallel_for_index(res_[2], [&](int z) {
@@ -29,7 +32,7 @@ LightGrid::LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir) : res_
                 const double px = bounds_.min[0] + (x + 0.5) * voxel_[0];
                 const double py = bounds_.min[1] + (y + 0.5) * voxel_[1];
                 const double pz = bounds_.min[2] + (z + 0.5) * voxel_[2];
-                dens[size_t(z) * slab + size_t(y) * row + size_t(x)] = cloud.density_at(px, py, pz, 1e30);
+                dens[size_t(z) * slab + size_t(y) * row + size_t(x)] = density(px, py, pz);
             }
     });
     // 2. Toward the sky: a running sum down each column (midpoint rule).

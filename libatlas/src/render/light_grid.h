@@ -5,14 +5,20 @@
 
 #include "cloud_sampler.h"
 
+#include <functional>
 #include <vector>
 
 namespace atlas::render::detail {
 
 class LightGrid {
 public:
+    // Density (at density 1 = extinction per metre) at a grid point.
+    using DensityFn = std::function<float(double x, double y, double z)>;
     // Builds both grids at `res` over the cloud's bounds (TBB, deterministic).
     LightGrid(const CloudSampler& cloud, Vec3i res, Vec3d sun_dir);
+    // The same over any box and density: the 2.5D layer's flattened shell
+    // (x, y, altitude). `density` is called from several threads.
+    LightGrid(const Box3d& bounds, Vec3i res, Vec3d sun_dir, const DensityFn& density);
     // Summed density toward the sun / the sky from world point p (trilinear).
     float sun(double x, double y, double z) const { return sample(sun_, x, y, z); }
     float sky(double x, double y, double z) const { return sample(sky_, x, y, z); }

@@ -154,6 +154,13 @@ void validate_layer_scene(const LayerScene& scene);
 void check_finite(const Field2D& f, const std::string& what);
 void check_finite(const Field3D& f, const std::string& what);
 
+// Physical mode with ms_diffusion: the side (metres) of the square patch of
+// the shell the diffusion term covers (RenderSettings::light_grid voxels
+// over it, from the shell's bottom to its top), centred under the camera's
+// look-at point when that lies in the shell, else where the view ray meets
+// the shell's middle. Outside it the octaves alone light the clouds.
+inline constexpr double kLayerDiffusionPatch = 16000;
+
 struct LayerReport {
     bool base_noise = false, detail_noise = false, curl = false;
     bool cheap_search = true;     // HZD: cheap base-only samples until a cloud is near
@@ -166,6 +173,7 @@ struct LayerReport {
     int sky_layers = 0;
     int point_lights = 0;         // lights integrated (given + flashes)
     bool sky_gradient = false;
+    bool diffusion = false;       // physical model with ms_diffusion: the diffusion term ran over a kLayerDiffusionPatch square
     uint64_t cheap_samples = 0;   // base-only density evaluations (view rays)
     uint64_t full_samples = 0;    // full density evaluations (view rays)
     uint64_t skipped_steps = 0;   // envelope jumps
@@ -181,7 +189,9 @@ struct LayerResult {
 
 // Renders the layer with the camera, sun, sky, size, quality (step scale),
 // extinction, phase, ambient, multiple scattering, seed, thread, light and
-// light-field settings of `settings` (mode and light grid are voxel-only).
+// light-field settings of `settings` (mode is voxel-only; the light grid
+// sets the diffusion patch's resolution in the physical mode, see
+// kLayerDiffusionPatch).
 // Point lights and flashes (lights.h) light the layer as they light voxels:
 // inverse square (5 m core), radius window, Beer from light_samples cheap
 // density samples toward the light, dual-lobe HG.
