@@ -115,38 +115,8 @@ print(','.join(['$name', 'cycles', '$n spp', '$t'] + ['%.4f' % m.get(k, float('n
   echo "$name: done" >&2
 done
 
-$PY - "$CSV" "$OUT/table.md" "$SMOKE" "$ROOT/docs/images/cycles_error_vs_time.png" <<'EOF'
-import csv, sys
-rows = list(csv.DictReader(open(sys.argv[1])))
-with open(sys.argv[2], "w") as f:
-    f.write("| scene | renderer | setting | s | mean rel. (Y > 5% mean) | RMSE | cloud mean rel. | cloud RMSE | cloud bias |\n")
-    f.write("|---|---|---|---|---|---|---|---|---|\n")
-    for r in rows:
-        f.write(f"| {r['scene']} | {r['renderer']} | {r['setting']} | {r['seconds']} | {r['mean_rel']} | {r['rmse']} | {r['cloud_mean_rel']} | {r['cloud_rmse']} | {r['cloud_bias']} |\n")
-print(open(sys.argv[2]).read())
-if sys.argv[3] == "1":
-    sys.exit(0)
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-scenes = sorted({r["scene"] for r in rows}, key=[r["scene"] for r in rows].index)
-fig, axes = plt.subplots(1, len(scenes), figsize=(4.2 * len(scenes), 3.6), squeeze=False)
-for ax, s in zip(axes[0], scenes):
-    cyc = [r for r in rows if r["scene"] == s and r["renderer"] == "cycles" and "reference" not in r["setting"]]
-    ax.loglog([float(r["seconds"]) for r in cyc], [float(r["cloud_mean_rel"]) for r in cyc], "o-", label="Cycles (" + ", ".join(r["setting"].split()[0] for r in cyc) + " spp)")
-    for r in cyc:
-        ax.annotate(r["setting"].split()[0], (float(r["seconds"]), float(r["cloud_mean_rel"])), fontsize=7)
-    at = [r for r in rows if r["scene"] == s and r["renderer"] == "atlas"]
-    for r in at:
-        mk = "s" if "artistic on" in r["setting"] else ("^" if "defaults" in r["setting"] else "x")
-        ax.loglog(float(r["seconds"]), float(r["cloud_mean_rel"]), mk, label="Atlas " + r["setting"].replace("artistic off; ", ""))
-    ax.axhline(0.10, color="grey", lw=0.8, ls="--")
-    ax.set_title(s)
-    ax.set_xlabel("wall seconds (2-core machine, shared)")
-    ax.set_ylabel("cloud mean relative luminance error")
-    ax.grid(True, which="both", lw=0.3)
-axes[0][-1].legend(fontsize=6, loc="best")
-fig.tight_layout()
-fig.savefig(sys.argv[4], dpi=90)
-print("wrote", sys.argv[4])
-EOF
+if [ "$SMOKE" = 1 ]; then
+  $PY "$ROOT/scripts/error_vs_time_plot.py" "$CSV" "$OUT/table.md"
+else
+  $PY "$ROOT/scripts/error_vs_time_plot.py" "$CSV" "$OUT/table.md" "$ROOT/docs/images/cycles_error_vs_time.png"
+fi

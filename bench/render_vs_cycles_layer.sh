@@ -9,14 +9,15 @@
 # layers); the same at --extinction 0 gives the preview's background (sky and ground); Cycles
 # renders the patch with a transparent film (--alpha), composited over that background by
 # render_compare.py --background. Rows: Cycles reference, Atlas artistic off / on, Atlas quality
-# 0.5 / 2, Cycles at the ladder's sample counts (seed 7). Writes OUT/results.csv and OUT/table.md.
+# 0.5 / 2, light grid 64,64,16 / 192,192,48, no diffusion, Cycles at the ladder's sample counts
+# (seed 7). Writes OUT/results.csv, OUT/table.md and docs/images/cycles_layer_error_vs_time.png.
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=$ROOT/build
 OUT=$ROOT/build/render_vs_cycles_layer
 SIZE=160x90
 REF_SPP=1024
-LADDER="1 4 16 64"
+LADDER="1 4 16 64 256"
 REUSE=0
 while [ $# -gt 0 ]; do
   case $1 in
@@ -80,18 +81,16 @@ for name in superstorm hzd_weather fc6_forecast; do
     t=$(atlas "$d/q$q.exr" "$g" --view orbit:30,25 $FOV --artistic off --quality $q --export-scene "$d/scene_q")
     row "$name" atlas "artistic off; quality $q" "$t" "$d/q$q.exr" "$ref" "$d/background.exr" "$mask"
   done
+  for lg in 64,64,16 192,192,48; do
+    t=$(atlas "$d/lg$lg.exr" "$g" --view orbit:30,25 $FOV --artistic off --light-grid $lg --export-scene "$d/scene_lg")
+    row "$name" atlas "artistic off; light grid $lg" "$t" "$d/lg$lg.exr" "$ref" "$d/background.exr" "$mask"
+  done
+  t=$(atlas "$d/octaves.exr" "$g" --view orbit:30,25 $FOV --artistic off --ms-diffusion off --export-scene "$d/scene_oct")
+  row "$name" atlas "artistic off; octaves only (no diffusion)" "$t" "$d/octaves.exr" "$ref" "$d/background.exr" "$mask"
   for n in $LADDER; do
     t=$(cycles "$d/scene" "$d/l$n.cycles.exr" "$n" 7)
     row "$name" cycles "$n spp" "$t" "$d/l$n.cycles.exr" "$ref" "$d/background.exr" "$mask"
   done
   echo "$name: done" >&2
 done
-$PY - "$CSV" "$OUT/table.md" <<'PYEOF'
-import csv, sys
-rows = list(csv.DictReader(open(sys.argv[1])))
-with open(sys.argv[2], "w") as f:
-    f.write("| scene | renderer: setting | wall s | mean rel. | RMSE | cloud mean rel. | cloud RMSE | cloud bias |\n|---|---|---|---|---|---|---|---|\n")
-    for r in rows:
-        f.write(f"| {r['scene']} | {r['renderer'].capitalize()}: {r['setting']} | {r['seconds']} | {r['mean_rel']} | {r['rmse']} | {r['cloud_mean_rel']} | {r['cloud_rmse']} | {r['cloud_bias']} |\n")
-print(open(sys.argv[2]).read())
-PYEOF
+$PY "$ROOT/scripts/error_vs_time_plot.py" "$CSV" "$OUT/table.md" "$ROOT/docs/images/cycles_layer_error_vs_time.png"

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace atlas::render {
@@ -241,6 +242,17 @@ TEST(MsDiffusion, LayerPatchSameBytesForAnyThreadCountAndOnlyInThePhysicalMode) 
         EXPECT_EQ(0, std::memcmp(t1.image.channel(c).data(), t3.image.channel(c).data(), t1.image.channel(c).size_bytes())) << c;
     const auto f = t1.report.active_features();
     EXPECT_NE(std::find(f.begin(), f.end(), "ms_diffusion"), f.end());
+    // A patch past the voxel cap is refused before it is allocated, naming
+    // the grid (1024 x 1024 x 162 here: levels of 15.6 m over 2.5 km).
+    RenderSettings big = s;
+    big.light_grid = {{1024, 1024, 32}};
+    try {
+        render_layer(sc, big);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("1024 x 1024 x 162 voxels"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("--light-grid"), std::string::npos) << e.what();
+    }
     // The artistic look ignores the setting.
     s.artistic = true;
     EXPECT_FALSE(render_layer(sc, s).report.diffusion);

@@ -214,6 +214,7 @@ namespace {
 // centre's, so the sun keeps its world direction in the patch.
 class LayerDiffusion {
 public:
+    static constexpr double kMaxPatchVoxels = 32e6;
     LayerDiffusion(const LayerModel& m, const RenderSettings& s, const Box2d& patch, double earth_radius) : m_(m), radius_(earth_radius) {
         // light_grid voxels over the patch; vertically at least as many as
         // make the voxels no taller than they are wide (a 13 km storm in 32
@@ -226,6 +227,17 @@ public:
         const int levels = std::max(s.light_grid[2] - 2, static_cast<int>(std::ceil(thickness / dx)));
         const double dz = thickness / levels;
         res_ = {{s.light_grid[0], s.light_grid[1], levels + 2}};
+        // Refused before allocating: about 56 bytes per voxel (the light
+        // grid's density, sun and sky depths, the solver's levels and flux).
+        const double voxels = double(res_[0]) * res_[1] * res_[2];
+        if (voxels > kMaxPatchVoxels) {
+            char buf[320];
+            std::snprintf(buf, sizeof buf,
+                          "render (2.5D): the diffusion patch would hold %d x %d x %d voxels (%.0f M, about %.1f GB; at most %.0f M): lower the light "
+                          "grid (--light-grid), or turn the term off (--ms-diffusion off)",
+                          res_[0], res_[1], res_[2], voxels / 1e6, voxels * 56 / 1e9, kMaxPatchVoxels / 1e6);
+            throw Error(buf);
+        }
         box_ = Box3d{{{patch.min[0], patch.min[1], m.bottom() - dz}}, {{patch.max[0], patch.max[1], m.top() + dz}}};
         const Vec3d c = m.centre();
         const Vec3d sun = detail::normalized(s.sun_direction);

@@ -279,7 +279,7 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
             grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun);
             if (diffuse) {
                 const double g = settings.hg_forward_weight * settings.hg_forward + (1 - settings.hg_forward_weight) * settings.hg_back;
-                diffusion = std::make_unique<detail::DiffusionGrid>(*grid, settings.extinction, g, settings.ms_diffusion_sweeps);
+                diffusion = std::make_unique<detail::DiffusionGrid>(*grid, settings.extinction, g, settings.ms_diffusion_sweeps, detail::DiffusionGrid::Voxels::Thin, true);
             }
         });
     report.diffusion = diffusion != nullptr;
