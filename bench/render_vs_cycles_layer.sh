@@ -83,7 +83,7 @@ for name in superstorm hzd_weather fc6_forecast; do
   done
   for lg in 64,64,16 192,192,48; do
     t=$(atlas "$d/lg$lg.exr" "$g" --view orbit:30,25 $FOV --artistic off --light-grid $lg --export-scene "$d/scene_lg")
-    row "$name" atlas "artistic off; light grid $lg" "$t" "$d/lg$lg.exr" "$ref" "$d/background.exr" "$mask"
+    row "$name" atlas "artistic off; light grid ${lg//,/x}" "$t" "$d/lg$lg.exr" "$ref" "$d/background.exr" "$mask"
   done
   t=$(atlas "$d/octaves.exr" "$g" --view orbit:30,25 $FOV --artistic off --ms-diffusion off --export-scene "$d/scene_oct")
   row "$name" atlas "artistic off; octaves only (no diffusion)" "$t" "$d/octaves.exr" "$ref" "$d/background.exr" "$mask"

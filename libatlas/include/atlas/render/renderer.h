@@ -108,7 +108,10 @@ struct RenderSettings {
     // of a coarse-to-fine cascade (1..4096). Per sample the multiply
     // scattered sun light is the larger of the octaves' and the diffusion's
     // P1 in-scattered radiance sigma_s (phi + 3 g F . w) / (4 pi)
-    // (F = -D grad phi, w toward the eye); multiple_scattering scales it.
+    // (F = -D grad phi + g / (1 - g) T (-sun): the first scatter's forward
+    // peak; w toward the eye); multiple_scattering scales it. The 2.5D mode
+    // solves it over a 16 km patch of its shell (layer.h,
+    // kLayerDiffusionPatch).
     // Needs ms_octaves > 0 and multiple_scattering > 0; ignored with
     // artistic = true. false: the octaves alone (the bytes of the renderer
     // before it existed). The CLI's --artistic off turns it on.
