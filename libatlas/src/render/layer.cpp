@@ -226,28 +226,29 @@ public:
         const double dx = std::min((patch.max[0] - patch.min[0]) / s.light_grid[0], (patch.max[1] - patch.min[1]) / s.light_grid[1]);
         const int levels = std::max(s.light_grid[2] - 2, static_cast<int>(std::ceil(thickness / dx)));
         const double dz = thickness / levels;
-        res_ = {{s.light_grid[0], s.light_grid[1], levels + 2}};
+        const Vec3i res{{s.light_grid[0], s.light_grid[1], levels + 2}};
         // Refused before allocating: about 56 bytes per voxel (the light
         // grid's density, sun and sky depths, the solver's levels and flux).
-        const double voxels = double(res_[0]) * res_[1] * res_[2];
+        const double voxels = double(res[0]) * res[1] * res[2];
         if (voxels > kMaxPatchVoxels) {
             char buf[320];
             std::snprintf(buf, sizeof buf,
                           "render (2.5D): the diffusion patch would hold %d x %d x %d voxels (%.0f M, about %.1f GB; at most %.0f M): lower the light "
                           "grid (--light-grid), or turn the term off (--ms-diffusion off)",
-                          res_[0], res_[1], res_[2], voxels / 1e6, voxels * 56 / 1e9, kMaxPatchVoxels / 1e6);
+                          res[0], res[1], res[2], voxels / 1e6, voxels * 56 / 1e9, kMaxPatchVoxels / 1e6);
             throw Error(buf);
         }
         box_ = Box3d{{{patch.min[0], patch.min[1], m.bottom() - dz}}, {{patch.max[0], patch.max[1], m.top() + dz}}};
         const Vec3d c = m.centre();
         const Vec3d sun = detail::normalized(s.sun_direction);
+        // The light grid is only the solver's input: freed once it has run.
         with_thread_limit(s.threads, [&] {
-            grid_ = std::make_unique<detail::LightGrid>(box_, res_, sun, [&](double x, double y, double a) {
+            const detail::LightGrid grid(box_, res, sun, [&](double x, double y, double a) {
                 const Vec3d p = c + detail::normalized(Vec3d{{x - c[0], y - c[1], radius_}}) * (radius_ + a);
                 return static_cast<float>(m.density(p, a, true));
             });
-            const double g = s.hg_forward_weight * s.hg_forward + (1 - s.hg_forward_weight) * s.hg_back;
-            diffusion_ = std::make_unique<detail::DiffusionGrid>(*grid_, s.extinction, g, s.ms_diffusion_sweeps, detail::DiffusionGrid::Voxels::Thick, true);
+            diffusion_ = std::make_unique<detail::DiffusionGrid>(grid, s.extinction, detail::phase_mean_cosine(s), s.ms_diffusion_sweeps,
+                                                                 detail::DiffusionGrid::Voxels::Thick, true);
         });
     }
     // The P1 in-scattered weight at world p (altitude h) toward the eye, -1
@@ -265,9 +266,7 @@ public:
 private:
     const LayerModel& m_;
     double radius_;
-    Vec3i res_;
     Box3d box_;
-    std::unique_ptr<detail::LightGrid> grid_;
     std::unique_ptr<detail::DiffusionGrid> diffusion_;
 };
 
@@ -561,7 +560,7 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
     }
     report.point_lights = int(lights.size());
     std::unique_ptr<LayerDiffusion> diffusion;
-    if (!settings.artistic && settings.ms_diffusion && settings.ms_octaves > 0 && settings.multiple_scattering > 0 && model.any_cloud()) {
+    if (detail::diffusion_wanted(settings) && model.any_cloud()) {
         const Vec2d c = diffusion_patch_centre(model, settings.camera, scene.earth_radius);
         const double half = 0.5 * kLayerDiffusionPatch;
         diffusion = std::make_unique<LayerDiffusion>(model, settings, Box2d{{{c[0] - half, c[1] - half}}, {{c[0] + half, c[1] + half}}}, scene.earth_radius);

@@ -76,6 +76,12 @@ struct SunTerms {
     std::array<double, 16> ms_phase{}; // physical mode: the octaves' phase (g x ms_anisotropy^n)
 };
 
+// Whether the settings ask for the diffusion term (diffusion.h): the physical
+// model with octaves and multiple scattering on; and the phase function's
+// mean cosine it diffuses with (the dual lobe's).
+inline bool diffusion_wanted(const RenderSettings& s) { return !s.artistic && s.ms_diffusion && s.ms_octaves > 0 && s.multiple_scattering > 0; }
+inline double phase_mean_cosine(const RenderSettings& s) { return s.hg_forward_weight * s.hg_forward + (1 - s.hg_forward_weight) * s.hg_back; }
+
 inline SunTerms sun_terms(const RenderSettings& s, double cos_theta) {
     SunTerms t{dual_hg(s, cos_theta), 0.5 + 0.5 * cos_theta, std::clamp(cos_theta, 0.0, 0.9), {}};
     if (!s.artistic) {

@@ -272,15 +272,14 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], scene.modeling->resolution()[a]);
     // The diffusion term needs the grid in reference mode too (its source is
     // the grid's sun transmittance); the march there still uses marched light.
-    const bool diffuse = !settings.artistic && settings.ms_diffusion && settings.ms_octaves > 0 && settings.multiple_scattering > 0;
+    const bool diffuse = detail::diffusion_wanted(settings);
     std::unique_ptr<detail::DiffusionGrid> diffusion;
     if (fast || diffuse)
         with_thread_limit(settings.threads, [&] {
             grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun);
-            if (diffuse) {
-                const double g = settings.hg_forward_weight * settings.hg_forward + (1 - settings.hg_forward_weight) * settings.hg_back;
-                diffusion = std::make_unique<detail::DiffusionGrid>(*grid, settings.extinction, g, settings.ms_diffusion_sweeps, detail::DiffusionGrid::Voxels::Thin, true);
-            }
+            if (diffuse)
+                diffusion = std::make_unique<detail::DiffusionGrid>(*grid, settings.extinction, detail::phase_mean_cosine(settings), settings.ms_diffusion_sweeps,
+                                                                    detail::DiffusionGrid::Voxels::Thin, true);
         });
     report.diffusion = diffusion != nullptr;
 
