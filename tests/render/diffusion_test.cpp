@@ -258,5 +258,34 @@ TEST(MsDiffusion, LayerPatchSameBytesForAnyThreadCountAndOnlyInThePhysicalMode) 
     EXPECT_FALSE(render_layer(sc, s).report.diffusion);
 }
 
+TEST(MsDiffusion, LayerSunUnderTheHorizonLightsNothing) {
+    // Physical mode, the sun 10 degrees under the horizon: the Earth hides it
+    // from every cloud (marched sun depth infinite, no diffusion patch), so
+    // the image is the one without a sun, byte for byte. Before, the march
+    // to the shell's top and the flattened patch lit the deck from below.
+    const LayerScene sc = deck();
+    RenderSettings s = slab_view(true, 0.33);
+    s.width = 16;
+    s.height = 9;
+    s.camera.position = {{20000, 12000, 6000}};
+    s.camera.look_at = {{20000, 20000, 2500}};
+    s.camera.fov_deg = 40;
+    s.extinction = 0.016;
+    s.sky_colour = {{0.1f, 0.2f, 0.5f}};
+    s.sun_direction = sun_direction(30, -10);
+    const LayerResult below = render_layer(sc, s);
+    EXPECT_FALSE(below.report.diffusion);
+    s.sun_colour = {{0, 0, 0}};
+    const LayerResult dark = render_layer(sc, s);
+    for (int c = 0; c < 4; ++c)
+        EXPECT_EQ(0, std::memcmp(below.image.channel(c).data(), dark.image.channel(c).data(), below.image.channel(c).size_bytes())) << c;
+    // The control: the same sun 10 degrees up lights the deck.
+    s.sun_colour = {{1, 1, 1}};
+    s.sun_direction = sun_direction(30, 10);
+    const LayerResult above = render_layer(sc, s);
+    EXPECT_TRUE(above.report.diffusion);
+    EXPECT_GT(above.image.at(1, 8, 4), dark.image.at(1, 8, 4) + 0.1);
+}
+
 } // namespace
 } // namespace atlas::render

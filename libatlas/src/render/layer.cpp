@@ -347,7 +347,10 @@ struct LayerIntegrator {
     // samples and its end at 21 light steps made a far cumulus field's single
     // scattering 41% too dark against Cycles (docs/render.md, "2.5D against
     // Cycles").
+    // A sun the Earth hides (below the local horizon) gives an infinite depth.
     double sun_depth_marched(const Vec3d& p) const {
+        double g0, g1;
+        if (sphere_roots(p, sun, m.centre(), r_ground, g0, g1) && g0 >= 0 && g1 > g0) return std::numeric_limits<double>::infinity();
         const double len = ray_sphere_exit_or_hit(p, sun, m.centre(), r_outer);
         if (!(len > 0)) return 0;
         double acc = 0, t = 0, dt = 0.25 * light_step;
@@ -563,7 +566,11 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
     if (detail::diffusion_wanted(settings) && model.any_cloud()) {
         const Vec2d c = diffusion_patch_centre(model, settings.camera, scene.earth_radius);
         const double half = 0.5 * kLayerDiffusionPatch;
-        diffusion = std::make_unique<LayerDiffusion>(model, settings, Box2d{{{c[0] - half, c[1] - half}}, {{c[0] + half, c[1] + half}}}, scene.earth_radius);
+        // A sun under the patch centre's horizon lights none of it (the
+        // flattened patch would take it from below): no term then.
+        const Vec3d up = detail::normalized(Vec3d{{c[0], c[1], 0.0}} - model.centre());
+        if (dot(detail::normalized(settings.sun_direction), up) > 0)
+            diffusion = std::make_unique<LayerDiffusion>(model, settings, Box2d{{{c[0] - half, c[1] - half}}, {{c[0] + half, c[1] + half}}}, scene.earth_radius);
     }
     report.diffusion = diffusion != nullptr;
     LayerIntegrator in{model,
