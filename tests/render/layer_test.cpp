@@ -7,12 +7,12 @@
 #include "atlas/ndf/vertical_profile.h"
 #include "atlas/noise/recipes.h"
 #include "atlas/render/layer.h"
+#include "render_scenes.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
-#include <cstring>
 #include <numbers>
 
 using namespace atlas;
@@ -59,12 +59,7 @@ RenderSettings small_settings(int w = 64, int h = 36) {
     return s;
 }
 
-bool same_bytes(const Field2D& a, const Field2D& b) {
-    if (a.channels() != b.channels() || a.width() != b.width() || a.height() != b.height()) return false;
-    for (int c = 0; c < a.channels(); ++c)
-        if (std::memcmp(a.channel(c).data(), b.channel(c).data(), a.channel(c).size() * sizeof(float)) != 0) return false;
-    return true;
-}
+using atlas::render::testing::same_bytes;
 
 } // namespace
 

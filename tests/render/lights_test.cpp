@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 using namespace atlas;
@@ -90,12 +89,6 @@ void expect_sane(const Field2D& img, const std::string& what) {
                 ASSERT_LE(v, 1.0f) << what;
             }
         }
-}
-
-bool same_bytes(const Field2D& a, const Field2D& b) {
-    for (int c = 0; c < 4; ++c)
-        if (std::memcmp(a.channel(c).data(), b.channel(c).data(), a.channel(c).size_bytes()) != 0) return false;
-    return true;
 }
 
 } // namespace

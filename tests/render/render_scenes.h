@@ -6,10 +6,19 @@
 #include "atlas/render/scene.h"
 
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <memory>
 
 namespace atlas::render::testing {
+
+// Two images with the same shape and the same bytes in every channel.
+inline bool same_bytes(const Field2D& a, const Field2D& b) {
+    if (a.channels() != b.channels() || a.width() != b.width() || a.height() != b.height()) return false;
+    for (int c = 0; c < a.channels(); ++c)
+        if (std::memcmp(a.channel(c).data(), b.channel(c).data(), a.channel(c).size_bytes()) != 0) return false;
+    return true;
+}
 
 // A res^3 grid over [0, size]^3 with the modeling channels and SDF from
 // callbacks of the world position.
