@@ -406,6 +406,11 @@ TEST_F(Fixture, ReportJsonHasTheDocumentedKeys) {
     EXPECT_EQ(j["summary"]["skipped"], 1);
     EXPECT_EQ(j["outputs"].size(), 2u);
     EXPECT_EQ(j["outputs"][0]["written"].size(), 1u);
+    // The budget and what the ledger counted: at least the one value 'sum' held
+    // while its output was written, at most the budget.
+    EXPECT_EQ(j["memory"]["budget"], MemoryBudget::kDefaultLimit);
+    EXPECT_GE(j["memory"]["peak_counted"].get<uint64_t>(), uint64_t(8 * 8 * 4 * 4));
+    EXPECT_LE(j["memory"]["peak_counted"].get<uint64_t>(), MemoryBudget::kDefaultLimit);
 }
 
 TEST_F(Fixture, GetReturnsAValueWithoutWriting) {

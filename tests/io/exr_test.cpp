@@ -88,6 +88,39 @@ TEST(Exr, Field3DLayoutAndAttributes) {
             for (int x = 0; x < nx; ++x) EXPECT_EQ(px[size_t((z * ny + (ny - 1 - y)) * nx + x)], f.at(0, x, y, z));
 }
 
+// The writer works in strips of rows (a few MiB each): an image several strips
+// tall, in float and in half, read back by OpenEXR itself, texel for texel.
+TEST(Exr, Field3DTallerThanOneStripIsWhole) {
+    TempDir dir;
+    const int nx = 512, ny = 16, nz = 300; // 4800 rows of 2 channels: 3 strips of 1024 rows and a partial one
+    Field3D f = make_field3d({{nx, ny, nz}}, Box3d{{{0, 0, 0}}, {{1, 1, 1}}}, {"a", "b"},
+                             [](int x, int y, int z, int c) { return float((x + 3 * y + 5 * z + 7 * c) % 2048); });
+    for (bool half : {false, true}) {
+        ExrOptions o;
+        o.half = half;
+        const fs::path path = dir / (half ? "h.exr" : "f.exr");
+        write_exr(f, path, o);
+        Imf::InputFile in(path.string().c_str());
+        const Imath::Box2i dw = in.header().dataWindow();
+        ASSERT_EQ(dw.max.y - dw.min.y + 1, ny * nz);
+        std::vector<float> a(size_t(nx) * ny * nz), b(a.size());
+        Imf::FrameBuffer fb;
+        fb.insert("a", Imf::Slice(Imf::FLOAT, (char*)a.data(), sizeof(float), sizeof(float) * nx));
+        fb.insert("b", Imf::Slice(Imf::FLOAT, (char*)b.data(), sizeof(float), sizeof(float) * nx));
+        in.setFrameBuffer(fb);
+        in.readPixels(dw.min.y, dw.max.y);
+        size_t wrong = 0;
+        for (int z = 0; z < nz; ++z)
+            for (int y = 0; y < ny; ++y)
+                for (int x = 0; x < nx; ++x) {
+                    const size_t i = size_t((z * ny + (ny - 1 - y)) * nx + x);
+                    wrong += a[i] != f.at(0, x, y, z);
+                    wrong += b[i] != f.at(1, x, y, z);
+                }
+        EXPECT_EQ(wrong, 0u) << (half ? "half" : "float");
+    }
+}
+
 TEST(Exr, Field2DAttributesAreV2d) {
     TempDir dir;
     Field2D f({{4, 2}}, 1, Box2d{{{-4.0, 0.0}}, {{4.0, 1.0}}});

@@ -62,7 +62,7 @@ TEST(TgaSlices, EachSliceIs32BitRgbaWithBottomUpRows) {
     o.rle = false;
     write_tga_slices(f, dir.path(), "s", o);
     for (int z = 0; z < nz; ++z) {
-        char name[16];
+        char name[32];
         std::snprintf(name, sizeof name, "s.%03d.tga", z + 1);
         const std::string b = read_bytes(dir / name);
         ASSERT_GE(b.size(), size_t(18 + nx * ny * 4)) << name;

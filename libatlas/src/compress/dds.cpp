@@ -115,11 +115,17 @@ static void validate(const DdsTexture& t, const std::string& what) {
 }
 
 std::vector<uint8_t> encode_dds(const DdsTexture& t) {
+    std::vector<uint8_t> b = encode_dds_header(t);
+    b.insert(b.end(), t.data.begin(), t.data.end());
+    return b;
+}
+
+std::vector<uint8_t> encode_dds_header(const DdsTexture& t) {
     validate(t, "encode_dds");
     if (t.data.size() != t.total_bytes())
         throw Error("encode_dds: data holds " + std::to_string(t.data.size()) + " bytes, the description needs " + std::to_string(t.total_bytes()));
     std::vector<uint8_t> b;
-    b.reserve(148 + t.data.size());
+    b.reserve(148);
     put32(b, kMagic);
     put32(b, 124);
     uint32_t flags = DDSD_CAPS | DDSD_HEIGHT | DDSD_WIDTH | DDSD_PIXELFORMAT;
@@ -154,17 +160,13 @@ std::vector<uint8_t> encode_dds(const DdsTexture& t) {
     put32(b, 0);
     put32(b, 0);
     put32(b, 0);
-    if (legacy) {
-        b.insert(b.end(), t.data.begin(), t.data.end());
-        return b;
-    }
+    if (legacy) return b;
     // DDS_HEADER_DXT10
     put32(b, uint32_t(t.format));
     put32(b, t.volume ? kDim3D : kDim2D);
     put32(b, 0); // misc flag (not a cube map)
     put32(b, uint32_t(t.array_size));
     put32(b, 0); // alpha mode unknown
-    b.insert(b.end(), t.data.begin(), t.data.end());
     return b;
 }
 

@@ -89,22 +89,29 @@ uint64_t remove_stale_staging(const fs::path& dir) {
     return removed;
 }
 
-void write_file_checked(const fs::path& path, const void* data, size_t size) {
+void write_file_checked(const fs::path& path, const void* data, size_t size) { write_file_checked(path, {BytePiece{data, size}}); }
+
+void write_file_checked(const fs::path& path, std::initializer_list<BytePiece> pieces) {
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd < 0) throw Error(path.string() + ": cannot create the file: " + std::strerror(errno));
-    const auto* p = static_cast<const char*>(data);
-    size_t left = size;
-    while (left > 0) {
-        const ssize_t n = ::write(fd, p, std::min<size_t>(left, size_t(1) << 30));
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            const int err = n < 0 ? errno : ENOSPC;
-            ::close(fd);
-            throw Error(path.string() + ": write failed after " + std::to_string(size - left) + " of " + std::to_string(size) +
-                        " bytes: " + std::strerror(err));
+    size_t size = 0, done = 0;
+    for (const BytePiece& piece : pieces) size += piece.size;
+    for (const BytePiece& piece : pieces) {
+        const auto* p = static_cast<const char*>(piece.data);
+        size_t left = piece.size;
+        while (left > 0) {
+            const ssize_t n = ::write(fd, p, std::min<size_t>(left, size_t(1) << 30));
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) {
+                const int err = n < 0 ? errno : ENOSPC;
+                ::close(fd);
+                throw Error(path.string() + ": write failed after " + std::to_string(done) + " of " + std::to_string(size) +
+                            " bytes: " + std::strerror(err));
+            }
+            p += n;
+            left -= size_t(n);
+            done += size_t(n);
         }
-        p += n;
-        left -= size_t(n);
     }
     if (::close(fd) != 0) throw Error(path.string() + ": write failed when closing the file: " + std::strerror(errno));
 }

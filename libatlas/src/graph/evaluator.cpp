@@ -200,10 +200,16 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     const detail::MemoryLedger::Attachment attached(budget, ledger);
     ledger.reset_peak();
     ledger.set_evictor([cache = cache_.get()](uint64_t missing) { cache->evict(missing); });
+    result.memory_budget = opt.memory_budget;
     struct EvictorReset {
         const detail::MemoryLedger& l;
-        ~EvictorReset() { l.set_evictor(nullptr); }
-    } evictor_reset{ledger};
+        CookResult& r;
+        // Also on a failed cook: the report says how much was counted when it stopped.
+        ~EvictorReset() {
+            l.set_evictor(nullptr);
+            r.memory_peak = l.peak();
+        }
+    } evictor_reset{ledger, result};
 
     // 1. Targets: the requested graph outputs, or explicit node ports.
     std::vector<const GraphOutput*> outputs;
@@ -691,6 +697,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     }
     if (opt.cache_dir && opt.cache_max_bytes > 0) disk_cache::prune(*opt.cache_dir, opt.cache_max_bytes);
     result.seconds = seconds_since(t_start);
+    result.memory_peak = ledger.peak();
     return result;
 }
 

@@ -6,7 +6,6 @@
 #include "atlas/core/files.h"
 
 #include <algorithm>
-#include <fstream>
 #include <sstream>
 
 namespace atlas::io {
@@ -15,11 +14,10 @@ namespace fs = std::filesystem;
 using namespace atlas::compress;
 
 void write_dds_file(const fs::path& path, const DdsTexture& tex) {
-    const std::vector<uint8_t> bytes = encode_dds(tex);
+    // Header and data written as they are: no file-sized copy of the texture.
+    const std::vector<uint8_t> header = encode_dds_header(tex);
     write_file_atomic(path, [&](const fs::path& tmp) {
-        std::ofstream f(tmp, std::ios::binary);
-        f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-        if (!f) throw Error("cannot write " + path.string());
+        write_file_checked(tmp, {{header.data(), header.size()}, {tex.data.data(), tex.data.size()}});
     });
 }
 
@@ -52,21 +50,14 @@ CompressReport compress_to_dds(const Field3D& field, const fs::path& path, const
         msg << " (allow_over_bound writes the file anyway)";
         throw BoundError(msg.str(), enc.report);
     }
-    const std::vector<uint8_t> bytes = encode_dds(enc.dds);
+    const std::vector<uint8_t> header = encode_dds_header(enc.dds);
     const std::string manifest = enc.manifest.to_json();
     StagedOutputs staged(path.parent_path().empty() ? fs::path(".") : path.parent_path());
-    {
-        std::ofstream f(staged.stage(path.filename()), std::ios::binary);
-        f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-        if (!f) throw Error("compress: cannot write " + path.string());
-    }
-    {
-        fs::path side = path.filename();
-        side += ".json";
-        std::ofstream f(staged.stage(side), std::ios::binary);
-        f << manifest;
-        if (!f) throw Error("compress: cannot write the manifest of " + path.string());
-    }
+    // Header and data written as they are (no file-sized copy); every write and the close checked.
+    write_file_checked(staged.stage(path.filename()), {{header.data(), header.size()}, {enc.dds.data.data(), enc.dds.data.size()}});
+    fs::path side = path.filename();
+    side += ".json";
+    write_file_checked(staged.stage(side), manifest.data(), manifest.size());
     staged.commit();
     return enc.report;
 }

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 namespace atlas::io {
@@ -63,27 +64,40 @@ Imf::Header base_header(int width, int height, const std::vector<std::string>& n
     return h;
 }
 
-void write_planes(const fs::path& path, const Planes& p, const std::vector<std::string>& names, bool half, Imf::Header header) {
+// Writes the image in strips of rows, each channel's strip filled by
+// fill(channel, file row, destination) (file row 0 = top of the image), so
+// the writer holds a few MiB besides the value instead of a whole copy of it
+// (and another in half): a 512x512x64 NVDF is 256 MiB a copy.
+void write_rows(const fs::path& path, int width, int height, const std::vector<std::string>& names, bool half, Imf::Header header,
+                const std::function<void(int, int, float*)>& fill) {
     for (const auto& n : names) header.channels().insert(n, Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
+    const size_t nc = names.size(), w = size_t(width);
+    // A multiple of 32 rows (the most any OpenEXR compression groups), about 4 MiB of floats.
+    const int strip = int(std::clamp<size_t>((size_t(4) << 20) / std::max<size_t>(1, w * nc * sizeof(float)) / 32 * 32, 32, 4096));
+    std::vector<std::vector<float>> rows(nc, std::vector<float>(w * size_t(std::min(strip, height))));
     // OpenEXR converts pixel types when reading, not when writing: half
     // channels need half buffers (rounded to nearest even by Imath).
-    std::vector<std::vector<::half>> halves(half ? names.size() : 0);
-    Imf::FrameBuffer fb;
-    for (size_t c = 0; c < names.size(); ++c) {
-        if (half) {
-            halves[c].assign(p.data[c].begin(), p.data[c].end());
-            fb.insert(names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves[c].data()), sizeof(::half), sizeof(::half) * size_t(p.width)));
-        } else {
-            fb.insert(names[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(p.data[c].data())), sizeof(float),
-                                           sizeof(float) * size_t(p.width)));
-        }
-    }
+    std::vector<std::vector<::half>> halves(half ? nc : 0, std::vector<::half>(half ? rows[0].size() : 0));
     try {
         // One thread: OpenEXR's output is the same bytes either way, and the
         // caller decides the parallelism.
         Imf::OutputFile file(path.string().c_str(), header, 1);
-        file.setFrameBuffer(fb);
-        file.writePixels(p.height);
+        for (int y0 = 0; y0 < height; y0 += strip) {
+            const int n = std::min(strip, height - y0);
+            Imf::FrameBuffer fb;
+            for (size_t c = 0; c < nc; ++c) {
+                for (int r = 0; r < n; ++r) fill(int(c), y0 + r, rows[c].data() + size_t(r) * w);
+                const Imath::V2i origin(0, y0);
+                if (half) {
+                    std::copy_n(rows[c].begin(), size_t(n) * w, halves[c].begin());
+                    fb.insert(names[c], Imf::Slice::Make(Imf::HALF, halves[c].data(), origin, width, n, sizeof(::half), sizeof(::half) * w));
+                } else {
+                    fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, rows[c].data(), origin, width, n, sizeof(float), sizeof(float) * w));
+                }
+            }
+            file.setFrameBuffer(fb);
+            file.writePixels(n);
+        }
     } catch (const std::exception& e) {
         throw Error(path.string() + ": cannot write EXR: " + e.what());
     }
@@ -217,20 +231,16 @@ Value make_field2d(const Imf::Header& hd, const Planes& p, const std::vector<std
 void write_exr(const Field2D& f, const fs::path& path, const ExrOptions& o) {
     check_channel_names(f.channel_names(), path);
     if (o.half) check_half_range(f, path);
-    Planes p;
-    p.width = f.width();
-    p.height = f.height();
-    p.data.assign(size_t(f.channels()), std::vector<float>(f.voxel_count()));
-    for (int c = 0; c < f.channels(); ++c)
-        for (int y = 0; y < p.height; ++y)
-            std::copy_n(f.channel(c).data() + f.index(0, y), size_t(p.width), p.data[size_t(c)].data() + size_t(p.height - 1 - y) * size_t(p.width));
-    Imf::Header hd = base_header(p.width, p.height, f.channel_names(), o.channel_meaning);
+    const int width = f.width(), height = f.height();
+    Imf::Header hd = base_header(width, height, f.channel_names(), o.channel_meaning);
     const auto& b = f.bounds();
     const Vec2d v = f.voxel_size();
     hd.insert("atlas:bounds_min", Imf::V2dAttribute(Imath::V2d(b.min[0], b.min[1])));
     hd.insert("atlas:bounds_max", Imf::V2dAttribute(Imath::V2d(b.max[0], b.max[1])));
     hd.insert("atlas:voxel_size", Imf::V2dAttribute(Imath::V2d(v[0], v[1])));
-    write_planes(path, p, f.channel_names(), o.half, hd);
+    write_rows(path, width, height, f.channel_names(), o.half, hd, [&](int c, int row, float* dst) {
+        std::copy_n(f.channel(c).data() + f.index(0, height - 1 - row), size_t(width), dst);
+    });
 }
 
 void write_exr(const Field3D& f, const fs::path& path, const ExrOptions& o) {
@@ -240,23 +250,18 @@ void write_exr(const Field3D& f, const fs::path& path, const ExrOptions& o) {
     // EXR coordinates are int; the stacked image must fit.
     if (int64_t(ny) * nz > (int64_t(1) << 30))
         throw Error(path.string() + ": cannot write EXR: " + std::to_string(ny) + "x" + std::to_string(nz) + " rows are too many for one image");
-    Planes p;
-    p.width = nx;
-    p.height = ny * nz;
-    p.data.assign(size_t(f.channels()), std::vector<float>(f.voxel_count()));
-    for (int c = 0; c < f.channels(); ++c)
-        for (int z = 0; z < nz; ++z)
-            for (int y = 0; y < ny; ++y)
-                std::copy_n(f.channel(c).data() + f.index(0, y, z), size_t(nx),
-                            p.data[size_t(c)].data() + (size_t(z) * size_t(ny) + size_t(ny - 1 - y)) * size_t(nx));
-    Imf::Header hd = base_header(p.width, p.height, f.channel_names(), o.channel_meaning);
+    // Slices stacked top to bottom (z = 0 first), each with its rows flipped.
+    Imf::Header hd = base_header(nx, ny * nz, f.channel_names(), o.channel_meaning);
     const auto& b = f.bounds();
     const Vec3d v = f.voxel_size();
     hd.insert("atlas:bounds_min", Imf::V3dAttribute(Imath::V3d(b.min[0], b.min[1], b.min[2])));
     hd.insert("atlas:bounds_max", Imf::V3dAttribute(Imath::V3d(b.max[0], b.max[1], b.max[2])));
     hd.insert("atlas:voxel_size", Imf::V3dAttribute(Imath::V3d(v[0], v[1], v[2])));
     hd.insert("atlas:resolution", Imf::V3iAttribute(Imath::V3i(nx, ny, nz)));
-    write_planes(path, p, f.channel_names(), o.half, hd);
+    write_rows(path, nx, ny * nz, f.channel_names(), o.half, hd, [&](int c, int row, float* dst) {
+        const int z = row / ny, y = ny - 1 - row % ny;
+        std::copy_n(f.channel(c).data() + f.index(0, y, z), size_t(nx), dst);
+    });
 }
 
 Value read_exr(const fs::path& path, const MemoryBudget* budget) {

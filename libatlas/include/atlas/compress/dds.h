@@ -68,6 +68,9 @@ struct DdsTexture {
 // Serialises to the DDS file bytes ("DDS " + header + DX10 header + data).
 // Throws atlas::Error if data.size() != total_bytes() or the description is invalid.
 std::vector<uint8_t> encode_dds(const DdsTexture& tex);
+// The bytes before the data (what encode_dds puts ahead of tex.data), with the
+// same checks: a writer can put the header and tex.data on disk without a copy.
+std::vector<uint8_t> encode_dds_header(const DdsTexture& tex);
 // Parses DDS bytes (DX10 header, or the legacy DXT1 / ATI1 / BC4U / BC4S FourCCs);
 // throws atlas::Error naming `what` on truncated or unsupported files.
 DdsTexture decode_dds(const std::vector<uint8_t>& bytes, const std::string& what = "DDS data");

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,13 @@ std::string read_file_bytes(const fs::path& path);
 // naming the file and the system's reason, never a silently short file.
 // Not atomic by itself (write into a StagedOutputs path).
 void write_file_checked(const fs::path& path, const void* data, size_t size);
+// The same for a file made of several pieces written one after another (a
+// header and a payload), so a caller need not join them into one more copy.
+struct BytePiece {
+    const void* data;
+    size_t size;
+};
+void write_file_checked(const fs::path& path, std::initializer_list<BytePiece> pieces);
 
 // A fast streaming checksum of a byte sequence, for telling whether bytes
 // changed or were damaged (cache entries, output files), not for cache keys

@@ -88,6 +88,9 @@ struct CookResult {
     double seconds = 0;
     int jobs = 1;
     bool checked = false;
+    // The --memory-budget and the most the cook's ledger counted at once
+    // (values, the in-memory cache, running nodes' scratch, writers' copies).
+    uint64_t memory_budget = 0, memory_peak = 0;
     // "ok", "failed" or "cancelled"; for a failure, the message and where:
     // the node (empty when the graph itself failed) and its file:line:col.
     std::string status = "ok";
