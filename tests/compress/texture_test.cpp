@@ -196,6 +196,26 @@ TEST(Texture, UncompressedFormatsRoundTrip) {
     }
 }
 
+// The file is written as header and data in two pieces: its bytes are what
+// encode_dds joins in memory, with the DX10 and the legacy FourCC headers.
+TEST(Texture, FileBytesAreTheEncodedTexture) {
+    const fs::path dir = temp_dir();
+    const Field3D f = sdf_field(20, 12, 3, 0);
+    for (int k = 0; k < 3; ++k) {
+        CompressOptions o;
+        o.format = k == 2 ? Format::Bc4 : Format::Bc1;
+        o.legacy_bc1_header = k == 1;
+        o.mip_levels = 0;
+        const fs::path p = dir / ("bytes" + std::to_string(k) + ".dds");
+        compress_to_dds(f, p, o);
+        std::ifstream in(p, std::ios::binary);
+        const std::vector<uint8_t> file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const std::vector<uint8_t> expected = encode_dds(encode_texture(f, o).dds);
+        EXPECT_EQ(file, expected) << "case " << k;
+        EXPECT_EQ(file.size(), encode_dds_header(encode_texture(f, o).dds).size() + encode_texture(f, o).dds.data.size()) << "case " << k;
+    }
+}
+
 TEST(Texture, SameBytesForAnyThreadCount) {
     const Field3D f = sdf_field(48, 40, 3, 0);
     for (Format fmt : {Format::Bc4, Format::Bc1Scalar, Format::Bc1}) {
