@@ -263,25 +263,32 @@ TEST(MsDiffusion, LayerPatchSameBytesForAnyThreadCountAndOnlyInThePhysicalMode) 
 }
 
 TEST(MsDiffusion, LayerSunUnderTheHorizonLightsNothing) {
-    // Physical mode, the sun 10 degrees under the horizon: the Earth hides it
-    // from every cloud (marched sun depth infinite, no diffusion patch), so
-    // the image is the one without a sun, byte for byte. Before, the march
-    // to the shell's top and the flattened patch lit the deck from below.
-    const LayerScene sc = deck();
-    RenderSettings s = deck_view(16, 9);
-    s.sky_colour = {{0.1f, 0.2f, 0.5f}};
-    s.sun_direction = sun_direction(30, -10);
-    const LayerResult below = render_layer(sc, s);
-    EXPECT_FALSE(below.report.diffusion);
-    s.sun_colour = {{0, 0, 0}};
-    const LayerResult dark = render_layer(sc, s);
-    EXPECT_TRUE(atlas::render::testing::same_bytes(below.image, dark.image));
-    // The control: the same sun 10 degrees up lights the deck.
-    s.sun_colour = {{1, 1, 1}};
-    s.sun_direction = sun_direction(30, 10);
-    const LayerResult above = render_layer(sc, s);
-    EXPECT_TRUE(above.report.diffusion);
-    EXPECT_GT(above.image.at(1, 8, 4), dark.image.at(1, 8, 4) + 0.1);
+    // The sun 10 degrees under the horizon: the Earth hides it from every
+    // cloud (sun depth infinite; in the physical mode no diffusion patch
+    // either), so the image is the one without a sun, byte for byte, with the
+    // artistic terms on and off. Before, the physical march to the shell's top
+    // and the flattened patch lit the deck from below, and the look's cone
+    // lit it as if the Earth were not there.
+    for (bool artistic : {false, true}) {
+        const LayerScene sc = deck();
+        RenderSettings s = deck_view(16, 9);
+        s.artistic = artistic;
+        s.sky_colour = {{0.1f, 0.2f, 0.5f}};
+        s.sun_direction = sun_direction(30, -10);
+        const LayerResult below = render_layer(sc, s);
+        EXPECT_FALSE(below.report.diffusion);
+        s.sun_colour = {{0, 0, 0}};
+        const LayerResult dark = render_layer(sc, s);
+        EXPECT_TRUE(atlas::render::testing::same_bytes(below.image, dark.image)) << "artistic " << artistic;
+        for (int c = 0; c < below.image.channels(); ++c)
+            for (float v : below.image.channel(c)) ASSERT_TRUE(std::isfinite(v)) << "artistic " << artistic;
+        // The control: the same sun 10 degrees up lights the deck.
+        s.sun_colour = {{1, 1, 1}};
+        s.sun_direction = sun_direction(30, 10);
+        const LayerResult above = render_layer(sc, s);
+        EXPECT_EQ(above.report.diffusion, !artistic);
+        EXPECT_GT(above.image.at(1, 8, 4), dark.image.at(1, 8, 4) + 0.1) << "artistic " << artistic;
+    }
 }
 
 } // namespace

@@ -304,6 +304,12 @@ struct LayerIntegrator {
     double light_core2;
     const LayerDiffusion* diffusion; // null unless physical with ms_diffusion
 
+    // The ray from p toward the sun meets the ground sphere ahead of p.
+    bool earth_hides_sun(const Vec3d& p) const {
+        double g0, g1;
+        return sphere_roots(p, sun, m.centre(), r_ground, g0, g1) && g0 >= 0 && g1 > g0;
+    }
+
     // Summed density toward a point light `len` metres away: light_samples cheap samples.
     double light_depth(const Vec3d& p, const Vec3d& d, double len) const {
         const int n = s.light_samples;
@@ -321,7 +327,9 @@ struct LayerIntegrator {
     // coarse (trans < 0.3 or far): also the cone's six steps taken as three of
     // twice the length (the same 6 light steps covered; docs/PERFORMANCE.md
     // "2.5D", error against quality 3).
+    // A sun the Earth hides (below p's local horizon) gives an infinite depth, in both modes.
     double sun_depth(const Vec3d& p, bool cheap, bool coarse) const {
+        if (earth_hides_sun(p)) return std::numeric_limits<double>::infinity();
         double acc = 0;
         if (coarse) {
             for (int i = 0; i < 3; ++i) {
@@ -349,8 +357,7 @@ struct LayerIntegrator {
     // Cycles").
     // A sun the Earth hides (below the local horizon) gives an infinite depth.
     double sun_depth_marched(const Vec3d& p) const {
-        double g0, g1;
-        if (sphere_roots(p, sun, m.centre(), r_ground, g0, g1) && g0 >= 0 && g1 > g0) return std::numeric_limits<double>::infinity();
+        if (earth_hides_sun(p)) return std::numeric_limits<double>::infinity();
         const double len = ray_sphere_exit_or_hit(p, sun, m.centre(), r_outer);
         if (!(len > 0)) return 0;
         double acc = 0, t = 0, dt = 0.25 * light_step;

@@ -134,7 +134,8 @@ inline void shade(const RenderSettings& s, const SunTerms& st, double tau, doubl
     const double beer = std::exp(-tau);
     const double powder = 1 - std::exp(-2 * tau);
     const double direct = beer * (powder + (1 - powder) * st.powder_mix) * st.sun_phase;
-    const double ms = dp * std::exp(-tau * remap(st.ms_sun, 0.0, 0.9, 0.25, ms_relax));
+    // tau is infinite where the Earth hides the sun: no light, not inf x 0.
+    const double ms = std::isinf(tau) ? 0.0 : dp * std::exp(-tau * remap(st.ms_sun, 0.0, 0.9, 0.25, ms_relax));
     const double amb = std::sqrt(1 - dp) * std::exp(-sky_tau);
     sun_w = direct + s.multiple_scattering * ms;
     sky_w = s.ambient_strength * amb;
