@@ -210,9 +210,9 @@ TEST(Texture, FileBytesAreTheEncodedTexture) {
         compress_to_dds(f, p, o);
         std::ifstream in(p, std::ios::binary);
         const std::vector<uint8_t> file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        const std::vector<uint8_t> expected = encode_dds(encode_texture(f, o).dds);
-        EXPECT_EQ(file, expected) << "case " << k;
-        EXPECT_EQ(file.size(), encode_dds_header(encode_texture(f, o).dds).size() + encode_texture(f, o).dds.data.size()) << "case " << k;
+        const DdsTexture tex = encode_texture(f, o).dds;
+        EXPECT_EQ(file, encode_dds(tex)) << "case " << k;
+        EXPECT_EQ(file.size(), encode_dds_header(tex).size() + tex.data.size()) << "case " << k;
     }
 }
 

@@ -204,7 +204,9 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     struct EvictorReset {
         const detail::MemoryLedger& l;
         CookResult& r;
-        // Also on a failed cook: the report says how much was counted when it stopped.
+        // A failed cook's report (read from last_) says how much was counted when it
+        // stopped; a cook that returns sets the peak itself, as the copy it returns
+        // is made before this runs.
         ~EvictorReset() {
             l.set_evictor(nullptr);
             r.memory_peak = l.peak();

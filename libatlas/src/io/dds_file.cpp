@@ -13,12 +13,17 @@ namespace atlas::io {
 namespace fs = std::filesystem;
 using namespace atlas::compress;
 
-void write_dds_file(const fs::path& path, const DdsTexture& tex) {
-    // Header and data written as they are: no file-sized copy of the texture.
+namespace {
+// Header and data written as they are (no file-sized copy of the texture);
+// every write and the close checked.
+void write_dds_checked(const fs::path& path, const DdsTexture& tex) {
     const std::vector<uint8_t> header = encode_dds_header(tex);
-    write_file_atomic(path, [&](const fs::path& tmp) {
-        write_file_checked(tmp, {{header.data(), header.size()}, {tex.data.data(), tex.data.size()}});
-    });
+    write_file_checked(path, {{header.data(), header.size()}, {tex.data.data(), tex.data.size()}});
+}
+} // namespace
+
+void write_dds_file(const fs::path& path, const DdsTexture& tex) {
+    write_file_atomic(path, [&](const fs::path& tmp) { write_dds_checked(tmp, tex); });
 }
 
 DdsTexture read_dds_file(const fs::path& path) {
@@ -50,11 +55,9 @@ CompressReport compress_to_dds(const Field3D& field, const fs::path& path, const
         msg << " (allow_over_bound writes the file anyway)";
         throw BoundError(msg.str(), enc.report);
     }
-    const std::vector<uint8_t> header = encode_dds_header(enc.dds);
     const std::string manifest = enc.manifest.to_json();
     StagedOutputs staged(path.parent_path().empty() ? fs::path(".") : path.parent_path());
-    // Header and data written as they are (no file-sized copy); every write and the close checked.
-    write_file_checked(staged.stage(path.filename()), {{header.data(), header.size()}, {enc.dds.data.data(), enc.dds.data.size()}});
+    write_dds_checked(staged.stage(path.filename()), enc.dds);
     fs::path side = path.filename();
     side += ".json";
     write_file_checked(staged.stage(side), manifest.data(), manifest.size());
