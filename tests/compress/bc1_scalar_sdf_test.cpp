@@ -26,7 +26,7 @@ using test::unit;
 
 constexpr float kLo = -256.0f, kHi = 4096.0f;
 
-#if defined(__SANITIZE_ADDRESS__) || !defined(NDEBUG)
+#if defined(ATLAS_SANITIZED) || !defined(NDEBUG)
 constexpr int kSdfBlocks = 600; // sanitizer / Debug builds: the exhaustive search is ~20x slower
 #else
 constexpr int kSdfBlocks = 10000;

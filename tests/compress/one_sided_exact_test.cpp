@@ -27,7 +27,7 @@ using test::unit;
 
 constexpr float kLo = -256.0f, kHi = 4096.0f;
 
-#if defined(__SANITIZE_ADDRESS__) || !defined(NDEBUG)
+#if defined(ATLAS_SANITIZED) || !defined(NDEBUG)
 constexpr int kNx = 32, kNy = 32, kNz = 4;
 #else
 constexpr int kNx = 96, kNy = 64, kNz = 8;

@@ -1,7 +1,8 @@
 # Installs the build tree into a scratch prefix, then configures and builds
 # examples/embed against that prefix alone (find_package(Atlas), not the build
 # tree) and runs both hosts on the quickstart.
-#   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... [-DLAUNCHER=ccache] -P install_test.cmake
+#   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... [-DLAUNCHER=ccache]
+#         [-DHOST_C_COMPILER=... -DHOST_CXX_COMPILER=...] -P install_test.cmake
 # WORK_DIR is fixed (inside the build tree) so that ccache sees the same paths each run.
 foreach(v BUILD_DIR SOURCE_DIR WORK_DIR)
   if(NOT ${v})
@@ -32,6 +33,9 @@ endforeach()
 set(launcher "")
 if(LAUNCHER)
   set(launcher "-DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER}" "-DCMAKE_C_COMPILER_LAUNCHER=${LAUNCHER}")
+endif()
+if(HOST_C_COMPILER AND HOST_CXX_COMPILER)
+  list(APPEND launcher "-DCMAKE_C_COMPILER=${HOST_C_COMPILER}" "-DCMAKE_CXX_COMPILER=${HOST_CXX_COMPILER}")
 endif()
 run("${CMAKE_COMMAND}" -S "${SOURCE_DIR}/examples/embed" -B "${host}" -G Ninja -DCMAKE_BUILD_TYPE=Release
     "-DCMAKE_PREFIX_PATH=${prefix}" ${launcher})

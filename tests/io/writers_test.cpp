@@ -171,7 +171,11 @@ TEST(Writers, BadOptionValuesNameOptionAndExpectation) {
     for (const auto& [value, format, opts, name] : cases) {
         const fs::path p = dir / ("out." + format);
         SCOPED_TRACE(format + " " + opts.begin()->first + "=" + opts.begin()->second);
-        expect_error_containing([&] { write_value(value, p, format, opts); }, {"output 'out." + format + "'", "'" + name + "'"});
+        // The lambda captures plain references: clang 14 cannot capture structured bindings.
+        const Value& v = value;
+        const std::string& f = format;
+        const OutputOptions& o = opts;
+        expect_error_containing([&] { write_value(v, p, f, o); }, {"output 'out." + format + "'", "'" + name + "'"});
     }
 }
 

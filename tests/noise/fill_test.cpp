@@ -50,7 +50,9 @@ TEST(NoiseFill, DifferentSeedsDiffer) {
 }
 
 TEST(NoiseFill, TwoDimensionalFillIsDeterministicAndWithinRange) {
-    for (const auto& [name, s] : test::all_kernels()) {
+    for (const auto& [name, kernel_settings] : test::all_kernels()) {
+        // A lambda captures a copy's name, not a structured binding (clang 14 cannot).
+        const NoiseSpec& s = kernel_settings;
         const int comps = noise_components(s.kernel, 2);
         Field2D a({{33, 17}}, comps, Box2d{{{0, 0}}, {{1, 1}}}), b({{33, 17}}, comps, Box2d{{{0, 0}}, {{1, 1}}});
         tbb::task_arena(1).execute([&] { fill_noise(a, 0, s); });

@@ -70,14 +70,9 @@ const char* kVoxelNodes = R"(
 
 void write(const std::string& name, const std::string& text) { std::ofstream(work_dir() / name) << text; }
 
-// The work directory holds a cache with the HZD and Nubis noise (~100 MB): removed at exit.
-struct RemoveWorkDir {
-    ~RemoveWorkDir() {
-        std::error_code ec;
-        fs::remove_all(work_dir(), ec);
-    }
-} remove_work_dir;
-
+// The work directory holds a cache with the HZD and Nubis noise (~100 MB): it lives in
+// the process's private TMPDIR, which the suites' main() removes at exit
+// (tests/support/gtest_main.cpp).
 } // namespace
 
 TEST(LayerCli, NdfSetGraphRendersInLayerModeSameBytesForAnyJobs) {

@@ -131,6 +131,7 @@ void ContentHasher::block(const unsigned char* p) {
 }
 
 ContentHasher& ContentHasher::add(const void* data, size_t size) {
+    if (size == 0) return *this; // data may be null then (an empty vector's data())
     const auto* p = static_cast<const unsigned char*>(data);
     total_ += size;
     if (buffered_) {

@@ -80,7 +80,7 @@ void detail::check_ply_header(const fs::path& file, bool need_faces) {
     struct Element {
         std::string name;
         uint64_t count = 0;
-        std::vector<std::string> props;
+        std::vector<std::string> props, types; // types: the scalar type, or "list"
         bool has_list = false;
     };
     std::vector<Element> elements;
@@ -93,15 +93,17 @@ void detail::check_ply_header(const fs::path& file, bool need_faces) {
             uint64_t n = 0;
             const auto r = w.size() == 3 ? std::from_chars(w[2].data(), w[2].data() + w[2].size(), n) : std::from_chars_result{nullptr, std::errc::invalid_argument};
             if (w.size() != 3 || r.ec != std::errc() || r.ptr != w[2].data() + w[2].size()) fail("expected 'element NAME COUNT'");
-            elements.push_back({w[1], n, {}, false});
+            elements.push_back({w[1], n, {}, {}, false});
         } else if (w[0] == "property") {
             if (elements.empty()) fail("a property before any element");
             if (w.size() == 5 && w[1] == "list") {
                 if (!is_scalar(w[2]) || !is_scalar(w[3])) fail("unknown list types '" + w[2] + "', '" + w[3] + "'");
                 elements.back().has_list = true;
                 elements.back().props.push_back(w[4]);
+                elements.back().types.push_back("list");
             } else if (w.size() == 3 && is_scalar(w[1])) {
                 elements.back().props.push_back(w[2]);
+                elements.back().types.push_back(w[1]);
             } else {
                 fail("expected 'property TYPE NAME' or 'property list COUNT_TYPE INDEX_TYPE NAME'");
             }
@@ -120,6 +122,19 @@ void detail::check_ply_header(const fs::path& file, bool need_faces) {
     for (const char* axis : {"x", "y", "z"})
         if (std::find(vertex->props.begin(), vertex->props.end(), axis) == vertex->props.end())
             throw Error(f + ": PLY header: the vertex element has no property '" + axis + "'");
+    // CGAL's readers take the coordinates (and normals) as float or double only, all of
+    // one type for point sets; any other type reaches a null pointer inside CGAL.
+    std::string coordinate_type;
+    for (size_t i = 0; i < vertex->props.size(); ++i) {
+        const std::string& name = vertex->props[i];
+        if (name != "x" && name != "y" && name != "z" && name != "nx" && name != "ny" && name != "nz") continue;
+        const std::string& t = vertex->types[i];
+        const std::string kind = t == "float" || t == "float32" ? "float" : t == "double" || t == "float64" ? "double" : "";
+        if (kind.empty() || (!coordinate_type.empty() && kind != coordinate_type))
+            throw Error(f + ": PLY header: the vertex property '" + name + "' is " + (t == "list" ? "a list" : t) +
+                        "; expected x, y, z (and nx, ny, nz) all float or all double");
+        coordinate_type = kind;
+    }
     if (need_faces && (!face || !face->has_list)) throw Error(f + ": PLY header: no 'face' element with a list of vertex indices");
     // Every property takes at least one byte (binary) or two (ascii: a digit
     // and a separator): counts the file cannot hold are refused.
