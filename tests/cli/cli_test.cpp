@@ -634,6 +634,10 @@ TEST(CliHostile, MalformedPlyAndStlAreRefusedByName) {
         // A byte-typed coordinate reached a null pointer inside CGAL (sanitized fuzz run).
         {"ucharx.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty uchar x\nproperty float y\nproperty float z\n"
                        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
+        // ... and so did one behind a second, well-typed vertex element (the check saw only the last).
+        {"twovertex.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty uchar x\nproperty float y\nproperty float z\n"
+                          "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                          "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
         {"huge.stl", std::string(80, 'x') + std::string("\xff\xff\xff\x7f", 4) + std::string(50, '\0')},
     };
     for (const auto& [name, bytes] : cases) {

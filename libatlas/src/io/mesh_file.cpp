@@ -115,6 +115,9 @@ void detail::check_ply_header(const fs::path& file, bool need_faces) {
     const Element* face = nullptr;
     for (const auto& e : elements) {
         if (e.props.empty()) throw Error(f + ": PLY header: element '" + e.name + "' has no properties");
+        // CGAL's readers act on each element of a name; the checks below see one.
+        if ((e.name == "vertex" && vertex) || (e.name == "face" && face))
+            throw Error(f + ": PLY header: element '" + e.name + "' is declared twice");
         if (e.name == "vertex") vertex = &e;
         if (e.name == "face") face = &e;
     }
