@@ -132,7 +132,10 @@ struct Errors {
     double rmse() const { return n ? std::sqrt(sq / double(n)) : 0; }
 };
 
-enum class Codec { AtlasFast, AtlasNormal, AtlasBest, AtlasNormalAll, SquishRange, SquishCluster, SquishIterative, RgbcxDefault, RgbcxHq };
+// AtlasNormalWithinItsMax: `normal` given a bound equal to the largest block error of an
+// unbounded `normal` encode of the same image (found before the clock starts): the max error
+// is no worse than the unbounded encode's, and the encoder spends the room on squared error.
+enum class Codec { AtlasFast, AtlasNormal, AtlasBest, AtlasNormalAll, AtlasNormalWithinItsMax, SquishRange, SquishCluster, SquishIterative, RgbcxDefault, RgbcxHq };
 
 // Thread CPU seconds: the machine is shared, so wall time overstates every encoder's cost.
 double cpu_now() {
@@ -147,6 +150,7 @@ const char* codec_name(Codec c) {
     case Codec::AtlasNormal: return "atlas_normal";
     case Codec::AtlasBest: return "atlas_best";
     case Codec::AtlasNormalAll: return "atlas_normal_all6decoders";
+    case Codec::AtlasNormalWithinItsMax: return "atlas_normal_within_its_max";
     case Codec::SquishRange: return "squish_fast_rangefit";
     case Codec::SquishCluster: return "squish_normal_clusterfit";
     case Codec::SquishIterative: return "squish_best_iterativeclusterfit";
@@ -156,7 +160,9 @@ const char* codec_name(Codec c) {
     return "?";
 }
 
-bool is_atlas(Codec c) { return c == Codec::AtlasFast || c == Codec::AtlasNormal || c == Codec::AtlasBest || c == Codec::AtlasNormalAll; }
+bool is_atlas(Codec c) {
+    return c == Codec::AtlasFast || c == Codec::AtlasNormal || c == Codec::AtlasBest || c == Codec::AtlasNormalAll || c == Codec::AtlasNormalWithinItsMax;
+}
 
 BlockOptions atlas_options(Codec c) {
     BlockOptions o;
@@ -168,11 +174,13 @@ BlockOptions atlas_options(Codec c) {
 // Encodes the whole image single-threaded; returns seconds, fills the errors. As for BC4,
 // the blocks' texels are gathered before the clock starts, in each encoder's input type
 // (8-bit RGBA for the peers, float RGB for Atlas), so only the encoders are timed.
-double run_bc1(const Image& im, Codec codec, Errors& err) {
+// bound >= 0 (normalized units): Atlas's max_error (the BC1 bound sweep).
+double run_bc1(const Image& im, Codec codec, Errors& err, float bound = -1.0f) {
     const int bw = im.w / 4, bh = im.h / 4;
     const size_t nblocks = size_t(bw) * size_t(bh);
     std::vector<uint8_t> blocks(nblocks * 8);
-    const BlockOptions o = atlas_options(codec);
+    BlockOptions o = atlas_options(codec);
+    if (bound >= 0) o.max_error = bound;
     const int flags = squish::kDxt1 | (codec == Codec::SquishRange ? squish::kColourRangeFit
                                        : codec == Codec::SquishIterative ? squish::kColourIterativeClusterFit
                                                                          : squish::kColourClusterFit);
@@ -190,6 +198,11 @@ double run_bc1(const Image& im, Codec codec, Errors& err) {
                 rgba[b * 64 + 4 * size_t(t) + 3] = 255;
             }
         }
+    if (codec == Codec::AtlasNormalWithinItsMax) { // the bound: the unbounded encode's largest block error
+        float largest = 0;
+        for (size_t b = 0; b < nblocks; ++b) largest = std::max(largest, encode_bc1_block(&rgbf[b * 48], atlas_options(Codec::AtlasNormal), &blocks[b * 8]).max_error);
+        o.max_error = largest;
+    }
     const double t0 = cpu_now();
     for (size_t b = 0; b < nblocks; ++b) {
         uint8_t* out = &blocks[b * 8];
@@ -277,6 +290,21 @@ void peer(benchmark::State& state, int image, bool bc4, Codec codec) {
     state.counters["max_err_8bit"] = err.max;
 }
 
+// BC1 `normal` given --max-error as `steps` 8-bit steps: the squared error the bound buys,
+// and what it costs (docs/PERFORMANCE.md, the bound sweep).
+void bc1_bound_sweep(benchmark::State& state, int image, int steps) {
+    const Image& im = images()[size_t(image)];
+    Errors err;
+    for (auto _ : state) {
+        err = Errors{};
+        const double s = run_bc1(im, Codec::AtlasNormal, err, float(steps) / 255.0f);
+        state.SetIterationTime(s);
+        state.counters["Mtexels_per_s"] = double(im.w) * im.h / s / 1e6;
+    }
+    state.counters["rmse_8bit"] = err.rmse();
+    state.counters["max_err_8bit"] = err.max;
+}
+
 int write_inputs(const std::string& dir) {
     int k = 0;
     for (const Image& im : images()) {
@@ -357,7 +385,7 @@ int main(int argc, char** argv) {
 #if defined(ATLAS_BENCH_RGBCX)
     rgbcx::init();
 #endif
-    std::vector<Codec> bc1 = {Codec::AtlasFast, Codec::AtlasNormal, Codec::AtlasBest, Codec::AtlasNormalAll,
+    std::vector<Codec> bc1 = {Codec::AtlasFast, Codec::AtlasNormal, Codec::AtlasBest, Codec::AtlasNormalAll, Codec::AtlasNormalWithinItsMax,
                               Codec::SquishRange, Codec::SquishCluster, Codec::SquishIterative};
     std::vector<Codec> bc4 = {Codec::AtlasFast, Codec::AtlasNormal, Codec::AtlasBest, Codec::AtlasNormalAll, Codec::SquishCluster};
 #if defined(ATLAS_BENCH_RGBCX)
@@ -371,6 +399,9 @@ int main(int argc, char** argv) {
         for (Codec c : bc4)
             benchmark::RegisterBenchmark(("BC4/" + std::string(c == Codec::SquishCluster ? "squish" : codec_name(c)) + tag).c_str(),
                                          peer, i, true, c)
+                ->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+        for (int steps : {4, 8, 16, 32, 64})
+            benchmark::RegisterBenchmark(("BC1Bound/atlas_normal_max" + std::to_string(steps) + tag).c_str(), bc1_bound_sweep, i, steps)
                 ->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
     }
     for (auto [nx, nz] : {std::pair{128, 16}, std::pair{256, 32}, std::pair{512, 64}})

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 namespace atlas::compress {
@@ -94,13 +95,24 @@ TEST(Bc1Eval, Avx2EqualsSelectIndices) {
         detail::bc1_interval_palette(c0, c1, set, p);
         detail::bc1_interval_palette_cm(c0, c1, set, q);
         const float stop = k % 4 == 0 ? float(unit(k, 3)) * 0.2f : INFINITY;
-        for (bool os : {false, true}) {
-            const detail::Selection a = detail::select_indices(p, src, os, stop);
-            const detail::Selection b = os ? detail::bc1_select_avx2<true>(q, planes, stop) : detail::bc1_select_avx2<false>(q, planes, stop);
-            ASSERT_EQ(std::memcmp(&a.max_err, &b.max_err, 4), 0) << "case " << k << " os " << os;
-            ASSERT_EQ(std::memcmp(&a.sum_sq, &b.sum_sq, 8), 0) << "case " << k << " os " << os;
-            ASSERT_EQ(std::memcmp(a.idx, b.idx, 16), 0) << "case " << k << " os " << os;
-        }
+        // No budget, and budgets below and above the palette's least max error; no sum to
+        // beat, and one that stops some pairs part way.
+        const double sum_stop = k % 3 == 1 ? double(unit(k, 6)) * 0.5 : INFINITY;
+        for (float budget : {-1.0f, float(unit(k, 4)) * 0.1f, float(unit(k, 5)) * 0.6f})
+            for (bool os : {false, true}) {
+                const detail::Selection a = detail::select_indices(p, src, os, stop, budget, sum_stop);
+                const detail::Selection b = os ? detail::bc1_select_avx2<true>(q, planes, stop, budget, sum_stop)
+                                               : detail::bc1_select_avx2<false>(q, planes, stop, budget, sum_stop);
+                if (!std::isfinite(a.max_err)) { // stopped: both, and only a pair over the sum
+                    ASSERT_FALSE(std::isfinite(b.max_err)) << "case " << k;
+                    const detail::Selection full = detail::select_indices(p, src, os, stop, budget);
+                    ASSERT_TRUE(!std::isfinite(full.max_err) || full.sum_sq > sum_stop) << "case " << k;
+                    continue;
+                }
+                ASSERT_EQ(std::memcmp(&a.max_err, &b.max_err, 4), 0) << "case " << k << " os " << os << " budget " << budget;
+                ASSERT_EQ(std::memcmp(&a.sum_sq, &b.sum_sq, 8), 0) << "case " << k << " os " << os << " budget " << budget;
+                ASSERT_EQ(std::memcmp(a.idx, b.idx, 16), 0) << "case " << k << " os " << os << " budget " << budget;
+            }
     }
 }
 #endif
@@ -138,6 +150,87 @@ TEST(Bc1, NormalImprovesOnFastAndBestOnNormal) {
         ef += a; en += c; eb += d;
     }
     EXPECT_LT(en, ef);
+    EXPECT_LT(eb, en);  // best finds a better endpoint pair somewhere in 2000 blocks
+}
+
+// For a fixed palette and a budget, the selection is the least squared Reference error
+// over every assignment of entries whose worst-case error stays within the budget (or
+// within the palette's least max error when the budget is below it): checked against
+// all 4^16 assignments, pruned texel by texel, decoded by the public decoders.
+TEST(Bc1, BudgetedSelectionIsTheLeastSquaredErrorWithinTheBudget) {
+    for (uint64_t k = 0; k < 400; ++k) {
+        float src[48];
+        rgb_block(k * 11 + 5, src);
+        const uint16_t c0 = uint16_t(unit(k, 1) * 65536), c1 = uint16_t(unit(k, 2) * 65536);
+        const DecoderSet set = k % 2 ? kAllDecoders : kReferenceOnly;
+        // Each entry's worst-case error per texel over the decoders, and its Reference error.
+        float worst[16][4] = {}, ref[16][4] = {};
+        for (Decoder d : decoders_in(set)) {
+            float pal[4][3];
+            bc1_palette(c0, c1, d, pal);
+            float rp[4][3];
+            bc1_palette(c0, c1, Decoder::Reference, rp);
+            for (int t = 0; t < 16; ++t)
+                for (int i = 0; i < 4; ++i) {
+                    double sq = 0;
+                    for (int c = 0; c < 3; ++c) {
+                        const float tol = (d == Decoder::Conformant && !(c0 <= c1 && i == 3)) ? bc1_conformant_tolerance(rp[0][c], rp[1][c]) : 0.0f;
+                        worst[t][i] = std::max(worst[t][i], std::fabs(pal[i][c] - src[3 * t + c]) + tol);
+                        sq += double(rp[i][c] - src[3 * t + c]) * double(rp[i][c] - src[3 * t + c]);
+                    }
+                    ref[t][i] = float(sq);
+                }
+        }
+        float least_max = 0;
+        for (int t = 0; t < 16; ++t) least_max = std::max(least_max, *std::min_element(worst[t], worst[t] + 4));
+        detail::Palette<3> p;
+        detail::bc1_interval_palette(c0, c1, set, p);
+        for (float budget : {least_max * 0.5f, least_max * 1.3f + 0.01f, 2.0f}) {
+            const float allowed = std::max(budget, least_max);
+            // The best over all assignments: texels are independent once the allowance is fixed.
+            double best_sq = 0;
+            for (int t = 0; t < 16; ++t) {
+                double b = INFINITY;
+                for (int i = 0; i < 4; ++i)
+                    if (worst[t][i] <= allowed * (1 + 1e-6f) + 1e-7f) b = std::min(b, double(ref[t][i]));
+                best_sq += b;
+            }
+            const detail::Selection s = detail::select_indices(p, src, false, INFINITY, budget);
+            ASSERT_NEAR(s.sum_sq, best_sq, 1e-6 * best_sq + 1e-9) << "case " << k << " budget " << budget;
+            ASSERT_LE(s.max_err, allowed * (1 + 1e-6f) + 1e-7f) << "case " << k;
+            if (budget < least_max) { ASSERT_NEAR(s.max_err, least_max, 1e-6f) << "case " << k; } // unreachable: the least max, as before
+        }
+    }
+}
+
+// Given a bound, the encoder spends it on the squared error: every block stays within the
+// bound under every decoder (independent decode), and in all the squared error is lower
+// than the max-error-first objective's, which a bound at the unbounded result's own max
+// error would not change if the bound were ignored.
+TEST(Bc1, BoundSpentOnSquaredError) {
+    BlockOptions free_o, bound_o;
+    free_o.decoders = bound_o.decoders = kAllDecoders;
+    double free_sq = 0, bound_sq = 0;
+    int within = 0;
+    for (int k = 0; k < 1000; ++k) {
+        float src[48];
+        rgb_block(uint64_t(k) * 13 + 2, src);
+        uint8_t blk[8];
+        const BlockResult u = encode_bc1_block(src, free_o, blk);
+        bound_o.max_error = u.max_error * 1.25f; // room above the least max error found
+        const BlockResult b = encode_bc1_block(src, bound_o, blk);
+        float e, over;
+        double sq;
+        check_rgb(blk, kAllDecoders, src, e, over, sq);
+        ASSERT_LE(e, b.max_error + 1e-6f) << k;
+        ASSERT_NEAR(sq, b.sum_sq, 1e-6 + 1e-6 * b.sum_sq) << k;
+        if (b.max_error <= bound_o.max_error) ++within;
+        free_sq += u.sum_sq;
+        bound_sq += b.sum_sq;
+    }
+    std::printf("BC1 normal bounded at 1.25x the unbounded block max: squared error %.4f of max-first's\n", bound_sq / free_sq);
+    EXPECT_EQ(within, 1000); // the unbounded result itself was within every bound
+    EXPECT_LT(bound_sq, 0.97 * free_sq) << "bounded " << bound_sq << " vs max-first " << free_sq;
 }
 
 TEST(Bc1, OneSidedHoldsForEveryDecoderOnSmoothBlocks) {

@@ -1,5 +1,6 @@
 // BC1 RGB encoder: principal-axis endpoints, then +-1 hill climbing on the 565
-// endpoints under the decoder-set objective (max error, then squared error).
+// endpoints under the decoder-set objective: max error, then squared error; or, given
+// a bound (max_error), the squared error among the choices within it.
 #include "atlas/compress/bc1.h"
 
 #include "bc1_eval.h"
@@ -38,29 +39,36 @@ bool use_avx2() {
 
 class Search {
 public:
-    Search(const float* src, const BlockOptions& o) : src_(src), o_(o), planes_(src), avx2_(use_avx2()) {}
+    // Given a bound (max_error >= 0), the search minimises the squared error within it
+    // (better_within); without one, the max error first (better).
+    Search(const float* src, const BlockOptions& o)
+        : src_(src), o_(o), budget_(o.max_error >= 0 ? o.max_error : -1.0f), planes_(src), avx2_(use_avx2()) {}
 
     // Evaluates the ordered pair (c0, c1); keeps it when better. A pair evaluated before
     // in this block is skipped: it was not better than the incumbent then, and the
     // incumbent has only improved since (so skipping changes no result).
     void try_pair(uint16_t c0, uint16_t c1) {
         if (seen(c0, c1)) return;
-        const float stop = best.valid ? best.sel.max_err : INFINITY;
+        const float stop = detail::stop_within(best.sel, best.valid, budget_);
+        // Against an incumbent within the bound, a pair must have the smaller sum (or an
+        // equal one): its selection stops once its sum passes the incumbent's.
+        const double sum_stop = best.valid && best.sel.max_err <= budget_ ? best.sel.sum_sq : INFINITY;
         detail::Selection s;
 #if defined(ATLAS_BC1_AVX2)
         if (avx2_) {
             detail::Bc1PaletteCm p;
             detail::bc1_interval_palette_cm(c0, c1, o_.decoders, p);
-            s = o_.one_sided_below ? detail::bc1_select_avx2<true>(p, planes_, stop) : detail::bc1_select_avx2<false>(p, planes_, stop);
+            s = o_.one_sided_below ? detail::bc1_select_avx2<true>(p, planes_, stop, budget_, sum_stop)
+                                   : detail::bc1_select_avx2<false>(p, planes_, stop, budget_, sum_stop);
         } else
 #endif
         {
             detail::Palette<3> p;
             detail::bc1_interval_palette(c0, c1, o_.decoders, p);
-            s = detail::select_indices(p, src_, o_.one_sided_below, stop);
+            s = detail::select_indices(p, src_, o_.one_sided_below, stop, budget_, sum_stop);
         }
         if (!std::isfinite(s.max_err)) return;
-        if (!best.valid || detail::better(s, best.sel)) { best.c0 = c0; best.c1 = c1; best.sel = s; best.valid = true; }
+        if (!best.valid || detail::better_within(s, best.sel, budget_)) { best.c0 = c0; best.c1 = c1; best.sel = s; best.valid = true; }
     }
     // Both modes of an unordered pair.
     void try_both(uint16_t a, uint16_t b) {
@@ -87,6 +95,36 @@ public:
         }
     }
 
+    // Given a bound: the endpoints that minimise the squared error for the incumbent's
+    // indices (least squares per channel, each texel's weight on c0 being 1, 0, 2/3, 1/3 in
+    // 4-colour mode and 1, 0, 1/2 in 3-colour mode, black texels left out), rounded to 565 and
+    // tried in both modes, while that improves the incumbent (the cluster-fit step of
+    // squish and rgbcx; the max-error-first search has no use for it).
+    void fit_squared_error(int steps) {
+        if (budget_ < 0) return;
+        for (int it = 0; it < steps && best.valid; ++it) {
+            const bool four = best.c0 > best.c1;
+            double aa = 0, ab = 0, bb = 0, ax[3] = {0, 0, 0}, bx[3] = {0, 0, 0};
+            for (int t = 0; t < 16; ++t) {
+                const int i = best.sel.idx[t];
+                if (!four && i == 3) continue; // black
+                const double a = i == 0 ? 1.0 : i == 1 ? 0.0 : four ? (i == 2 ? 2.0 / 3.0 : 1.0 / 3.0) : 0.5, b = 1.0 - a;
+                aa += a * a, ab += a * b, bb += b * b;
+                for (int c = 0; c < 3; ++c) ax[c] += a * src_[3 * t + c], bx[c] += b * src_[3 * t + c];
+            }
+            const double det = aa * bb - ab * ab;
+            if (!(det > 1e-9)) return; // every texel on one entry: nothing to fit
+            double e0[3], e1[3];
+            for (int c = 0; c < 3; ++c) {
+                e0[c] = (bb * ax[c] - ab * bx[c]) / det;
+                e1[c] = (aa * bx[c] - ab * ax[c]) / det;
+            }
+            const uint16_t before0 = best.c0, before1 = best.c1;
+            try_both(pack(quantize(e0)), pack(quantize(e1)));
+            if (best.c0 == before0 && best.c1 == before1) return; // no better pair
+        }
+    }
+
     Candidate best;
 
 private:
@@ -106,6 +144,7 @@ private:
 
     const float* src_;
     const BlockOptions& o_;
+    float budget_;
     detail::Bc1Planes planes_;
     bool avx2_;
     uint32_t seen_[256] = {};
@@ -162,6 +201,7 @@ BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, u
             if (pa != pb) s.try_pair(std::max(pa, pb), std::min(pa, pb));
         }
         s.refine(3);
+        s.fit_squared_error(3); // given a bound only
     }
     const bool missed = !s.best.valid || (options.max_error >= 0 && s.best.sel.max_err > options.max_error);
     if (options.quality == Quality::Best || missed) {
@@ -181,6 +221,7 @@ BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, u
             s.try_both(pack(quantize(a)), pack(quantize(b)));
         }
         s.refine(32);
+        s.fit_squared_error(8);
     }
     if (!s.best.valid) {
         // One-sided with no feasible candidate: all-black (0 is below any source >= 0).

@@ -33,7 +33,8 @@ struct Bc1Planes {
 inline bool bc1_cpu_has_avx2() { return __builtin_cpu_supports("avx2") != 0; }
 
 template <bool OneSided>
-__attribute__((target("avx2"))) inline Selection bc1_select_avx2(const Bc1PaletteCm& p, const Bc1Planes& s, float stop_above) {
+__attribute__((target("avx2"))) inline Selection bc1_select_avx2(const Bc1PaletteCm& p, const Bc1Planes& s, float stop_above, float budget = -1.0f,
+                                                                 double sum_stop = std::numeric_limits<double>::infinity()) {
     Selection out;
     const __m256 zero = _mm256_setzero_ps(), vinf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
     const __m256 vstop = _mm256_set1_ps(stop_above);
@@ -62,36 +63,51 @@ __attribute__((target("avx2"))) inline Selection bc1_select_avx2(const Bc1Palett
     _mm256_storeu_ps(bm, block);
     float block_max = 0;
     for (int j = 0; j < 8; ++j) block_max = std::max(block_max, bm[j]);
-    out.max_err = block_max;
-    // Texels in groups of 4 (double lanes): group g holds texels 4g .. 4g + 3.
-    __m256d best_sq[4], best_i[4];
-    for (int g = 0; g < 4; ++g) { best_sq[g] = _mm256_set1_pd(std::numeric_limits<double>::infinity()); best_i[g] = _mm256_setzero_pd(); }
-    __m256d sd[3][4];
-    for (int ch = 0; ch < 3; ++ch)
-        for (int g = 0; g < 4; ++g) sd[ch][g] = _mm256_cvtps_pd(_mm_load_ps(s.c[ch] + 4 * g));
+    // The allowance per texel: the least block max, or the budget above it (select_indices).
+    const float allowance = budget > block_max ? budget : block_max;
+    // Texels in groups of 4 (double lanes): group g holds texels 4g .. 4g + 3, each taking
+    // its first least squared error among the entries within the allowance.
+    const __m256 vmaxf = _mm256_set1_ps(allowance);
+    __m256 ok[4][2];
+    bool usable[4];
     for (int i = 0; i < 4; ++i) {
-        const __m256d r0 = _mm256_set1_pd(double(p.ref[0][i])), r1 = _mm256_set1_pd(double(p.ref[1][i])), r2 = _mm256_set1_pd(double(p.ref[2][i]));
-        const __m256d vi = _mm256_set1_pd(double(i));
-        // Entries no texel may use are skipped (they change nothing below).
-        const __m256 vmaxf = _mm256_set1_ps(block_max);
-        const __m256 ok0 = _mm256_cmp_ps(err[i][0], vmaxf, _CMP_LE_OQ), ok1 = _mm256_cmp_ps(err[i][1], vmaxf, _CMP_LE_OQ);
-        if (!_mm256_movemask_ps(_mm256_or_ps(ok0, ok1))) continue;
-        for (int g = 0; g < 4; ++g) {
-            const __m256 okh = (g >> 1) ? ok1 : ok0;
+        ok[i][0] = _mm256_cmp_ps(err[i][0], vmaxf, _CMP_LE_OQ);
+        ok[i][1] = _mm256_cmp_ps(err[i][1], vmaxf, _CMP_LE_OQ);
+        usable[i] = _mm256_movemask_ps(_mm256_or_ps(ok[i][0], ok[i][1])) != 0; // entries no texel may use are skipped
+    }
+    double total = 0;
+    for (int g = 0; g < 4; ++g) {
+        __m256d best_sq = _mm256_set1_pd(std::numeric_limits<double>::infinity()), best_i = _mm256_setzero_pd();
+        const __m256d s0 = _mm256_cvtps_pd(_mm_load_ps(s.c[0] + 4 * g)), s1 = _mm256_cvtps_pd(_mm_load_ps(s.c[1] + 4 * g)),
+                      s2 = _mm256_cvtps_pd(_mm_load_ps(s.c[2] + 4 * g));
+        for (int i = 0; i < 4; ++i) {
+            if (!usable[i]) continue;
+            const __m256 okh = ok[i][g >> 1];
             const __m128 ok4 = (g & 1) ? _mm256_extractf128_ps(okh, 1) : _mm256_castps256_ps128(okh);
             const __m256d allowed = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_castps_si128(ok4))); // the lanes' masks, widened
-            const __m256d d0 = _mm256_sub_pd(r0, sd[0][g]), d1 = _mm256_sub_pd(r1, sd[1][g]), d2 = _mm256_sub_pd(r2, sd[2][g]);
+            const __m256d d0 = _mm256_sub_pd(_mm256_set1_pd(double(p.ref[0][i])), s0), d1 = _mm256_sub_pd(_mm256_set1_pd(double(p.ref[1][i])), s1),
+                          d2 = _mm256_sub_pd(_mm256_set1_pd(double(p.ref[2][i])), s2);
             const __m256d sq = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
-            const __m256d take = _mm256_and_pd(allowed, _mm256_cmp_pd(sq, best_sq[g], _CMP_LT_OQ)); // first minimum wins
-            best_sq[g] = _mm256_blendv_pd(best_sq[g], sq, take);
-            best_i[g] = _mm256_blendv_pd(best_i[g], vi, take);
+            const __m256d take = _mm256_and_pd(allowed, _mm256_cmp_pd(sq, best_sq, _CMP_LT_OQ)); // first minimum wins
+            best_sq = _mm256_blendv_pd(best_sq, sq, take);
+            best_i = _mm256_blendv_pd(best_i, _mm256_set1_pd(double(i)), take);
         }
+        double sq[4], bi[4];
+        _mm256_storeu_pd(sq, best_sq);
+        _mm256_storeu_pd(bi, best_i);
+        for (int j = 0; j < 4; ++j) { out.idx[4 * g + j] = uint8_t(bi[j]); total += sq[j]; } // texel order, as select_indices
+        // The sum only grows (squares are >= 0): past the incumbent's, the pair cannot win.
+        if (total > sum_stop) { out.max_err = std::numeric_limits<float>::infinity(); return out; }
     }
-    double sq[16], bi[16];
-    for (int g = 0; g < 4; ++g) { _mm256_storeu_pd(sq + 4 * g, best_sq[g]); _mm256_storeu_pd(bi + 4 * g, best_i[g]); }
-    double total = 0;
-    for (int t = 0; t < 16; ++t) { out.idx[t] = uint8_t(bi[t]); total += sq[t]; }
     out.sum_sq = total;
+    out.max_err = block_max;
+    if (allowance > block_max) { // the chosen entries' errors, as select_indices takes them
+        alignas(32) float e[4][16];
+        for (int i = 0; i < 4; ++i) { _mm256_store_ps(e[i], err[i][0]); _mm256_store_ps(e[i] + 8, err[i][1]); }
+        float chosen = 0;
+        for (int t = 0; t < 16; ++t) chosen = std::max(chosen, e[out.idx[t]][t]);
+        out.max_err = chosen;
+    }
     return out;
 }
 #else

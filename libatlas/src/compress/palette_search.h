@@ -35,6 +35,24 @@ inline bool better(const Selection& a, const Selection& b) {
     return a.max_err < b.max_err || (a.max_err == b.max_err && a.sum_sq < b.sum_sq);
 }
 
+// The objective within a max-error budget (BC1 RGB given a bound; budget < 0: none, then
+// this is `better`): a selection within the budget beats one over it; among those within
+// it the smaller squared error wins (then the smaller max error); among those over it,
+// `better` decides. A strict weak order, so a search keeps improving one incumbent.
+inline bool better_within(const Selection& a, const Selection& b, float budget) {
+    const bool fa = a.max_err <= budget, fb = b.max_err <= budget;
+    if (fa != fb) return fa;
+    if (fa) return a.sum_sq < b.sum_sq || (a.sum_sq == b.sum_sq && a.max_err < b.max_err);
+    return better(a, b);
+}
+
+// The early-exit threshold for a candidate against the incumbent `inc` under
+// better_within: a candidate whose block max error exceeds it cannot win.
+inline float stop_within(const Selection& inc, bool have, float budget) {
+    if (!have) return std::numeric_limits<float>::infinity();
+    return inc.max_err <= budget ? budget : inc.max_err;
+}
+
 // Per-texel worst-case error of entry i; +inf when one-sided and above the source.
 template <int C, bool OneSided>
 inline float entry_error_t(const Palette<C>& p, int i, const float* s) {
@@ -131,9 +149,9 @@ inline bool palette_within(const Palette<1>& p, const float* src, bool one_sided
 }
 
 template <int C, bool OneSided>
-inline Selection select_indices_t(const Palette<C>& p, const float* src, float stop_above) {
+inline Selection select_indices_t(const Palette<C>& p, const float* src, float stop_above, float budget, double sum_stop) {
 #if defined(__SSE2__)
-    if constexpr (C == 1) return select_indices_scalar_t<OneSided>(p, src, stop_above);
+    if constexpr (C == 1) return select_indices_scalar_t<OneSided>(p, src, stop_above); // no budget for C == 1
 #endif
     Selection out;
     float block_max = 0;
@@ -143,32 +161,48 @@ inline Selection select_indices_t(const Palette<C>& p, const float* src, float s
         if (!(best <= stop_above)) return out; // infeasible or worse than the incumbent
         block_max = std::max(block_max, best);
     }
-    out.max_err = block_max;
+    // Each texel may use any entry within the allowance: the palette's least block max
+    // error, or the budget when that is larger (then the block's max error is that of the
+    // entries chosen).
+    const float allowance = budget > block_max ? budget : block_max;
+    float chosen_max = 0;
     double total = 0;
     for (int t = 0; t < 16; ++t) {
         const float* s = src + t * C;
         double best_sq = std::numeric_limits<double>::infinity();
         int best_i = 0;
+        float best_e = 0;
         for (int i = 0; i < p.n; ++i) {
-            if (!(entry_error_t<C, OneSided>(p, i, s) <= block_max)) continue;
+            const float e = entry_error_t<C, OneSided>(p, i, s);
+            if (!(e <= allowance)) continue;
             double sq = 0;
             for (int c = 0; c < C; ++c) { const double d = double(p.ref[i][c]) - s[c]; sq += d * d; }
-            if (sq < best_sq) { best_sq = sq; best_i = i; }
+            if (sq < best_sq) { best_sq = sq; best_i = i; best_e = e; }
         }
         out.idx[t] = uint8_t(best_i);
+        chosen_max = std::max(chosen_max, best_e);
         total += best_sq;
+        // The sum only grows (squares are >= 0): past the incumbent's, the pair cannot win.
+        if ((t & 3) == 3 && total > sum_stop) { out.max_err = std::numeric_limits<float>::infinity(); return out; }
     }
+    out.max_err = allowance > block_max ? chosen_max : block_max;
     out.sum_sq = total;
     return out;
 }
 
 // Optimal indices for a fixed palette: minimises the block's max error, then the
 // squared Reference error among index choices that keep that max. Returns
-// max_err = +inf early when the max already exceeds `stop_above`.
+// max_err = +inf early when the max already exceeds `stop_above`. With a budget
+// (C == 3 only; < 0: none) at or above that least max error, each texel takes its least
+// squared error among the entries within the budget instead: optimal for better_within.
+// sum_stop (C == 3 only): max_err = +inf too once the squared error, summed in texel
+// order, exceeds it (the incumbent's, when a pair must beat it on the sum to win).
 template <int C>
 inline Selection select_indices(const Palette<C>& p, const float* src, bool one_sided,
-                                float stop_above = std::numeric_limits<float>::infinity()) {
-    return one_sided ? select_indices_t<C, true>(p, src, stop_above) : select_indices_t<C, false>(p, src, stop_above);
+                                float stop_above = std::numeric_limits<float>::infinity(), float budget = -1.0f,
+                                double sum_stop = std::numeric_limits<double>::infinity()) {
+    return one_sided ? select_indices_t<C, true>(p, src, stop_above, budget, sum_stop)
+                     : select_indices_t<C, false>(p, src, stop_above, budget, sum_stop);
 }
 
 } // namespace atlas::compress::detail

@@ -32,7 +32,8 @@ namespace atlas::compress {
 // 5: bc1-scalar one-sided fit with an endpoint or both unused, shared-R bottom after the
 // first pass, single-entry search for blocks whose spread is under their error.
 // 6: BC1 RGB normal also starts from the other three box diagonals, 4 power iterations.
-constexpr int kEncoderVersion = 6;
+// 7: BC1 RGB given max_error minimises the squared error within it (not the max error first).
+constexpr int kEncoderVersion = 7;
 
 // The most mip levels a front end asks for by number (a 65536 texture has 17
 // levels; "full" asks for all of them).
