@@ -83,7 +83,7 @@ std::vector<TextOption<CompressOptions>> make_compress_options() {
              INFINITY, {quality_name(Quality::Fast), quality_name(Quality::Normal), quality_name(Quality::Best)}},
             [](C& c, const V& v) { c.quality = parse_quality(v.word.c_str()); }),
         opt({"max_error", "--max-error", "E", K::Number,
-             "guarantee |decoded - source| <= E (source units) for every texel, or fail listing the blocks (default: no bound)", 0.0,
+             "guarantee |decoded - source| <= E (source units) for every texel, or fail listing the blocks; BC1 spends the room under E on the mean error (default: no bound)", 0.0,
              double(std::numeric_limits<float>::max())},
             [](C& c, const V& v) { c.max_error = float(v.number); }),
         opt({"one_sided", "--one-sided", "below", K::Choice, "'below': guarantee decoded <= source (SDFs for sphere tracing); mips are min-reduced",
