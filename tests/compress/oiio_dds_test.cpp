@@ -162,6 +162,55 @@ TEST(OiioDds, VolumeSlicesAndMipsStoreRowsTopDown) {
 }
 
 TEST(OiioDds, Bc1AgreesWithTool8RoundDecoder) { compare_with_oiio(Format::Bc1, 32, 20, 1.0001 / 255.0); }
+
+// BC1 given --max-error, as OpenImageIO decodes it: within the bound everywhere (the
+// bound covers the Tool8Round model, which OIIO matches within one 8-bit step), and the
+// room under the bound buys a lower RMSE than the unbounded encode's. A noisy colour
+// field, so blocks do not lie on one line in RGB.
+TEST(OiioDds, Bc1BoundHoldsUnderOiioAndLowersItsRmse) {
+    const fs::path dir = fs::temp_directory_path() / ("atlas_oiio_bound_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const int nx = 64, ny = 48;
+    Field3D f(Vec3i{{nx, ny, 1}}, 3, Box3d{{{0, 0, 0}}, {{1, 1, 1}}});
+    for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const uint32_t h = (uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ (uint32_t(c) * 83492791u);
+                f.at(c, x, y, 0) = float(0.5 + 0.3 * std::sin(0.3 * x + 1.7 * c) * std::cos(0.2 * y) + 0.06 * double(h % 1000u) / 1000.0);
+            }
+    auto oiio_errors = [&](const fs::path& p, double& max_err, double& rmse) {
+        OIIO::ImageSpec spec;
+        const std::vector<float> px = oiio_pixels(p, spec);
+        ASSERT_EQ(spec.width, nx);
+        double sq = 0;
+        max_err = 0;
+        for (int row = 0; row < ny; ++row)
+            for (int x = 0; x < nx; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    const double d = px[(size_t(row) * size_t(nx) + size_t(x)) * size_t(spec.nchannels) + size_t(c)] - f.at(c, x, ny - 1 - row, 0);
+                    max_err = std::max(max_err, std::fabs(d));
+                    sq += d * d;
+                }
+        rmse = std::sqrt(sq / (3.0 * nx * ny));
+    };
+    CompressOptions o;
+    o.format = Format::Bc1;
+    o.value_range = std::make_pair(0.0f, 1.0f);
+    o.decoders = decoder_bit(Decoder::Reference) | decoder_bit(Decoder::Tool8Round);
+    compress_to_dds(f, dir / "free.dds", o);
+    double free_max = 0, free_rmse = 0;
+    oiio_errors(dir / "free.dds", free_max, free_rmse);
+    o.max_error = 0.12f;
+    compress_to_dds(f, dir / "bound.dds", o); // throws if a block misses the bound
+    double bound_max = 0, bound_rmse = 0;
+    oiio_errors(dir / "bound.dds", bound_max, bound_rmse);
+    std::printf("BC1 via OIIO: unbounded max %.2f/255 RMSE %.3f/255; --max-error %.1f/255: max %.2f/255 RMSE %.3f/255\n", free_max * 255,
+                free_rmse * 255, double(*o.max_error) * 255, bound_max * 255, bound_rmse * 255);
+    EXPECT_LE(bound_max, double(*o.max_error) + 1.0001 / 255.0);
+    EXPECT_LT(free_max, double(*o.max_error)) << "the bound must leave room over the unbounded max error";
+    EXPECT_LT(bound_rmse, 0.97 * free_rmse);
+    fs::remove_all(dir);
+}
 TEST(OiioDds, Bc4AgreesWithTool8RoundDecoder) { compare_with_oiio(Format::Bc4, 32, 20, 1.0001 / 255.0); }
 
 } // namespace
