@@ -75,14 +75,25 @@ public:
         try_pair(std::max(a, b), std::min(a, b)); // 4 colours (3 when equal)
         try_pair(std::min(a, b), std::max(a, b)); // 3 colours + black
     }
-    // Rounds of +-1 moves on each channel of each endpoint, keeping the mode.
+    // Whether the incumbent is within a bound: only then do the squared-error moves below
+    // apply. Until then the search visits exactly the pairs the unbounded search visits, so
+    // a bound that search meets is always met.
+    bool within_bound() const { return budget_ >= 0 && best.valid && best.sel.max_err <= budget_; }
+
+    // Rounds of +-1 moves on each channel of each endpoint, in both modes. Within a bound, only the move against the squared error's gradient is tried on each
+    // channel of each endpoint (the gradient of the least-squares model of fit_squared_error
+    // at the incumbent's indices): half the pairs, where every pair within the bound costs
+    // its full squared-error pass.
     void refine(int rounds) {
         for (int r = 0; r < rounds && best.valid; ++r) {
             const uint16_t b0 = best.c0, b1 = best.c1;
             const uint32_t before_key = (uint32_t(b0) << 16) | b1;
+            int descent[2][3] = {{0, 0, 0}, {0, 0, 0}}; // 0: both directions
+            if (within_bound()) squared_error_descent(descent);
             for (int end = 0; end < 2; ++end)
                 for (int ch = 0; ch < 3; ++ch)
                     for (int dir = -1; dir <= 1; dir += 2) {
+                        if (descent[end][ch] != 0 && dir != descent[end][ch]) continue;
                         uint16_t e[2] = {b0, b1};
                         const int shift = ch == 0 ? 11 : ch == 1 ? 5 : 0, m = ch == 1 ? 63 : 31;
                         int v = (e[end] >> shift) & m;
@@ -95,20 +106,47 @@ public:
         }
     }
 
-    // Given a bound: the endpoints that minimise the squared error for the incumbent's
+    // The incumbent's weight on c0 per texel (1, 0, 2/3, 1/3 in 4-colour mode; 1, 0, 1/2 in
+    // 3-colour mode); -1 for a black texel (3-colour index 3), which no endpoint moves.
+    void incumbent_weights(double a[16]) const {
+        const bool four = best.c0 > best.c1;
+        for (int t = 0; t < 16; ++t) {
+            const int i = best.sel.idx[t];
+            a[t] = !four && i == 3 ? -1.0 : i == 0 ? 1.0 : i == 1 ? 0.0 : four ? (i == 2 ? 2.0 / 3.0 : 1.0 / 3.0) : 0.5;
+        }
+    }
+    // The sign of the move that lowers the squared error per endpoint channel, from the
+    // gradient of sum_t (a_t e0 + (1 - a_t) e1 - x_t)^2 at the incumbent's endpoints.
+    void squared_error_descent(int descent[2][3]) const {
+        double a[16];
+        incumbent_weights(a);
+        float pal[4][3];
+        bc1_palette(best.c0, best.c1, Decoder::Reference, pal);
+        for (int c = 0; c < 3; ++c) {
+            double g0 = 0, g1 = 0;
+            for (int t = 0; t < 16; ++t) {
+                if (a[t] < 0) continue;
+                const double r = a[t] * pal[0][c] + (1.0 - a[t]) * pal[1][c] - src_[3 * t + c];
+                g0 += a[t] * r, g1 += (1.0 - a[t]) * r;
+            }
+            descent[0][c] = g0 > 0 ? -1 : g0 < 0 ? 1 : 0;
+            descent[1][c] = g1 > 0 ? -1 : g1 < 0 ? 1 : 0;
+        }
+    }
+
+    // Within a bound: the endpoints that minimise the squared error for the incumbent's
     // indices (least squares per channel, each texel's weight on c0 being 1, 0, 2/3, 1/3 in
     // 4-colour mode and 1, 0, 1/2 in 3-colour mode, black texels left out), rounded to 565 and
     // tried in both modes, while that improves the incumbent (the cluster-fit step of
     // squish and rgbcx; the max-error-first search has no use for it).
     void fit_squared_error(int steps) {
-        if (budget_ < 0) return;
-        for (int it = 0; it < steps && best.valid; ++it) {
-            const bool four = best.c0 > best.c1;
+        for (int it = 0; it < steps && within_bound(); ++it) {
+            double w[16];
+            incumbent_weights(w);
             double aa = 0, ab = 0, bb = 0, ax[3] = {0, 0, 0}, bx[3] = {0, 0, 0};
             for (int t = 0; t < 16; ++t) {
-                const int i = best.sel.idx[t];
-                if (!four && i == 3) continue; // black
-                const double a = i == 0 ? 1.0 : i == 1 ? 0.0 : four ? (i == 2 ? 2.0 / 3.0 : 1.0 / 3.0) : 0.5, b = 1.0 - a;
+                if (w[t] < 0) continue; // black
+                const double a = w[t], b = 1.0 - a;
                 aa += a * a, ab += a * b, bb += b * b;
                 for (int c = 0; c < 3; ++c) ax[c] += a * src_[3 * t + c], bx[c] += b * src_[3 * t + c];
             }
@@ -200,8 +238,9 @@ BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, u
             const uint16_t pa = pack(quantize(a)), pb = pack(quantize(b));
             if (pa != pb) s.try_pair(std::max(pa, pb), std::min(pa, pb));
         }
+        s.fit_squared_error(1); // within a bound only: a least-squares start for the descent
         s.refine(3);
-        s.fit_squared_error(3); // given a bound only
+        s.fit_squared_error(3);
     }
     const bool missed = !s.best.valid || (options.max_error >= 0 && s.best.sel.max_err > options.max_error);
     if (options.quality == Quality::Best || missed) {

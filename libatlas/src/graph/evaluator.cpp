@@ -714,10 +714,10 @@ std::vector<std::filesystem::path> CookResult::depends(const std::filesystem::pa
     return v;
 }
 
-std::vector<std::string> CookResult::with_status(const std::string& status) const {
+std::vector<std::string> CookResult::with_status(const std::string& wanted) const {
     std::vector<std::string> v;
     for (const auto& [name, r] : nodes)
-        if (r.status == status) v.push_back(name);
+        if (r.status == wanted) v.push_back(name);
     return v;
 }
 

@@ -87,16 +87,16 @@ struct Level {
     };
     Row row(const std::vector<double>& v, int j, int k) const {
         const size_t c = id(0, j, k), pl = size_t(nx) * ny;
-        Row r;
-        r.c = &v[c];
-        r.ax = ax[size_t(k)];
-        r.wx = wrap[0];
+        Row out;
+        out.c = &v[c];
+        out.ax = ax[size_t(k)];
+        out.wx = wrap[0];
         const std::ptrdiff_t last = std::ptrdiff_t(ny - 1) * nx;
-        r.s = j > 0 ? r.c - nx : wrap[1] ? r.c + last : r.c, r.ay_s = (j > 0 || wrap[1]) ? ay[size_t(k)] : 0.0;
-        r.n = j < ny - 1 ? r.c + nx : wrap[1] ? r.c - last : r.c, r.ay_n = (j < ny - 1 || wrap[1]) ? ay[size_t(k)] : 0.0;
-        r.d = k > 0 ? r.c - pl : r.c, r.az_d = k > 0 ? az[size_t(k)] : 0.0;
-        r.u = k < nz - 1 ? r.c + pl : r.c, r.az_u = k < nz - 1 ? az[size_t(k + 1)] : 0.0;
-        return r;
+        out.s = j > 0 ? out.c - nx : wrap[1] ? out.c + last : out.c, out.ay_s = (j > 0 || wrap[1]) ? ay[size_t(k)] : 0.0;
+        out.n = j < ny - 1 ? out.c + nx : wrap[1] ? out.c - last : out.c, out.ay_n = (j < ny - 1 || wrap[1]) ? ay[size_t(k)] : 0.0;
+        out.d = k > 0 ? out.c - pl : out.c, out.az_d = k > 0 ? az[size_t(k)] : 0.0;
+        out.u = k < nz - 1 ? out.c + pl : out.c, out.az_u = k < nz - 1 ? az[size_t(k + 1)] : 0.0;
+        return out;
     }
     static double off(const Row& r, int i, int nx_) {
         double s = 0;

@@ -96,7 +96,7 @@ struct CookResult {
     std::string status = "ok";
     std::string error, error_node, error_where;
 
-    std::vector<std::string> with_status(const std::string& status) const;
+    std::vector<std::string> with_status(const std::string& wanted) const;
     // Every file the cook depends on: the graph file (when given) and the inputs, without repeats.
     std::vector<std::filesystem::path> depends(const std::filesystem::path& graph_file) const;
     // The --report JSON document (stable keys, see docs/report.md).
