@@ -621,8 +621,8 @@ MeasuredRun run_measured(const std::vector<std::string>& args) {
 } // namespace
 
 // Hostile mesh files never reach CGAL's PLY/STL readers unchecked (a property
-// outside any element crashed it, so did a coordinate typed uchar; a huge count
-// reserved memory for it).
+// outside any element crashed it, so did a coordinate typed uchar; a huge element
+// count or list length reserved memory for it).
 TEST(CliHostile, MalformedPlyAndStlAreRefusedByName) {
     const fs::path d = fresh_dir("hostileply");
     const std::vector<std::pair<std::string, std::string>> cases = {
@@ -634,6 +634,13 @@ TEST(CliHostile, MalformedPlyAndStlAreRefusedByName) {
         // A byte-typed coordinate reached a null pointer inside CGAL (sanitized fuzz run).
         {"ucharx.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty uchar x\nproperty float y\nproperty float z\n"
                        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
+        // A list length in the body sized CGAL's buffer before it read the items (2^31 - 1
+        // items asked for 7 GB; found by the sanitized fuzz run): binary and ascii.
+        {"longlist.ply", std::string("ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                     "element face 1\nproperty list int int vertex_indices\nend_header\n") +
+                             std::string(36, '\0') + std::string("\xff\xff\xff\x7f", 4) + std::string(12, '\0')},
+        {"longlist_ascii.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                               "element face 1\nproperty list uint int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3000000000 0 1 2\n"},
         // ... and so did one behind a second, well-typed vertex element (the check saw only the last).
         {"twovertex.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty uchar x\nproperty float y\nproperty float z\n"
                           "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
