@@ -49,10 +49,13 @@ public:
     // incumbent has only improved since (so skipping changes no result).
     void try_pair(uint16_t c0, uint16_t c1) {
         if (seen(c0, c1)) return;
-        const float stop = detail::stop_within(best.sel, best.valid, budget_);
-        // Against an incumbent within the bound, a pair must have the smaller sum (or an
-        // equal one): its selection stops once its sum passes the incumbent's.
-        const double sum_stop = best.valid && best.sel.max_err <= budget_ ? best.sel.sum_sq : INFINITY;
+        // A pair whose block max error exceeds `stop` cannot win (better_within): the
+        // incumbent's max error, or the bound once the incumbent is within it. Against an
+        // incumbent within the bound a pair must also have the smaller sum (or an equal
+        // one), so its selection stops once its sum passes the incumbent's.
+        const bool within = within_bound();
+        const float stop = !best.valid ? INFINITY : within ? budget_ : best.sel.max_err;
+        const double sum_stop = within ? best.sel.sum_sq : INFINITY;
         detail::Selection s;
 #if defined(ATLAS_BC1_AVX2)
         if (avx2_) {
@@ -80,10 +83,10 @@ public:
     // a bound that search meets is always met.
     bool within_bound() const { return budget_ >= 0 && best.valid && best.sel.max_err <= budget_; }
 
-    // Rounds of +-1 moves on each channel of each endpoint, in both modes. Within a bound, only the move against the squared error's gradient is tried on each
-    // channel of each endpoint (the gradient of the least-squares model of fit_squared_error
-    // at the incumbent's indices): half the pairs, where every pair within the bound costs
-    // its full squared-error pass.
+    // Rounds of +-1 moves on each channel of each endpoint, in both modes. Within a bound
+    // only the move against the squared error's gradient (of the least-squares model of
+    // fit_squared_error at the incumbent's indices) is tried per channel: half the pairs,
+    // where every pair within the bound costs its full squared-error pass.
     void refine(int rounds) {
         for (int r = 0; r < rounds && best.valid; ++r) {
             const uint16_t b0 = best.c0, b1 = best.c1;

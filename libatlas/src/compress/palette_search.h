@@ -46,13 +46,6 @@ inline bool better_within(const Selection& a, const Selection& b, float budget) 
     return better(a, b);
 }
 
-// The early-exit threshold for a candidate against the incumbent `inc` under
-// better_within: a candidate whose block max error exceeds it cannot win.
-inline float stop_within(const Selection& inc, bool have, float budget) {
-    if (!have) return std::numeric_limits<float>::infinity();
-    return inc.max_err <= budget ? budget : inc.max_err;
-}
-
 // Per-texel worst-case error of entry i; +inf when one-sided and above the source.
 template <int C, bool OneSided>
 inline float entry_error_t(const Palette<C>& p, int i, const float* s) {

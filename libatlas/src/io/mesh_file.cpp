@@ -74,13 +74,19 @@ void detail::check_ply_header(const fs::path& file, bool need_faces) {
     if (w.size() != 3 || w[0] != "format" || (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
         fail("expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
     const bool ascii = w[1] == "ascii", binary_big_endian = w[1] == "binary_big_endian";
-    const std::vector<std::string> scalar = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "uint8",
-                                             "int16", "uint16", "int32", "uint32", "float32", "float64"};
-    auto is_scalar = [&](const std::string& t) { return std::find(scalar.begin(), scalar.end(), t) != scalar.end(); };
+    // The scalar types PLY names, with their size in a binary body (0: not a PLY type).
+    auto scalar_size = [](const std::string& t) -> size_t {
+        if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+        if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+        if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
+        if (t == "double" || t == "float64") return 8;
+        return 0;
+    };
+    auto is_scalar = [&](const std::string& t) { return scalar_size(t) != 0; };
     struct Element {
         std::string name;
         uint64_t count = 0;
-        std::vector<std::string> props, types; // types: the scalar type, or "list"
+        std::vector<std::string> props, types; // types: the scalar type, or "list COUNT_TYPE ITEM_TYPE"
         bool has_list = false;
     };
     std::vector<Element> elements;
@@ -153,81 +159,73 @@ void detail::check_ply_header(const fs::path& file, bool need_faces) {
 
     // The lists' lengths are in the body, and CGAL sizes each list by its length before
     // reading it (a length of 2^31 asked for 7 GB): every length must fit in what is left
-    // of the file, at least one byte per item (binary) or two (ascii).
+    // of the file, at least one byte per item (binary) or two (ascii). A file that ends
+    // early stops the scan: CGAL reports that itself.
     if (std::none_of(elements.begin(), elements.end(), [](const Element& e) { return e.has_list; })) return;
-    auto scalar_size = [](const std::string& t) -> size_t {
-        if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-        if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-        if (t == "double" || t == "float64") return 8;
-        return 4; // int, uint, float and their sized names
-    };
     in.clear();
     in.seekg(std::streamoff(header_bytes));
-    uint64_t pos = header_bytes;
-    auto too_long = [&](const Element& e, uint64_t entry, double n) {
-        throw Error(f + ": PLY body: element '" + e.name + "' entry " + std::to_string(entry) + " has a list of " +
-                    (std::isfinite(n) ? std::to_string(int64_t(std::min(n, 9e18))) : std::string("a non-finite number of")) +
-                    " items, more than the rest of the file holds");
+    uint64_t pos = header_bytes; // binary: the body offset
+    std::string tok;             // ascii: the current word
+    auto skip = [&](uint64_t n, size_t item_size) -> bool {
+        if (!ascii) {
+            pos += n * item_size;
+            return bool(in.seekg(std::streamoff(pos)));
+        }
+        for (uint64_t i = 0; i < n; ++i)
+            if (!(in >> tok)) return false;
+        return true;
+    };
+    // A list's length, as a double (negative or NaN when the file says so); false at the end.
+    auto list_length = [&](const std::string& count_type, double& n) -> bool {
+        if (ascii) {
+            if (!(in >> tok)) return false;
+            n = std::strtod(tok.c_str(), nullptr);
+            return true;
+        }
+        const size_t cs = scalar_size(count_type);
+        unsigned char b[8] = {};
+        if (!in.read(reinterpret_cast<char*>(b), std::streamsize(cs))) return false;
+        pos += cs;
+        if (binary_big_endian) std::reverse(b, b + cs);
+        if (count_type == "float" || count_type == "float32") {
+            float v;
+            std::memcpy(&v, b, 4);
+            n = v;
+        } else if (count_type == "double" || count_type == "float64") {
+            std::memcpy(&n, b, 8);
+        } else {
+            uint64_t u = 0;
+            std::memcpy(&u, b, cs); // little-endian host (x86-64, the supported platform)
+            const bool is_signed = count_type == "char" || count_type == "int8" || count_type == "short" || count_type == "int16" ||
+                                   count_type == "int" || count_type == "int32";
+            n = is_signed && ((u >> (8 * cs - 1)) & 1) ? -1.0 : double(u);
+        }
+        return true;
     };
     for (const Element& e : elements) {
-        if (!e.has_list) { // fixed size: skipped whole (binary) or token by token (ascii)
-            if (ascii) {
-                std::string tok;
-                for (uint64_t k = 0; k < e.count * e.props.size(); ++k)
-                    if (!(in >> tok)) return; // a short file: CGAL reports it
-            } else {
-                uint64_t entry = 0;
-                for (const auto& t : e.types) entry += scalar_size(t);
-                pos += entry * e.count;
-                in.seekg(std::streamoff(pos));
-            }
+        if (!e.has_list) { // fixed size: skipped whole
+            uint64_t entry = 0;
+            for (const auto& t : e.types) entry += scalar_size(t);
+            if (!(ascii ? skip(e.count * e.props.size(), 1) : skip(e.count, entry))) return;
             continue;
         }
         for (uint64_t k = 0; k < e.count; ++k)
             for (const auto& t : e.types) {
                 if (t.rfind("list ", 0) != 0) { // a scalar
-                    if (ascii) {
-                        std::string tok;
-                        if (!(in >> tok)) return;
-                    } else {
-                        pos += scalar_size(t);
-                        in.seekg(std::streamoff(pos));
-                    }
+                    if (!skip(1, scalar_size(t))) return;
                     continue;
                 }
                 const size_t sp = t.find(' ', 5);
                 const std::string count_type = t.substr(5, sp - 5), item_type = t.substr(sp + 1);
                 double n = 0;
-                if (ascii) {
-                    std::string tok;
-                    if (!(in >> tok)) return;
-                    n = std::strtod(tok.c_str(), nullptr);
-                    const uint64_t left = size > uint64_t(in.tellg()) ? size - uint64_t(in.tellg()) : 0;
-                    if (!(n >= 0) || n > double(left) / 2 + 1) too_long(e, k, n);
-                    for (uint64_t i = 0; i < uint64_t(n); ++i)
-                        if (!(in >> tok)) return;
-                } else {
-                    const size_t cs = scalar_size(count_type);
-                    unsigned char b[8] = {};
-                    if (!in.read(reinterpret_cast<char*>(b), std::streamsize(cs))) return;
-                    if (binary_big_endian) std::reverse(b, b + cs);
-                    pos += cs;
-                    if (count_type == "float" || count_type == "float32") { float v; std::memcpy(&v, b, 4); n = v; }
-                    else if (count_type == "double" || count_type == "float64") { std::memcpy(&n, b, 8); }
-                    else {
-                        uint64_t u = 0;
-                        std::memcpy(&u, b, cs); // little-endian host (x86-64, the supported platform)
-                        const bool is_signed = count_type == "char" || count_type == "int8" || count_type == "short" || count_type == "int16" ||
-                                               count_type == "int" || count_type == "int32";
-                        if (is_signed && cs < 8 && (u >> (8 * cs - 1)) & 1) n = -1; // negative
-                        else n = double(u);
-                    }
-                    const uint64_t left = size > pos ? size - pos : 0;
-                    const size_t is = scalar_size(item_type);
-                    if (!(n >= 0) || n > double(left / is)) too_long(e, k, n);
-                    pos += uint64_t(n) * is;
-                    in.seekg(std::streamoff(pos));
-                }
+                if (!list_length(count_type, n)) return;
+                const uint64_t at = ascii ? uint64_t(in.tellg()) : pos, left = size > at ? size - at : 0;
+                const double most = ascii ? double(left) / 2 + 1 : double(left / scalar_size(item_type));
+                if (!(n >= 0) || n > most)
+                    throw Error(f + ": PLY body: element '" + e.name + "' entry " + std::to_string(k) + " has a list of " +
+                                (std::isfinite(n) ? std::to_string(int64_t(std::min(n, 9e18))) : std::string("a non-finite number of")) +
+                                " items, more than the rest of the file holds");
+                if (!skip(uint64_t(n), scalar_size(item_type))) return;
             }
     }
 }
