@@ -37,10 +37,38 @@ struct ForwardFlux {
     double out(double t, int a, int side) const { return ag * t * -sun[a] * side; }
 };
 
+// Light arriving from outside through the medium's faces (Marshak with an
+// incoming partial current J: phi_s / 4 - F / 2 = J): the sky field's
+// source. j[a][side > 0] is J through a face of outward normal side x axis a,
+// for the sky basis L(w) = saturate(w . up), up = +z: J = int over the
+// hemisphere the face sees of L (w . n) dw = 2 pi / 3 on top faces, 2 / 3 on
+// side faces, 0 on bottom faces (below the horizon the sky is the horizon
+// colour, which this basis leaves out). All zero for the sun's field.
+// free_phi, free_flux: the field in free space, held by outside voxels away
+// from the medium (the sky basis's phi = int L dw = pi and flux = int L
+// (-w) dw = (0, 0, -2 pi / 3): light that has not met the cloud; 0 for the
+// sun's field of scattered light).
+struct Incoming {
+    double j[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+    double free_phi = 0, free_flux_z = 0;
+    double at(int a, int side) const { return j[a][side > 0 ? 1 : 0]; }
+    static Incoming sky_basis() {
+        Incoming in;
+        constexpr double kPi = 3.14159265358979323846;
+        in.j[0][0] = in.j[0][1] = in.j[1][0] = in.j[1][1] = 2.0 / 3.0;
+        in.j[2][1] = 2 * kPi / 3;
+        in.free_phi = kPi;
+        in.free_flux_z = -2 * kPi / 3;
+        return in;
+    }
+};
+
 // Outward flux through a Marshak face of a voxel of resistance r = 1.5 sigma'
-// h: phi = 0 at 2D beyond the face, F = D (phi - phi_s) / (h / 2) + G and
-// F = phi_s / 2 give F = (phi + r G) / (r + 2).
-inline double marshak_flux(double phi, double r, double g_out) { return (phi + r * g_out) / (r + kMarshak); }
+// h: phi = 0 at 2D beyond the face (or phi_s / 4 - F / 2 = J with light
+// coming in), F = D (phi - phi_s) / (h / 2) + G give F = (phi - 4 J + r G) / (r + 2).
+inline double marshak_flux(double phi, double r, double g_out, double j_in = 0) { return (phi - 4 * j_in + r * g_out) / (r + kMarshak); }
+// The surface value phi_s = 2 F + 4 J of that face.
+inline double marshak_surface(double phi, double r, double g_out, double j_in) { return 2 * marshak_flux(phi, r, g_out, j_in) + 4 * j_in; }
 
 // One colour's sweep: every voxel with (x + y + z) % 2 == colour reads only
 // voxels of the other colour, so z slabs run in parallel with the same bytes.
@@ -85,7 +113,7 @@ void sweep(Level& L, double reduce, int colour) {
 // outside the medium see the surface, not 0 (measured on the calibration
 // shapes: the same as extrapolating through the surface value, 0.069 against
 // 0.070 mean error). Reads medium voxels only.
-void fill_outside(Level& L, double reduce, bool extrapolate, const ForwardFlux& ff) {
+void fill_outside(Level& L, double reduce, bool extrapolate, const ForwardFlux& ff, const Incoming& in) {
     const double min_sig = kDiffusionMinTau / L.hmin();
     parallel_for_index(L.n[2], [&](int z) {
         for (int y = 0; y < L.n[1]; ++y)
@@ -103,11 +131,11 @@ void fill_outside(Level& L, double reduce, bool extrapolate, const ForwardFlux& 
                         const size_t j = L.idx(cc[0], cc[1], cc[2]);
                         if (L.sig[j] < min_sig) continue;
                         const double rj = 1.5 * reduce * L.sig[j] * L.h[a];
-                        const double surface = 2 * marshak_flux(L.phi[j], rj, ff.out(L.tb[j], a, -side));
+                        const double surface = marshak_surface(L.phi[j], rj, ff.out(L.tb[j], a, -side), in.at(a, -side));
                         acc += extrapolate ? 2 * surface - L.phi[j] : surface;
                         ++cnt;
                     }
-                L.phi[i] = cnt ? static_cast<float>(acc / cnt) : 0.0f; // may be < 0 extrapolated: lookups clamp
+                L.phi[i] = static_cast<float>(cnt ? acc / cnt : in.free_phi); // may be < 0 extrapolated: lookups clamp
             }
     });
 }
@@ -178,12 +206,37 @@ void prolong(const Level& c, Level& f) {
     });
 }
 
-void solve(Level& L, double reduce, int sweeps, bool extrapolate, const ForwardFlux& ff) {
+void solve(Level& L, double reduce, int sweeps, bool extrapolate, const ForwardFlux& ff, const Incoming& in) {
     for (int s = 0; s < sweeps; ++s) {
         sweep(L, reduce, 0);
         sweep(L, reduce, 1);
     }
-    fill_outside(L, reduce, extrapolate, ff);
+    fill_outside(L, reduce, extrapolate, ff, in);
+}
+
+// The incoming light's share of the balance (independent of phi, so it is a
+// source): each Marshak face adds leak x 4 J / ((r + 2) h). Replaces q.
+void set_incoming_source(Level& L, double reduce, const Incoming& in) {
+    const double min_sig = kDiffusionMinTau / L.hmin();
+    L.q.assign(L.size(), 0.0f);
+    parallel_for_index(L.n[2], [&](int z) {
+        for (int y = 0; y < L.n[1]; ++y)
+            for (int x = 0; x < L.n[0]; ++x) {
+                const size_t i = L.idx(x, y, z);
+                if (L.sig[i] < min_sig) continue;
+                double q = 0;
+                const int c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a)
+                    for (int side = -1; side <= 1; side += 2) {
+                        int cc[3] = {c[0], c[1], c[2]};
+                        cc[a] += side;
+                        if (cc[a] >= 0 && cc[a] < L.n[a] && L.sig[L.idx(cc[0], cc[1], cc[2])] >= min_sig) continue;
+                        const double r = 1.5 * reduce * L.sig[i] * L.h[a];
+                        q += L.leak[i] * 4 * in.at(a, side) / ((r + kMarshak) * L.h[a]);
+                    }
+                L.q[i] = static_cast<float>(q);
+            }
+    });
 }
 
 // The forward flux's divergence moved into the source (it does not depend
@@ -216,9 +269,82 @@ void add_forward_source(Level& L, double reduce, const ForwardFlux& ff) {
     L.q = std::move(q);
 }
 
+// Cascade: the coarsest level solved with 4x the sweeps, each finer one
+// started from the coarser solution.
+void cascade(std::vector<Level>& levels, double reduce, int sweeps, bool thick, const ForwardFlux& ff, const Incoming& in) {
+    for (size_t l = levels.size(); l-- > 0;) {
+        if (l + 1 < levels.size()) prolong(levels[l + 1], levels[l]);
+        solve(levels[l], reduce, l + 1 == levels.size() ? 4 * sweeps : sweeps, thick, ff, in);
+    }
+}
+
+// The diffuse flux F = -D grad phi (+ the forward flux) per voxel (per E):
+// the mean of the face fluxes on each axis (marshak_flux outward at the
+// medium's faces); outside voxels next to the medium take their medium
+// neighbours' mean, others 0.
+std::vector<float> voxel_fluxes(const Level& top, double reduce, const ForwardFlux& ff, const Incoming& in) {
+    const double min_sig = kDiffusionMinTau / top.hmin();
+    const Vec3i& res = top.n;
+    const std::vector<float>& phi = top.phi;
+    std::vector<float> flux(3 * top.size(), 0.0f);
+    parallel_for_index(res[2], [&](int z) {
+        for (int y = 0; y < res[1]; ++y)
+            for (int x = 0; x < res[0]; ++x) {
+                const size_t i = top.idx(x, y, z);
+                const double si = top.sig[i];
+                if (si < min_sig) continue;
+                const int c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a) {
+                    const double ri = 1.5 * reduce * si * top.h[a];
+                    double f = 0;
+                    for (int side = -1; side <= 1; side += 2) {
+                        int cc[3] = {c[0], c[1], c[2]};
+                        cc[a] += side;
+                        double face; // flux toward +axis through this face
+                        if (cc[a] >= 0 && cc[a] < res[a] && top.sig[top.idx(cc[0], cc[1], cc[2])] >= min_sig) {
+                            const size_t j = top.idx(cc[0], cc[1], cc[2]);
+                            face = side * ((phi[i] - phi[j]) / (ri + 1.5 * reduce * top.sig[j] * top.h[a]) +
+                                           ff.out(0.5 * (top.tb[i] + top.tb[j]), a, side));
+                        } else {
+                            face = side * marshak_flux(phi[i], ri, ff.out(top.tb[i], a, side), in.at(a, side));
+                        }
+                        f += 0.5 * face;
+                    }
+                    flux[3 * i + size_t(a)] = static_cast<float>(f);
+                }
+            }
+    });
+    parallel_for_index(res[2], [&](int z) {
+        for (int y = 0; y < res[1]; ++y)
+            for (int x = 0; x < res[0]; ++x) {
+                const size_t i = top.idx(x, y, z);
+                if (top.sig[i] >= min_sig) continue;
+                double acc[3] = {0, 0, 0};
+                int cnt = 0;
+                const int c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a)
+                    for (int side = -1; side <= 1; side += 2) {
+                        int cc[3] = {c[0], c[1], c[2]};
+                        cc[a] += side;
+                        if (cc[a] < 0 || cc[a] >= res[a]) continue;
+                        const size_t j = top.idx(cc[0], cc[1], cc[2]);
+                        if (top.sig[j] < min_sig) continue;
+                        // flux of medium voxels is final here: this pass writes outside voxels only
+                        for (int b = 0; b < 3; ++b) acc[b] += flux[3 * j + size_t(b)];
+                        ++cnt;
+                    }
+                if (cnt)
+                    for (int b = 0; b < 3; ++b) flux[3 * i + size_t(b)] = static_cast<float>(acc[b] / cnt);
+                else
+                    flux[3 * i + 2] = static_cast<float>(in.free_flux_z);
+            }
+    });
+    return flux;
+}
+
 } // namespace
 
-DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g, int sweeps, Voxels voxels, bool forward)
+DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g, int sweeps, Voxels voxels, bool forward, bool sky)
     : res_(grid.resolution()), bounds_(grid.bounds()), voxel_(grid.voxel()) {
     const bool thick = voxels == Voxels::Thick;
     const double reduce = 1 - g;
@@ -288,12 +414,7 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
         add_forward_source(fine, reduce, ff);
     }
     while (std::max({levels.back().n[0], levels.back().n[1], levels.back().n[2]}) > 4) levels.push_back(coarsen(levels.back(), size));
-    // Cascade: the coarsest level solved with 4x the sweeps, each finer one
-    // started from the coarser solution.
-    for (size_t l = levels.size(); l-- > 0;) {
-        if (l + 1 < levels.size()) prolong(levels[l + 1], levels[l]);
-        solve(levels[l], reduce, l + 1 == levels.size() ? 4 * sweeps : sweeps, thick, ff);
-    }
+    cascade(levels, reduce, sweeps, thick, ff, Incoming{});
     const Level& top = levels[0]; // (push_back above moved the levels)
     phi_ = top.phi;
     // Outflow through the medium's boundary faces (the conservation check).
@@ -316,75 +437,41 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
                 }
             }
     outflow_total_ = out;
-    // The diffuse flux F = -D grad phi (+ the forward flux) per voxel (per
-    // E): the mean of the face fluxes on each axis (marshak_flux outward at
-    // the medium's faces); outside voxels next to the medium take their
-    // medium neighbours' mean, others 0.
-    flux_.assign(3 * n, 0.0f);
-    parallel_for_index(res_[2], [&](int z) {
-        for (int y = 0; y < res_[1]; ++y)
-            for (int x = 0; x < res_[0]; ++x) {
-                const size_t i = top.idx(x, y, z);
-                const double si = top.sig[i];
-                if (si < min_sig) continue;
-                const int c[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a) {
-                    const double ri = 1.5 * reduce * si * voxel_[a];
-                    double f = 0;
-                    for (int side = -1; side <= 1; side += 2) {
-                        int cc[3] = {c[0], c[1], c[2]};
-                        cc[a] += side;
-                        double face; // flux toward +axis through this face
-                        if (cc[a] >= 0 && cc[a] < res_[a] && top.sig[top.idx(cc[0], cc[1], cc[2])] >= min_sig) {
-                            const size_t j = top.idx(cc[0], cc[1], cc[2]);
-                            face = side * ((phi_[i] - phi_[j]) / (ri + 1.5 * reduce * top.sig[j] * voxel_[a]) +
-                                           ff.out(0.5 * (top.tb[i] + top.tb[j]), a, side));
-                        } else {
-                            face = side * marshak_flux(phi_[i], ri, ff.out(top.tb[i], a, side));
-                        }
-                        f += 0.5 * face;
-                    }
-                    flux_[3 * i + size_t(a)] = static_cast<float>(f);
-                }
-            }
-    });
-    parallel_for_index(res_[2], [&](int z) {
-        for (int y = 0; y < res_[1]; ++y)
-            for (int x = 0; x < res_[0]; ++x) {
-                const size_t i = top.idx(x, y, z);
-                if (top.sig[i] >= min_sig) continue;
-                double acc[3] = {0, 0, 0};
-                int cnt = 0;
-                const int c[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a)
-                    for (int side = -1; side <= 1; side += 2) {
-                        int cc[3] = {c[0], c[1], c[2]};
-                        cc[a] += side;
-                        if (cc[a] < 0 || cc[a] >= res_[a]) continue;
-                        const size_t j = top.idx(cc[0], cc[1], cc[2]);
-                        if (top.sig[j] < min_sig) continue;
-                        // flux_ of medium voxels is final here: this pass writes outside voxels only
-                        for (int b = 0; b < 3; ++b) acc[b] += flux_[3 * j + size_t(b)];
-                        ++cnt;
-                    }
-                if (cnt)
-                    for (int b = 0; b < 3; ++b) flux_[3 * i + size_t(b)] = static_cast<float>(acc[b] / cnt);
-            }
-    });
+    flux_ = voxel_fluxes(top, reduce, ff, Incoming{});
+    if (sky) {
+        // The sky basis saturate(w . up) through the faces: no volume
+        // source, no forward peak; every level gets its own faces' source.
+        const Incoming in = Incoming::sky_basis();
+        for (Level& L : levels) {
+            set_incoming_source(L, reduce, in);
+            std::fill(L.phi.begin(), L.phi.end(), 0.0f);
+        }
+        cascade(levels, reduce, sweeps, thick, ForwardFlux{}, in);
+        sky_phi_ = levels[0].phi;
+        sky_flux_ = voxel_fluxes(levels[0], reduce, ForwardFlux{}, in);
+    }
     g_ = g;
 }
 
-double DiffusionGrid::radiance(double x, double y, double z, const Vec3d& toward_eye) const {
+double DiffusionGrid::p1_weight(const std::vector<float>& phi_grid, const std::vector<float>& flux, double x, double y, double z,
+                                 const Vec3d& toward_eye) const {
     double w[8];
     size_t idx[8];
     corners(x, y, z, idx, w);
     double phi = 0, f[3] = {0, 0, 0};
     for (int k = 0; k < 8; ++k) {
-        phi += w[k] * phi_[idx[k]];
-        for (int b = 0; b < 3; ++b) f[b] += w[k] * flux_[3 * idx[k] + size_t(b)];
+        phi += w[k] * phi_grid[idx[k]];
+        for (int b = 0; b < 3; ++b) f[b] += w[k] * flux[3 * idx[k] + size_t(b)];
     }
     phi = std::max(0.0, phi);
     return std::max(0.0, phi + 3 * g_ * (f[0] * toward_eye[0] + f[1] * toward_eye[1] + f[2] * toward_eye[2]));
+}
+
+double DiffusionGrid::radiance(double x, double y, double z, const Vec3d& toward_eye) const { return p1_weight(phi_, flux_, x, y, z, toward_eye); }
+
+double DiffusionGrid::sky_radiance(double x, double y, double z, const Vec3d& toward_eye) const {
+    constexpr double kFourPi = 4 * 3.14159265358979323846;
+    return sky_phi_.empty() ? -1.0 : p1_weight(sky_phi_, sky_flux_, x, y, z, toward_eye) / kFourPi;
 }
 
 void DiffusionGrid::corners(double x, double y, double z, size_t idx[8], double w[8]) const {

@@ -248,19 +248,23 @@ public:
                 return static_cast<float>(m.density(p, a, true));
             });
             diffusion_ = std::make_unique<detail::DiffusionGrid>(grid, s.extinction, detail::phase_mean_cosine(s), s.ms_diffusion_sweeps,
-                                                                 detail::DiffusionGrid::Voxels::Thick, true);
+                                                                 detail::DiffusionGrid::Voxels::Thick, true, true);
         });
     }
-    // The P1 in-scattered weight at world p (altitude h) toward the eye, -1
-    // outside the patch (the octaves alone there).
-    double radiance(const Vec3d& p, double h, const Vec3d& toward_eye) const {
+    // The P1 in-scattered weights at world p (altitude h) toward the eye:
+    // the sun's (DiffusionGrid::radiance) and the sky basis's
+    // (DiffusionGrid::sky_radiance); -1, -1 outside the patch (the octaves
+    // and the sphere's mean sky alone there).
+    void radiances(const Vec3d& p, double h, const Vec3d& toward_eye, double& sun_w, double& sky_w) const {
+        sun_w = sky_w = -1;
         const Vec3d c = m_.centre();
         const double up = p[2] - c[2];
-        if (!(up > 0)) return -1;
+        if (!(up > 0)) return;
         // Inverse of the radial projection: the patch point under p.
         const double x = c[0] + radius_ * (p[0] - c[0]) / up, y = c[1] + radius_ * (p[1] - c[1]) / up;
-        if (x < box_.min[0] || x > box_.max[0] || y < box_.min[1] || y > box_.max[1] || h < box_.min[2] || h > box_.max[2]) return -1;
-        return diffusion_->radiance(x, y, h, toward_eye);
+        if (x < box_.min[0] || x > box_.max[0] || y < box_.min[1] || y > box_.max[1] || h < box_.min[2] || h > box_.max[2]) return;
+        sun_w = diffusion_->radiance(x, y, h, toward_eye);
+        sky_w = diffusion_->sky_radiance(x, y, h, toward_eye);
     }
 
 private:
@@ -466,10 +470,15 @@ struct LayerIntegrator {
                     const bool cheap_light = trans < 0.7 || tm > 15000; // far samples are hazed and small on screen
                     const double tau = ext * (s.artistic ? sun_depth(pl, cheap_light, trans < 0.3 || tm > 15000) : sun_depth_marched(pl)) * rain;
                     const double sky_tau = ext * sky_depth(pl, hl, col) * rain;
-                    double sun_w, sky_w;
+                    double sun_w, sky_w, diffuse_sun = -1, diffuse_sky = -1;
+                    if (diffusion) diffusion->radiances(pl, hl, dir * -1.0, diffuse_sun, diffuse_sky);
                     const double dp = detail::saturate(shape);
-                    detail::shade(s, st, tau, dp, detail::remap(dp, 0.0, 1.0, 0.25, 0.05), sky_tau, sun_w, sky_w,
-                                  diffusion ? diffusion->radiance(pl, hl, dir * -1.0) : -1.0);
+                    detail::shade(s, st, tau, dp, detail::remap(dp, 0.0, 1.0, 0.25, 0.05), sky_tau, sun_w, sky_w, diffuse_sun);
+                    // The sky's light from the diffusion patch where it has one:
+                    // lerp(horizon, zenith, its weight) instead of the sphere's mean.
+                    double amb[3] = {ambient[0], ambient[1], ambient[2]};
+                    if (diffuse_sky >= 0)
+                        for (int c = 0; c < 3; ++c) amb[c] = sky.at(c, diffuse_sky);
                     const double haze = sc.haze_distance > 0 ? 1 - std::exp(-tm / sc.haze_distance) : 0.0;
                     const double absorbed = -std::expm1(-sigma * dt);
                     const double w = trans * absorbed;
@@ -478,7 +487,7 @@ struct LayerIntegrator {
                         detail::point_light_radiance(s, lights, light_core2, p, dir,
                                                      [&](const Vec3d& q, const Vec3d& d2, double len) { return light_depth(q, d2, len); }, glow);
                     for (int c = 0; c < 3; ++c) {
-                        const double ls = sun_w * s.sun_colour[c] + sky_w * ambient[c] + glow[c];
+                        const double ls = sun_w * s.sun_colour[c] + sky_w * amb[c] + glow[c];
                         rgb[c] += w * (ls + (double(haze_colour[c]) - ls) * haze);
                     }
                     trans *= std::exp(-sigma * dt);
