@@ -10,8 +10,9 @@ void declare(NodeDeclaration& d) {
           "vote with (fast) generalized winding numbers where the rays disagree (survives holes and self-intersections; "
           "metric winding_fallback_voxels). Distances go to the surface of the union of overlapping parts (buried faces "
           "are skipped). method 'edt': exact point-triangle distance within `exact_band` voxels (4 around open rims and "
-          "the grid's faces), exact EDT to the surface's grid-line crossings beyond (over by < 0.5 voxel on closed "
-          "surfaces, up to 0.75 measured beyond open rims); 'openvdb': OpenVDB meshToUnsignedDistanceField (cubic voxels).");
+          "the grid's faces), beyond it the exact EDT to the surface's grid-line crossings lowered by the band's closest "
+          "points carried outwards (over by < 0.3 voxel, up to 0.75 measured where an open surface leaves the grid); "
+          "'openvdb': OpenVDB meshToUnsignedDistanceField (cubic voxels).");
     d.input("mesh", PortType::Mesh, "the mesh (repair foreign meshes with volume/read_mesh)");
     d.output("sdf", PortType::Field3D, "signed distance, metres, channel 'sdf'");
     d.output("density", PortType::Field3D, "1 inside, 0 outside, one-voxel linear edge (0.5 on the surface), channel 'density'");
@@ -44,5 +45,5 @@ void cook(CookContext& ctx) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "volume/mesh_to_sdf", .version = 3, .declare = declare, .cook = cook});
+    registry.add({.name = "volume/mesh_to_sdf", .version = 4, .declare = declare, .cook = cook});
 }

@@ -188,8 +188,9 @@ TEST(MeshSdf, MatchesBruteForce) {
                 const double e = std::abs(got - ref);
                 (std::abs(ref) <= 1.5 ? worst_band : worst) = std::max(std::abs(ref) <= 1.5 ? worst_band : worst, e);
             }
+    std::printf("sphere: band %.2g voxel, beyond %.3f voxel\n", worst_band, worst);
     EXPECT_LT(worst_band, 1e-4); // exact band
-    EXPECT_LT(worst, 0.5);       // documented bound beyond the band
+    EXPECT_LT(worst, 0.3);       // documented bound beyond the band (closest points carried outwards)
 }
 
 TEST(MeshSdf, OpenVdbVariantSignAndError) {
@@ -355,11 +356,15 @@ TEST(MeshSdf, OverlappingSpheresDistanceToUnion) {
                     ASSERT_EQ(got < 0, ref < 0) << x << "," << y << "," << z;
                 }
                 const double e = std::abs(got - ref);
-                (std::abs(ref) <= 1.5 ? worst_band : worst) = std::max(std::abs(ref) <= 1.5 ? worst_band : worst, e);
+                // The exact band is 1.5 voxels from the mesh, which lies up to the chord sag
+                // (< 0.03 m) inside the true spheres: voxels within 0.03 m of the band's edge
+                // may be beyond it (no triangle writes there; the flood's values, < 0.3 voxel off).
+                (std::abs(ref) <= 1.47 ? worst_band : worst) = std::max(std::abs(ref) <= 1.47 ? worst_band : worst, e);
             }
+    std::printf("overlapping spheres: band %.3f voxel, beyond %.3f voxel\n", worst_band, worst);
     // Tessellation (32 x 64 sphere: chord sag < 0.03 m) plus the method's bound.
     EXPECT_LT(worst_band, 0.04);
-    EXPECT_LT(worst, 0.5);
+    EXPECT_LT(worst, 0.3);
 }
 
 TEST(MeshWinding, FastWindingNumberMatchesExact) {
@@ -489,10 +494,10 @@ TEST(MeshSdf, AccuracyNearOpenRimsAndGridEdges) {
             sheet.triangles.push_back({a, a + 22, a + 21});
         }
     const Case cases[] = {
-        {"closed sphere", uv_sphere({{12.3, 11.6, 12.4}}, 7.3, 24, 48), 0.5},
-        {"open cap (rim)", cap, 0.8},
-        {"sphere leaving the grid", uv_sphere({{21.3, 20.6, 12.4}}, 7.3, 24, 48), 0.5},
-        {"sheet leaving the grid", sheet, 0.8},
+        {"closed sphere", uv_sphere({{12.3, 11.6, 12.4}}, 7.3, 24, 48), 0.25},
+        {"open cap (rim)", cap, 0.35},
+        {"sphere leaving the grid", uv_sphere({{21.3, 20.6, 12.4}}, 7.3, 24, 48), 0.3},
+        {"sheet leaving the grid", sheet, 0.8}, // the surface beyond the grid has no band: no points to carry
     };
     for (const Case& c : cases) {
         const Field3D s = mesh_to_sdf(c.mesh, {{24, 24, 24}}, grid_box(24));
@@ -550,10 +555,13 @@ TEST(MeshSdf, OpenVdbMatchesBruteForce) {
                     en.far, en.sign);
         EXPECT_EQ(e.sign, 0);
         EXPECT_LE(e.band, 0.3);
-        // Beyond the band both methods use the same EDT: no worse than `edt`, whose 0.5
-        // voxel claim this bunny breaks (0.61 voxel measured here, docs/volumes.md).
-        EXPECT_LE(e.far, en.far + 1e-3);
+        // Beyond its band `openvdb` has the grid-line crossings' EDT alone (0.61 voxel
+        // measured here, docs/volumes.md); `edt` also carries its band's closest points
+        // outwards (0.23 measured): better, and within its 0.3 claim.
         EXPECT_LE(e.far, 0.65);
+        EXPECT_EQ(en.sign, 0);
+        EXPECT_LE(en.far, 0.3);
+        EXPECT_LE(en.far, e.far);
     }
     {
         const Vec3d c1{{9.2, 12.1, 11.9}}, c2{{14.6, 11.7, 12.3}};

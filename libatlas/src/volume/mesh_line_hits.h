@@ -82,8 +82,10 @@ UnionSurface union_surface(const Mesh& mesh);
 
 // Squared distance from p to the unburied part of straddling triangle ti: its closest
 // point if unburied, else the nearest unburied corner, edge point or intersection
-// segment point (+inf when none). Both mesh SDF methods use it.
-double straddling_squared_distance(const Mesh& mesh, const UnionSurface& us, uint32_t ti, const Vec3d& p);
+// segment point (+inf when none); that point in `closest` when given. Both mesh SDF
+// methods use it.
+double straddling_squared_distance(const Mesh& mesh, const UnionSurface& us, uint32_t ti, const Vec3d& p,
+                                   Vec3d* closest = nullptr);
 
 // Hits whose inside state (count > 0.5, from both ends of the line) does not
 // change across them are interior to the union (a surface crossing inside

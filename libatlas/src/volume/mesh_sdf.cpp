@@ -4,6 +4,7 @@
 #include "atlas/core/parallel.h"
 #include "atlas/volume/mesh_repair.h"
 #include "atlas/volume/mesh_voxelize.h"
+#include "closest_point_flood.h"
 #include "mesh_line_hits.h"
 
 #include <algorithm>
@@ -42,6 +43,13 @@ Vec3d closest_on_triangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const 
 
 double diagonal(const Box3d& b) { return length(b.size()); }
 
+// A triangle at a voxel's distance (squared) in the exact band's outer layer.
+struct BandRecord {
+    uint64_t voxel;
+    float e;
+    uint32_t triangle;
+};
+
 // Exact band (voxels) around rims and near the grid's faces.
 constexpr double kWideBandVoxels = 4;
 
@@ -56,11 +64,17 @@ Vec3d closest_on_segment(const Vec3d& p, const Vec3d& a, const Vec3d& b) {
 
 namespace detail {
 
-double straddling_squared_distance(const Mesh& m, const UnionSurface& us, uint32_t ti, const Vec3d& p) {
+double straddling_squared_distance(const Mesh& m, const UnionSurface& us, uint32_t ti, const Vec3d& p, Vec3d* closest) {
     const auto& t = m.triangles[ti];
     const Vec3d v[3] = {to_d(m.vertices[t[0]]), to_d(m.vertices[t[1]]), to_d(m.vertices[t[2]])};
     double best = std::numeric_limits<double>::infinity();
-    auto offer = [&](const Vec3d& q) { best = std::min(best, dot(q - p, q - p)); };
+    auto offer = [&](const Vec3d& q) {
+        const double e = dot(q - p, q - p);
+        if (e < best) {
+            best = e;
+            if (closest) *closest = q;
+        }
+    };
     const Vec3d q = closest_on_triangle(p, v[0], v[1], v[2]);
     if (!us.point_buried(m, ti, q)) offer(q);
     else {
@@ -123,6 +137,10 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
     // triangles: none. Straddling triangles: the nearest point of their unburied part,
     // which is the triangle's closest point if unburied, else on an edge, a corner
     // or an intersection segment (parallel per triangle, merged in order).
+    // Beyond the band: the grid-line crossings' EDT, lowered by the band's closest
+    // points carried outwards (detail::flood_closest_points): the voxels of the band's
+    // outer layer record which triangle is at their distance (every tied one, so the
+    // records do not depend on which thread came first).
     const double vmin = std::min({h[0], h[1], h[2]});
     const double band = o.exact_band_voxels * vmin;
     // Where grid-line crossings are sparse - beyond an open rim, and where the
@@ -170,6 +188,10 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
     auto centre_of = [&](int x, int y, int z) {
         return Vec3d{{bounds.min[0] + (x + 0.5) * h[0], bounds.min[1] + (y + 0.5) * h[1], bounds.min[2] + (z + 0.5) * h[2]}};
     };
+    // Squared distance beyond which a voxel lies in the outer layer (the last voxel) of a
+    // triangle's exact band bw: its closest point seeds the flood (closest_point_flood.h).
+    auto outer_layer2 = [&](double bw) { return float(std::max(0.0, bw - vmin) * std::max(0.0, bw - vmin)); };
+    std::vector<detail::ClosestPointSeed> seeds;
     auto exact_band = [&](float* d2) {
         if (!(band > 0)) return;
         // Triangles in z-order of their centres (voxel units, z, y, x ascending in
@@ -186,18 +208,25 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
             order[ti] = {key, uint32_t(ti)};
         });
         std::sort(order.begin(), order.end());
-        parallel_blocks(order.size(), 256, [&](size_t o0, size_t o1) {
+        constexpr size_t kBlock = 256;
+        std::vector<std::vector<BandRecord>> records(block_count(order.size(), kBlock) + 1);
+        parallel_blocks(order.size(), kBlock, [&](size_t o0, size_t o1) {
+            std::vector<BandRecord>& rec = records[o0 / kBlock];
             for (size_t oi = o0; oi < o1; ++oi) {
                 const uint32_t ti = order[oi].second;
                 if (!us.trivial() && us.state[ti] != detail::UnionSurface::kSurface) continue;
                 const auto& t = m.triangles[ti];
                 const Vec3d a = to_d(m.vertices[t[0]]), b = to_d(m.vertices[t[1]]), c = to_d(m.vertices[t[2]]);
                 int lo[3], hi[3];
-                if (!voxel_range(a, b, c, lo, hi, needs_wide[ti] ? wide : band)) continue;
+                const double bw = needs_wide[ti] ? wide : band;
+                if (!voxel_range(a, b, c, lo, hi, bw)) continue;
+                // Beyond its band a triangle writes nothing: the flood's points reach there
+                // (a value written there without its point would stop the flood short).
+                const float layer2 = outer_layer2(bw), top2 = float(bw * bw);
                 // The distance to the triangle's plane is a lower bound of the distance to it:
                 // where its square is already above the voxel's value (an upper bound: the
-                // EDT's), the triangle cannot lower it (with a margin for rounding, so the
-                // result is that of the full loop).
+                // EDT's) or the band's, the triangle cannot lower it (with a margin for
+                // rounding, so the result is that of the full loop).
                 const Vec3d nrm = cross(b - a, c - a);
                 const double nn = dot(nrm, nrm);
                 const bool planar = nn > 0 && std::isfinite(nn);
@@ -210,35 +239,74 @@ Field3D mesh_to_sdf(const Mesh& m, Vec3i res, Box3d bounds, const MeshSdfOptions
                             float now = cur.load(std::memory_order_relaxed);
                             if (planar) {
                                 const double pd = dot(p - a, u);
-                                if (pd * pd * (1 - 1e-6) >= double(now)) continue;
+                                if (pd * pd * (1 - 1e-6) >= std::min(double(now), double(top2))) continue;
                             }
                             const Vec3d q = closest_on_triangle(p, a, b, c) - p;
                             const float e = float(dot(q, q));
+                            if (e > now || e > top2) continue;
                             while (e < now && !cur.compare_exchange_weak(now, e, std::memory_order_relaxed)) {}
+                            // Ties (e == now) too: whichever thread came first, every triangle
+                            // at the voxel's final distance leaves a record.
+                            if (e >= layer2) rec.push_back({out.index(x, y, z), e, ti});
                         }
             }
         });
-        if (straddling.empty()) return;
-        std::vector<std::vector<std::pair<size_t, float>>> found(straddling.size());
-        parallel_for_each(straddling.size(), 1, [&](size_t si) {
-            const uint32_t ti = straddling[si];
-            const auto& t = m.triangles[ti];
-            const Vec3d v[3] = {to_d(m.vertices[t[0]]), to_d(m.vertices[t[1]]), to_d(m.vertices[t[2]])};
-            int lo[3], hi[3];
-            if (!voxel_range(v[0], v[1], v[2], lo, hi, needs_wide[ti] ? wide : band)) return;
-            for (int z = lo[2]; z <= hi[2]; ++z)
-                for (int y = lo[1]; y <= hi[1]; ++y)
-                    for (int x = lo[0]; x <= hi[0]; ++x) {
-                        const double best = detail::straddling_squared_distance(m, us, ti, out.voxel_center(x, y, z));
-                        if (best < std::numeric_limits<double>::infinity()) found[si].push_back({out.index(x, y, z), float(best)});
-                    }
+        if (!straddling.empty()) {
+            std::vector<std::vector<std::pair<size_t, float>>> found(straddling.size());
+            parallel_for_each(straddling.size(), 1, [&](size_t si) {
+                const uint32_t ti = straddling[si];
+                const auto& t = m.triangles[ti];
+                const Vec3d v[3] = {to_d(m.vertices[t[0]]), to_d(m.vertices[t[1]]), to_d(m.vertices[t[2]])};
+                int lo[3], hi[3];
+                const double bw = needs_wide[ti] ? wide : band;
+                if (!voxel_range(v[0], v[1], v[2], lo, hi, bw)) return;
+                for (int z = lo[2]; z <= hi[2]; ++z)
+                    for (int y = lo[1]; y <= hi[1]; ++y)
+                        for (int x = lo[0]; x <= hi[0]; ++x) {
+                            const float e = float(detail::straddling_squared_distance(m, us, ti, out.voxel_center(x, y, z)));
+                            if (e <= float(bw * bw)) found[si].push_back({out.index(x, y, z), e});
+                        }
+            });
+            std::vector<BandRecord>& rec = records.back();
+            for (size_t si = 0; si < straddling.size(); ++si) {
+                const float layer2 = outer_layer2(needs_wide[straddling[si]] ? wide : band);
+                for (const auto& [i, e] : found[si]) {
+                    d2[i] = std::min(d2[i], e);
+                    if (e >= layer2) rec.push_back({i, e, straddling[si]});
+                }
+            }
+        }
+        // The outer layer's closest points: each voxel's records at its final distance
+        // (ties: all of them, in block order; equal points in practice, and the flood
+        // takes them in a fixed order), then their points.
+        parallel_for_each(records.size(), 1, [&](size_t bi) {
+            std::erase_if(records[bi], [&](const BandRecord& r) { return r.e != d2[r.voxel]; });
         });
-        for (const auto& f : found)
-            for (const auto& [i, e] : f) d2[i] = std::min(d2[i], e);
+        size_t total = 0;
+        for (const auto& r : records) total += r.size();
+        seeds.resize(total);
+        std::vector<size_t> start(records.size() + 1, 0);
+        for (size_t bi = 0; bi < records.size(); ++bi) start[bi + 1] = start[bi] + records[bi].size();
+        parallel_for_each(records.size(), 1, [&](size_t bi) {
+            for (size_t k = 0; k < records[bi].size(); ++k) {
+                const BandRecord& r = records[bi][k];
+                const size_t v = r.voxel;
+                const int x = int(v % size_t(res[0])), y = int(v / size_t(res[0]) % size_t(res[1])), z = int(v / (size_t(res[0]) * size_t(res[1])));
+                const Vec3d p = centre_of(x, y, z);
+                const auto& t = m.triangles[r.triangle];
+                Vec3d q;
+                if (!us.trivial() && us.state[r.triangle] == detail::UnionSurface::kStraddling)
+                    detail::straddling_squared_distance(m, us, r.triangle, p, &q);
+                else q = closest_on_triangle(p, to_d(m.vertices[t[0]]), to_d(m.vertices[t[1]]), to_d(m.vertices[t[2]]));
+                seeds[start[bi] + k] = {v, q};
+            }
+        });
     };
     // Far field: exact EDT to the crossing points on the grid lines; sign from the vote.
     const float far = float(o.far_distance > 0 ? o.far_distance : diagonal(bounds));
     const uint64_t fallback = detail::mesh_signed_distance(hits, us, m, res, bounds, far, out.channel(0).data(), exact_band);
+    // Beyond the band: the band's closest points carried outwards (no seeds without a band).
+    detail::flood_closest_points(out.channel(0).data(), res, bounds, seeds);
     if (stats) {
         stats->line_hits = hits.total;
         stats->winding_fallback_voxels = fallback;
