@@ -26,6 +26,32 @@ constexpr double kOmega = 1.8;
 // The Marshak boundary's resistance: phi = 0 at 2D beyond the face.
 constexpr double kMarshak = 2.0;
 
+// Every voxel of the level (medium or not: f decides), z slabs in parallel:
+// f(i, c) with c its (x, y, z). Each call may write voxel i's own entries only.
+template <class F>
+void for_voxels(const Level& L, F&& f) {
+    parallel_for_index(L.n[2], [&](int z) {
+        for (int y = 0; y < L.n[1]; ++y)
+            for (int x = 0; x < L.n[0]; ++x) {
+                const int c[3] = {x, y, z};
+                f(L.idx(x, y, z), c);
+            }
+    });
+}
+
+// Voxel c's six faces: f(a, side, j) with j the neighbour across the face on
+// axis a, side -1 / +1, or kNoVoxel beyond the grid's edge.
+inline constexpr size_t kNoVoxel = ~size_t(0);
+template <class F>
+void for_faces(const Level& L, const int c[3], F&& f) {
+    for (int a = 0; a < 3; ++a)
+        for (int side = -1; side <= 1; side += 2) {
+            int cc[3] = {c[0], c[1], c[2]};
+            cc[a] += side;
+            f(a, side, cc[a] >= 0 && cc[a] < L.n[a] ? L.idx(cc[0], cc[1], cc[2]) : kNoVoxel);
+        }
+}
+
 // The forward peak of the first-scattered light (P1 with an anisotropic
 // source): F = -D grad phi + 3 D Q1 with Q1 = g sigma Tbar (-sun), so a face
 // of normal n carries the extra flux ag Tbar (-sun . n), ag = g / (1 - g)
@@ -115,28 +141,18 @@ void sweep(Level& L, double reduce, int colour) {
 // 0.070 mean error). Reads medium voxels only.
 void fill_outside(Level& L, double reduce, bool extrapolate, const ForwardFlux& ff, const Incoming& in) {
     const double min_sig = kDiffusionMinTau / L.hmin();
-    parallel_for_index(L.n[2], [&](int z) {
-        for (int y = 0; y < L.n[1]; ++y)
-            for (int x = 0; x < L.n[0]; ++x) {
-                const size_t i = L.idx(x, y, z);
-                if (L.sig[i] >= min_sig) continue;
-                double acc = 0;
-                int cnt = 0;
-                const int c[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a)
-                    for (int side = -1; side <= 1; side += 2) {
-                        int cc[3] = {c[0], c[1], c[2]};
-                        cc[a] += side;
-                        if (cc[a] < 0 || cc[a] >= L.n[a]) continue;
-                        const size_t j = L.idx(cc[0], cc[1], cc[2]);
-                        if (L.sig[j] < min_sig) continue;
-                        const double rj = 1.5 * reduce * L.sig[j] * L.h[a];
-                        const double surface = marshak_surface(L.phi[j], rj, ff.out(L.tb[j], a, -side), in.at(a, -side));
-                        acc += extrapolate ? 2 * surface - L.phi[j] : surface;
-                        ++cnt;
-                    }
-                L.phi[i] = static_cast<float>(cnt ? acc / cnt : in.free_phi); // may be < 0 extrapolated: lookups clamp
-            }
+    for_voxels(L, [&](size_t i, const int c[3]) {
+        if (L.sig[i] >= min_sig) return;
+        double acc = 0;
+        int cnt = 0;
+        for_faces(L, c, [&](int a, int side, size_t j) {
+            if (j == kNoVoxel || L.sig[j] < min_sig) return;
+            const double rj = 1.5 * reduce * L.sig[j] * L.h[a];
+            const double surface = marshak_surface(L.phi[j], rj, ff.out(L.tb[j], a, -side), in.at(a, -side));
+            acc += extrapolate ? 2 * surface - L.phi[j] : surface;
+            ++cnt;
+        });
+        L.phi[i] = static_cast<float>(cnt ? acc / cnt : in.free_phi); // may be < 0 extrapolated: lookups clamp
     });
 }
 
@@ -219,23 +235,15 @@ void solve(Level& L, double reduce, int sweeps, bool extrapolate, const ForwardF
 void set_incoming_source(Level& L, double reduce, const Incoming& in) {
     const double min_sig = kDiffusionMinTau / L.hmin();
     L.q.assign(L.size(), 0.0f);
-    parallel_for_index(L.n[2], [&](int z) {
-        for (int y = 0; y < L.n[1]; ++y)
-            for (int x = 0; x < L.n[0]; ++x) {
-                const size_t i = L.idx(x, y, z);
-                if (L.sig[i] < min_sig) continue;
-                double q = 0;
-                const int c[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a)
-                    for (int side = -1; side <= 1; side += 2) {
-                        int cc[3] = {c[0], c[1], c[2]};
-                        cc[a] += side;
-                        if (cc[a] >= 0 && cc[a] < L.n[a] && L.sig[L.idx(cc[0], cc[1], cc[2])] >= min_sig) continue;
-                        const double r = 1.5 * reduce * L.sig[i] * L.h[a];
-                        q += L.leak[i] * 4 * in.at(a, side) / ((r + kMarshak) * L.h[a]);
-                    }
-                L.q[i] = static_cast<float>(q);
-            }
+    for_voxels(L, [&](size_t i, const int c[3]) {
+        if (L.sig[i] < min_sig) return;
+        double q = 0;
+        for_faces(L, c, [&](int a, int side, size_t j) {
+            if (j != kNoVoxel && L.sig[j] >= min_sig) return;
+            const double r = 1.5 * reduce * L.sig[i] * L.h[a];
+            q += L.leak[i] * 4 * in.at(a, side) / ((r + kMarshak) * L.h[a]);
+        });
+        L.q[i] = static_cast<float>(q);
     });
 }
 
@@ -245,26 +253,18 @@ void set_incoming_source(Level& L, double reduce, const Incoming& in) {
 void add_forward_source(Level& L, double reduce, const ForwardFlux& ff) {
     const double min_sig = kDiffusionMinTau / L.hmin();
     std::vector<float> q = L.q;
-    parallel_for_index(L.n[2], [&](int z) {
-        for (int y = 0; y < L.n[1]; ++y)
-            for (int x = 0; x < L.n[0]; ++x) {
-                const size_t i = L.idx(x, y, z);
-                if (L.sig[i] < min_sig) continue;
-                double out = 0;
-                const int c[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a)
-                    for (int side = -1; side <= 1; side += 2) {
-                        int cc[3] = {c[0], c[1], c[2]};
-                        cc[a] += side;
-                        if (cc[a] >= 0 && cc[a] < L.n[a] && L.sig[L.idx(cc[0], cc[1], cc[2])] >= min_sig) {
-                            out += ff.out(0.5 * (L.tb[i] + L.tb[L.idx(cc[0], cc[1], cc[2])]), a, side) / L.h[a];
-                        } else {
-                            const double r = 1.5 * reduce * L.sig[i] * L.h[a];
-                            out += L.leak[i] * r * ff.out(L.tb[i], a, side) / (r + kMarshak) / L.h[a];
-                        }
-                    }
-                q[i] = static_cast<float>(L.q[i] - out);
+    for_voxels(L, [&](size_t i, const int c[3]) {
+        if (L.sig[i] < min_sig) return;
+        double out = 0;
+        for_faces(L, c, [&](int a, int side, size_t j) {
+            if (j != kNoVoxel && L.sig[j] >= min_sig) {
+                out += ff.out(0.5 * (L.tb[i] + L.tb[j]), a, side) / L.h[a];
+            } else {
+                const double r = 1.5 * reduce * L.sig[i] * L.h[a];
+                out += L.leak[i] * r * ff.out(L.tb[i], a, side) / (r + kMarshak) / L.h[a];
             }
+        });
+        q[i] = static_cast<float>(L.q[i] - out);
     });
     L.q = std::move(q);
 }
@@ -284,60 +284,37 @@ void cascade(std::vector<Level>& levels, double reduce, int sweeps, bool thick, 
 // neighbours' mean, others 0.
 std::vector<float> voxel_fluxes(const Level& top, double reduce, const ForwardFlux& ff, const Incoming& in) {
     const double min_sig = kDiffusionMinTau / top.hmin();
-    const Vec3i& res = top.n;
     const std::vector<float>& phi = top.phi;
     std::vector<float> flux(3 * top.size(), 0.0f);
-    parallel_for_index(res[2], [&](int z) {
-        for (int y = 0; y < res[1]; ++y)
-            for (int x = 0; x < res[0]; ++x) {
-                const size_t i = top.idx(x, y, z);
-                const double si = top.sig[i];
-                if (si < min_sig) continue;
-                const int c[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a) {
-                    const double ri = 1.5 * reduce * si * top.h[a];
-                    double f = 0;
-                    for (int side = -1; side <= 1; side += 2) {
-                        int cc[3] = {c[0], c[1], c[2]};
-                        cc[a] += side;
-                        double face; // flux toward +axis through this face
-                        if (cc[a] >= 0 && cc[a] < res[a] && top.sig[top.idx(cc[0], cc[1], cc[2])] >= min_sig) {
-                            const size_t j = top.idx(cc[0], cc[1], cc[2]);
-                            face = side * ((phi[i] - phi[j]) / (ri + 1.5 * reduce * top.sig[j] * top.h[a]) +
-                                           ff.out(0.5 * (top.tb[i] + top.tb[j]), a, side));
-                        } else {
-                            face = side * marshak_flux(phi[i], ri, ff.out(top.tb[i], a, side), in.at(a, side));
-                        }
-                        f += 0.5 * face;
-                    }
-                    flux[3 * i + size_t(a)] = static_cast<float>(f);
-                }
-            }
+    for_voxels(top, [&](size_t i, const int c[3]) {
+        const double si = top.sig[i];
+        if (si < min_sig) return;
+        double f[3] = {0, 0, 0};
+        for_faces(top, c, [&](int a, int side, size_t j) {
+            const double ri = 1.5 * reduce * si * top.h[a];
+            double face; // flux toward +axis through this face
+            if (j != kNoVoxel && top.sig[j] >= min_sig)
+                face = side * ((phi[i] - phi[j]) / (ri + 1.5 * reduce * top.sig[j] * top.h[a]) + ff.out(0.5 * (top.tb[i] + top.tb[j]), a, side));
+            else
+                face = side * marshak_flux(phi[i], ri, ff.out(top.tb[i], a, side), in.at(a, side));
+            f[a] += 0.5 * face;
+        });
+        for (int a = 0; a < 3; ++a) flux[3 * i + size_t(a)] = static_cast<float>(f[a]);
     });
-    parallel_for_index(res[2], [&](int z) {
-        for (int y = 0; y < res[1]; ++y)
-            for (int x = 0; x < res[0]; ++x) {
-                const size_t i = top.idx(x, y, z);
-                if (top.sig[i] >= min_sig) continue;
-                double acc[3] = {0, 0, 0};
-                int cnt = 0;
-                const int c[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a)
-                    for (int side = -1; side <= 1; side += 2) {
-                        int cc[3] = {c[0], c[1], c[2]};
-                        cc[a] += side;
-                        if (cc[a] < 0 || cc[a] >= res[a]) continue;
-                        const size_t j = top.idx(cc[0], cc[1], cc[2]);
-                        if (top.sig[j] < min_sig) continue;
-                        // flux of medium voxels is final here: this pass writes outside voxels only
-                        for (int b = 0; b < 3; ++b) acc[b] += flux[3 * j + size_t(b)];
-                        ++cnt;
-                    }
-                if (cnt)
-                    for (int b = 0; b < 3; ++b) flux[3 * i + size_t(b)] = static_cast<float>(acc[b] / cnt);
-                else
-                    flux[3 * i + 2] = static_cast<float>(in.free_flux_z);
-            }
+    for_voxels(top, [&](size_t i, const int c[3]) {
+        if (top.sig[i] >= min_sig) return;
+        double acc[3] = {0, 0, 0};
+        int cnt = 0;
+        for_faces(top, c, [&](int, int, size_t j) {
+            if (j == kNoVoxel || top.sig[j] < min_sig) return;
+            // flux of medium voxels is final here: this pass writes outside voxels only
+            for (int b = 0; b < 3; ++b) acc[b] += flux[3 * j + size_t(b)];
+            ++cnt;
+        });
+        if (cnt)
+            for (int b = 0; b < 3; ++b) flux[3 * i + size_t(b)] = static_cast<float>(acc[b] / cnt);
+        else
+            flux[3 * i + 2] = static_cast<float>(in.free_flux_z);
     });
     return flux;
 }
@@ -419,22 +396,17 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
     phi_ = top.phi;
     // Outflow through the medium's boundary faces (the conservation check).
     double out = 0;
-    for (int z = 0; z < res_[2]; ++z)
+    for (int z = 0; z < res_[2]; ++z) // serial: the same sum for any thread count
         for (int y = 0; y < res_[1]; ++y)
             for (int x = 0; x < res_[0]; ++x) {
                 const size_t i = top.idx(x, y, z);
                 const double si = top.sig[i];
                 if (si < min_sig) continue;
                 const int c[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a) {
-                    const double area = vol / voxel_[a];
-                    for (int side = -1; side <= 1; side += 2) {
-                        int cc[3] = {c[0], c[1], c[2]};
-                        cc[a] += side;
-                        const bool inside = cc[a] >= 0 && cc[a] < res_[a] && top.sig[top.idx(cc[0], cc[1], cc[2])] >= min_sig;
-                        if (!inside) out += top.leak[i] * area * marshak_flux(phi_[i], 1.5 * reduce * si * voxel_[a], ff.out(top.tb[i], a, side));
-                    }
-                }
+                for_faces(top, c, [&](int a, int side, size_t j) {
+                    if (j != kNoVoxel && top.sig[j] >= min_sig) return;
+                    out += top.leak[i] * (vol / voxel_[a]) * marshak_flux(phi_[i], 1.5 * reduce * si * voxel_[a], ff.out(top.tb[i], a, side));
+                });
             }
     outflow_total_ = out;
     flux_ = voxel_fluxes(top, reduce, ff, Incoming{});
