@@ -169,6 +169,38 @@ TEST(MsDiffusion, ThickBlockFacesTheSkyItSees) {
     EXPECT_NEAR(centre_green(render_clouds(sc, s)), 0.3, 1e-3);
 }
 
+TEST(MsDiffusion, LightShedByOneCloudLightsAnother) {
+    // Two walls of cloud (300 m thick, 800 m tall, optical depth 19 across)
+    // face each other across a 200 m gap, the sun straight overhead; the
+    // camera in the gap looks at the right wall's inner face. The light the
+    // left wall sheds into the gap (RenderSettings::ms_inter_cloud) makes
+    // that face brighter; the right wall alone sheds nothing onto itself (its
+    // faces are flat: the rays about their normals meet no medium), so there
+    // the term changes the face by less than 1% (the extra sweeps of the
+    // second solve).
+    auto wall = [](Vec3d p, double x0, double x1) { return std::max({x0 - p[0], p[0] - x1, p[2] - 800.0}); };
+    const CloudScene both = testing::make_scene(64, 1000, [&](Vec3d p) { return std::min(wall(p, 100, 400), wall(p, 600, 900)); },
+                                                [](Vec3d, double) { return 1.0; });
+    const CloudScene right = testing::make_scene(64, 1000, [&](Vec3d p) { return wall(p, 600, 900); }, [](Vec3d, double) { return 1.0; });
+    RenderSettings s = physical(true);
+    s.width = s.height = 5;
+    s.camera.position = {{450, 500, 400}};
+    s.camera.look_at = {{700, 500, 400}};
+    s.camera.up = {{0, 0, 1}};
+    s.camera.fov_deg = 5;
+    s.sun_direction = sun_direction(0, 90);
+    s.extinction = 0.064;
+    auto face = [&](const CloudScene& sc, bool shed) {
+        RenderSettings t = s;
+        t.ms_inter_cloud = shed;
+        return centre_green(render_clouds(sc, t));
+    };
+    const double with = face(both, true), without = face(both, false);
+    EXPECT_GT(with, 1.05 * without) << with << " vs " << without;
+    const double alone_with = face(right, true), alone_without = face(right, false);
+    EXPECT_NEAR(alone_with, alone_without, 0.01 * alone_without) << alone_with << " vs " << alone_without;
+}
+
 TEST(MsDiffusion, SideLitThickBoxIsBrighterThanTheOctaves) {
     // The calibration's worst case (docs/render.md): a uniform 1 km box at
     // optical thickness 16 lit from the side, where the octaves are 31-35%

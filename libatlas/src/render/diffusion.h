@@ -61,9 +61,12 @@ public:
     // peak (P1 with an anisotropic source, Q1 = g sigma_s T (-sun)): the
     // flux gains 3 D Q1 = g / (1 - g) T (-sun) and its divergence moves into
     // the source. false: the source is isotropic.
-    // sky: also solve the sky's field (sky_radiance).
+    // sky: also solve the sky's field (sky_radiance). inter_cloud: add the
+    // light the medium sheds onto other parts of itself (traced through the
+    // grid, two bounces between clouds, the sun's field solved again after
+    // each).
     DiffusionGrid(const LightGrid& grid, double extinction, double g, int sweeps, Voxels voxels = Voxels::Thin, bool forward = false,
-                  bool sky = false);
+                  bool sky = false, bool inter_cloud = false);
     // phi / E at world point p (trilinear, >= 0; outside-medium voxels next
     // to the medium hold the Marshak surface value or the extrapolation
     // through it (Voxels), others 0).
@@ -83,7 +86,8 @@ public:
     // its base (it sees the horizon colour below).
     double sky_radiance(double x, double y, double z, const Vec3d& toward_eye) const;
     // Total source and total outflow through the medium's faces, both per
-    // E (square metres): equal when the solve has converged (no absorption).
+    // E (square metres): equal when the solve has converged (no absorption)
+    // without inter_cloud (with it the faces also pass on the shed light).
     double total_source() const { return source_total_; }
     double total_outflow() const { return outflow_total_; }
 

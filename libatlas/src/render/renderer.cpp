@@ -286,7 +286,7 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
             grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun);
             if (diffuse)
                 diffusion = std::make_unique<detail::DiffusionGrid>(*grid, settings.extinction, detail::phase_mean_cosine(settings), settings.ms_diffusion_sweeps,
-                                                                    detail::DiffusionGrid::Voxels::Thin, true, true);
+                                                                    detail::DiffusionGrid::Voxels::Thin, true, true, settings.ms_inter_cloud);
         });
     report.diffusion = diffusion != nullptr;
 

@@ -109,7 +109,10 @@ struct RenderSettings {
     // scattered sun light is the larger of the octaves' and the diffusion's
     // P1 in-scattered radiance sigma_s (phi + 3 g F . w) / (4 pi)
     // (F = -D grad phi + g / (1 - g) T (-sun): the first scatter's forward
-    // peak; w toward the eye); multiple_scattering scales it. The 2.5D mode
+    // peak; w toward the eye); multiple_scattering scales it. Inside the
+    // grid the sky's colour is lerp(horizon, zenith, the sky field's
+    // weight) instead of the sphere's mean (the same grid solves the sky's
+    // light coming in through the medium's faces). The 2.5D mode
     // solves it over a 16 km patch of its shell (layer.h,
     // kLayerDiffusionPatch).
     // Needs ms_octaves > 0 and multiple_scattering > 0; ignored with
@@ -117,6 +120,11 @@ struct RenderSettings {
     // before it existed). The CLI's --artistic off turns it on.
     bool ms_diffusion = false;
     int ms_diffusion_sweeps = 32;
+    // With ms_diffusion: the light the clouds shed onto each other (two
+    // bounces, traced through the light grid) adds to the diffusion's source
+    // (docs/render.md, "The light clouds shed onto each other"). Library
+    // knob for comparisons; the CLI keeps it on.
+    bool ms_inter_cloud = true;
 };
 
 // Which parts of the method ran (features the scene does not need are left
