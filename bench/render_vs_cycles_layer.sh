@@ -11,7 +11,8 @@
 # render_compare.py --background. The reference: --ref-spp samples, --bounces volume bounces
 # (default 1024: at 128 the superstorm loses ~6% of its light to the cut-off paths). Rows: Cycles reference, Atlas artistic off / on, Atlas quality
 # 0.5 / 2, light grid 64,64,16 / 192,192,48, no diffusion, Cycles at the ladder's sample counts
-# (seed 7). Writes OUT/results.csv, OUT/table.md and docs/images/cycles_layer_error_vs_time.png.
+# (seed 7). Writes OUT/results.csv, OUT/table.md, docs/images/cycles_layer_error_vs_time.png and
+# docs/images/cycles_layer_compare.png (each scene's default preview, the reference, their ratio).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=$ROOT/build
@@ -97,3 +98,15 @@ for name in superstorm hzd_weather fc6_forecast; do
   echo "$name: done" >&2
 done
 $PY "$ROOT/scripts/error_vs_time_plot.py" "$CSV" "$OUT/table.md" "$ROOT/docs/images/cycles_layer_error_vs_time.png"
+# The default preview beside the reference, per scene, and where it is brighter or darker.
+$PY -c "
+import sys; sys.path.insert(0, '$ROOT/scripts')
+import render_compare as rc
+rows = []
+for name in ('superstorm', 'hzd_weather', 'fc6_forecast'):
+    d = '$OUT/' + name
+    rows.append((rc.luminance(d + '/physical_default.exr'), rc.composite_luminance(d + '/ref.cycles.exr', d + '/background.exr'),
+                 rc.cloud_mask(d + '/physical_default.exr')))
+rc.comparison_rows(rows, '$ROOT/docs/images/cycles_layer_compare.png')
+"
+echo "wrote $ROOT/docs/images/cycles_layer_compare.png" >&2

@@ -73,6 +73,31 @@ def metrics(y, ref, threshold=0.05, cloud=None):
     return m
 
 
+def comparison_rows(rows, out_png, scale=3):
+    """A picture of the comparison: per row (preview luminance, reference luminance, cloud mask) the
+    preview, the reference (both gamma 2.2 over the reference's 99th percentile) and their ratio on
+    the cloud pixels (red: the preview brighter, blue: darker, full colour at a factor of 2; grey off
+    the clouds), each pixel scale x scale. Written with OpenImageIO (docs/render.md)."""
+    strips = []
+    for y, ref, cloud in rows:
+        top = max(float(np.percentile(ref, 99)), 1e-12)
+        a = np.clip(y / top, 0, 1) ** (1 / 2.2)
+        b = np.clip(ref / top, 0, 1) ** (1 / 2.2)
+        r = np.where(cloud, np.log2(np.maximum(y, 1e-9) / np.maximum(ref, 1e-9)), 0.0)
+        red, blue = np.clip(r, 0, 1), np.clip(-r, 0, 1)
+        ratio = np.stack([1 - blue, 1 - red - blue, 1 - red], -1) * np.where(cloud, 1.0, 0.5)[..., None]
+        grey = lambda v: np.repeat(v[..., None], 3, -1)
+        strips.append(np.concatenate([grey(a), grey(b), np.clip(ratio, 0, 1)], 1))
+    img = np.concatenate(strips, 0)
+    img = np.repeat(np.repeat(img, scale, 0), scale, 1)
+    out = oiio.ImageOutput.create(out_png)
+    if out is None:
+        raise SystemExit(f"{out_png}: {oiio.geterror()}")
+    out.open(out_png, oiio.ImageSpec(img.shape[1], img.shape[0], 3, oiio.UINT8))
+    out.write_image(np.ascontiguousarray((img * 255 + 0.5).astype(np.uint8)))
+    out.close()
+
+
 def main(argv):
     args = [a for a in argv[1:] if not a.startswith("--")]
     threshold = 0.05
