@@ -182,14 +182,12 @@ TEST(MsDiffusion, LightShedByOneCloudLightsAnother) {
     const CloudScene both = testing::make_scene(64, 1000, [&](Vec3d p) { return std::min(wall(p, 100, 400), wall(p, 600, 900)); },
                                                 [](Vec3d, double) { return 1.0; });
     const CloudScene right = testing::make_scene(64, 1000, [&](Vec3d p) { return wall(p, 600, 900); }, [](Vec3d, double) { return 1.0; });
-    RenderSettings s = physical(true);
-    s.width = s.height = 5;
+    RenderSettings s = slab_view(true, 0.33); // 5 x 5, extinction 0.064, g = 0.33; then the view into the gap
     s.camera.position = {{450, 500, 400}};
     s.camera.look_at = {{700, 500, 400}};
     s.camera.up = {{0, 0, 1}};
     s.camera.fov_deg = 5;
     s.sun_direction = sun_direction(0, 90);
-    s.extinction = 0.064;
     auto face = [&](const CloudScene& sc, bool shed) {
         RenderSettings t = s;
         t.ms_inter_cloud = shed;

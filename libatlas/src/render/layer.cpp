@@ -297,7 +297,6 @@ struct LayerIntegrator {
     const RenderSettings& s;
     Vec3d sun;
     Vec3d cam_up; // local up at the camera
-    double ambient[3];
     double base_step, grow, max_step;
     double light_step;
     double r_ground, r_inner, r_outer;
@@ -471,15 +470,10 @@ struct LayerIntegrator {
                     const bool cheap_light = trans < 0.7 || tm > 15000; // far samples are hazed and small on screen
                     const double tau = ext * (s.artistic ? sun_depth(pl, cheap_light, trans < 0.3 || tm > 15000) : sun_depth_marched(pl)) * rain;
                     const double sky_tau = ext * sky_depth(pl, hl, col) * rain;
-                    double sun_w, sky_w, diffuse_sun = -1, diffuse_sky = -1;
-                    if (diffusion) diffusion->radiances(pl, hl, dir * -1.0, diffuse_sun, diffuse_sky);
+                    double sun_w, sky_w, diffuse_sun = -1, sky_field = -1;
+                    if (diffusion) diffusion->radiances(pl, hl, dir * -1.0, diffuse_sun, sky_field);
                     const double dp = detail::saturate(shape);
                     detail::shade(s, st, tau, dp, detail::remap(dp, 0.0, 1.0, 0.25, 0.05), sky_tau, sun_w, sky_w, diffuse_sun);
-                    // The sky's light from the diffusion patch where it has one:
-                    // lerp(horizon, zenith, its weight) instead of the sphere's mean.
-                    double amb[3] = {ambient[0], ambient[1], ambient[2]};
-                    if (diffuse_sky >= 0)
-                        for (int c = 0; c < 3; ++c) amb[c] = sky.at(c, diffuse_sky);
                     const double haze = sc.haze_distance > 0 ? 1 - std::exp(-tm / sc.haze_distance) : 0.0;
                     const double absorbed = -std::expm1(-sigma * dt);
                     const double w = trans * absorbed;
@@ -488,7 +482,7 @@ struct LayerIntegrator {
                         detail::point_light_radiance(s, lights, light_core2, p, dir,
                                                      [&](const Vec3d& q, const Vec3d& d2, double len) { return light_depth(q, d2, len); }, glow);
                     for (int c = 0; c < 3; ++c) {
-                        const double ls = sun_w * s.sun_colour[c] + sky_w * amb[c] + glow[c];
+                        const double ls = sun_w * s.sun_colour[c] + sky_w * sky.light(c, sky_field) + glow[c];
                         rgb[c] += w * (ls + (double(haze_colour[c]) - ls) * haze);
                     }
                     trans *= std::exp(-sigma * dt);
@@ -514,7 +508,7 @@ struct LayerIntegrator {
             const double lit = std::max(0.0, dot(n, sun));
             const double haze = sc.haze_distance > 0 ? 1 - std::exp(-tg / sc.haze_distance) : 0.0;
             for (int c = 0; c < 3; ++c) {
-                const double g = sc.ground_albedo[c] * (s.sun_colour[c] * lit + ambient[c]);
+                const double g = sc.ground_albedo[c] * (s.sun_colour[c] * lit + sky.ambient[c]);
                 out[c] = g + (double(haze_colour[c]) - g) * haze;
             }
             return;
@@ -536,7 +530,7 @@ struct LayerIntegrator {
             if (!(a > 0)) continue;
             const double ph = 0.55 + 0.45 * std::min(4.0, detail::hg(dot(dir, sun), 0.5));
             for (int c = 0; c < 3; ++c) {
-                const double lc = 0.8 * s.sun_colour[c] * ph * std::max(0.1, sun[2] + 0.2) + 0.6 * ambient[c];
+                const double lc = 0.8 * s.sun_colour[c] * ph * std::max(0.1, sun[2] + 0.2) + 0.6 * sky.ambient[c];
                 out[c] += (lc - out[c]) * a;
             }
         }
@@ -595,7 +589,6 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
                        settings,
                        detail::normalized(settings.sun_direction),
                        detail::normalized(settings.camera.position - model.centre()),
-                       {sky.ambient[0], sky.ambient[1], sky.ambient[2]},
                        std::clamp(thickness / 96.0, 5.0, 60.0) / settings.quality,
                        2500.0, // the step doubles every 2.5 km of distance
                        400.0 / settings.quality, // at most 400 m (the search strides twice that)

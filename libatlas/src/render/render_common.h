@@ -183,6 +183,10 @@ struct Sky {
         for (int c = 0; c < 3; ++c) ambient[c] = double(horizon[c]) + (double(zenith[c]) - double(horizon[c])) * k;
     }
     double at(int c, double up_t) const { return double(horizon[c]) + (double(zenith[c]) - double(horizon[c])) * up_t; }
+    // The sky's light in a cloud: with the diffusion's sky field (its weight
+    // field >= 0, DiffusionGrid::sky_radiance) lerp(horizon, zenith, field),
+    // else (field < 0: no field there) the ambient mean.
+    double light(int c, double field) const { return field >= 0 ? at(c, field) : ambient[c]; }
 };
 
 // The pinhole camera of the settings: the view direction of pixel (x, y),

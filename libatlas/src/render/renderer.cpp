@@ -105,8 +105,7 @@ struct Integrator {
     double light_step;
     double ref_step;
     bool near_detail;
-    double ambient[3];                // sky light reaching the cloud, per channel
-    const detail::Sky& sky;           // zenith and horizon (the diffusion's sky field)
+    const detail::Sky& sky;           // the sky light reaching the cloud: its mean, or the diffusion's sky field
     const std::vector<PointLight>& lights;
     double light_core2;               // squared core radius of the inverse-square falloff
 
@@ -210,17 +209,12 @@ struct Integrator {
                     double sun_w, sky_w;
                     detail::shade(s, st, ext * sun_sum, detail::saturate(v.profile), remap(v.sdf, -128.0, 0.0, 0.05, 0.25), ext * sky_sum,
                                   sun_w, sky_w, diffusion ? diffusion->radiance(p[0], p[1], p[2], dir * -1.0) : -1.0);
-                    // The sky's light from the diffusion's sky field where there is one:
-                    // lerp(horizon, zenith, its weight) instead of the sphere's mean.
-                    double amb[3] = {ambient[0], ambient[1], ambient[2]};
-                    const double diffuse_sky = diffusion ? diffusion->sky_radiance(p[0], p[1], p[2], dir * -1.0) : -1.0;
-                    if (diffuse_sky >= 0)
-                        for (int c = 0; c < 3; ++c) amb[c] = sky.at(c, diffuse_sky);
+                    const double sky_field = diffusion ? diffusion->sky_radiance(p[0], p[1], p[2], dir * -1.0) : -1.0;
                     // Energy-conserving step integral: (1 - exp(-sigma dt)) of the
                     // light is scattered toward the eye (albedo 1).
                     const double absorbed = -std::expm1(-sigma * dt);
                     const double w = trans * absorbed;
-                    for (int c = 0; c < 3; ++c) rgb[c] += w * (sun_w * s.sun_colour[c] + sky_w * amb[c]);
+                    for (int c = 0; c < 3; ++c) rgb[c] += w * (sun_w * s.sun_colour[c] + sky_w * sky.light(c, sky_field));
                     if constexpr (kLights) {
                         double glow[3];
                         point_light_radiance(p, dir, glow);
@@ -300,7 +294,6 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
                   fast ? 0.5 * grid->voxel_min() : 0.0,
                   settings.reference_step > 0 ? settings.reference_step : 0.25 * vmin,
                   report.near_camera_detail,
-                  {sky.ambient[0], sky.ambient[1], sky.ambient[2]},
                   sky,
                   lights,
                   0.25 * vmin * vmin};
