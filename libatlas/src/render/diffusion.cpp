@@ -157,6 +157,18 @@ void fill_outside(Level& L, double reduce, bool extrapolate, const ForwardFlux& 
     });
 }
 
+// The extinction's gradient at voxel c, per metre per metre (central
+// differences, 0 beyond the grid): the surface's inward normal direction.
+Vec3d extinction_gradient(const Level& L, const int c[3]) {
+    auto sig = [&](int x, int y, int z) {
+        if (x < 0 || y < 0 || z < 0 || x >= L.n[0] || y >= L.n[1] || z >= L.n[2]) return 0.0;
+        return double(L.sig[L.idx(x, y, z)]);
+    };
+    const int x = c[0], y = c[1], z = c[2];
+    return Vec3d{{(sig(x + 1, y, z) - sig(x - 1, y, z)) / L.h[0], (sig(x, y + 1, z) - sig(x, y - 1, z)) / L.h[1],
+                  (sig(x, y, z + 1) - sig(x, y, z - 1)) / L.h[2]}};
+}
+
 // A smooth surface of unit normal n drawn in voxel faces has |nx| + |ny| +
 // |nz| times its area on the axis faces (1.5x on average over a sphere), so
 // the Marshak leak through a boundary voxel's faces is scaled by 1 / that
@@ -164,18 +176,10 @@ void fill_outside(Level& L, double reduce, bool extrapolate, const ForwardFlux& 
 // Axis-aligned faces (a box) keep factor 1; so does a voxel with no gradient.
 void leak_factors(Level& L) {
     L.leak.assign(L.size(), 1.0f);
-    auto sig = [&](int x, int y, int z) {
-        if (x < 0 || y < 0 || z < 0 || x >= L.n[0] || y >= L.n[1] || z >= L.n[2]) return 0.0;
-        return double(L.sig[L.idx(x, y, z)]);
-    };
-    parallel_for_index(L.n[2], [&](int z) {
-        for (int y = 0; y < L.n[1]; ++y)
-            for (int x = 0; x < L.n[0]; ++x) {
-                const double g[3] = {(sig(x + 1, y, z) - sig(x - 1, y, z)) / L.h[0], (sig(x, y + 1, z) - sig(x, y - 1, z)) / L.h[1],
-                                     (sig(x, y, z + 1) - sig(x, y, z - 1)) / L.h[2]};
-                const double l2 = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]), l1 = std::fabs(g[0]) + std::fabs(g[1]) + std::fabs(g[2]);
-                if (l1 > 0) L.leak[L.idx(x, y, z)] = static_cast<float>(l2 / l1);
-            }
+    for_voxels(L, [&](size_t i, const int c[3]) {
+        const Vec3d g = extinction_gradient(L, c);
+        const double l2 = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]), l1 = std::fabs(g[0]) + std::fabs(g[1]) + std::fabs(g[2]);
+        if (l1 > 0) L.leak[i] = static_cast<float>(l2 / l1);
     });
 }
 
@@ -349,19 +353,15 @@ std::vector<float> shed_light_source(const Level& L, double reduce, const Forwar
         if (!medium(i)) return;
         double acc = 0;
         int cnt = 0;
+        // The outgoing partial current: the net outflow plus what came in.
+        const double j_in = jin.empty() ? 0.0 : double(jin[i]);
         for_faces(L, c, [&](int a, int side, size_t j) {
             if (medium(j)) return;
-            // The outgoing partial current: the net outflow plus what came in.
-            const double j_in = jin.empty() ? 0.0 : double(jin[i]);
             acc += std::max(0.0, marshak_flux(L.phi[i], 1.5 * reduce * L.sig[i] * L.h[a], ff.out(L.tb[i], a, side), j_in) + j_in);
             ++cnt;
         });
         if (cnt) jout[i] = static_cast<float>(acc / cnt);
     });
-    auto sig = [&](int x, int y, int z) {
-        if (x < 0 || y < 0 || z < 0 || x >= L.n[0] || y >= L.n[1] || z >= L.n[2]) return 0.0;
-        return double(L.sig[L.idx(x, y, z)]);
-    };
     const double hm = L.hmin();
     constexpr double kTwoPi = 6.283185307179586;
     std::vector<float> q(L.size(), 0.0f), jn(L.size(), 0.0f);
@@ -375,8 +375,7 @@ std::vector<float> shed_light_source(const Level& L, double reduce, const Forwar
             faces[a] += side;
         });
         if (conductance == 0) return;
-        const int x = c[0], y = c[1], z = c[2];
-        Vec3d n{{sig(x - 1, y, z) - sig(x + 1, y, z), sig(x, y - 1, z) - sig(x, y + 1, z), sig(x, y, z - 1) - sig(x, y, z + 1)}};
+        Vec3d n = extinction_gradient(L, c) * -1.0; // outward, in metres (not voxel units: the 2.5D patch's voxels are flatter than wide)
         if (!(dot(n, n) > 0)) n = Vec3d{{faces[0], faces[1], faces[2]}}; // no gradient: the open faces' mean
         if (!(dot(n, n) > 0)) return;
         n = normalized(n);
