@@ -47,13 +47,21 @@ public:
     //          change across the voxel on axis a (the steeper one-sided
     //          difference, their sum capped at the centre's depth); outside
     //          voxels hold the value extrapolated through the surface value
-    //          (2 phi_s - phi), so lookups fall to phi_s at the surface. On a
-    //          flat deck (tests/render/diffusion_test.cpp) the mean chord's
-    //          deposit depends on the sun's angle in thick voxels (optical
-    //          depth 5.3 per voxel: 0.43 of Chandrasekhar's reflection with
-    //          the sun 25 degrees high, 0.98 at 60); this stays within 6% at
-    //          1.3 per voxel for the sun 25-80 degrees high, and is 30-35%
-    //          too bright at 5.3 per voxel at every angle.
+    //          (2 phi_s - phi), so lookups fall to phi_s at the surface.
+    //          Where half a voxel is more than one optical depth thick (fading
+    //          in up to 2), the source lies near the sunward face: that
+    //          Marshak face passes q h L(x) straight out (L the Langevin
+    //          function of half the sun's optical depth change x across the
+    //          voxel), and the lookups put the share of the rise to the
+    //          node's phi that a view ray meets within the source's depth at
+    //          the face. On a flat deck (tests/render/diffusion_test.cpp) the
+    //          mean chord's deposit depends on the sun's angle in thick
+    //          voxels (optical depth 5.3 per voxel: 0.43 of Chandrasekhar's
+    //          reflection with the sun 25 degrees high, 0.98 at 60); this
+    //          stays within 6% at 1.3 per voxel for the sun 25-80 degrees
+    //          high, and within 14% at 5.3 per voxel (0.86 / 1.00 / 0.98 with
+    //          the sun 25 / 60 / 80 degrees high; 1.35 / 1.36 / 1.30 with
+    //          the source at the voxel's centre).
     enum class Voxels { Thin, Thick };
     // extinction: per metre at density 1; g: the phase function's mean
     // cosine; sweeps: red-black SOR sweeps per level (the coarsest gets 4x).

@@ -227,16 +227,17 @@ public:
         const int levels = std::max(s.light_grid[2] - 2, static_cast<int>(std::ceil(thickness / dx)));
         const double dz = thickness / levels;
         const Vec3i res{{s.light_grid[0], s.light_grid[1], levels + 2}};
-        // Refused before allocating: about 88 bytes per voxel (the light
-        // grid's density, sun and sky depths, the solver's levels, the sun's
-        // and the sky's fields and fluxes, the shed light's passes).
+        // Refused before allocating: about 100 bytes per voxel (the light
+        // grid's density, sun and sky depths, the solver's levels, the
+        // near-face source's depth changes, the sun's and the sky's fields
+        // and fluxes, the shed light's passes).
         const double voxels = double(res[0]) * res[1] * res[2];
         if (voxels > kMaxPatchVoxels) {
             char buf[320];
             std::snprintf(buf, sizeof buf,
                           "render (2.5D): the diffusion patch would hold %d x %d x %d voxels (%.0f M, about %.1f GB; at most %.0f M): lower the light "
                           "grid (--light-grid), or turn the term off (--ms-diffusion off)",
-                          res[0], res[1], res[2], voxels / 1e6, voxels * 88 / 1e9, kMaxPatchVoxels / 1e6);
+                          res[0], res[1], res[2], voxels / 1e6, voxels * 100 / 1e9, kMaxPatchVoxels / 1e6);
             throw Error(buf);
         }
         box_ = Box3d{{{patch.min[0], patch.min[1], m.bottom() - dz}}, {{patch.max[0], patch.max[1], m.top() + dz}}};
