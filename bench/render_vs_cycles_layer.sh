@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The 2.5D preview's luminance error against Blender's Cycles (docs/render.md, "2.5D against Cycles").
 #
-#   bench/render_vs_cycles_layer.sh [--build DIR] [--out DIR] [--size WxH] [--ref-spp N] [--bounces N] [--ladder "1 4 .."] [--reuse-ref]
+#   bench/render_vs_cycles_layer.sh [--build DIR] [--out DIR] [--size WxH] [--ref-spp N] [--ref-seeds K] [--bounces N] [--ladder "1 4 .."] [--reuse-ref]
 #
 # Per graph (superstorm: --view orbit:30,25; hzd_weather, fc6_forecast: the same with --fov 20): atlas preview
 # --artistic off --export-scene bakes the layer's density over a 16 km patch under the camera's
@@ -9,7 +9,10 @@
 # layers); the same at --extinction 0 gives the preview's background (sky and ground); Cycles
 # renders the patch with a transparent film (--alpha), composited over that background by
 # render_compare.py --background. The reference: --ref-spp samples, --bounces volume bounces
-# (default 1024: at 128 the superstorm loses ~6% of its light to the cut-off paths). Rows: Cycles reference, Atlas artistic off / on, Atlas quality
+# (default 1024: at 128 the superstorm loses ~6% of its light to the cut-off paths), the mean of
+# --ref-seeds independent renders (seeds 0..K-1, default 4: one 1024-spp render is ~4% from the
+# others per pixel, which the preview's error would carry; the row "one seed against the others"
+# gives that noise). --reuse-ref keeps OUT's renders whose samples and bounces match. Rows: Cycles reference, Atlas artistic off / on, Atlas quality
 # 0.5 / 2, light grid 64,64,16 / 192,192,48, no diffusion, Cycles at the ladder's sample counts
 # (seed 7). Writes OUT/results.csv, OUT/table.md, docs/images/cycles_layer_error_vs_time.png and
 # docs/images/cycles_layer_compare.png (each scene's default preview, the reference, their ratio).
@@ -19,6 +22,7 @@ BUILD=$ROOT/build
 OUT=$ROOT/build/render_vs_cycles_layer
 SIZE=160x90
 REF_SPP=1024
+REF_SEEDS=4
 BOUNCES=1024
 LADDER="1 4 16 64 256"
 REUSE=0
@@ -28,6 +32,7 @@ while [ $# -gt 0 ]; do
     --out) OUT=$2; shift 2 ;;
     --size) SIZE=$2; shift 2 ;;
     --ref-spp) REF_SPP=$2; shift 2 ;;
+    --ref-seeds) REF_SEEDS=$2; shift 2 ;;
     --bounces) BOUNCES=$2; shift 2 ;;
     --ladder) LADDER=$2; shift 2 ;;
     --reuse-ref) REUSE=1; shift ;;
@@ -69,15 +74,28 @@ for name in superstorm hzd_weather fc6_forecast; do
   g=$ROOT/graphs/$name.yaml
   t=$(atlas "$d/physical_default.exr" "$g" --view orbit:30,25 $FOV --artistic off --export-scene "$d/scene")
   atlas "$d/background.exr" "$g" --view orbit:30,25 $FOV --artistic off --extinction 0 --export-scene "$d/scene_bg" > /dev/null
-  ref=$d/ref.cycles.exr
-  if [ $REUSE = 1 ] && [ -f "$ref" ] && [ "$($PY -c "import json; j = json.load(open('$ref.json')); print(j['samples'], j.get('bounces', 128))" 2>/dev/null)" = "$REF_SPP $BOUNCES" ]; then
-    tref=$($PY -c "import json; print('%.2f' % json.load(open('$ref.json'))['seconds'])")
-  else
-    tref=$(cycles "$d/scene" "$ref" "$REF_SPP" 0)
-  fi
-  echo "$name: cycles reference $REF_SPP spp in $tref s; $(grep -o 'exported.*voxels of [0-9.]* m' "$d/physical_default.exr.log")" >&2
+  # The reference: seed 0 in ref.cycles.exr, seed k in ref_seed<k>.cycles.exr, their mean in ref_mean.cycles.exr.
+  refs=() tref=0
+  for ((k = 0; k < REF_SEEDS; ++k)); do
+    r=$d/ref.cycles.exr; [ $k = 0 ] || r=$d/ref_seed$k.cycles.exr
+    if [ $REUSE = 1 ] && [ -f "$r" ] && [ "$($PY -c "import json; j = json.load(open('$r.json')); print(j['samples'], j.get('bounces', 128))" 2>/dev/null)" = "$REF_SPP $BOUNCES" ]; then
+      t=$($PY -c "import json; print('%.2f' % json.load(open('$r.json'))['seconds'])")
+    else
+      t=$(cycles "$d/scene" "$r" "$REF_SPP" $k)
+    fi
+    tref=$($PY -c "print('%.2f' % ($tref + $t))")
+    [ $k != 0 ] || t0=$t
+    refs+=("$r")
+  done
+  ref=$d/ref_mean.cycles.exr
+  $PY -c "import sys; sys.path.insert(0, '$ROOT/scripts'); import render_compare as rc; rc.average_images(sys.argv[1:], '$ref')" "${refs[@]}"
+  echo "$name: cycles reference $REF_SEEDS x $REF_SPP spp in $tref s; $(grep -o 'exported.*voxels of [0-9.]* m' "$d/physical_default.exr.log")" >&2
   mask=$d/physical_default.exr
-  row "$name" cycles "$REF_SPP spp (reference)" "$tref" "$ref" "$ref" "$d/background.exr" "$mask"
+  row "$name" cycles "$REF_SEEDS x $REF_SPP spp (reference)" "$tref" "$ref" "$ref" "$d/background.exr" "$mask"
+  if [ "$REF_SEEDS" -gt 1 ]; then # the reference's own noise: seed 0 against the mean of the others
+    $PY -c "import sys; sys.path.insert(0, '$ROOT/scripts'); import render_compare as rc; rc.average_images(sys.argv[1:], '$d/ref_others.cycles.exr')" "${refs[@]:1}"
+    row "$name" cycles "$REF_SPP spp, seed 0 against the other seeds' mean (the reference's noise)" "$t0" "${refs[0]}" "$d/ref_others.cycles.exr" "$d/background.exr" "$mask"
+  fi
   row "$name" atlas "artistic off; defaults" "$t" "$d/physical_default.exr" "$ref" "$d/background.exr" "$mask"
   t=$(atlas "$d/artistic_on.exr" "$g" --view orbit:30,25 $FOV --artistic on --export-scene "$d/scene_on")
   row "$name" atlas "artistic on (the look); defaults" "$t" "$d/artistic_on.exr" "$ref" "$d/background.exr" "$mask"
@@ -105,7 +123,7 @@ import render_compare as rc
 rows = []
 for name in ('superstorm', 'hzd_weather', 'fc6_forecast'):
     d = '$OUT/' + name
-    rows.append((rc.luminance(d + '/physical_default.exr'), rc.composite_luminance(d + '/ref.cycles.exr', d + '/background.exr'),
+    rows.append((rc.luminance(d + '/physical_default.exr'), rc.composite_luminance(d + '/ref_mean.cycles.exr', d + '/background.exr'),
                  rc.cloud_mask(d + '/physical_default.exr')))
 rc.comparison_rows(rows, '$ROOT/docs/images/cycles_layer_compare.png')
 "

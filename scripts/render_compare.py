@@ -48,6 +48,31 @@ def composite_luminance(reference, background):
     return y + (1 - c["a"]) * yb
 
 
+def average_images(paths, out):
+    """The per-channel mean of same-sized EXRs (independent renders of one scene: a reference of
+    their summed samples; linear in premultiplied RGBA, so compositing the mean is the mean of the
+    composites), written as a float EXR with the first one's channel names (OpenImageIO)."""
+    specs, sums = None, None
+    for p in paths:
+        inp = oiio.ImageInput.open(p)
+        if inp is None:
+            raise SystemExit(f"{p}: {oiio.geterror()}")
+        spec = inp.spec()
+        px = np.asarray(inp.read_image(0, 0, 0, spec.nchannels, oiio.FLOAT), dtype=np.float64)
+        inp.close()
+        if specs is None:
+            specs, sums = spec, px
+        elif (spec.width, spec.height, list(spec.channelnames)) != (specs.width, specs.height, list(specs.channelnames)):
+            raise SystemExit(f"{p}: size or channels differ from {paths[0]}")
+        else:
+            sums = sums + px
+    spec = oiio.ImageSpec(specs.width, specs.height, specs.nchannels, oiio.FLOAT)
+    spec.channelnames = specs.channelnames
+    o = oiio.ImageOutput.create(out)
+    if o is None or not o.open(out, spec) or not o.write_image((sums / len(paths)).astype(np.float32)) or not o.close():
+        raise SystemExit(f"{out}: {oiio.geterror()}")
+
+
 def cloud_mask(path, max_transmittance=0.9):
     """Pixels where an Atlas preview EXR sees cloud (transmittance below max_transmittance)."""
     return channels(path)["transmittance"] < max_transmittance
