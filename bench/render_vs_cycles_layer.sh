@@ -94,7 +94,7 @@ for name in superstorm hzd_weather fc6_forecast; do
   row "$name" cycles "$REF_SEEDS x $REF_SPP spp (reference)" "$tref" "$ref" "$ref" "$d/background.exr" "$mask"
   if [ "$REF_SEEDS" -gt 1 ]; then # the reference's own noise: seed 0 against the mean of the others
     $PY -c "import sys; sys.path.insert(0, '$ROOT/scripts'); import render_compare as rc; rc.average_images(sys.argv[1:], '$d/ref_others.cycles.exr')" "${refs[@]:1}"
-    row "$name" cycles "$REF_SPP spp, seed 0 against the other seeds' mean (the reference's noise)" "$t0" "${refs[0]}" "$d/ref_others.cycles.exr" "$d/background.exr" "$mask"
+    row "$name" cycles "$REF_SPP spp, seed 0 against the mean of the other seeds (the reference noise)" "$t0" "${refs[0]}" "$d/ref_others.cycles.exr" "$d/background.exr" "$mask"
   fi
   row "$name" atlas "artistic off; defaults" "$t" "$d/physical_default.exr" "$ref" "$d/background.exr" "$mask"
   t=$(atlas "$d/artistic_on.exr" "$g" --view orbit:30,25 $FOV --artistic on --export-scene "$d/scene_on")
