@@ -79,12 +79,12 @@ for name in superstorm hzd_weather fc6_forecast; do
   for ((k = 0; k < REF_SEEDS; ++k)); do
     r=$d/ref.cycles.exr; [ $k = 0 ] || r=$d/ref_seed$k.cycles.exr
     if [ $REUSE = 1 ] && [ -f "$r" ] && [ "$($PY -c "import json; j = json.load(open('$r.json')); print(j['samples'], j.get('bounces', 128))" 2>/dev/null)" = "$REF_SPP $BOUNCES" ]; then
-      t=$($PY -c "import json; print('%.2f' % json.load(open('$r.json'))['seconds'])")
+      tr=$($PY -c "import json; print('%.2f' % json.load(open('$r.json'))['seconds'])")
     else
-      t=$(cycles "$d/scene" "$r" "$REF_SPP" $k)
+      tr=$(cycles "$d/scene" "$r" "$REF_SPP" $k)
     fi
-    tref=$($PY -c "print('%.2f' % ($tref + $t))")
-    [ $k != 0 ] || t0=$t
+    tref=$($PY -c "print('%.2f' % ($tref + $tr))")
+    [ $k != 0 ] || t0=$tr
     refs+=("$r")
   done
   ref=$d/ref_mean.cycles.exr
@@ -94,7 +94,7 @@ for name in superstorm hzd_weather fc6_forecast; do
   row "$name" cycles "$REF_SEEDS x $REF_SPP spp (reference)" "$tref" "$ref" "$ref" "$d/background.exr" "$mask"
   if [ "$REF_SEEDS" -gt 1 ]; then # the reference's own noise: seed 0 against the mean of the others
     $PY -c "import sys; sys.path.insert(0, '$ROOT/scripts'); import render_compare as rc; rc.average_images(sys.argv[1:], '$d/ref_others.cycles.exr')" "${refs[@]:1}"
-    row "$name" cycles "$REF_SPP spp, seed 0 against the mean of the other seeds (the reference noise)" "$t0" "${refs[0]}" "$d/ref_others.cycles.exr" "$d/background.exr" "$mask"
+    row "$name" cycles "$REF_SPP spp seed 0 against the mean of the other seeds (the reference noise)" "$t0" "${refs[0]}" "$d/ref_others.cycles.exr" "$d/background.exr" "$mask"
   fi
   row "$name" atlas "artistic off; defaults" "$t" "$d/physical_default.exr" "$ref" "$d/background.exr" "$mask"
   t=$(atlas "$d/artistic_on.exr" "$g" --view orbit:30,25 $FOV --artistic on --export-scene "$d/scene_on")
