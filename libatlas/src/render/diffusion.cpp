@@ -58,10 +58,6 @@ void for_faces(const Level& L, const int c[3], F&& f) {
         }
 }
 
-// The forward peak of the first-scattered light (P1 with an anisotropic
-// source): F = -D grad phi + 3 D Q1 with Q1 = g sigma Tbar (-sun), so a face
-// of normal n carries the extra flux ag Tbar (-sun . n), ag = g / (1 - g)
-// (sigma cancels). ag = 0: the isotropic source.
 // coth x - 1 / x (x >= 0), by its series near 0.
 double langevin(double x) {
     if (x < 1e-3) return x / 3;
@@ -85,6 +81,10 @@ double near_face_rise(double half, double x) {
     return std::clamp((want - i2 - e) / (i1 - i2), 0.0, 1.0);
 }
 
+// The forward peak of the first-scattered light (P1 with an anisotropic
+// source): F = -D grad phi + 3 D Q1 with Q1 = g sigma Tbar (-sun), so a face
+// of normal n carries the extra flux ag Tbar (-sun . n), ag = g / (1 - g)
+// (sigma cancels). ag = 0: the isotropic source.
 // near: also the thick voxels' near-face source (Level::near) at Marshak
 // faces; both do not depend on phi, so the balance takes them as a source
 // (add_forward_source).
