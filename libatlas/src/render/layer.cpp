@@ -299,7 +299,7 @@ struct LayerIntegrator {
     Vec3d sun;
     Vec3d cam_up; // local up at the camera
     double base_step, grow, max_step;
-    double step_quality; // the quality the steps are divided by (physical_step_quality)
+    double step_quality; // what the steps are divided by: the quality, 4x that in the physical mode
     double light_step;
     double r_ground, r_inner, r_outer;
     bool use_envelope;
