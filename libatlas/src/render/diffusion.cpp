@@ -596,11 +596,8 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
     g_ = g;
 }
 
-double DiffusionGrid::p1_weight(const std::vector<float>& phi_grid, const std::vector<float>& flux, double x, double y, double z,
+double DiffusionGrid::p1_weight(const std::vector<float>& phi_grid, const std::vector<float>& flux, const size_t idx[8], const double w[8],
                                  const Vec3d& toward_eye) const {
-    double w[8];
-    size_t idx[8];
-    corners(x, y, z, idx, w);
     double phi = 0, f[3] = {0, 0, 0};
     for (int k = 0; k < 8; ++k) {
         phi += w[k] * phi_grid[idx[k]];
@@ -610,11 +607,13 @@ double DiffusionGrid::p1_weight(const std::vector<float>& phi_grid, const std::v
     return std::max(0.0, phi + 3 * g_ * (f[0] * toward_eye[0] + f[1] * toward_eye[1] + f[2] * toward_eye[2]));
 }
 
-double DiffusionGrid::radiance(double x, double y, double z, const Vec3d& toward_eye) const { return p1_weight(phi_, flux_, x, y, z, toward_eye); }
-
-double DiffusionGrid::sky_radiance(double x, double y, double z, const Vec3d& toward_eye) const {
+void DiffusionGrid::radiances(double x, double y, double z, const Vec3d& toward_eye, double& sun, double& sky) const {
     constexpr double kFourPi = 4 * 3.14159265358979323846;
-    return sky_phi_.empty() ? -1.0 : p1_weight(sky_phi_, sky_flux_, x, y, z, toward_eye) / kFourPi;
+    double w[8];
+    size_t idx[8];
+    corners(x, y, z, idx, w);
+    sun = p1_weight(phi_, flux_, idx, w, toward_eye);
+    sky = sky_phi_.empty() ? -1.0 : p1_weight(sky_phi_, sky_flux_, idx, w, toward_eye) / kFourPi;
 }
 
 void DiffusionGrid::corners(double x, double y, double z, size_t idx[8], double w[8]) const {
@@ -633,26 +632,6 @@ void DiffusionGrid::corners(double x, double y, double z, size_t idx[8], double 
         idx[k] = size_t(zz) * slab + size_t(yy) * row + size_t(xx);
         w[k] = (k & 1 ? t[0] : 1 - t[0]) * (k & 2 ? t[1] : 1 - t[1]) * (k & 4 ? t[2] : 1 - t[2]);
     }
-}
-
-float DiffusionGrid::fluence(double x, double y, double z) const {
-    const double u[3] = {(x - bounds_.min[0]) / voxel_[0] - 0.5, (y - bounds_.min[1]) / voxel_[1] - 0.5, (z - bounds_.min[2]) / voxel_[2] - 0.5};
-    int i0[3], i1[3];
-    float t[3];
-    for (int a = 0; a < 3; ++a) {
-        const double v = std::clamp(u[a], 0.0, double(res_[a] - 1));
-        i0[a] = std::min(static_cast<int>(v), res_[a] - 1);
-        i1[a] = std::min(i0[a] + 1, res_[a] - 1);
-        t[a] = static_cast<float>(v - i0[a]);
-    }
-    const size_t row = size_t(res_[0]), slab = row * size_t(res_[1]);
-    auto at = [&](int xx, int yy, int zz) { return phi_[size_t(zz) * slab + size_t(yy) * row + size_t(xx)]; };
-    const float c00 = at(i0[0], i0[1], i0[2]) + (at(i1[0], i0[1], i0[2]) - at(i0[0], i0[1], i0[2])) * t[0];
-    const float c10 = at(i0[0], i1[1], i0[2]) + (at(i1[0], i1[1], i0[2]) - at(i0[0], i1[1], i0[2])) * t[0];
-    const float c01 = at(i0[0], i0[1], i1[2]) + (at(i1[0], i0[1], i1[2]) - at(i0[0], i0[1], i1[2])) * t[0];
-    const float c11 = at(i0[0], i1[1], i1[2]) + (at(i1[0], i1[1], i1[2]) - at(i0[0], i1[1], i1[2])) * t[0];
-    const float c0 = c00 + (c10 - c00) * t[1], c1 = c01 + (c11 - c01) * t[1];
-    return std::max(0.0f, c0 + (c1 - c0) * t[2]);
 }
 
 } // namespace atlas::render::detail

@@ -69,30 +69,31 @@ public:
     // peak (P1 with an anisotropic source, Q1 = g sigma_s T (-sun)): the
     // flux gains 3 D Q1 = g / (1 - g) T (-sun) and its divergence moves into
     // the source. false: the source is isotropic.
-    // sky: also solve the sky's field (sky_radiance). inter_cloud: add the
+    // sky: also solve the sky's field (radiances' sky). inter_cloud: add the
     // light the medium sheds onto other parts of itself (traced through the
     // grid, two bounces between clouds, the sun's field solved again after
     // each).
     DiffusionGrid(const LightGrid& grid, double extinction, double g, int sweeps, Voxels voxels = Voxels::Thin, bool forward = false,
                   bool sky = false, bool inter_cloud = false);
-    // phi / E at world point p (trilinear, >= 0; outside-medium voxels next
-    // to the medium hold the Marshak surface value or the extrapolation
-    // through it (Voxels), others 0).
-    float fluence(double x, double y, double z) const;
-    // The in-scattered radiance weight of the diffuse light toward the eye
-    // (unit toward_eye = -view direction) in P1: phi + 3 g F . toward_eye,
-    // F = -D grad phi the diffuse flux (per E), clamped at 0; trilinear.
-    double radiance(double x, double y, double z, const Vec3d& toward_eye) const;
-    // The sky's light in the medium (built with sky = true; else -1): the
-    // same P1 weight for the sky basis L(w) = saturate(w . up) (up = +z)
-    // coming in through the medium's faces, divided by 4 pi, so that the
-    // sky lerp(horizon, zenith, saturate(w . up)) gives the in-scattered
-    // radiance horizon + (zenith - horizon) x this, every order of
-    // scattering included (a uniform sky gives its own colour: the
-    // furnace). 1/4 (the sphere's mean) in an optically thin medium, up
-    // to 2/3 at a thick cloud's top (it reflects the sky it sees) and 0 at
-    // its base (it sees the horizon colour below).
-    double sky_radiance(double x, double y, double z, const Vec3d& toward_eye) const;
+    // Both fields at world point (x, y, z) toward the eye (unit toward_eye =
+    // -view direction), trilinear from one set of corner weights (every
+    // sample of the march asks for both):
+    //   sun  the in-scattered radiance weight of the diffuse sun light in
+    //        P1: phi + 3 g F . toward_eye, F = -D grad phi the diffuse flux
+    //        (per E), clamped at 0 (outside-medium voxels next to the medium
+    //        hold the Marshak surface value or the extrapolation through it
+    //        (Voxels), others 0).
+    //   sky  the sky's light in the medium (built with sky = true; else -1):
+    //        the same P1 weight for the sky basis L(w) = saturate(w . up)
+    //        (up = +z) coming in through the medium's faces, divided by
+    //        4 pi, so that the sky lerp(horizon, zenith, saturate(w . up))
+    //        gives the in-scattered radiance horizon + (zenith - horizon) x
+    //        this, every order of scattering included (a uniform sky gives
+    //        its own colour: the furnace). 1/4 (the sphere's mean) in an
+    //        optically thin medium, up to 2/3 at a thick cloud's top (it
+    //        reflects the sky it sees) and 0 at its base (it sees the
+    //        horizon colour below).
+    void radiances(double x, double y, double z, const Vec3d& toward_eye, double& sun, double& sky) const;
     // Total source and total outflow through the medium's faces, both per
     // E (square metres): equal when the solve has converged (no absorption)
     // without inter_cloud (with it the faces also pass on the shed light).
@@ -104,7 +105,7 @@ private:
     Box3d bounds_;
     Vec3d voxel_;
     void corners(double x, double y, double z, size_t idx[8], double w[8]) const;
-    double p1_weight(const std::vector<float>& phi, const std::vector<float>& flux, double x, double y, double z, const Vec3d& toward_eye) const;
+    double p1_weight(const std::vector<float>& phi, const std::vector<float>& flux, const size_t idx[8], const double w[8], const Vec3d& toward_eye) const;
     std::vector<float> phi_, flux_; // flux_: 3 per voxel
     std::vector<float> sky_phi_, sky_flux_; // the sky basis's (empty unless built)
     double g_ = 0;

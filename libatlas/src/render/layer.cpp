@@ -254,8 +254,8 @@ public:
         });
     }
     // The P1 in-scattered weights at world p (altitude h) toward the eye:
-    // the sun's (DiffusionGrid::radiance) and the sky basis's
-    // (DiffusionGrid::sky_radiance); -1, -1 outside the patch (the octaves
+    // the sun's and the sky basis's (DiffusionGrid::radiances); -1, -1
+    // outside the patch (the octaves
     // and the sphere's mean sky alone there).
     void radiances(const Vec3d& p, double h, const Vec3d& toward_eye, double& sun_w, double& sky_w) const {
         sun_w = sky_w = -1;
@@ -265,8 +265,7 @@ public:
         // Inverse of the radial projection: the patch point under p.
         const double x = c[0] + radius_ * (p[0] - c[0]) / up, y = c[1] + radius_ * (p[1] - c[1]) / up;
         if (x < box_.min[0] || x > box_.max[0] || y < box_.min[1] || y > box_.max[1] || h < box_.min[2] || h > box_.max[2]) return;
-        sun_w = diffusion_->radiance(x, y, h, toward_eye);
-        sky_w = diffusion_->sky_radiance(x, y, h, toward_eye);
+        diffusion_->radiances(x, y, h, toward_eye, sun_w, sky_w);
     }
 
 private:

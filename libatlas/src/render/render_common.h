@@ -101,7 +101,7 @@ inline SunTerms sun_terms(const RenderSettings& s, double cos_theta) {
 //   ms_relax    Beer relaxation deep inside (0.05 deep .. 0.25 at the surface)
 //   sky_tau     optical depth toward the sky
 //   diffusion   the diffusion term's in-scattered weight at the sample
-//               (DiffusionGrid::radiance; physical mode with ms_diffusion),
+//               (DiffusionGrid::radiances' sun; physical mode with ms_diffusion),
 //               < 0 without it
 inline void shade(const RenderSettings& s, const SunTerms& st, double tau, double dp, double ms_relax, double sky_tau, double& sun_w,
                   double& sky_w, double diffusion = -1) {
@@ -184,7 +184,7 @@ struct Sky {
     }
     double at(int c, double up_t) const { return double(horizon[c]) + (double(zenith[c]) - double(horizon[c])) * up_t; }
     // The sky's light in a cloud: with the diffusion's sky field (its weight
-    // field >= 0, DiffusionGrid::sky_radiance) lerp(horizon, zenith, field),
+    // field >= 0, DiffusionGrid::radiances' sky) lerp(horizon, zenith, field),
     // else (field < 0: no field there) the ambient mean.
     double light(int c, double field) const { return field >= 0 ? at(c, field) : ambient[c]; }
 };

@@ -206,10 +206,10 @@ struct Integrator {
                 if (sigma > 0) {
                     double sun_sum, sky_sum;
                     light_depths(p, sun_sum, sky_sum);
-                    double sun_w, sky_w;
+                    double sun_w, sky_w, diffuse_sun = -1, sky_field = -1;
+                    if (diffusion) diffusion->radiances(p[0], p[1], p[2], dir * -1.0, diffuse_sun, sky_field);
                     detail::shade(s, st, ext * sun_sum, detail::saturate(v.profile), remap(v.sdf, -128.0, 0.0, 0.05, 0.25), ext * sky_sum,
-                                  sun_w, sky_w, diffusion ? diffusion->radiance(p[0], p[1], p[2], dir * -1.0) : -1.0);
-                    const double sky_field = diffusion ? diffusion->sky_radiance(p[0], p[1], p[2], dir * -1.0) : -1.0;
+                                  sun_w, sky_w, diffuse_sun);
                     // Energy-conserving step integral: (1 - exp(-sigma dt)) of the
                     // light is scattered toward the eye (albedo 1).
                     const double absorbed = -std::expm1(-sigma * dt);
