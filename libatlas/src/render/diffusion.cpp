@@ -9,9 +9,14 @@ namespace atlas::render::detail {
 
 namespace {
 
+// A neighbour index beyond the grid's edge (for_faces).
+inline constexpr size_t kNoVoxel = ~size_t(0);
+
 struct Level {
+    Level(const Vec3i& n_, const Vec3d& h_) : n(n_), h(h_), min_sig(kDiffusionMinTau / std::min({h_[0], h_[1], h_[2]})) {}
     Vec3i n;
     Vec3d h;
+    double min_sig; // a voxel takes part at sigma_t >= this (kDiffusionMinTau over its smallest edge)
     std::vector<float> sig; // sigma_t per metre
     std::vector<float> q;   // source per metre (per E)
     std::vector<float> phi;
@@ -25,6 +30,8 @@ struct Level {
     size_t idx(int x, int y, int z) const { return (size_t(z) * size_t(n[1]) + size_t(y)) * size_t(n[0]) + size_t(x); }
     size_t size() const { return size_t(n[0]) * size_t(n[1]) * size_t(n[2]); }
     double hmin() const { return std::min({h[0], h[1], h[2]}); }
+    // Voxel j is medium (kNoVoxel: beyond the grid, not medium).
+    bool medium(size_t j) const { return j != kNoVoxel && sig[j] >= min_sig; }
 };
 
 // Successive over-relaxation factor of the red-black sweeps.
@@ -47,7 +54,6 @@ void for_voxels(const Level& L, F&& f) {
 
 // Voxel c's six faces: f(a, side, j) with j the neighbour across the face on
 // axis a, side -1 / +1, or kNoVoxel beyond the grid's edge.
-inline constexpr size_t kNoVoxel = ~size_t(0);
 template <class F>
 void for_faces(const Level& L, const int c[3], F&& f) {
     for (int a = 0; a < 3; ++a)
@@ -151,7 +157,7 @@ inline double marshak_surface(double phi, double r, double g_out, double j_in) {
 // One colour's sweep: every voxel with (x + y + z) % 2 == colour reads only
 // voxels of the other colour, so z slabs run in parallel with the same bytes.
 void sweep(Level& L, double reduce, int colour) {
-    const double min_sig = kDiffusionMinTau / L.hmin();
+    const double min_sig = L.min_sig;
     parallel_for_index(L.n[2], [&](int z) {
         for (int y = 0; y < L.n[1]; ++y) {
             for (int x = (y + z + colour) & 1; x < L.n[0]; x += 2) {
@@ -192,13 +198,12 @@ void sweep(Level& L, double reduce, int colour) {
 // shapes: the same as extrapolating through the surface value, 0.069 against
 // 0.070 mean error). Reads medium voxels only.
 void fill_outside(Level& L, double reduce, bool extrapolate, const ForwardFlux& ff, const Incoming& in) {
-    const double min_sig = kDiffusionMinTau / L.hmin();
     for_voxels(L, [&](size_t i, const int c[3]) {
-        if (L.sig[i] >= min_sig) return;
+        if (L.medium(i)) return;
         double acc = 0;
         int cnt = 0;
         for_faces(L, c, [&](int a, int side, size_t j) {
-            if (j == kNoVoxel || L.sig[j] < min_sig) return;
+            if (!L.medium(j)) return;
             const double rj = 1.5 * reduce * L.sig[j] * L.h[a];
             double surface = marshak_surface(L.phi[j], rj, ff.marshak(L, j, a, -side), in.at(a, -side));
             const double x = ff.near_x(L, j, a, -side);
@@ -237,11 +242,13 @@ void leak_factors(Level& L) {
 }
 
 Level coarsen(const Level& f, const Vec3d& size) {
-    Level c;
+    Vec3i n;
+    Vec3d h;
     for (int a = 0; a < 3; ++a) {
-        c.n[a] = std::max(1, (f.n[a] + 1) / 2);
-        c.h[a] = size[a] / c.n[a];
+        n[a] = std::max(1, (f.n[a] + 1) / 2);
+        h[a] = size[a] / n[a];
     }
+    Level c(n, h);
     c.sig.assign(c.size(), 0.0f);
     c.q.assign(c.size(), 0.0f);
     c.tb.assign(c.size(), 0.0f);
@@ -291,13 +298,12 @@ void solve(Level& L, double reduce, int sweeps, bool extrapolate, const ForwardF
 // The incoming light's share of the balance (independent of phi, so it is a
 // source): each Marshak face adds leak x 4 J / ((r + 2) h). Replaces q.
 void set_incoming_source(Level& L, double reduce, const Incoming& in) {
-    const double min_sig = kDiffusionMinTau / L.hmin();
     L.q.assign(L.size(), 0.0f);
     for_voxels(L, [&](size_t i, const int c[3]) {
-        if (L.sig[i] < min_sig) return;
+        if (!L.medium(i)) return;
         double q = 0;
         for_faces(L, c, [&](int a, int side, size_t j) {
-            if (j != kNoVoxel && L.sig[j] >= min_sig) return;
+            if (L.medium(j)) return;
             const double r = 1.5 * reduce * L.sig[i] * L.h[a];
             q += L.leak[i] * 4 * in.at(a, side) / ((r + kMarshak) * L.h[a]);
         });
@@ -309,13 +315,12 @@ void set_incoming_source(Level& L, double reduce, const Incoming& in) {
 // on phi): interior faces with the two voxels' mean Tbar, Marshak faces
 // through marshak_flux's r G / (r + 2). Writes each voxel's own q only.
 void add_forward_source(Level& L, double reduce, const ForwardFlux& ff) {
-    const double min_sig = kDiffusionMinTau / L.hmin();
     std::vector<float> q = L.q;
     for_voxels(L, [&](size_t i, const int c[3]) {
-        if (L.sig[i] < min_sig) return;
+        if (!L.medium(i)) return;
         double out = 0;
         for_faces(L, c, [&](int a, int side, size_t j) {
-            if (j != kNoVoxel && L.sig[j] >= min_sig) {
+            if (L.medium(j)) {
                 out += ff.out(0.5 * (L.tb[i] + L.tb[j]), a, side) / L.h[a];
             } else {
                 const double r = 1.5 * reduce * L.sig[i] * L.h[a];
@@ -341,17 +346,16 @@ void cascade(std::vector<Level>& levels, double reduce, int sweeps, bool thick, 
 // medium's faces); outside voxels next to the medium take their medium
 // neighbours' mean, others 0.
 std::vector<float> voxel_fluxes(const Level& top, double reduce, const ForwardFlux& ff, const Incoming& in) {
-    const double min_sig = kDiffusionMinTau / top.hmin();
     const std::vector<float>& phi = top.phi;
     std::vector<float> flux(3 * top.size(), 0.0f);
     for_voxels(top, [&](size_t i, const int c[3]) {
+        if (!top.medium(i)) return;
         const double si = top.sig[i];
-        if (si < min_sig) return;
         double f[3] = {0, 0, 0};
         for_faces(top, c, [&](int a, int side, size_t j) {
             const double ri = 1.5 * reduce * si * top.h[a];
             double face; // flux toward +axis through this face
-            if (j != kNoVoxel && top.sig[j] >= min_sig)
+            if (top.medium(j))
                 face = side * ((phi[i] - phi[j]) / (ri + 1.5 * reduce * top.sig[j] * top.h[a]) + ff.out(0.5 * (top.tb[i] + top.tb[j]), a, side));
             else
                 face = side * marshak_flux(phi[i], ri, ff.marshak(top, i, a, side), in.at(a, side));
@@ -360,11 +364,11 @@ std::vector<float> voxel_fluxes(const Level& top, double reduce, const ForwardFl
         for (int a = 0; a < 3; ++a) flux[3 * i + size_t(a)] = static_cast<float>(f[a]);
     });
     for_voxels(top, [&](size_t i, const int c[3]) {
-        if (top.sig[i] >= min_sig) return;
+        if (top.medium(i)) return;
         double acc[3] = {0, 0, 0};
         int cnt = 0;
         for_faces(top, c, [&](int, int, size_t j) {
-            if (j == kNoVoxel || top.sig[j] < min_sig) return;
+            if (!top.medium(j)) return;
             // flux of medium voxels is final here: this pass writes outside voxels only
             for (int b = 0; b < 3; ++b) acc[b] += flux[3 * j + size_t(b)];
             ++cnt;
@@ -399,17 +403,15 @@ constexpr double kShedStart = 1.0; // rays start this many voxels out along the 
 // plus what came in) of the last solve. 2: hzd_weather within 0.1 point of 3.
 constexpr int kShedBounces = 2;
 std::vector<float> shed_light_source(const Level& L, double reduce, const ForwardFlux& ff, std::vector<float>& jin) {
-    const double min_sig = kDiffusionMinTau / L.hmin();
-    auto medium = [&](size_t j) { return j != kNoVoxel && L.sig[j] >= min_sig; };
     std::vector<float> jout(L.size(), 0.0f);
     for_voxels(L, [&](size_t i, const int c[3]) {
-        if (!medium(i)) return;
+        if (!L.medium(i)) return;
         double acc = 0;
         int cnt = 0;
         // The outgoing partial current: the net outflow plus what came in.
         const double j_in = jin.empty() ? 0.0 : double(jin[i]);
         for_faces(L, c, [&](int a, int side, size_t j) {
-            if (medium(j)) return;
+            if (L.medium(j)) return;
             acc += std::max(0.0, marshak_flux(L.phi[i], 1.5 * reduce * L.sig[i] * L.h[a], ff.marshak(L, i, a, side), j_in) + j_in);
             ++cnt;
         });
@@ -419,10 +421,10 @@ std::vector<float> shed_light_source(const Level& L, double reduce, const Forwar
     constexpr double kTwoPi = 6.283185307179586;
     std::vector<float> q(L.size(), 0.0f), jn(L.size(), 0.0f);
     for_voxels(L, [&](size_t i, const int c[3]) {
-        if (!medium(i)) return;
+        if (!L.medium(i)) return;
         double conductance = 0, faces[3] = {0, 0, 0};
         for_faces(L, c, [&](int a, int side, size_t j) {
-            if (medium(j)) return;
+            if (L.medium(j)) return;
             const double r = 1.5 * reduce * L.sig[i] * L.h[a];
             conductance += L.leak[i] * 4 / ((r + kMarshak) * L.h[a]);
             faces[a] += side;
@@ -449,7 +451,7 @@ std::vector<float> shed_light_source(const Level& L, double reduce, const Forwar
                     const int qx = int(std::floor(p[0])), qy = int(std::floor(p[1])), qz = int(std::floor(p[2]));
                     if (qx < 0 || qy < 0 || qz < 0 || qx >= L.n[0] || qy >= L.n[1] || qz >= L.n[2]) break;
                     const size_t j = L.idx(qx, qy, qz);
-                    if (j == i || !medium(j)) continue;
+                    if (j == i || !L.medium(j)) continue;
                     if (step >= kShedMinDistance) sum += jout[j];
                     break;
                 }
@@ -468,11 +470,10 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
     const bool thick = voxels == Voxels::Thick;
     const double reduce = 1 - g;
     const Vec3d size = bounds_.size();
-    std::vector<Level> levels(1);
+    std::vector<Level> levels;
     levels.reserve(16);
+    levels.emplace_back(res_, voxel_);
     Level& fine = levels[0];
-    fine.n = res_;
-    fine.h = voxel_;
     const size_t n = fine.size();
     fine.sig.resize(n);
     fine.q.resize(n);
@@ -485,7 +486,7 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
     const auto& dens = grid.density();
     const auto& depth = grid.sun_depths();
     const double vol = voxel_[0] * voxel_[1] * voxel_[2];
-    const double min_sig = kDiffusionMinTau / fine.hmin();
+    const double min_sig = fine.min_sig;
     const size_t stride[3] = {1, size_t(res_[0]), size_t(res_[0]) * size_t(res_[1])};
     double src = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -571,11 +572,11 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
         for (int y = 0; y < res_[1]; ++y)
             for (int x = 0; x < res_[0]; ++x) {
                 const size_t i = top.idx(x, y, z);
+                if (!top.medium(i)) continue;
                 const double si = top.sig[i];
-                if (si < min_sig) continue;
                 const int c[3] = {x, y, z};
                 for_faces(top, c, [&](int a, int side, size_t j) {
-                    if (j != kNoVoxel && top.sig[j] >= min_sig) return;
+                    if (top.medium(j)) return;
                     out += top.leak[i] * (vol / voxel_[a]) * marshak_flux(phi_[i], 1.5 * reduce * si * voxel_[a], ff.marshak(top, i, a, side));
                 });
             }
