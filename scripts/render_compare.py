@@ -22,14 +22,20 @@ import numpy as np
 import OpenImageIO as oiio
 
 
-def channels(path):
-    """{lower-case channel name: H x W float64 array}, row 0 at the top."""
+def read_image(path):
+    """(the OpenImageIO spec, H x W x C float64 pixels), row 0 at the top."""
     inp = oiio.ImageInput.open(path)
     if inp is None:
         raise SystemExit(f"{path}: {oiio.geterror()}")
     spec = inp.spec()
     px = np.asarray(inp.read_image(0, 0, 0, spec.nchannels, oiio.FLOAT), dtype=np.float64).reshape(spec.height, spec.width, spec.nchannels)
     inp.close()
+    return spec, px
+
+
+def channels(path):
+    """{lower-case channel name: H x W float64 array}, row 0 at the top."""
+    spec, px = read_image(path)
     return {n.lower(): px[..., i] for i, n in enumerate(spec.channelnames)}
 
 
@@ -54,12 +60,7 @@ def average_images(paths, out):
     composites), written as a float EXR with the first one's channel names (OpenImageIO)."""
     specs, sums = None, None
     for p in paths:
-        inp = oiio.ImageInput.open(p)
-        if inp is None:
-            raise SystemExit(f"{p}: {oiio.geterror()}")
-        spec = inp.spec()
-        px = np.asarray(inp.read_image(0, 0, 0, spec.nchannels, oiio.FLOAT), dtype=np.float64)
-        inp.close()
+        spec, px = read_image(p)
         if specs is None:
             specs, sums = spec, px
         elif (spec.width, spec.height, list(spec.channelnames)) != (specs.width, specs.height, list(specs.channelnames)):
