@@ -200,7 +200,7 @@ std::vector<TextOption<P>> make_preview_options() {
         [] {
             TextOption<P> o{{"ms_octaves", "--ms-octaves", "N[,A,B,C[,P]]", K::Text,
                              "with artistic off: octaves of multiple scattering (0 = single scattering; empty: " + std::to_string(kPhysicalMsOctaves) +
-                                 "), optionally their energy, extinction and anisotropy factors and scatter power"}};
+                                 "), optionally their energy, extinction and anisotropy factors and scatter power (defaults 0.5, 0.5 or 0.75 with the diffusion term, 0.5, 1)"}};
             o.check_text = check_ms_octaves;
             o.apply = [](P& p, const V& v) {
                 if (!ms_octave_numbers(v.text, p.ms_octaves)) p.ms_octaves.clear();

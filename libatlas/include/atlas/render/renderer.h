@@ -41,6 +41,9 @@ enum class RenderMode {
 
 // Octaves of multiple scattering the CLI's --artistic off uses.
 inline constexpr int kPhysicalMsOctaves = 8;
+// The octaves' extinction factor (RenderSettings::ms_extinction) the CLI's
+// --artistic off uses beside the diffusion term (the octaves alone keep 0.5).
+inline constexpr double kPhysicalMsExtinctionWithDiffusion = 0.75;
 
 struct RenderSettings {
     Camera camera;
