@@ -53,7 +53,9 @@ def radiance(boxes, sigma, target, direction, sun=None, paths=40000, seed=1):
         tmin, tmax = ray_boxes(p[idx], w[idx], lo, hi)
         ins = inside[idx]
         # Outside: on to the next box the ray meets, or away (the sky basis of its direction).
-        ahead = np.where(tmax > 1e-9, np.maximum(tmin, 0), np.inf)
+        # (tmin > tmax: the ray's line misses that box; with one box an exiting path never sees
+        # that with tmax > 0, with two it can, and it jumped into empty space "inside")
+        ahead = np.where((tmax > 1e-9) & (tmin <= tmax), np.maximum(tmin, 0), np.inf)
         t_hit = ahead.min(axis=1)
         gone = ~ins & ~np.isfinite(t_hit)
         sky_acc[idx[gone]] = np.maximum(0, w[idx[gone], 2])

@@ -277,20 +277,17 @@ TEST(MsDiffusion, TowerFlankSeesTheDeckBelowItsHorizon) {
     // The sky field with the sky other clouds hide (diffusion.cpp,
     // shed_light_source with light coming in): a 200 m tower (optical depth
     // 6.4 across) on a 1 km deck (6.4 deep), the sky basis saturate(w . up)
-    // only, isotropic phase. Unoccluded, the tower's flank takes 0 from
-    // below its horizon; there it sees the deck's top, which reflects the
-    // sky above it. So near the deck the flank's basis rises (measured 0.27
-    // -> 0.45 at 50 m above it), high up it barely moves (0.250 -> 0.267 at
-    // 500 m), the deck's top next to the tower, which sees the tower's wall
-    // where it saw the low sky, falls (0.473 -> 0.428 at 50 m from it), and
-    // the flank stays under the open deck's top (0.48: a vertical face that
-    // sees the deck below and the sky above takes in less than a top that
-    // sees the whole sky).
+    // only, isotropic phase, against every scattering order by analog Monte
+    // Carlo (/usr/bin/python3 scripts/box_mc.py bench/box_mc/tower_0.032.json
+    // --paths 400000, standard errors 0.0005). Unoccluded, the tower's flank
+    // takes 0 from below its horizon, where it sees the deck's top, which
+    // reflects the sky above it: without the pass the flank near the deck is
+    // 34-40% under the brute force (0.268 against 0.406 at 50 m above it);
+    // with it every view is within 12% (measured +11, +9, -9, -8, -4%).
     auto box = [](Vec3d p, Vec3d lo, Vec3d hi) { return std::max({lo[0] - p[0], p[0] - hi[0], lo[1] - p[1], p[1] - hi[1], lo[2] - p[2], p[2] - hi[2]}); };
     const CloudScene sc = testing::make_scene(
         64, 1000, [&](Vec3d p) { return std::min(box(p, {{0, 0, 100}}, {{1000, 1000, 300}}), box(p, {{400, 400, 300}}, {{600, 600, 900}})); },
         [](Vec3d, double) { return 1.0; });
-    const double r = std::sqrt(0.5);
     auto basis = [&](Vec3d target, Vec3d dir, bool shed) {
         RenderSettings s = slab_view(true, 0.0);
         s.extinction = 0.032;
@@ -304,15 +301,17 @@ TEST(MsDiffusion, TowerFlankSeesTheDeckBelowItsHorizon) {
         s.camera.fov_deg = 0.5;
         return 1 - centre_green(render_clouds(sc, s));
     };
-    const Vec3d east{{1, 0, 0}}, down_east{{r, 0, -r}};
-    const double low = basis({{400, 500, 350}}, east, true), low_without = basis({{400, 500, 350}}, east, false);
-    const double high = basis({{400, 500, 800}}, east, true), high_without = basis({{400, 500, 800}}, east, false);
-    const double near = basis({{350, 500, 300}}, down_east, true), near_without = basis({{350, 500, 300}}, down_east, false);
-    const double open_top = basis({{100, 500, 300}}, down_east, true);
-    EXPECT_GT(low, 1.3 * low_without) << low << " vs " << low_without;
-    EXPECT_NEAR(high, high_without, 0.1 * high_without) << high << " vs " << high_without;
-    EXPECT_LT(near, 0.95 * near_without) << near << " vs " << near_without;
-    EXPECT_LT(low, open_top) << low << " vs the open deck " << open_top;
+    const double r = std::sqrt(0.5);
+    struct View { Vec3d target, dir; double brute_force; };
+    const View views[5] = {{{{400, 500, 350}}, {{1, 0, 0}}, 0.4061},  // the flank 50 m above the deck
+                           {{{400, 500, 450}}, {{1, 0, 0}}, 0.3607},  // 150 m
+                           {{{400, 500, 800}}, {{1, 0, 0}}, 0.2929},  // 500 m
+                           {{{350, 500, 300}}, {{r, 0, -r}}, 0.4632}, // the deck's top 50 m from the tower
+                           {{{100, 500, 300}}, {{r, 0, -r}}, 0.5073}}; // 300 m
+    for (const View& v : views)
+        EXPECT_NEAR(basis(v.target, v.dir, true), v.brute_force, 0.12 * v.brute_force) << v.target[0] << ", " << v.target[2];
+    for (int k = 0; k < 2; ++k) // the negative control: the flank near the deck without the pass
+        EXPECT_LT(basis(views[k].target, views[k].dir, false), 0.75 * views[k].brute_force) << views[k].target[2];
 }
 
 TEST(MsDiffusion, LightShedByOneCloudLightsAnother) {
