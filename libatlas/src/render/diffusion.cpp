@@ -146,13 +146,13 @@ struct Incoming {
     // where the surface itself takes in E(n) = int L (w . n)+ dw =
     // (2 / 3) ((pi - t) cos t + sin t), t the angle between n and up: 15-20%
     // more on slopes 15-60 degrees from flat (a box's face keeps 1).
-    // The factor E(n) / that, 1 without a gradient or a sky; n from
+    // The factor E(n) / that, 1 without a gradient (or a sky: no J); n from
     // smoothed_extinction_gradient (on binary voxels the central difference
     // is an axis on every tread and riser, factor 1: the voxel-mode slab at
     // 45 degrees stayed 17% under Chandrasekhar).
     double slope_factor(const Vec3d& n) const {
         const double l1 = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
-        if (!(l1 > 0) || free_phi == 0) return 1;
+        if (!(l1 > 0)) return 1;
         double stair = 0;
         for (int a = 0; a < 3; ++a) stair += std::fabs(n[a]) * at(a, n[a] > 0 ? 1 : -1);
         stair /= l1;
@@ -218,11 +218,14 @@ void sweep(Level& L, double reduce, int colour) {
 
 // The extinction's gradient at voxel c, per metre per metre (central
 // differences, 0 beyond the grid): the surface's inward normal direction.
+// sigma_t at voxel (x, y, z), 0 beyond the grid.
+double sigma_or_zero(const Level& L, int x, int y, int z) {
+    if (x < 0 || y < 0 || z < 0 || x >= L.n[0] || y >= L.n[1] || z >= L.n[2]) return 0.0;
+    return double(L.sig[L.idx(x, y, z)]);
+}
+
 Vec3d extinction_gradient(const Level& L, const int c[3]) {
-    auto sig = [&](int x, int y, int z) {
-        if (x < 0 || y < 0 || z < 0 || x >= L.n[0] || y >= L.n[1] || z >= L.n[2]) return 0.0;
-        return double(L.sig[L.idx(x, y, z)]);
-    };
+    auto sig = [&](int x, int y, int z) { return sigma_or_zero(L, x, y, z); };
     const int x = c[0], y = c[1], z = c[2];
     return Vec3d{{(sig(x + 1, y, z) - sig(x - 1, y, z)) / L.h[0], (sig(x, y + 1, z) - sig(x, y - 1, z)) / L.h[1],
                   (sig(x, y, z + 1) - sig(x, y, z - 1)) / L.h[2]}};
@@ -237,14 +240,18 @@ Vec3d smoothed_extinction_gradient(const Level& L, const int c[3]) {
     for (int dz = -1; dz <= 1; ++dz)
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
-                const int x = c[0] + dx, y = c[1] + dy, z = c[2] + dz;
-                if (x < 0 || y < 0 || z < 0 || x >= L.n[0] || y >= L.n[1] || z >= L.n[2]) continue;
-                const double sg = L.sig[L.idx(x, y, z)];
+                const double sg = sigma_or_zero(L, c[0] + dx, c[1] + dy, c[2] + dz);
                 g[0] += sg * dx;
                 g[1] += sg * dy;
                 g[2] += sg * dz;
             }
     return Vec3d{{g[0] / L.h[0], g[1] / L.h[1], g[2] / L.h[2]}};
+}
+
+// Incoming::slope_factor at voxel c; 1 without light coming in (the sun's
+// field), where the 27-voxel gradient is not needed.
+double slope_factor_at(const Level& L, const int c[3], const Incoming& in) {
+    return in.free_phi == 0 ? 1.0 : in.slope_factor(smoothed_extinction_gradient(L, c) * -1.0);
 }
 
 // Outside-medium voxels next to the medium take the mean of their medium
@@ -350,7 +357,7 @@ void set_incoming_source(Level& L, double reduce, const Incoming& in) {
             const double r = 1.5 * reduce * L.sig[i] * L.h[a];
             q += L.leak[i] * 4 * in.at(a, side) / ((r + kMarshak) * L.h[a]);
         });
-        q *= in.slope_factor(smoothed_extinction_gradient(L, c) * -1.0);
+        if (q > 0) q *= slope_factor_at(L, c, in); // only voxels with sky coming in
         L.q[i] = static_cast<float>(q);
     });
 }
@@ -463,9 +470,10 @@ std::vector<float> shed_light_source(const Level& L, double reduce, const Forwar
         int cnt = 0;
         // The outgoing partial current: the net outflow plus what came in.
         const double j_shed = jin.empty() ? 0.0 : double(jin[i]);
-        const double slope = in.slope_factor(smoothed_extinction_gradient(L, c) * -1.0);
+        double slope = -1; // computed at the first open face: interior voxels have none
         for_faces(L, c, [&](int a, int side, size_t j) {
             if (L.medium(j)) return;
+            if (slope < 0) slope = slope_factor_at(L, c, in);
             const double j_in = std::max(0.0, in.at(a, side) * slope + j_shed);
             acc += std::max(0.0, marshak_flux(L.phi[i], 1.5 * reduce * L.sig[i] * L.h[a], ff.marshak(L, i, a, side), j_in) + j_in);
             ++cnt;
