@@ -481,3 +481,38 @@ TEST(Bc4, BestEqualsBruteForceOnRandomSmoothAndSdfBlocks) {
 
 } // namespace
 } // namespace atlas::compress
+
+namespace atlas::compress {
+namespace {
+
+// Flat blocks on a level (8-bit sources, maps clamped at 0 or 1) come from a table that
+// fast / normal fill with their own search's results: the table must change nothing but
+// the time, for UNORM and SNORM, any decoder set, one-sided or not, with a bound.
+TEST(Bc4, FlatBlockTableEqualsTheSearch) {
+    for (bool snorm : {false, true})
+        for (Quality q : {Quality::Fast, Quality::Normal})
+            for (DecoderSet set : {kReferenceOnly, kAllDecoders})
+                for (bool os : {false, true}) {
+                    BlockOptions o;
+                    o.quality = q;
+                    o.decoders = set;
+                    o.one_sided_below = os;
+                    o.max_error = os ? 0.5f / 255.0f : -1.0f;
+                    EXPECT_EQ(detail::bc4_flat_table_mismatches(snorm, o), 0)
+                        << "snorm " << snorm << " quality " << quality_name(q) << " decoders " << set << " one-sided " << os;
+                }
+    // A flat block off the levels (and -0.0, whose bits are not level 0's) still
+    // searches, and decodes within its reported error.
+    Bc4Encoder enc(false, BlockOptions{});
+    for (float v : {-0.0f, 0.3f, 100.5f / 255.0f}) {
+        float src[16], lo[16], hi[16];
+        std::fill(src, src + 16, v);
+        uint8_t blk[8];
+        const BlockResult r = enc.encode(src, blk);
+        decode_bc4_interval(blk, false, kAllDecoders, lo, hi);
+        for (int t = 0; t < 16; ++t) EXPECT_LE(std::max(hi[t] - v, v - lo[t]), r.max_error + 1e-7f) << v;
+    }
+}
+
+} // namespace
+} // namespace atlas::compress

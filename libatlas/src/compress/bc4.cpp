@@ -199,6 +199,14 @@ struct PairTables {
     std::vector<float> num_lo[2], num_hi[2], num_ref[2];
     int num_base[2] = {0, 0}; // index = num - num_base
     bool avx2 = false;        // fast / normal evaluate with AVX2 (same results, bc4_eval.h)
+    // fast / normal's results for flat blocks on a level: 16 texels with the bits of
+    // level L's float L / scale (8-bit sources; maps clamped at 0 or 1), at L - the
+    // lowest level. Filled by the constructor with encode's own results, so a hit writes
+    // the same bytes as the candidate search it replaces (36 ns -> 6 ns a block here).
+    bool flat_ready = false;
+    float flat_src[256];
+    uint8_t flat_out[256][8];
+    BlockResult flat_res[256];
 };
 } // namespace
 
@@ -322,9 +330,43 @@ Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
     if (options_.decoders == 0) options_.decoders = kReferenceOnly;
     build_tables(*tables_, snorm_, options_.decoders);
     tables_->avx2 = detail::bc4_cpu_has_avx2();
+    if (options_.quality != Quality::Best) { // best's exhaustive search per level would cost seconds
+        const int lmin = snorm_ ? -127 : 0, lmax = snorm_ ? 127 : 255;
+        const float scale = snorm_ ? 127.0f : 255.0f;
+        for (int l = lmin; l <= lmax; ++l) {
+            const int i = l - lmin;
+            float src[16];
+            std::fill(src, src + 16, float(l) / scale);
+            tables_->flat_src[i] = src[0];
+            tables_->flat_res[i] = encode(src, tables_->flat_out[i]);
+        }
+        tables_->flat_ready = true;
+    }
 }
 
 Bc4Encoder::~Bc4Encoder() = default;
+
+namespace detail {
+long bc4_flat_table_mismatches(bool snorm, const BlockOptions& options) {
+    Bc4Encoder enc(snorm, options);
+    PairTables& T = *enc.tables_;
+    if (!T.flat_ready) return 0;
+    long bad = 0;
+    const int n = snorm ? 255 : 256;
+    for (int i = 0; i < n; ++i) {
+        float src[16];
+        std::fill(src, src + 16, T.flat_src[i]);
+        uint8_t with[8], without[8];
+        const BlockResult a = enc.encode(src, with);
+        T.flat_ready = false;
+        const BlockResult b = enc.encode(src, without);
+        T.flat_ready = true;
+        bad += std::memcmp(with, without, 8) != 0 || std::memcmp(&a.max_error, &b.max_error, 4) != 0 ||
+               std::memcmp(&a.sum_sq, &b.sum_sq, 8) != 0 || a.one_sided_ok != b.one_sided_ok;
+    }
+    return bad;
+}
+} // namespace detail
 
 namespace {
 
@@ -562,6 +604,16 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
 #endif
     const float scale = snorm_ ? 127.0f : 255.0f;
     const int lo_lim = snorm_ ? -127 : 0, hi_lim = snorm_ ? 127 : 255;
+    if (flat && tables_->flat_ready) {
+        const float x = src[0] * scale;
+        if (x >= float(lo_lim) && x <= float(hi_lim)) { // finite, so the rounding below is defined
+            const int i = int(x + (x >= 0 ? 0.5f : -0.5f)) - lo_lim;
+            if (std::memcmp(&src[0], &tables_->flat_src[i], 4) == 0) {
+                std::memcpy(out, tables_->flat_out[i], 8);
+                return tables_->flat_res[i];
+            }
+        }
+    }
     auto clampi = [&](int v) { return std::clamp(v, lo_lim, hi_lim); };
     // floor / ceil of a scaled extreme, in integers (clamped first: the levels are within +-255).
     auto in_range = [](float x) { return x > -1024.0f ? (x < 1024.0f ? x : 1024.0f) : -1024.0f; }; // NaN -> -1024

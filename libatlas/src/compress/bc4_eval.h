@@ -246,14 +246,15 @@ __attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, c
     const __m256 sq0 = _mm256_mul_ps(ek[0], ek[0]), sq1 = _mm256_mul_ps(ek[1], ek[1]);
     const __m128 acc = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm256_castps256_ps128(sq0), _mm256_extractf128_ps(sq0, 1)), _mm256_castps256_ps128(sq1)),
                                   _mm256_extractf128_ps(sq1, 1));
-    const __m256 m8 = _mm256_max_ps(ek[1], _mm256_max_ps(ek[0], _mm256_setzero_ps()));
-    float a[4], m[8];
-    _mm_storeu_ps(a, acc);
-    _mm256_storeu_ps(m, m8);
-    float r = m[0];
-    for (int j = 1; j < 8; ++j) r = m[j] > r ? m[j] : r;
+    // The largest of the 16 (errors are >= 0 and not NaN: any order gives the same) and
+    // the sum as (0 + 1) + (2 + 3), both in registers.
+    const __m256 m8 = _mm256_max_ps(ek[1], ek[0]);
+    __m128 m4 = _mm_max_ps(_mm256_castps256_ps128(m8), _mm256_extractf128_ps(m8, 1));
+    m4 = _mm_max_ps(m4, _mm_movehl_ps(m4, m4));
+    const float r = _mm_cvtss_f32(_mm_max_ss(m4, _mm_shuffle_ps(m4, m4, 1)));
+    const __m128 pairs = _mm_hadd_ps(acc, acc); // (0 + 1), (2 + 3)
     out.max_err = r;
-    out.sum = (a[0] + a[1]) + (a[2] + a[3]);
+    out.sum = _mm_cvtss_f32(_mm_hadd_ps(pairs, pairs));
     return !(r == stop && !(out.sum < inc_sum));
 }
 
@@ -287,14 +288,11 @@ __attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, 
         acc = _mm256_add_pd(acc, _mm256_mul_pd(d0, d0));
         acc = _mm256_add_pd(acc, _mm256_mul_pd(d1, d1));
     }
-    float m[8];
-    double a[4];
-    _mm256_storeu_ps(m, mx);
-    _mm256_storeu_pd(a, acc);
-    float r = m[0];
-    for (int j = 1; j < 8; ++j) r = m[j] > r ? m[j] : r;
-    max_err = r;
-    sum_sq = (a[0] + a[1]) + (a[2] + a[3]);
+    __m128 m4 = _mm_max_ps(_mm256_castps256_ps128(mx), _mm256_extractf128_ps(mx, 1));
+    m4 = _mm_max_ps(m4, _mm_movehl_ps(m4, m4));
+    max_err = _mm_cvtss_f32(_mm_max_ss(m4, _mm_shuffle_ps(m4, m4, 1)));
+    const __m128d pairs = _mm_hadd_pd(_mm256_castpd256_pd128(acc), _mm256_extractf128_pd(acc, 1)); // (0 + 1), (2 + 3)
+    sum_sq = _mm_cvtsd_f64(_mm_hadd_pd(pairs, pairs));
     bits = uint64_t(half[0]) | (uint64_t(half[1]) << 24);
 }
 

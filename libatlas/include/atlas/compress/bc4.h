@@ -20,6 +20,13 @@ void decode_bc4_block(const uint8_t block[8], bool snorm, Decoder d, float out[1
 // The worst-case interval [lo, hi] of every texel of a block over a decoder set.
 void decode_bc4_interval(const uint8_t block[8], bool snorm, DecoderSet set, float lo[16], float hi[16]);
 
+namespace detail {
+// Test hook: how many of the flat-block results an encoder with these options keeps
+// (flat blocks on a level, fast / normal) differ in bytes or result from its candidate
+// search run without them; 0 when the table only saves time.
+long bc4_flat_table_mismatches(bool snorm, const BlockOptions& options);
+} // namespace detail
+
 // Encodes BC4 blocks. Construction precomputes the palettes of all 65,536 endpoint
 // pairs for the decoder set (about 12 MB with the search-pruning tables); encode() is const and thread-safe.
 // Objective: minimise the block's max error under the decoder set (subject to
@@ -39,6 +46,7 @@ public:
     const BlockOptions& options() const { return options_; }
 
 private:
+    friend long detail::bc4_flat_table_mismatches(bool snorm, const BlockOptions& options);
     struct Tables;
     bool snorm_;
     BlockOptions options_;
