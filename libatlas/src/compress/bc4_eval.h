@@ -220,17 +220,22 @@ __attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, c
     __m256 ek[2];
     for (int h = 0; h < 2; ++h) {
         const __m256 s = _mm256_loadu_ps(src + 8 * h);
-        __m256 best = _mm256_setzero_ps();
-        for (int i = 0; i < p.n; ++i) {
+        // The 8 entries' keys (p.n is always 8), then their minimum as a tree: the keys
+        // differ in their index bits and are not NaN, so any order gives the same minimum,
+        // and the tree's 3 dependent minima replace a chain of 7 (latency-bound).
+        static_assert(sizeof(p.lo) / sizeof(p.lo[0]) == 8, "BC4 palettes have 8 entries");
+        __m256 key[8];
+        for (int i = 0; i < 8; ++i) {
             const __m256 vlo = _mm256_set1_ps(p.lo[i][0]), vhi = _mm256_set1_ps(p.hi[i][0]);
             __m256 e = _mm256_max_ps(_mm256_sub_ps(vhi, s), _mm256_sub_ps(s, vlo));
             if constexpr (OneSided) {
                 const __m256 above = _mm256_cmp_ps(vhi, s, _CMP_GT_OQ);
                 e = _mm256_blendv_ps(e, vinf, above);
             }
-            const __m256 key = _mm256_or_ps(_mm256_and_ps(e, clear), _mm256_castsi256_ps(_mm256_set1_epi32(i)));
-            best = i == 0 ? key : _mm256_min_ps(key, best);
+            key[i] = _mm256_or_ps(_mm256_and_ps(e, clear), _mm256_castsi256_ps(_mm256_set1_epi32(i)));
         }
+        const __m256 best = _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(key[0], key[1]), _mm256_min_ps(key[2], key[3])),
+                                          _mm256_min_ps(_mm256_min_ps(key[4], key[5]), _mm256_min_ps(key[6], key[7])));
         _mm256_storeu_ps(reinterpret_cast<float*>(out.key + 8 * h), best);
         ek[h] = _mm256_and_ps(best, clear);
         if (_mm256_movemask_ps(_mm256_or_ps(_mm256_cmp_ps(ek[h], vstop, _CMP_GT_OQ), _mm256_cmp_ps(ek[h], vinf, _CMP_GE_OQ)))) return false;

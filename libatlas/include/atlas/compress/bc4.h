@@ -21,10 +21,11 @@ void decode_bc4_block(const uint8_t block[8], bool snorm, Decoder d, float out[1
 void decode_bc4_interval(const uint8_t block[8], bool snorm, DecoderSet set, float lo[16], float hi[16]);
 
 namespace detail {
-// Test hook: how many of the flat-block results an encoder with these options keeps
-// (flat blocks on a level, fast / normal) differ in bytes or result from its candidate
-// search run without them; 0 when the table only saves time.
-long bc4_flat_table_mismatches(bool snorm, const BlockOptions& options);
+// Test hook: of `count` blocks (16 texels each), how many an encoder with these options
+// encodes differently (bytes or result) with its same-bytes shortcuts (the flat-block
+// table, skipping a candidate that cannot win) than without them; 0 when they only save
+// time.
+long bc4_shortcut_mismatches(bool snorm, const BlockOptions& options, const float* blocks, size_t count);
 } // namespace detail
 
 // Encodes BC4 blocks. Construction precomputes the palettes of all 65,536 endpoint
@@ -46,7 +47,7 @@ public:
     const BlockOptions& options() const { return options_; }
 
 private:
-    friend long detail::bc4_flat_table_mismatches(bool snorm, const BlockOptions& options);
+    friend long detail::bc4_shortcut_mismatches(bool snorm, const BlockOptions& options, const float* blocks, size_t count);
     struct Tables;
     bool snorm_;
     BlockOptions options_;
