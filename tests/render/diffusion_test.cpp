@@ -448,11 +448,13 @@ TEST(MsDiffusion, LayerDeckReflectsLikeChandrasekharAtEverySunHeight) {
     // closed form as the voxel slab: looking straight down on the deck's
     // centre from 10 km, isotropic phase, the sun 25, 60 and 80 degrees
     // high. At 0.016/m the deck's optical depth is 40, 1.3 per patch voxel
-    // (125 x 125 x 78 m). Measured: 1.056, 1.002, 0.983 of Chandrasekhar;
+    // (125 x 125 x 78 m). Measured: 1.022, 0.988, 0.973 of Chandrasekhar
+    // (1.055, 0.995, 0.976 without the sub-voxel share, diffusion.h);
     // the octaves alone 0.43, 0.26, 0.23 (the negative control). At 0.064/m
     // (5.3 per voxel, the superstorm's) the near-face source (diffusion.cpp,
-    // ForwardFlux::marshak) gives 0.86, 1.00, 0.98; with the source at the
-    // voxel's centre it was 1.35, 1.36, 1.30 (the bound's control).
+    // ForwardFlux::marshak) gives 0.923, 1.037, 1.014 (0.919, 1.014, 0.988
+    // without the share); with the source at the voxel's centre it was 1.35,
+    // 1.36, 1.30 (the bound's control).
     const LayerScene sc = deck();
     for (double el : {25.0, 60.0, 80.0}) {
         const double mu0 = std::sin(el * std::numbers::pi / 180);

@@ -632,6 +632,7 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
     if (inter_cloud) shed_bounces(levels[0], reduce, sweeps, thick, ff, Incoming{}, kShedBounces);
     const Level& top = levels[0]; // (push_back above moved the levels)
     phi_ = top.phi;
+    tbar_ = top.tb;
     // Outflow through the medium's boundary faces (the conservation check).
     double out = 0;
     for (int z = 0; z < res_[2]; ++z) // serial: the same sum for any thread count
@@ -682,6 +683,16 @@ void DiffusionGrid::radiances(double x, double y, double z, const Vec3d& toward_
     corners(x, y, z, idx, w);
     sun = p1_weight(phi_, flux_, idx, w, toward_eye);
     sky = sky_phi_.empty() ? -1.0 : p1_weight(sky_phi_, sky_flux_, idx, w, toward_eye) / kFourPi;
+}
+
+double DiffusionGrid::mean_sun_transmittance(double x, double y, double z) const {
+    double w[8];
+    size_t idx[8];
+    corners(x, y, z, idx, w);
+    double t = 0, ws = 0;
+    for (int k = 0; k < 8; ++k)
+        if (tbar_[idx[k]] > 0) { t += w[k] * tbar_[idx[k]]; ws += w[k]; }
+    return ws > 0 ? t / ws : -1.0;
 }
 
 void DiffusionGrid::corners(double x, double y, double z, size_t idx[8], double w[8]) const {
