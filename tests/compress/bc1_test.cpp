@@ -11,6 +11,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <thread>
+#include <vector>
+#include <array>
 
 namespace atlas::compress {
 namespace {
@@ -357,6 +360,48 @@ TEST(Bc1Scalar, ConstantBlockReachesEndpointPrecision) {
             // One endpoint step, plus the widening of the bounds to exact arithmetic (2^-21
             // relative, on the endpoint's upper bound and on its lower one).
             if (set == kReferenceOnly) { ASSERT_LE(r.max_error, u.endpoint_step * 1.001f + 1e-7f + 2.0f * src[0] / 2097152.0f) << src[0]; }
+        }
+    }
+}
+
+// Flat blocks are answered from the last flat block this thread encoded when colour and
+// options repeat (bc1_encode.cpp, FlatMemo). Encoding a sequence with runs of flat
+// colours, options switching between equal colours, and non-flat blocks in between must
+// give what each block gives alone on a fresh thread (an empty memo).
+TEST(Bc1, FlatBlockMemoEqualsAFreshSearch) {
+    std::vector<std::array<float, 48>> blocks;
+    auto flat = [&](float r, float g, float b) {
+        std::array<float, 48> a;
+        for (int t = 0; t < 16; ++t) { a[size_t(3 * t)] = r; a[size_t(3 * t + 1)] = g; a[size_t(3 * t + 2)] = b; }
+        blocks.push_back(a);
+    };
+    for (int k = 0; k < 40; ++k) {
+        const float r = float(unit(uint64_t(k), 1)), g = float(unit(uint64_t(k), 2)), b = float(unit(uint64_t(k), 3));
+        flat(r, g, b);
+        flat(r, g, b);
+        if (k % 3 == 0) { // a non-flat block between two flat ones of the same colour
+            std::array<float, 48> a;
+            for (int i = 0; i < 48; ++i) a[size_t(i)] = float(unit(uint64_t(k), 10 + uint64_t(i)));
+            blocks.push_back(a);
+            flat(r, g, b);
+        }
+        if (k % 5 == 0) flat(r, g, std::nextafter(b, 2.0f)); // one ulp off: a different colour
+    }
+    std::vector<BlockOptions> opts(4);
+    opts[1].max_error = 8.0f / 255.0f;
+    opts[2].decoders = kReferenceOnly;
+    opts[3].one_sided_below = true;
+    for (size_t i = 0; i < blocks.size(); ++i) {
+        for (size_t oi = 0; oi < opts.size(); ++oi) { // every block under each option set in turn: same colour, options changing
+            const BlockOptions& o = opts[(i + oi) % opts.size()];
+            uint8_t a[8], b[8];
+            const BlockResult ra = encode_bc1_block(blocks[i].data(), o, a);
+            BlockResult rb;
+            std::thread([&] { rb = encode_bc1_block(blocks[i].data(), o, b); }).join();
+            ASSERT_EQ(std::memcmp(a, b, 8), 0) << "block " << i << " options " << (i + oi) % opts.size();
+            ASSERT_EQ(std::memcmp(&ra.max_error, &rb.max_error, 4), 0) << "block " << i;
+            ASSERT_EQ(std::memcmp(&ra.sum_sq, &rb.sum_sq, 8), 0) << "block " << i;
+            ASSERT_EQ(ra.one_sided_ok, rb.one_sided_ok) << "block " << i;
         }
     }
 }

@@ -192,9 +192,51 @@ private:
     int nseen_ = 0;
 };
 
+// The search for one block (encode_bc1_block's, without the flat-block memo).
+BlockResult search_block(const float rgb[48], const BlockOptions& options, uint8_t out[8]);
+
+// The last flat block (16 texels with the same bits) this thread encoded, and its
+// options and result. Flat blocks come in runs of one colour (sky, clamped maps: 77%
+// of the cloud render's flat blocks repeat the flat block before them, 94% of the
+// weather map's), and the search is a pure function of the block and the options, so
+// a repeat is answered from here with the same bytes on any thread and in any order.
+struct FlatMemo {
+    bool valid = false;
+    uint32_t colour[3];
+    BlockOptions options;
+    uint8_t out[8];
+    BlockResult result;
+    bool same_options(const BlockOptions& o) const {
+        return std::memcmp(&o.max_error, &options.max_error, 4) == 0 && o.quality == options.quality &&
+               o.one_sided_below == options.one_sided_below && o.decoders == options.decoders;
+    }
+};
+thread_local FlatMemo flat_memo;
+
 } // namespace
 
 BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, uint8_t out[8]) {
+    uint32_t bits[48];
+    std::memcpy(bits, rgb, sizeof bits);
+    bool flat = true;
+    for (int t = 1; t < 16 && flat; ++t) flat = bits[3 * t] == bits[0] && bits[3 * t + 1] == bits[1] && bits[3 * t + 2] == bits[2];
+    if (!flat) return search_block(rgb, options, out);
+    FlatMemo& m = flat_memo;
+    if (m.valid && std::memcmp(m.colour, bits, sizeof m.colour) == 0 && m.same_options(options)) {
+        std::memcpy(out, m.out, 8);
+        return m.result;
+    }
+    const BlockResult r = search_block(rgb, options, out);
+    m.valid = true;
+    std::memcpy(m.colour, bits, sizeof m.colour);
+    m.options = options;
+    std::memcpy(m.out, out, 8);
+    m.result = r;
+    return r;
+}
+
+namespace {
+BlockResult search_block(const float rgb[48], const BlockOptions& options, uint8_t out[8]) {
     double mean[3] = {0, 0, 0}, lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
     for (int t = 0; t < 16; ++t)
         for (int c = 0; c < 3; ++c) {
@@ -283,5 +325,6 @@ BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, u
     detail::write_bc1_block(s.best.c0, s.best.c1, s.best.sel.idx, out);
     return {s.best.sel.max_err, s.best.sel.sum_sq, true};
 }
+} // namespace
 
 } // namespace atlas::compress
