@@ -216,14 +216,14 @@ void sweep(Level& L, double reduce, int colour) {
     });
 }
 
-// The extinction's gradient at voxel c, per metre per metre (central
-// differences, 0 beyond the grid): the surface's inward normal direction.
 // sigma_t at voxel (x, y, z), 0 beyond the grid.
 double sigma_or_zero(const Level& L, int x, int y, int z) {
     if (x < 0 || y < 0 || z < 0 || x >= L.n[0] || y >= L.n[1] || z >= L.n[2]) return 0.0;
     return double(L.sig[L.idx(x, y, z)]);
 }
 
+// The extinction's gradient at voxel c, per metre per metre (central
+// differences, 0 beyond the grid): the surface's inward normal direction.
 Vec3d extinction_gradient(const Level& L, const int c[3]) {
     auto sig = [&](int x, int y, int z) { return sigma_or_zero(L, x, y, z); };
     const int x = c[0], y = c[1], z = c[2];
@@ -676,19 +676,24 @@ double DiffusionGrid::p1_weight(const std::vector<float>& phi_grid, const std::v
     return std::max(0.0, phi + 3 * g_ * (f[0] * toward_eye[0] + f[1] * toward_eye[1] + f[2] * toward_eye[2]));
 }
 
-void DiffusionGrid::radiances(double x, double y, double z, const Vec3d& toward_eye, double& sun, double& sky) const {
+void DiffusionGrid::radiances(double x, double y, double z, const Vec3d& toward_eye, double& sun, double& sky, double* mean_t) const {
     constexpr double kFourPi = 4 * 3.14159265358979323846;
     double w[8];
     size_t idx[8];
     corners(x, y, z, idx, w);
     sun = p1_weight(phi_, flux_, idx, w, toward_eye);
     sky = sky_phi_.empty() ? -1.0 : p1_weight(sky_phi_, sky_flux_, idx, w, toward_eye) / kFourPi;
+    if (mean_t) *mean_t = mean_transmittance(idx, w);
 }
 
 double DiffusionGrid::mean_sun_transmittance(double x, double y, double z) const {
     double w[8];
     size_t idx[8];
     corners(x, y, z, idx, w);
+    return mean_transmittance(idx, w);
+}
+
+double DiffusionGrid::mean_transmittance(const size_t idx[8], const double w[8]) const {
     double t = 0, ws = 0;
     for (int k = 0; k < 8; ++k)
         if (tbar_[idx[k]] > 0) { t += w[k] * tbar_[idx[k]]; ws += w[k]; }

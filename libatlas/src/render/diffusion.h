@@ -111,7 +111,9 @@ public:
     //        optically thin medium, up to 2/3 at a thick cloud's top (it
     //        reflects the sky it sees) and 0 at its base (it sees the
     //        horizon colour below).
-    void radiances(double x, double y, double z, const Vec3d& toward_eye, double& sun, double& sky) const;
+    //   mean_t  (when given) mean_sun_transmittance at the point, from the
+    //        same corner weights.
+    void radiances(double x, double y, double z, const Vec3d& toward_eye, double& sun, double& sky, double* mean_t = nullptr) const;
     // The sun's transmittance averaged over the light-grid voxels (the mean the
     // sun's source is formed from), trilinear over the corners inside the medium;
     // -1 where none is.
@@ -128,6 +130,7 @@ private:
     Vec3d voxel_;
     void corners(double x, double y, double z, size_t idx[8], double w[8]) const;
     double p1_weight(const std::vector<float>& phi, const std::vector<float>& flux, const size_t idx[8], const double w[8], const Vec3d& toward_eye) const;
+    double mean_transmittance(const size_t idx[8], const double w[8]) const;
     std::vector<float> phi_, flux_; // flux_: 3 per voxel
     std::vector<float> tbar_; // the fine level's mean sun transmittance per voxel (0 outside the medium)
     std::vector<float> sky_phi_, sky_flux_; // the sky basis's (empty unless built)

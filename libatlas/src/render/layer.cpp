@@ -257,25 +257,17 @@ public:
     // the sun's and the sky basis's (DiffusionGrid::radiances); -1, -1
     // outside the patch (the octaves
     // and the sphere's mean sky alone there).
-    void radiances(const Vec3d& p, double h, const Vec3d& toward_eye, double& sun_w, double& sky_w) const {
-        sun_w = sky_w = -1;
+    // mean_t: DiffusionGrid::mean_sun_transmittance there (-1 outside the patch
+    // or the medium).
+    void radiances(const Vec3d& p, double h, const Vec3d& toward_eye, double& sun_w, double& sky_w, double& mean_t) const {
+        sun_w = sky_w = mean_t = -1;
         const Vec3d c = m_.centre();
         const double up = p[2] - c[2];
         if (!(up > 0)) return;
         // Inverse of the radial projection: the patch point under p.
         const double x = c[0] + radius_ * (p[0] - c[0]) / up, y = c[1] + radius_ * (p[1] - c[1]) / up;
         if (x < box_.min[0] || x > box_.max[0] || y < box_.min[1] || y > box_.max[1] || h < box_.min[2] || h > box_.max[2]) return;
-        diffusion_->radiances(x, y, h, toward_eye, sun_w, sky_w);
-    }
-    // DiffusionGrid::mean_sun_transmittance at world p (altitude h); -1 outside the
-    // patch or the medium.
-    double mean_sun_transmittance(const Vec3d& p, double h) const {
-        const Vec3d c = m_.centre();
-        const double up = p[2] - c[2];
-        if (!(up > 0)) return -1;
-        const double x = c[0] + radius_ * (p[0] - c[0]) / up, y = c[1] + radius_ * (p[1] - c[1]) / up;
-        if (x < box_.min[0] || x > box_.max[0] || y < box_.min[1] || y > box_.max[1] || h < box_.min[2] || h > box_.max[2]) return -1;
-        return diffusion_->mean_sun_transmittance(x, y, h);
+        diffusion_->radiances(x, y, h, toward_eye, sun_w, sky_w, &mean_t);
     }
 
 private:
@@ -484,12 +476,10 @@ struct LayerIntegrator {
                     const bool cheap_light = trans < 0.7 || tm > 15000; // far samples are hazed and small on screen
                     const double tau = ext * (s.artistic ? sun_depth(pl, cheap_light, trans < 0.3 || tm > 15000) : sun_depth_marched(pl)) * rain;
                     const double sky_tau = ext * sky_depth(pl, hl, col) * rain;
-                    double sun_w, sky_w, diffuse_sun = -1, sky_field = -1;
-                    if (diffusion) diffusion->radiances(pl, hl, dir * -1.0, diffuse_sun, sky_field);
-                    if (diffusion && diffuse_sun > 0) { // the sun's sub-voxel share (diffusion.h)
-                        const double tbar = diffusion->mean_sun_transmittance(pl, hl);
-                        if (tbar > 0) diffuse_sun *= detail::subgrid_sun_factor(std::exp(-tau / rain), tbar);
-                    }
+                    double sun_w, sky_w, diffuse_sun = -1, sky_field = -1, tbar = -1;
+                    if (diffusion) diffusion->radiances(pl, hl, dir * -1.0, diffuse_sun, sky_field, tbar);
+                    // The sun's sub-voxel share (diffusion.h).
+                    if (diffuse_sun > 0 && tbar > 0) diffuse_sun *= detail::subgrid_sun_factor(std::exp(-tau / rain), tbar);
                     const double dp = detail::saturate(shape);
                     detail::shade(s, st, tau, dp, detail::remap(dp, 0.0, 1.0, 0.25, 0.05), sky_tau, sun_w, sky_w, diffuse_sun);
                     const double haze = sc.haze_distance > 0 ? 1 - std::exp(-tm / sc.haze_distance) : 0.0;
