@@ -206,10 +206,6 @@ struct FlatMemo {
     BlockOptions options;
     uint8_t out[8];
     BlockResult result;
-    bool same_options(const BlockOptions& o) const {
-        return std::memcmp(&o.max_error, &options.max_error, 4) == 0 && o.quality == options.quality &&
-               o.one_sided_below == options.one_sided_below && o.decoders == options.decoders;
-    }
 };
 thread_local FlatMemo flat_memo;
 
@@ -222,7 +218,7 @@ BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, u
     for (int t = 1; t < 16 && flat; ++t) flat = bits[3 * t] == bits[0] && bits[3 * t + 1] == bits[1] && bits[3 * t + 2] == bits[2];
     if (!flat) return search_block(rgb, options, out);
     FlatMemo& m = flat_memo;
-    if (m.valid && std::memcmp(m.colour, bits, sizeof m.colour) == 0 && m.same_options(options)) {
+    if (m.valid && std::memcmp(m.colour, bits, sizeof m.colour) == 0 && m.options == options) {
         std::memcpy(out, m.out, 8);
         return m.result;
     }

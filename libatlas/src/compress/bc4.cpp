@@ -199,7 +199,6 @@ struct PairTables {
     std::vector<float> num_lo[2], num_hi[2], num_ref[2];
     int num_base[2] = {0, 0}; // index = num - num_base
     bool avx2 = false;        // fast / normal evaluate with AVX2 (same results, bc4_eval.h)
-    bool narrow = false;      // the Reference decoder alone: every entry's interval is its exact value to ulps
     // fast / normal's results for flat blocks on a level: 16 texels with the bits of
     // level L's float L / scale (8-bit sources; maps clamped at 0 or 1), at L - the
     // lowest level. Filled by the constructor with encode's own results, so a hit writes
@@ -332,7 +331,6 @@ Bc4Encoder::Bc4Encoder(bool snorm, const BlockOptions& options)
     if (options_.decoders == 0) options_.decoders = kReferenceOnly;
     build_tables(*tables_, snorm_, options_.decoders);
     tables_->avx2 = detail::bc4_cpu_has_avx2();
-    tables_->narrow = options_.decoders == kReferenceOnly;
     if (options_.quality != Quality::Best) { // best's exhaustive search per level would cost seconds
         const int lmin = snorm_ ? -127 : 0, lmax = snorm_ ? 127 : 255;
         const float scale = snorm_ ? 127.0f : 255.0f;
@@ -639,6 +637,8 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     const int qhi0 = clampi(floor_i(smax * scale)), qhi1 = clampi(ceil_i(smax * scale));
     auto byte_of = [&](int v) { return uint8_t(snorm_ ? uint8_t(int8_t(v)) : uint8_t(v)); };
     const bool os = options_.one_sided_below;
+    // The Reference decoder alone: every entry's interval is its exact value to ulps.
+    const bool narrow = options_.decoders == kReferenceOnly;
     // Candidate pairs (each once), evaluated in order; ties keep the earlier one.
     int cands[32];
     int ncand = 0;
@@ -682,7 +682,7 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     } else {
         for (int c = 0; c < ncand; ++c) {
             const int k = cands[c];
-            if (best_k >= 0 && tables_->shortcuts && tables_->narrow && k == swapped(best_k) && endpoints_only(keys[1 - cur]) && smin >= tables_->end_lo[k >> 8] &&
+            if (best_k >= 0 && tables_->shortcuts && narrow && k == swapped(best_k) && endpoints_only(keys[1 - cur]) && smin >= tables_->end_lo[k >> 8] &&
                 smax <= tables_->end_hi[k & 255])
                 continue; // cannot win (endpoints_only)
             entry_palette(*tables_, k, snorm_, pal[cur]);

@@ -27,6 +27,7 @@ struct BlockOptions {
     // Every decoded texel <= its source under every decoder in `decoders`.
     bool one_sided_below = false;
     DecoderSet decoders = kAllDecoders;
+    bool operator==(const BlockOptions&) const = default;
 };
 
 // What one encoded block achieved under the decoder set of its options.
