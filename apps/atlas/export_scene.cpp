@@ -132,12 +132,12 @@ std::string export_layer_scene(const std::filesystem::path& dir, render::LayerSc
     layer.sky_layers.clear();
     layer.envelope = {};
     render::validate_layer_scene(layer);
-    // The bake box: the patch plus the bilinear footprint of a texel, the
-    // curl distortion and the tops' downwind skew; from the shell's bottom
+    // The bake box: the patch plus the clouds' reach beyond it (layer_reach:
+    // the bilinear footprint of a texel, the curl distortion and the tops'
+    // downwind skew); from the shell's bottom
     // lowered by the Earth's curvature at the box's corners (the density is
     // the curved-Earth layer's: layer_density at world points) to its top.
-    const Vec2d tex = ndf->voxel_size();
-    const double margin = 2 * std::max(tex[0], tex[1]) + layer.curl_amount + std::fabs(layer.cloud_top_offset);
+    const double margin = render::layer_reach(layer);
     const Box2d mb = ndf->bounds();
     const Vec2d mc{{0.5 * (mb.min[0] + mb.max[0]), 0.5 * (mb.min[1] + mb.max[1])}};
     const double far = std::hypot(std::fabs(c[0] - mc[0]) + h + margin, std::fabs(c[1] - mc[1]) + h + margin);

@@ -534,6 +534,41 @@ TEST(MsDiffusion, LayerDeckReflectsTheSkyLikeChandrasekhar) {
     }
 }
 
+TEST(MsDiffusion, LayerPatchHoldsTheCloudsReachPastTheSquare) {
+    // A wall of cloud one 250 m texel wide whose texel lies just past the
+    // 16 km square (x 28250-28500 m, the square's edge at 28000): its density
+    // reaches 28125-28625 m, all of it outside the square. layer_reach is 2
+    // texels (no curl, no skew): 500 m, and the patch grows by 4 voxels of
+    // 125 m to 28500. Seen head-on from the west with the patch centred on
+    // the look-at point (20000, 20000), the wall's face gets the diffusion
+    // term only through that growth (before it the patch ended at 28000 and
+    // the image was the octaves' alone, byte for byte).
+    Field2D set = ndf::make_ndf_set({{160, 160}}, Box2d{{{0, 0}}, {{40000, 40000}}}, 1500, 4000, nullptr);
+    for (int y = 0; y < 160; ++y) set.at(ndf::Coverage, 113, y) = 1.0f; // texel centre x = 28375
+    LayerScene sc = deck();
+    sc.ndf = std::make_shared<const Field2D>(std::move(set));
+    sc.curl_amount = 0;
+    EXPECT_DOUBLE_EQ(layer_reach(sc), 500.0);
+    sc.curl_amount = 120;
+    sc.cloud_top_offset = -300; // a skew either way reaches as far
+    EXPECT_DOUBLE_EQ(layer_reach(sc), 920.0);
+    sc.curl_amount = 0;
+    sc.cloud_top_offset = 0;
+    RenderSettings s = slab_view(true, 0.33);
+    s.width = s.height = 5;
+    s.camera.position = {{10000, 20000, 2750}};
+    s.camera.look_at = {{20000, 20000, 2750}};
+    s.camera.up = {{0, 0, 1}};
+    s.camera.fov_deg = 4;
+    const LayerResult with = render_layer(sc, s);
+    s.ms_diffusion = false;
+    const LayerResult without = render_layer(sc, s);
+    ASSERT_TRUE(with.report.diffusion);
+    const double a = with.image.at(1, 2, 2), b = without.image.at(1, 2, 2);
+    EXPECT_LT(with.image.at(3, 2, 2), 0.5) << "the centre pixel sees the wall";
+    EXPECT_GT(std::fabs(a - b), 0.02 * b) << a << " vs " << b;
+}
+
 TEST(MsDiffusion, LayerPatchSameBytesForAnyThreadCountAndOnlyInThePhysicalMode) {
     const LayerScene sc = deck();
     RenderSettings s = deck_view(24, 16);
@@ -546,14 +581,16 @@ TEST(MsDiffusion, LayerPatchSameBytesForAnyThreadCountAndOnlyInThePhysicalMode) 
     const auto f = t1.report.active_features();
     EXPECT_NE(std::find(f.begin(), f.end(), "ms_diffusion"), f.end());
     // A patch past the voxel cap is refused before it is allocated, naming
-    // the grid (1024 x 1024 x 162 here: levels of 15.6 m over 2.5 km).
+    // the grid (1280 x 1280 x 162 here: levels of 15.6 m over 2.5 km; the
+    // deck's coarse texels reach past the square's 2 km cap, so 128 columns
+    // of the square's 15.6 m are added on each side).
     RenderSettings big = s;
     big.light_grid = {{1024, 1024, 32}};
     try {
         render_layer(sc, big);
         ADD_FAILURE() << "no error";
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("1024 x 1024 x 162 voxels"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("1280 x 1280 x 162 voxels"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("--light-grid"), std::string::npos) << e.what();
     }
     // The artistic look ignores the setting.

@@ -144,6 +144,12 @@ struct LayerShell {
 };
 LayerShell layer_shell(const LayerScene& scene);
 
+// How far (metres, horizontally) a texel's cloud reaches beyond the texel's
+// centre: the bilinear footprint (2 texels), the curl distortion and the tops'
+// downwind skew. A patch of the map holds every cloud rooted in it when it is
+// grown by this much on each side (the diffusion patch, --export-scene's box).
+double layer_reach(const LayerScene& scene);
+
 // Throws atlas::Error naming the problem (null fields, missing channels,
 // non-finite values: "channel 'coverage' holds NaN at texel (x, y)", bad
 // numbers).
@@ -158,7 +164,11 @@ void check_finite(const Field3D& f, const std::string& what);
 // the shell the diffusion term covers (RenderSettings::light_grid voxels
 // over it, from the shell's bottom to its top), centred under the camera's
 // look-at point when that lies in the shell, else where the view ray meets
-// the shell's middle. Outside it the octaves alone light the clouds.
+// the shell's middle. The grid grows by whole voxels of that size on each
+// side to layer_reach (at most an eighth of the side), so it holds every
+// cloud rooted in the square (a cloud
+// cut at the patch's edge would lose its diffuse light there). Outside it
+// the octaves alone light the clouds.
 inline constexpr double kLayerDiffusionPatch = 16000;
 
 struct LayerReport {
@@ -173,7 +183,7 @@ struct LayerReport {
     int sky_layers = 0;
     int point_lights = 0;         // lights integrated (given + flashes)
     bool sky_gradient = false;
-    bool diffusion = false;       // physical model with ms_diffusion: the diffusion term ran over a kLayerDiffusionPatch square
+    bool diffusion = false;       // physical model with ms_diffusion: the diffusion term ran over a kLayerDiffusionPatch square (plus layer_reach)
     uint64_t cheap_samples = 0;   // base-only density evaluations (view rays)
     uint64_t full_samples = 0;    // full density evaluations (view rays)
     uint64_t skipped_steps = 0;   // envelope jumps
