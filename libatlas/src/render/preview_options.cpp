@@ -210,8 +210,8 @@ std::vector<TextOption<P>> make_preview_options() {
         [] {
             TextOption<P> o{{"ms_diffusion", "--ms-diffusion", "on|off[,SWEEPS]", K::Text,
                              "with artistic off: multiple scattering in thick media by diffusion on the light grid (2.5D: over a 16 km patch "
-                             "of the shell; docs/render.md \"Multiple scattering by diffusion\"; empty: on), optionally its SOR sweeps per "
-                             "level (default 32)"}};
+                             "of the shell and the clouds' reach past it; docs/render.md \"Multiple scattering by diffusion\"; empty: on), "
+                             "optionally its SOR sweeps per level (default 32)"}};
             o.check_text = check_ms_diffusion;
             o.apply = [](P& p, const V& v) {
                 bool on = false;

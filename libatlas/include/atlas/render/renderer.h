@@ -116,8 +116,8 @@ struct RenderSettings {
     // grid the sky's colour is lerp(horizon, zenith, the sky field's
     // weight) instead of the sphere's mean (the same grid solves the sky's
     // light coming in through the medium's faces). The 2.5D mode
-    // solves it over a 16 km patch of its shell (layer.h,
-    // kLayerDiffusionPatch).
+    // solves it over a 16 km patch of its shell and the clouds' reach past
+    // it (layer.h, kLayerDiffusionPatch).
     // Needs ms_octaves > 0 and multiple_scattering > 0; ignored with
     // artistic = true. false: the octaves alone (the bytes of the renderer
     // before it existed). The CLI's --artistic off turns it on.
