@@ -31,6 +31,16 @@ def files_under(d: pathlib.Path):
                   if p.is_file() and ".atlas-outputs.json" not in p.name and ".atlas-staging" not in str(p))
 
 
+@pytest.fixture(autouse=True)
+def worker_tmpdir(tmp_path, monkeypatch):
+    # A worker killed mid-tile (the tests below kill some on purpose) cannot remove the
+    # temporary directory its tile's report was going to: its spawned processes take
+    # TMPDIR from here, so such leftovers stay under pytest's tmp_path, not in /tmp.
+    d = tmp_path / "worker-tmp"
+    d.mkdir()
+    monkeypatch.setenv("TMPDIR", str(d))
+
+
 @pytest.fixture(scope="module")
 def single(tmp_path_factory):
     out = tmp_path_factory.mktemp("single")
