@@ -166,9 +166,8 @@ void check_finite(const Field3D& f, const std::string& what);
 // look-at point when that lies in the shell, else where the view ray meets
 // the shell's middle. The grid grows by whole voxels of that size on each
 // side to layer_reach (at most an eighth of the side), so it holds every
-// cloud rooted in the square (a cloud
-// cut at the patch's edge would lose its diffuse light there). Outside it
-// the octaves alone light the clouds.
+// cloud rooted in the square (a cloud cut at the patch's edge would lose its
+// diffuse light there). Outside it the octaves alone light the clouds.
 inline constexpr double kLayerDiffusionPatch = 16000;
 
 struct LayerReport {
