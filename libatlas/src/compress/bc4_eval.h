@@ -254,9 +254,7 @@ __attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, c
     // The largest of the 16 (errors are >= 0 and not NaN: any order gives the same) and
     // the sum as (0 + 1) + (2 + 3), both in registers.
     const __m256 m8 = _mm256_max_ps(ek[1], ek[0]);
-    __m128 m4 = _mm_max_ps(_mm256_castps256_ps128(m8), _mm256_extractf128_ps(m8, 1));
-    m4 = _mm_max_ps(m4, _mm_movehl_ps(m4, m4));
-    const float r = _mm_cvtss_f32(_mm_max_ss(m4, _mm_shuffle_ps(m4, m4, 1)));
+    const float r = max_of_lanes(_mm_max_ps(_mm256_castps256_ps128(m8), _mm256_extractf128_ps(m8, 1)));
     const __m128 pairs = _mm_hadd_ps(acc, acc); // (0 + 1), (2 + 3)
     out.max_err = r;
     out.sum = _mm_cvtss_f32(_mm_hadd_ps(pairs, pairs));
@@ -293,9 +291,7 @@ __attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, 
         acc = _mm256_add_pd(acc, _mm256_mul_pd(d0, d0));
         acc = _mm256_add_pd(acc, _mm256_mul_pd(d1, d1));
     }
-    __m128 m4 = _mm_max_ps(_mm256_castps256_ps128(mx), _mm256_extractf128_ps(mx, 1));
-    m4 = _mm_max_ps(m4, _mm_movehl_ps(m4, m4));
-    max_err = _mm_cvtss_f32(_mm_max_ss(m4, _mm_shuffle_ps(m4, m4, 1)));
+    max_err = max_of_lanes(_mm_max_ps(_mm256_castps256_ps128(mx), _mm256_extractf128_ps(mx, 1)));
     const __m128d pairs = _mm_hadd_pd(_mm256_castpd256_pd128(acc), _mm256_extractf128_pd(acc, 1)); // (0 + 1), (2 + 3)
     sum_sq = _mm_cvtsd_f64(_mm_hadd_pd(pairs, pairs));
     bits = uint64_t(half[0]) | (uint64_t(half[1]) << 24);

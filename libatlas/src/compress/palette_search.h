@@ -60,6 +60,12 @@ inline float entry_error_t(const Palette<C>& p, int i, const float* s) {
 }
 
 #if defined(__SSE2__)
+// The largest of 4 errors (>= 0, never NaN, so the order of the maxima does not matter).
+inline float max_of_lanes(__m128 v) {
+    v = _mm_max_ps(v, _mm_movehl_ps(v, v));
+    return _mm_cvtss_f32(_mm_max_ss(v, _mm_shuffle_ps(v, v, 1)));
+}
+
 // C == 1 (BC4, bc1-scalar), the encoders' hot loop, with SSE2 (x86-64 baseline):
 // the same IEEE operations as the generic path, hence the same choices. MAXPS(a, b)
 // is exactly `a > b ? a : b` and MINPS(a, b) `a < b ? a : b`, as written there.
@@ -88,10 +94,7 @@ inline Selection select_indices_scalar_t(const Palette<1>& p, const float* src, 
         if (_mm_movemask_ps(_mm_cmple_ps(best, vstop)) != 15) return out;
         block = _mm_max_ps(best, block);
     }
-    // Errors are >= 0 and never NaN, so the max does not depend on the order.
-    __m128 m = _mm_max_ps(block, _mm_movehl_ps(block, block));
-    m = _mm_max_ss(m, _mm_shuffle_ps(m, m, 1));
-    const float block_max = _mm_cvtss_f32(m);
+    const float block_max = max_of_lanes(block);
     out.max_err = block_max;
     const __m128 vmax = _mm_set1_ps(block_max);
     __m128d best_sq[8], best_i[8], sd[8];
