@@ -224,7 +224,7 @@ public:
     // columns: the grid's voxels across the patch (x, y); vertically from s.light_grid.
     LayerDiffusion(const LayerModel& m, const RenderSettings& s, const Box2d& patch, const std::array<int, 2>& columns, double earth_radius)
         : m_(m), radius_(earth_radius) {
-        // light_grid voxels over the patch; vertically at least as many as
+        // `columns` voxels across the patch; vertically at least as many as
         // make the voxels no taller than they are wide (a 13 km storm in 32
         // levels of 400 m: cloud error 36%, bias -7% against Cycles; in 104
         // levels 30%, -2%), plus one empty level above the shell's top and
@@ -263,10 +263,9 @@ public:
     }
     // The P1 in-scattered weights at world p (altitude h) toward the eye:
     // the sun's and the sky basis's (DiffusionGrid::radiances); -1, -1
-    // outside the patch (the octaves
-    // and the sphere's mean sky alone there).
-    // mean_t: DiffusionGrid::mean_sun_transmittance there (-1 outside the patch
-    // or the medium).
+    // outside the patch (the octaves and the sphere's mean sky alone there).
+    // mean_t: DiffusionGrid::mean_sun_transmittance there (-1 outside the
+    // patch or the medium).
     void radiances(const Vec3d& p, double h, const Vec3d& toward_eye, double& sun_w, double& sky_w, double& mean_t) const {
         sun_w = sky_w = mean_t = -1;
         const Vec3d c = m_.centre();
