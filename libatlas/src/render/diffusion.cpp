@@ -28,6 +28,14 @@ struct Level {
     // sunward face (0: none), where the source lies (DiffusionGrid's
     // constructor, ForwardFlux::marshak). 3 per voxel.
     std::vector<float> near;
+    // Sub-voxel surfaces (fine level only; else empty): per face (6 per voxel,
+    // 2 a + (side > 0)), the distance from the node to the medium's surface
+    // across that face in 1/kSurfaceUnits of a voxel on its axis
+    // (shadowed_face_surfaces), and per voxel the sweep's sum over its
+    // Marshak faces of leak / (h (r + 2)) (one stream the sweep reads in
+    // order, where the per-face shares are scattered).
+    std::vector<uint8_t> surface;
+    std::vector<float> marshak_den;
     size_t idx(int x, int y, int z) const { return (size_t(z) * size_t(n[1]) + size_t(y)) * size_t(n[0]) + size_t(x); }
     size_t size() const { return size_t(n[0]) * size_t(n[1]) * size_t(n[2]); }
     double hmin() const { return std::min({h[0], h[1], h[2]}); }
@@ -39,6 +47,18 @@ struct Level {
 constexpr double kOmega = 1.8;
 // The Marshak boundary's resistance: phi = 0 at 2D beyond the face.
 constexpr double kMarshak = 2.0;
+
+// The node-to-surface share of voxel i's Marshak face (a, side): 0.5 (the
+// face) unless the level has sub-voxel surfaces.
+inline double surface_share(const Level& L, size_t i, int a, int side) {
+    return L.surface.empty() ? 0.5 : L.surface[6 * i + size_t(2 * a + (side > 0 ? 1 : 0))] / double(kSurfaceUnits);
+}
+// That face's resistance r = 3 sigma' d, d the node's distance to the
+// surface (1.5 sigma' h at the face itself).
+inline double face_r(const Level& L, size_t i, int a, int side, double reduce) {
+    if (L.surface.empty()) return 1.5 * reduce * L.sig[i] * L.h[a];
+    return 3 * reduce * L.sig[i] * L.h[a] * surface_share(L, i, a, side);
+}
 
 // Every voxel of the level (medium or not: f decides), z slabs in parallel:
 // f(i, c) with c its (x, y, z). Each call may write voxel i's own entries only.
@@ -180,7 +200,8 @@ inline double marshak_surface(double phi, double r, double g_out, double j_in) {
 
 // One colour's sweep: every voxel with (x + y + z) % 2 == colour reads only
 // voxels of the other colour, so z slabs run in parallel with the same bytes.
-void sweep(Level& L, double reduce, int colour) {
+template <bool Subvoxel>
+void sweep_level(Level& L, double reduce, int colour) {
     const double min_sig = L.min_sig;
     parallel_for_index(L.n[2], [&](int z) {
         for (int y = 0; y < L.n[1]; ++y) {
@@ -206,14 +227,21 @@ void sweep(Level& L, double reduce, int colour) {
                                 continue;
                             }
                         }
-                        den += L.leak[i] * inv_h / (ri + kMarshak);
+                        if constexpr (!Subvoxel) den += L.leak[i] * inv_h / (ri + kMarshak); // else marshak_den below
                     }
                 }
+                if constexpr (Subvoxel) den += L.marshak_den[i];
                 const double old = L.phi[i];
                 L.phi[i] = static_cast<float>(std::max(0.0, old + kOmega * (num / den - old)));
             }
         }
     });
+}
+// Sub-voxel surfaces or not: two loops (the per-face shares read in the
+// sweep cost the superstorm's solve a quarter of its time).
+void sweep(Level& L, double reduce, int colour) {
+    if (L.surface.empty()) sweep_level<false>(L, reduce, colour);
+    else sweep_level<true>(L, reduce, colour);
 }
 
 // sigma_t at voxel (x, y, z), 0 beyond the grid.
@@ -266,11 +294,13 @@ void fill_outside(Level& L, double reduce, bool extrapolate, const ForwardFlux& 
         int cnt = 0;
         for_faces(L, c, [&](int a, int side, size_t j) {
             if (!L.medium(j)) return;
-            const double rj = 1.5 * reduce * L.sig[j] * L.h[a];
+            const double rj = face_r(L, j, a, -side, reduce);
             double surface = marshak_surface(L.phi[j], rj, ff.marshak(L, j, a, -side), in.at(a, -side));
             const double x = ff.near_x(L, j, a, -side);
             if (extrapolate && x > 0) surface += ForwardFlux::near_weight(L, j, a) * near_face_rise(0.5 * L.sig[j] * L.h[a], x) * (L.phi[j] - surface);
-            acc += extrapolate ? 2 * surface - L.phi[j] : surface;
+            if (!extrapolate) acc += surface;
+            else if (L.surface.empty()) acc += 2 * surface - L.phi[j];
+            else acc += L.phi[j] + (surface - L.phi[j]) / surface_share(L, j, a, -side); // linear through the surface
             ++cnt;
         });
         L.phi[i] = static_cast<float>(cnt ? acc / cnt : in.free_phi); // may be < 0 extrapolated: lookups clamp
@@ -354,7 +384,7 @@ void set_incoming_source(Level& L, double reduce, const Incoming& in) {
         double q = 0;
         for_faces(L, c, [&](int a, int side, size_t j) {
             if (L.medium(j)) return;
-            const double r = 1.5 * reduce * L.sig[i] * L.h[a];
+            const double r = face_r(L, i, a, side, reduce);
             q += L.leak[i] * 4 * in.at(a, side) / ((r + kMarshak) * L.h[a]);
         });
         if (q > 0) q *= slope_factor_at(L, c, in); // only voxels with sky coming in
@@ -374,7 +404,7 @@ void add_forward_source(Level& L, double reduce, const ForwardFlux& ff) {
             if (L.medium(j)) {
                 out += ff.out(0.5 * (L.tb[i] + L.tb[j]), a, side) / L.h[a];
             } else {
-                const double r = 1.5 * reduce * L.sig[i] * L.h[a];
+                const double r = face_r(L, i, a, side, reduce);
                 out += L.leak[i] * r * ff.marshak(L, i, a, side) / (r + kMarshak) / L.h[a];
             }
         });
@@ -409,7 +439,7 @@ std::vector<float> voxel_fluxes(const Level& top, double reduce, const ForwardFl
             if (top.medium(j))
                 face = side * ((phi[i] - phi[j]) / (ri + 1.5 * reduce * top.sig[j] * top.h[a]) + ff.out(0.5 * (top.tb[i] + top.tb[j]), a, side));
             else
-                face = side * marshak_flux(phi[i], ri, ff.marshak(top, i, a, side), in.at(a, side));
+                face = side * marshak_flux(phi[i], face_r(top, i, a, side, reduce), ff.marshak(top, i, a, side), in.at(a, side));
             f[a] += 0.5 * face;
         });
         for (int a = 0; a < 3; ++a) flux[3 * i + size_t(a)] = static_cast<float>(f[a]);
@@ -475,7 +505,7 @@ std::vector<float> shed_light_source(const Level& L, double reduce, const Forwar
             if (L.medium(j)) return;
             if (slope < 0) slope = slope_factor_at(L, c, in);
             const double j_in = std::max(0.0, in.at(a, side) * slope + j_shed);
-            acc += std::max(0.0, marshak_flux(L.phi[i], 1.5 * reduce * L.sig[i] * L.h[a], ff.marshak(L, i, a, side), j_in) + j_in);
+            acc += std::max(0.0, marshak_flux(L.phi[i], face_r(L, i, a, side, reduce), ff.marshak(L, i, a, side), j_in) + j_in);
             ++cnt;
         });
         if (cnt) jout[i] = static_cast<float>(acc / cnt);
@@ -488,7 +518,7 @@ std::vector<float> shed_light_source(const Level& L, double reduce, const Forwar
         double conductance = 0, faces[3] = {0, 0, 0};
         for_faces(L, c, [&](int a, int side, size_t j) {
             if (L.medium(j)) return;
-            const double r = 1.5 * reduce * L.sig[i] * L.h[a];
+            const double r = face_r(L, i, a, side, reduce);
             conductance += L.leak[i] * 4 / ((r + kMarshak) * L.h[a]);
             faces[a] += side;
         });
@@ -542,7 +572,68 @@ void shed_bounces(Level& L, double reduce, int sweeps, bool thick, const Forward
 
 } // namespace
 
-DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g, int sweeps, Voxels voxels, bool forward, bool sky, bool inter_cloud)
+std::vector<uint8_t> shadowed_face_surfaces(const LightGrid& grid, double extinction, const LightGrid::DensityFn& density) {
+    const Vec3i res = grid.resolution();
+    const Vec3d h = grid.voxel(), sun = grid.sun_direction();
+    const Box3d& box = grid.bounds();
+    const auto& dens = grid.density();
+    const double min_sig = kDiffusionMinTau / std::min({h[0], h[1], h[2]}); // Level::min_sig
+    const size_t n = size_t(res[0]) * size_t(res[1]) * size_t(res[2]);
+    std::vector<uint8_t> share(6 * n, uint8_t(kSurfaceUnits / 2));
+    auto idx = [&](int x, int y, int z) { return (size_t(z) * size_t(res[1]) + size_t(y)) * size_t(res[0]) + size_t(x); };
+    parallel_for_index(res[2], [&](int z) {
+        for (int y = 0; y < res[1]; ++y)
+            for (int x = 0; x < res[0]; ++x) {
+                const size_t i = idx(x, y, z);
+                const double node = dens[i];
+                if (!(extinction * node >= min_sig)) continue;
+                const int c[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a)
+                    for (int side = -1; side <= 1; side += 2) {
+                        if (!(side * sun[a] < 0)) continue; // a face turned toward the sun (or edge-on) keeps the face
+                        int cc[3] = {c[0], c[1], c[2]};
+                        cc[a] += side;
+                        if (cc[a] >= 0 && cc[a] < res[a] && extinction * dens[idx(cc[0], cc[1], cc[2])] >= min_sig) continue; // inside the medium
+                        // The density's share of the node's at t voxels from the node on this axis.
+                        auto ratio = [&](double t) {
+                            double p[3] = {box.min[0] + (x + 0.5) * h[0], box.min[1] + (y + 0.5) * h[1], box.min[2] + (z + 0.5) * h[2]};
+                            p[a] += side * t * h[a];
+                            const double r = density(p[0], p[1], p[2]) / node;
+                            return r > 0 ? std::min(r, 1.0) : 0.0; // NaN: 0
+                        };
+                        double mass = 0;
+                        int first_out = kSurfaceSamples; // the first sample under half the node's density
+                        bool step = true; // every sample in (>= 0.99) up to first_out, out (<= 0.01) after
+                        for (int k = 0; k < kSurfaceSamples; ++k) {
+                            const double r = ratio((k + 0.5) / kSurfaceSamples);
+                            mass += r;
+                            if (r < 0.5 && first_out == kSurfaceSamples) first_out = k;
+                            step = step && (k < first_out ? r >= 0.99 : r <= 0.01);
+                        }
+                        double d = mass / kSurfaceSamples;
+                        if (step) {
+                            // A sharp edge: the midpoint samples place it to a quarter voxel
+                            // only; bisect the interval it lies in (past the last sample: up
+                            // to the neighbour's centre) to 1/64 voxel.
+                            double lo = first_out == 0 ? 0.0 : (first_out - 0.5) / kSurfaceSamples;
+                            double hi = first_out == kSurfaceSamples ? 1.0 : (first_out + 0.5) / kSurfaceSamples;
+                            for (int b = 0; b < kSurfaceBisections; ++b) {
+                                const double mid = 0.5 * (lo + hi);
+                                (ratio(mid) >= 0.5 ? lo : hi) = mid;
+                            }
+                            d = 0.5 * (lo + hi);
+                        }
+                        // At least half a sample: the lookups extrapolate through the surface over d.
+                        d = std::clamp(d, 0.5 / kSurfaceSamples, 1.0);
+                        share[6 * i + size_t(2 * a + (side > 0 ? 1 : 0))] = static_cast<uint8_t>(std::lround(d * kSurfaceUnits));
+                    }
+            }
+    });
+    return share;
+}
+
+DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g, int sweeps, Voxels voxels, bool forward, bool sky, bool inter_cloud,
+                             std::vector<uint8_t> surfaces)
     : res_(grid.resolution()), bounds_(grid.bounds()), voxel_(grid.voxel()) {
     const bool thick = voxels == Voxels::Thick;
     const double reduce = 1 - g;
@@ -557,6 +648,7 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
     fine.tb.assign(n, 0.0f);
     fine.phi.assign(n, 0.0f);
     if (thick) fine.near.assign(3 * n, 0.0f);
+    if (thick && surfaces.size() == 6 * n) fine.surface = std::move(surfaces);
     // The sun's mean chord through a voxel: volume / projected area.
     const Vec3d& sun = grid.sun_direction();
     const double chord = 1.0 / (std::fabs(sun[0]) / voxel_[0] + std::fabs(sun[1]) / voxel_[1] + std::fabs(sun[2]) / voxel_[2]);
@@ -620,6 +712,17 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
     }
     source_total_ = src;
     leak_factors(fine);
+    if (!fine.surface.empty()) {
+        fine.marshak_den.assign(n, 0.0f);
+        for_voxels(fine, [&](size_t i, const int c[3]) {
+            if (!fine.medium(i)) return;
+            double den = 0;
+            for_faces(fine, c, [&](int a, int side, size_t j) {
+                if (!fine.medium(j)) den += fine.leak[i] / (fine.h[a] * (face_r(fine, i, a, side, reduce) + kMarshak));
+            });
+            fine.marshak_den[i] = static_cast<float>(den);
+        });
+    }
     ForwardFlux ff;
     ff.near = thick;
     if (forward) {
@@ -640,11 +743,10 @@ DiffusionGrid::DiffusionGrid(const LightGrid& grid, double extinction, double g,
             for (int x = 0; x < res_[0]; ++x) {
                 const size_t i = top.idx(x, y, z);
                 if (!top.medium(i)) continue;
-                const double si = top.sig[i];
                 const int c[3] = {x, y, z};
                 for_faces(top, c, [&](int a, int side, size_t j) {
                     if (top.medium(j)) return;
-                    out += top.leak[i] * (vol / voxel_[a]) * marshak_flux(phi_[i], 1.5 * reduce * si * voxel_[a], ff.marshak(top, i, a, side));
+                    out += top.leak[i] * (vol / voxel_[a]) * marshak_flux(phi_[i], face_r(top, i, a, side, reduce), ff.marshak(top, i, a, side));
                 });
             }
     outflow_total_ = out;

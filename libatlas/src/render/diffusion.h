@@ -28,6 +28,7 @@
 #include "light_grid.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 namespace atlas::render::detail {
@@ -51,6 +52,24 @@ inline constexpr double kDiffusionMinTau = 1e-3;
 inline constexpr double kSubgridSunShare = 0.15;
 inline constexpr double kSubgridSunCap = 1.5;
 inline double subgrid_sun_factor(double t, double tbar) { return 1 + kSubgridSunShare * (std::min(kSubgridSunCap, t / tbar) - 1); }
+
+// Where the medium's surface lies inside the voxels, across the faces turned
+// from the sun (docs/render.md, "The patch's edge"): 6 bytes per voxel (face
+// (a, side) at 2 a + (side > 0)), the distance from a medium voxel's node to
+// the surface in 1/kSurfaceUnits of a voxel on that axis, for each face whose
+// neighbour is outside the medium and whose outward normal points away from
+// the sun: the depth that holds the same optical thickness at the node's
+// density, from kSurfaceSamples densities between the node and the
+// neighbour's centre, each min(1, density / the node's) (a sharp edge, every
+// sample in or out, located by kSurfaceBisections bisections to 1/64 voxel),
+// at least half a sample; half a voxel (the face itself) everywhere else.
+// Faces toward the sun keep the face: their source (the sun's transmittance
+// over the whole voxel, the near-face deposit) is the full voxel's.
+// `density` is the light grid's (called from several threads).
+inline constexpr int kSurfaceSamples = 4;
+inline constexpr int kSurfaceBisections = 4;
+inline constexpr int kSurfaceUnits = 128;
+std::vector<uint8_t> shadowed_face_surfaces(const LightGrid& grid, double extinction, const LightGrid::DensityFn& density);
 
 class DiffusionGrid {
 public:
@@ -90,9 +109,14 @@ public:
     // sky: also solve the sky's field (radiances' sky). inter_cloud: add the
     // light the medium sheds onto other parts of itself (traced through the
     // grid, two bounces between clouds, the sun's field solved again after
-    // each).
+    // each). surfaces (Thick only; shadowed_face_surfaces' layout): a Marshak
+    // face whose surface lies d from the node has the resistance 3 sigma' d
+    // (1.5 sigma' h at the face), and the outside voxel beyond it holds the
+    // value extrapolated linearly through the surface value at d, so that
+    // the leak and the lookups follow the surface inside the voxel rather
+    // than the lattice (empty: every face at the face).
     DiffusionGrid(const LightGrid& grid, double extinction, double g, int sweeps, Voxels voxels = Voxels::Thin, bool forward = false,
-                  bool sky = false, bool inter_cloud = false);
+                  bool sky = false, bool inter_cloud = false, std::vector<uint8_t> surfaces = {});
     // Both fields at world point (x, y, z) toward the eye (unit toward_eye =
     // -view direction), trilinear from one set of corner weights (every
     // sample of the march asks for both):
