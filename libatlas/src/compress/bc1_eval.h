@@ -1,8 +1,9 @@
 // Internal: BC1 index selection (select_indices<3>, palette_search.h) with AVX2 on a
 // channel-major palette (bc1_interval_palette_cm), the same result bit for bit: the block's max error and every texel's entry through the same float
 // operations (MAXPS(a, b) is `a > b ? a : b`, MINPS likewise, as written there), the
-// squared Reference error of each entry in double in the same order ((d0^2 + d1^2) + d2^2),
-// the first minimum per texel, and the texels' squares summed in texel order. Run after a
+// squared Reference error of each entry in float in the same order ((d0^2 + d1^2) + d2^2;
+// 8 texels a register), the first minimum per texel, and the texels' squares summed in
+// double in texel order. Run after a
 // CPU check (bc1_encode.cpp); elsewhere the encoder calls select_indices itself. Tested
 // against select_indices: Bc1Eval.Avx2EqualsSelectIndices.
 #pragma once
@@ -65,8 +66,7 @@ __attribute__((target("avx2"))) inline Selection bc1_select_avx2(const Bc1Palett
     for (int j = 0; j < 8; ++j) block_max = std::max(block_max, bm[j]);
     // The allowance per texel: the least block max, or the budget above it (select_indices).
     const float allowance = budget > block_max ? budget : block_max;
-    // Texels in groups of 4 (double lanes): group g holds texels 4g .. 4g + 3, each taking
-    // its first least squared error among the entries within the allowance.
+    // Each texel takes its first least squared error among the entries within the allowance.
     const __m256 vmaxf = _mm256_set1_ps(allowance);
     __m256 ok[4][2];
     bool usable[4];
@@ -76,26 +76,22 @@ __attribute__((target("avx2"))) inline Selection bc1_select_avx2(const Bc1Palett
         usable[i] = _mm256_movemask_ps(_mm256_or_ps(ok[i][0], ok[i][1])) != 0; // entries no texel may use are skipped
     }
     double total = 0;
-    for (int g = 0; g < 4; ++g) {
-        __m256d best_sq = _mm256_set1_pd(std::numeric_limits<double>::infinity()), best_i = _mm256_setzero_pd();
-        const __m256d s0 = _mm256_cvtps_pd(_mm_load_ps(s.c[0] + 4 * g)), s1 = _mm256_cvtps_pd(_mm_load_ps(s.c[1] + 4 * g)),
-                      s2 = _mm256_cvtps_pd(_mm_load_ps(s.c[2] + 4 * g));
+    for (int h = 0; h < 2; ++h) {
+        __m256 best_sq = vinf, best_i = zero;
+        const __m256 s0 = _mm256_load_ps(s.c[0] + 8 * h), s1 = _mm256_load_ps(s.c[1] + 8 * h), s2 = _mm256_load_ps(s.c[2] + 8 * h);
         for (int i = 0; i < 4; ++i) {
             if (!usable[i]) continue;
-            const __m256 okh = ok[i][g >> 1];
-            const __m128 ok4 = (g & 1) ? _mm256_extractf128_ps(okh, 1) : _mm256_castps256_ps128(okh);
-            const __m256d allowed = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_castps_si128(ok4))); // the lanes' masks, widened
-            const __m256d d0 = _mm256_sub_pd(_mm256_set1_pd(double(p.ref[0][i])), s0), d1 = _mm256_sub_pd(_mm256_set1_pd(double(p.ref[1][i])), s1),
-                          d2 = _mm256_sub_pd(_mm256_set1_pd(double(p.ref[2][i])), s2);
-            const __m256d sq = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
-            const __m256d take = _mm256_and_pd(allowed, _mm256_cmp_pd(sq, best_sq, _CMP_LT_OQ)); // first minimum wins
-            best_sq = _mm256_blendv_pd(best_sq, sq, take);
-            best_i = _mm256_blendv_pd(best_i, _mm256_set1_pd(double(i)), take);
+            const __m256 d0 = _mm256_sub_ps(_mm256_set1_ps(p.ref[0][i]), s0), d1 = _mm256_sub_ps(_mm256_set1_ps(p.ref[1][i]), s1),
+                         d2 = _mm256_sub_ps(_mm256_set1_ps(p.ref[2][i]), s2);
+            const __m256 sq = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(d0, d0), _mm256_mul_ps(d1, d1)), _mm256_mul_ps(d2, d2));
+            const __m256 take = _mm256_and_ps(ok[i][h], _mm256_cmp_ps(sq, best_sq, _CMP_LT_OQ)); // first minimum wins
+            best_sq = _mm256_blendv_ps(best_sq, sq, take);
+            best_i = _mm256_blendv_ps(best_i, _mm256_set1_ps(float(i)), take);
         }
-        double sq[4], bi[4];
-        _mm256_storeu_pd(sq, best_sq);
-        _mm256_storeu_pd(bi, best_i);
-        for (int j = 0; j < 4; ++j) { out.idx[4 * g + j] = uint8_t(bi[j]); total += sq[j]; } // texel order, as select_indices
+        float sq[8], bi[8];
+        _mm256_storeu_ps(sq, best_sq);
+        _mm256_storeu_ps(bi, best_i);
+        for (int j = 0; j < 8; ++j) { out.idx[8 * h + j] = uint8_t(bi[j]); total += sq[j]; } // texel order, as select_indices
         // The sum only grows (squares are >= 0): past the incumbent's, the pair cannot win.
         if (total > sum_stop) { out.max_err = std::numeric_limits<float>::infinity(); return out; }
     }

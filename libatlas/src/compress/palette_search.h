@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -163,16 +164,19 @@ inline Selection select_indices_t(const Palette<C>& p, const float* src, float s
     const float allowance = budget > block_max ? budget : block_max;
     float chosen_max = 0;
     double total = 0;
+    // Each entry's squared error: BC1 (C == 3) in float, as its AVX2 path (bc1_eval.h: 8
+    // texels a register; encoder version 8), one channel in double, as the SSE2 path above.
+    using Square = std::conditional_t<C == 3, float, double>;
     for (int t = 0; t < 16; ++t) {
         const float* s = src + t * C;
-        double best_sq = std::numeric_limits<double>::infinity();
+        Square best_sq = std::numeric_limits<Square>::infinity();
         int best_i = 0;
         float best_e = 0;
         for (int i = 0; i < p.n; ++i) {
             const float e = entry_error_t<C, OneSided>(p, i, s);
             if (!(e <= allowance)) continue;
-            double sq = 0;
-            for (int c = 0; c < C; ++c) { const double d = double(p.ref[i][c]) - s[c]; sq += d * d; }
+            Square sq = 0;
+            for (int c = 0; c < C; ++c) { const Square d = Square(p.ref[i][c]) - Square(s[c]); sq += d * d; }
             if (sq < best_sq) { best_sq = sq; best_i = i; best_e = e; }
         }
         out.idx[t] = uint8_t(best_i);

@@ -33,7 +33,9 @@ namespace atlas::compress {
 // first pass, single-entry search for blocks whose spread is under their error.
 // 6: BC1 RGB normal also starts from the other three box diagonals, 4 power iterations.
 // 7: BC1 RGB given max_error minimises the squared error within it (not the max error first).
-constexpr int kEncoderVersion = 7;
+// 8: BC1 RGB ranks entries by their squared error in float; given max_error, its +-1 moves
+// after the first round stay in the incumbent's colour mode.
+constexpr int kEncoderVersion = 8;
 
 // The most mip levels a front end asks for by number (a 65536 texture has 17
 // levels; "full" asks for all of them).
