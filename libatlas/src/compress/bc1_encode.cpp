@@ -241,6 +241,37 @@ BlockResult encode_bc1_block(const float rgb[48], const BlockOptions& options, u
 }
 
 namespace {
+// Given a bound, a block whose squared error (summed over its 16 texels and 3 channels,
+// in [0, 1] units; 0.03 is 6.4 levels of 255 RMS) stays above this after the search
+// gets a second search from two clusters (two_cluster_endpoints). The weather map's panel
+// edges (grey beside white) end there in the max-error starts' basin.
+constexpr double kSecondStartSumSq = 0.03;
+
+// The texels split in two along the principal axis at the widest gap between their
+// projections (ties by texel order), each side's mean an endpoint (a: the upper side).
+// False when every projection is the same.
+bool two_cluster_endpoints(const float rgb[48], const double mean[3], const double axis[3], double a[3], double b[3]) {
+    double proj[16];
+    int order[16];
+    for (int t = 0; t < 16; ++t) {
+        double p = 0;
+        for (int c = 0; c < 3; ++c) p += (rgb[3 * t + c] - mean[c]) * axis[c];
+        proj[t] = p;
+        order[t] = t;
+    }
+    std::sort(order, order + 16, [&](int x, int y) { return proj[x] < proj[y] || (proj[x] == proj[y] && x < y); });
+    int cut = 0;
+    double gap = 0;
+    for (int k = 1; k < 16; ++k)
+        if (proj[order[k]] - proj[order[k - 1]] > gap) { gap = proj[order[k]] - proj[order[k - 1]]; cut = k; }
+    if (cut == 0) return false;
+    for (int c = 0; c < 3; ++c) a[c] = b[c] = 0;
+    for (int k = 0; k < 16; ++k)
+        for (int c = 0; c < 3; ++c) (k < cut ? b : a)[c] += rgb[3 * order[k] + c];
+    for (int c = 0; c < 3; ++c) { b[c] /= cut; a[c] /= 16 - cut; }
+    return true;
+}
+
 BlockResult search_block(const float rgb[48], const BlockOptions& options, uint8_t out[8]) {
     double mean[3] = {0, 0, 0}, lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
     for (int t = 0; t < 16; ++t)
@@ -277,20 +308,37 @@ BlockResult search_block(const float rgb[48], const BlockOptions& options, uint8
     Search s(rgb, options);
     s.try_both(pack(quantize(e0)), pack(quantize(e1)));
     if (options.quality != Quality::Fast) {
-        s.try_both(pack(quantize(hi)), pack(quantize(lo))); // box diagonal
-        for (int corner = 1; corner < 4; ++corner) { // the other box diagonals, 4-colour mode
-            double a[3], b[3];
-            for (int c = 0; c < 3; ++c) {
-                const bool flip = c < 2 && ((corner >> c) & 1);
-                a[c] = flip ? lo[c] : hi[c];
-                b[c] = flip ? hi[c] : lo[c];
+        // The box diagonals are max-error starts: given a bound the principal start already
+        // meets, the squared-error search below starts from it and an inset of it instead
+        // (encoder version 8). Until a pair meets the bound, the same pairs as unbounded.
+        if (!s.within_bound()) {
+            s.try_both(pack(quantize(hi)), pack(quantize(lo))); // box diagonal
+            for (int corner = 1; corner < 4; ++corner) { // the other box diagonals, 4-colour mode
+                double a[3], b[3];
+                for (int c = 0; c < 3; ++c) {
+                    const bool flip = c < 2 && ((corner >> c) & 1);
+                    a[c] = flip ? lo[c] : hi[c];
+                    b[c] = flip ? hi[c] : lo[c];
+                }
+                const uint16_t pa = pack(quantize(a)), pb = pack(quantize(b));
+                if (pa != pb) s.try_pair(std::max(pa, pb), std::min(pa, pb));
             }
-            const uint16_t pa = pack(quantize(a)), pb = pack(quantize(b));
-            if (pa != pb) s.try_pair(std::max(pa, pb), std::min(pa, pb));
+        }
+        if (s.within_bound()) { // the principal endpoints inset by 1/16 (a squared-error start), 4 colours
+            double a[3], b[3];
+            for (int c = 0; c < 3; ++c) { a[c] = e0[c] + (e1[c] - e0[c]) / 16; b[c] = e1[c] + (e0[c] - e1[c]) / 16; }
+            s.try_mode(pack(quantize(a)), pack(quantize(b)), true);
         }
         s.fit_squared_error(1); // within a bound only: a least-squares start for the descent
         s.refine(3);
         s.fit_squared_error(3);
+        double a[3], b[3];
+        if (s.within_bound() && s.best.sel.sum_sq > kSecondStartSumSq && two_cluster_endpoints(rgb, mean, axis, a, b)) {
+            s.try_both(pack(quantize(a)), pack(quantize(b)));
+            s.fit_squared_error(3);
+            s.refine(2);
+            s.fit_squared_error(3);
+        }
     }
     const bool missed = !s.best.valid || (options.max_error >= 0 && s.best.sel.max_err > options.max_error);
     if (options.quality == Quality::Best || missed) {

@@ -33,8 +33,9 @@ namespace atlas::compress {
 // first pass, single-entry search for blocks whose spread is under their error.
 // 6: BC1 RGB normal also starts from the other three box diagonals, 4 power iterations.
 // 7: BC1 RGB given max_error minimises the squared error within it (not the max error first).
-// 8: BC1 RGB ranks entries by their squared error in float; given max_error, its +-1 moves
-// after the first round stay in the incumbent's colour mode.
+// 8: BC1 RGB ranks entries by their squared error in float; given max_error, a start within
+// it skips the box diagonals for an inset one, the +-1 moves after the first round stay in
+// the incumbent's colour mode, and a block still far off searches again from two clusters.
 constexpr int kEncoderVersion = 8;
 
 // The most mip levels a front end asks for by number (a 65536 texture has 17
