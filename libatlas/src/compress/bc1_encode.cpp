@@ -91,10 +91,10 @@ public:
     // Rounds of +-1 moves on each channel of each endpoint, in both modes. Within a bound
     // only the move against the squared error's gradient (of the least-squares model of
     // fit_squared_error at the incumbent's indices) is tried per channel: half the pairs,
-    // where every pair within the bound costs its full squared-error pass; and after the
-    // first round only in the incumbent's mode (encoder version 8: half the render's
-    // evaluations within a bound were the other mode's, for 0.7406 -> 0.7636 RMSE and 12%
-    // of its time; docs/PERFORMANCE.md).
+    // where every pair within the bound costs its full squared-error pass; and, below
+    // Best, after the first round only in the incumbent's mode (encoder version 8: half the
+    // render's evaluations within a bound were the other mode's, for 0.7406 -> 0.7636 RMSE
+    // and 12% of its time; docs/PERFORMANCE.md).
     void refine(int rounds) {
         for (int r = 0; r < rounds && best.valid; ++r) {
             const uint16_t b0 = best.c0, b1 = best.c1;
@@ -111,7 +111,7 @@ public:
                         v += dir;
                         if (v < 0 || v > m) continue;
                         e[end] = uint16_t((e[end] & ~(m << shift)) | (v << shift));
-                        if (r >= 1 && within_bound()) try_mode(e[0], e[1], b0 > b1); // the incumbent's mode
+                        if (r >= 1 && within_bound() && o_.quality != Quality::Best) try_mode(e[0], e[1], b0 > b1); // the incumbent's mode
                         else try_both(e[0], e[1]);
                     }
             if (((uint32_t(best.c0) << 16) | best.c1) == before_key) break; // local optimum
