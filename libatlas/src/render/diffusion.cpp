@@ -237,8 +237,9 @@ void sweep_level(Level& L, double reduce, int colour) {
         }
     });
 }
-// Sub-voxel surfaces or not: two loops (the per-face shares read in the
-// sweep cost the superstorm's solve a quarter of its time).
+// Sub-voxel surfaces or not: two loops (one loop testing for the shares and
+// reading them per face cost the superstorm's solve a quarter of its time,
+// with or without shares).
 void sweep(Level& L, double reduce, int colour) {
     if (L.surface.empty()) sweep_level<false>(L, reduce, colour);
     else sweep_level<true>(L, reduce, colour);
