@@ -247,18 +247,12 @@ namespace {
 // edges (grey beside white) end there in the max-error starts' basin.
 constexpr double kSecondStartSumSq = 0.03;
 
-// The texels split in two along the principal axis at the widest gap between their
-// projections (ties by texel order), each side's mean an endpoint (a: the upper side).
-// False when every projection is the same.
-bool two_cluster_endpoints(const float rgb[48], const double mean[3], const double axis[3], double a[3], double b[3]) {
-    double proj[16];
+// The texels split in two at the widest gap between their projections on the principal
+// axis (search_block's `proj`; ties by texel order), each side's mean an endpoint (a: the
+// upper side). False when every projection is the same.
+bool two_cluster_endpoints(const float rgb[48], const double proj[16], double a[3], double b[3]) {
     int order[16];
-    for (int t = 0; t < 16; ++t) {
-        double p = 0;
-        for (int c = 0; c < 3; ++c) p += (rgb[3 * t + c] - mean[c]) * axis[c];
-        proj[t] = p;
-        order[t] = t;
-    }
+    for (int t = 0; t < 16; ++t) order[t] = t;
     std::sort(order, order + 16, [&](int x, int y) { return proj[x] < proj[y] || (proj[x] == proj[y] && x < y); });
     int cut = 0;
     double gap = 0;
@@ -295,15 +289,34 @@ BlockResult search_block(const float rgb[48], const BlockOptions& options, uint8
     }
     double len = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
     for (double& a : axis) a /= len;
-    double tmin = 1e30, tmax = -1e30;
+    double tmin = 1e30, tmax = -1e30, proj[16];
     for (int t = 0; t < 16; ++t) {
         double p = 0;
         for (int c = 0; c < 3; ++c) p += (rgb[3 * t + c] - mean[c]) * axis[c];
+        proj[t] = p;
         tmin = std::min(tmin, p);
         tmax = std::max(tmax, p);
     }
     double e0[3], e1[3];
     for (int c = 0; c < 3; ++c) { e0[c] = mean[c] + tmax * axis[c]; e1[c] = mean[c] + tmin * axis[c]; }
+    // Box diagonal `corner` (1..3: red and / or green flipped) and the principal endpoints
+    // inset by f, as 565 pairs.
+    auto box_corner = [&](int corner, uint16_t& pa, uint16_t& pb) {
+        double a[3], b[3];
+        for (int c = 0; c < 3; ++c) {
+            const bool flip = c < 2 && ((corner >> c) & 1);
+            a[c] = flip ? lo[c] : hi[c];
+            b[c] = flip ? hi[c] : lo[c];
+        }
+        pa = pack(quantize(a));
+        pb = pack(quantize(b));
+    };
+    auto inset = [&](double f, uint16_t& pa, uint16_t& pb) {
+        double a[3], b[3];
+        for (int c = 0; c < 3; ++c) { a[c] = e0[c] + (e1[c] - e0[c]) * f; b[c] = e1[c] + (e0[c] - e1[c]) * f; }
+        pa = pack(quantize(a));
+        pb = pack(quantize(b));
+    };
 
     Search s(rgb, options);
     s.try_both(pack(quantize(e0)), pack(quantize(e1)));
@@ -314,26 +327,21 @@ BlockResult search_block(const float rgb[48], const BlockOptions& options, uint8
         if (!s.within_bound()) {
             s.try_both(pack(quantize(hi)), pack(quantize(lo))); // box diagonal
             for (int corner = 1; corner < 4; ++corner) { // the other box diagonals, 4-colour mode
-                double a[3], b[3];
-                for (int c = 0; c < 3; ++c) {
-                    const bool flip = c < 2 && ((corner >> c) & 1);
-                    a[c] = flip ? lo[c] : hi[c];
-                    b[c] = flip ? hi[c] : lo[c];
-                }
-                const uint16_t pa = pack(quantize(a)), pb = pack(quantize(b));
+                uint16_t pa, pb;
+                box_corner(corner, pa, pb);
                 if (pa != pb) s.try_pair(std::max(pa, pb), std::min(pa, pb));
             }
         }
         if (s.within_bound()) { // the principal endpoints inset by 1/16 (a squared-error start), 4 colours
-            double a[3], b[3];
-            for (int c = 0; c < 3; ++c) { a[c] = e0[c] + (e1[c] - e0[c]) / 16; b[c] = e1[c] + (e0[c] - e1[c]) / 16; }
-            s.try_mode(pack(quantize(a)), pack(quantize(b)), true);
+            uint16_t pa, pb;
+            inset(0.0625, pa, pb);
+            s.try_mode(pa, pb, true);
         }
         s.fit_squared_error(1); // within a bound only: a least-squares start for the descent
         s.refine(3);
         s.fit_squared_error(3);
         double a[3], b[3];
-        if (s.within_bound() && s.best.sel.sum_sq > kSecondStartSumSq && two_cluster_endpoints(rgb, mean, axis, a, b)) {
+        if (s.within_bound() && s.best.sel.sum_sq > kSecondStartSumSq && two_cluster_endpoints(rgb, proj, a, b)) {
             s.try_both(pack(quantize(a)), pack(quantize(b)));
             s.fit_squared_error(3);
             s.refine(2);
@@ -344,18 +352,14 @@ BlockResult search_block(const float rgb[48], const BlockOptions& options, uint8
     if (options.quality == Quality::Best || missed) {
         // More starts: the other box diagonals, inset principal endpoints, then long refinement.
         for (int corner = 1; corner < 4; ++corner) {
-            double a[3], b[3];
-            for (int c = 0; c < 3; ++c) {
-                const bool flip = c < 2 && ((corner >> c) & 1);
-                a[c] = flip ? lo[c] : hi[c];
-                b[c] = flip ? hi[c] : lo[c];
-            }
-            s.try_both(pack(quantize(a)), pack(quantize(b)));
+            uint16_t pa, pb;
+            box_corner(corner, pa, pb);
+            s.try_both(pa, pb);
         }
         for (double f : {0.0625, 0.125, 0.25}) {
-            double a[3], b[3];
-            for (int c = 0; c < 3; ++c) { a[c] = e0[c] + (e1[c] - e0[c]) * f; b[c] = e1[c] + (e0[c] - e1[c]) * f; }
-            s.try_both(pack(quantize(a)), pack(quantize(b)));
+            uint16_t pa, pb;
+            inset(f, pa, pb);
+            s.try_both(pa, pb);
         }
         s.refine(32);
         s.fit_squared_error(8);
