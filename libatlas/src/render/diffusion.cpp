@@ -13,8 +13,11 @@ constexpr double kPi = 3.14159265358979323846;
 // A neighbour index beyond the grid's edge (for_faces).
 inline constexpr size_t kNoVoxel = ~size_t(0);
 
+// The least sigma_t of a voxel that takes part: kDiffusionMinTau over its smallest edge.
+inline double medium_min_sigma(const Vec3d& h) { return kDiffusionMinTau / std::min({h[0], h[1], h[2]}); }
+
 struct Level {
-    Level(const Vec3i& n_, const Vec3d& h_) : n(n_), h(h_), min_sig(kDiffusionMinTau / std::min({h_[0], h_[1], h_[2]})) {}
+    Level(const Vec3i& n_, const Vec3d& h_) : n(n_), h(h_), min_sig(medium_min_sigma(h_)) {}
     Vec3i n;
     Vec3d h;
     double min_sig; // a voxel takes part at sigma_t >= this (kDiffusionMinTau over its smallest edge)
@@ -578,7 +581,7 @@ std::vector<uint8_t> shadowed_face_surfaces(const LightGrid& grid, double extinc
     const Vec3d h = grid.voxel(), sun = grid.sun_direction();
     const Box3d& box = grid.bounds();
     const auto& dens = grid.density();
-    const double min_sig = kDiffusionMinTau / std::min({h[0], h[1], h[2]}); // Level::min_sig
+    const double min_sig = medium_min_sigma(h); // the fine Level's
     const size_t n = size_t(res[0]) * size_t(res[1]) * size_t(res[2]);
     std::vector<uint8_t> share(6 * n, uint8_t(kSurfaceUnits / 2));
     auto idx = [&](int x, int y, int z) { return (size_t(z) * size_t(res[1]) + size_t(y)) * size_t(res[0]) + size_t(x); };
