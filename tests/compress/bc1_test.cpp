@@ -45,6 +45,27 @@ void check_rgb(const uint8_t blk[8], DecoderSet set, const float src[48], float&
     }
 }
 
+// Each texel's least squared Reference error over the first `entries` entries of a palette
+// (bc1_palette) whose error on every channel is within `bound`, summed; +inf when a texel
+// has none.
+double least_squared_error(const float pal[4][3], int entries, const float src[48], double bound = INFINITY) {
+    double sum = 0;
+    for (int t = 0; t < 16; ++t) {
+        double best = INFINITY;
+        for (int i = 0; i < entries; ++i) {
+            double e = 0, m = 0;
+            for (int c = 0; c < 3; ++c) {
+                const double d = double(pal[i][c]) - src[3 * t + c];
+                e += d * d;
+                m = std::max(m, std::fabs(d));
+            }
+            if (m <= bound && e < best) best = e;
+        }
+        sum += best;
+    }
+    return sum;
+}
+
 void rgb_block(uint64_t k, float out[48]) {
     float r[16], g[16], b[16];
     scalar_block(k, 0, 1, r);
@@ -229,22 +250,7 @@ TEST(Bc1, BoundedPanelEdgeReachesTheGreyPairOptimum) {
             for (uint16_t c1 : greys) {
                 float pal[4][3];
                 bc1_palette(c0, c1, Decoder::Reference, pal);
-                double sq = 0, worst = 0;
-                for (int t = 0; t < 16; ++t) {
-                    double best = 1e30, best_e = 0;
-                    for (int i = 0; i < 4; ++i) { // 3-colour mode: entry 3 is black
-                        double e = 0, m = 0;
-                        for (int c = 0; c < 3; ++c) {
-                            const double d = double(pal[i][c]) - src[3 * t + c];
-                            e += d * d;
-                            m = std::max(m, std::fabs(d));
-                        }
-                        if (m <= o.max_error && e < best) { best = e; best_e = m; }
-                    }
-                    sq += best;
-                    worst = std::max(worst, best_e);
-                }
-                if (worst <= o.max_error) brute = std::min(brute, sq);
+                brute = std::min(brute, least_squared_error(pal, 4, src, o.max_error)); // 3-colour mode: entry 3 is black
             }
         uint8_t blk[8];
         const BlockResult r = encode_bc1_block(src, o, blk);
@@ -295,16 +301,7 @@ TEST(Bc1, BoundedTwoClustersAtMostTheClusterMeans) {
         if (c0 < c1) std::swap(c0, c1);
         float pal[4][3];
         bc1_palette(c0, c1, Decoder::Reference, pal);
-        double two = 0;
-        for (int t = 0; t < 16; ++t) {
-            double best = 1e30;
-            for (int i = 0; i < (c0 > c1 ? 4 : 3); ++i) {
-                double e = 0;
-                for (int c = 0; c < 3; ++c) e += double(pal[i][c] - src[3 * t + c]) * double(pal[i][c] - src[3 * t + c]);
-                best = std::min(best, e);
-            }
-            two += best;
-        }
+        const double two = least_squared_error(pal, c0 > c1 ? 4 : 3, src);
         uint8_t blk[8];
         const BlockResult r = encode_bc1_block(src, o, blk);
         float e, over;
