@@ -650,6 +650,11 @@ TEST(CliHostile, MalformedPlyAndStlAreRefusedByName) {
         {"cutlength.ply", std::string("ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
                                       "element face 4\nproperty list int32 int vertex_indices\nend_header\n") +
                               std::string(48, '\0') + std::string("men", 3)},
+        // A float-typed list length of -1e30: the message's integer of it was undefined
+        // (sanitized fuzz smoke run in CI).
+        {"negativelist.ply", std::string("ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                                         "element face 1\nproperty list float int vertex_indices\nend_header\n") +
+                                 std::string(48, '\0') + std::string("\xca\xf2\x49\xf1", 4) + std::string(12, '\0')},
         {"huge.stl", std::string(80, 'x') + std::string("\xff\xff\xff\x7f", 4) + std::string(50, '\0')},
     };
     for (const auto& [name, bytes] : cases) {
@@ -665,6 +670,9 @@ TEST(CliHostile, MalformedPlyAndStlAreRefusedByName) {
         // whatever its half-read bytes said (not always over 1 GiB: that depends on memory).
         if (name == "cutlength.ply") {
             EXPECT_NE(r.err.find("the file ends in element 'face' entry 0"), std::string::npos) << r.err;
+        }
+        if (name == "negativelist.ply") {
+            EXPECT_NE(r.err.find("element 'face' entry 0 has a list of a negative number of items"), std::string::npos) << r.err;
         }
     }
 }

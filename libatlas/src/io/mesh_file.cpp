@@ -226,7 +226,11 @@ void detail::check_ply_header(const fs::path& file, bool need_faces) {
                 if (!list_length(count_type, n)) ends_early(e, k);
                 const uint64_t at = ascii ? uint64_t(in.tellg()) : pos, left = size > at ? size - at : 0;
                 const double most = ascii ? double(left) / 2 + 1 : double(left / scalar_size(item_type));
-                if (!(n >= 0) || n > most)
+                if (!(n >= 0))
+                    throw Error(f + ": PLY body: element '" + e.name + "' entry " + std::to_string(k) + " has a list of " +
+                                (std::isfinite(n) ? std::string("a negative number of") : std::string("a non-finite number of")) +
+                                " items (a list length is a count from 0)");
+                if (n > most)
                     throw Error(f + ": PLY body: element '" + e.name + "' entry " + std::to_string(k) + " has a list of " +
                                 (std::isfinite(n) ? std::to_string(int64_t(std::min(n, 9e18))) : std::string("a non-finite number of")) +
                                 " items, more than the rest of the file holds");
