@@ -282,6 +282,16 @@ void build_tables(PairTables& T, bool snorm, DecoderSet decoders) {
         T.row_imin[b0][m] = std::min(T.row_imin[b0][m], imn);
         T.row_imax[b0][m] = std::max(T.row_imax[b0][m], imx);
     }
+    // The Reference decoder alone: an endpoint e's floats are those of the numerator
+    // steps * e (the same exact value, num / steps = e exactly), so the numerator tables
+    // hold both and line_palette reads a pair's whole grid from one of them. (Under the
+    // Conformant model interpolated entries are wider than endpoints: not filled there.)
+    if (decoders == kReferenceOnly)
+        for (int b = 0; b < 256; ++b)
+            for (int m = 0; m < 2; ++m) {
+                const size_t at = size_t((m == 0 ? 7 : 5) * level(uint8_t(b), snorm) - T.num_base[m]);
+                if (std::isnan(T.num_lo[m][at])) { T.num_lo[m][at] = T.end_lo[b]; T.num_hi[m][at] = T.end_hi[b]; T.num_ref[m][at] = T.end_ref[b]; }
+            }
 }
 
 // fast / normal's candidate palette of pair k from the per-entry tables: the same
@@ -587,6 +597,59 @@ bool keys_of(const PairTables& T, const detail::Palette<1>& p, const float src[1
 #endif
     return detail::bc4_keys<OneSided>(p, src, stop, inc_sum, k);
 }
+
+#if defined(ATLAS_BC4_AVX2)
+// The line palette (bc4_eval.h) of the pair on levels lo < hi: the 8-value mode (hi, lo)
+// or the 6-value mode (lo, hi); the Reference decoder alone (build_tables' numerator
+// slots at the endpoints). Grid value j has the numerator steps * lo + j (hi - lo).
+__attribute__((target("avx2"))) void line_palette(const PairTables& T, int lo, int hi, bool eight, detail::Bc4LinePalette& p) {
+    // 8 values: entry 1 (lo), 7, 6, .., 2, 0 (hi); 6 values: the constant below (6), 0
+    // (lo), 2, .., 5, 1 (hi), the constant above (7).
+    static constexpr int32_t kIndex[2][8] = {{1, 7, 6, 5, 4, 3, 2, 0}, {6, 0, 2, 3, 4, 5, 1, 7}};
+    static constexpr int32_t kPosition[2][8] = {{7, 0, 6, 5, 4, 3, 2, 1}, {1, 6, 2, 3, 4, 5, 0, 7}};
+    const int m = eight ? 0 : 1, steps = eight ? 7 : 5;
+    const int at = steps * lo - T.num_base[m], d = hi - lo;
+    // Eight values in registers (a vector load of scalar stores would wait for them).
+    auto line = [&](const float* v, float below, float above) __attribute__((target("avx2"))) {
+        const float* x = v + at;
+        return eight ? _mm256_setr_ps(x[0], x[d], x[2 * d], x[3 * d], x[4 * d], x[5 * d], x[6 * d], x[7 * d])
+                     : _mm256_setr_ps(below, x[0], x[d], x[2 * d], x[3 * d], x[4 * d], x[5 * d], above);
+    };
+    p.lo = line(T.num_lo[m].data(), T.c_lo, T.c_hi);
+    p.hi = line(T.num_hi[m].data(), T.c_lo, T.c_hi);
+    p.ref = line(T.num_ref[m].data(), T.c_lo, T.c_hi);
+    p.index = kIndex[m];
+    p.position = kPosition[m];
+    const float* ref = T.num_ref[m].data() + at;
+    p.origin = ref[0];
+    p.per_value = float(steps) / (ref[steps * d] - ref[0]);
+    p.first = eight ? 0.0f : 1.0f;
+}
+
+// The candidate loop below for a level pair (the extremes' floor and ceiling are the
+// levels lo < hi, the Reference decoder alone, two-sided, texels within +-2): the same
+// candidates, (hi, lo) then (lo, hi) unless `with_six` is off (fast), the same
+// shortcuts, each evaluated by its line palette (the same keys). Returns false if the
+// first candidate fails (it cannot: every key error is finite), leaving the loop to it.
+__attribute__((target("avx2"))) bool level_pair_search(const PairTables& T, const float src[16], float smin, float smax, int lo, int hi, bool snorm,
+                                                      bool with_six, int& best_k, detail::Selection& best, uint64_t& bits) {
+    auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
+    const int k8 = byte_of(hi) * 256 + byte_of(lo), k6 = swapped(k8);
+    detail::Bc4LinePalette pal[2];
+    detail::Bc4Keys keys[2];
+    line_palette(T, lo, hi, true, pal[0]);
+    if (!detail::bc4_line_keys_avx2(pal[0], src, detail::kBc4Infeasible, INFINITY, keys[0])) return false;
+    int w = 0;
+    const bool exact = keys[0].max_err == 0.0f && keys[0].sum == 0.0f;
+    if (with_six && !exact && !(endpoints_only(keys[0]) && smin >= T.end_lo[k6 >> 8] && smax <= T.end_hi[k6 & 255])) {
+        line_palette(T, lo, hi, false, pal[1]);
+        if (detail::bc4_line_keys_avx2(pal[1], src, keys[0].max_err, keys[0].sum, keys[1]) && detail::bc4_keys_better(keys[1], keys[0])) w = 1;
+    }
+    best_k = w ? k6 : k8;
+    detail::bc4_exact_avx2(pal[w], src, keys[w], best.max_err, best.sum_sq, bits);
+    return true;
+}
+#endif
 } // namespace
 
 BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
@@ -635,80 +698,90 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     auto ceil_i = [&](float x) { x = in_range(x); const int i = int(x); return i + (float(i) < x ? 1 : 0); };
     const int qlo0 = clampi(floor_i(smin * scale)), qlo1 = clampi(ceil_i(smin * scale));
     const int qhi0 = clampi(floor_i(smax * scale)), qhi1 = clampi(ceil_i(smax * scale));
-    auto byte_of = [&](int v) { return uint8_t(snorm_ ? uint8_t(int8_t(v)) : uint8_t(v)); };
     const bool os = options_.one_sided_below;
     // The Reference decoder alone: every entry's interval is its exact value to ulps.
     const bool narrow = options_.decoders == kReferenceOnly;
-    // Candidate pairs (each once), evaluated in order; ties keep the earlier one.
-    int cands[32];
-    int ncand = 0;
-    auto consider = [&](int a, int b) {
-        const int k = int(byte_of(a)) * 256 + int(byte_of(b));
-        for (int c = 0; c < ncand; ++c)
-            if (cands[c] == k) return;
-        cands[ncand++] = k;
-    };
-    // Floor / ceil of the extremes, the 8-value mode first (Best and blocks missing the
-    // bound start the exhaustive search from this incumbent: the result is the same,
-    // found sooner). One-sided: also the level below the floor. The bounds are exact
-    // (widened), so a minimum that sits on a level's float value can be an ulp below the
-    // level itself, and without a lower endpoint such a texel would be left with the
-    // constant 0.
-    const int hstep = options_.quality == Quality::Fast ? std::max(1, qhi1 - qhi0) : 1;
-    const int h0 = os && qhi0 > lo_lim ? qhi0 - hstep : qhi0, l0 = os ? clampi(qlo0 - 1) : qlo0;
-    for (int h = h0; h <= qhi1; h += hstep)
-        for (int l = l0; l <= qlo1; ++l)
-            if (clampi(h) > clampi(l)) consider(clampi(h), clampi(l)); // 8 interpolated values
-    // The 6-value mode (plus exact extremes). Fast skips it, except for flat blocks
-    // (a == b) where the 8-value mode has no pair (else they would fall to the
-    // exhaustive search).
-    for (int h = h0; h <= qhi1; h += hstep)
-        for (int l = l0; l <= qlo1; ++l) {
-            const int a = clampi(h), b = clampi(l);
-            if (options_.quality != Quality::Fast || os || a == b) consider(std::min(a, b), std::max(a, b));
-        }
-    detail::Bc4Keys keys[2];
-    detail::Palette<1> pal[2];
-    int cur = 0, best_k = -1;
+    int best_k = -1;
     detail::Selection best;
     uint64_t bits = 0;  // the winner's index field when `keyed`
     bool keyed = false; // else best.idx (select_indices)
-    if (!finite) { // NaN or huge texels: select_indices' comparisons, no keys
-        for (int c = 0; c < ncand; ++c) {
-            const int k = cands[c];
-            detail::Selection s = detail::select_indices(tables_->pal[size_t(k)], src, os, best.max_err);
-            if (best_k < 0 ? std::isfinite(s.max_err) : detail::better(s, best)) { best = s; best_k = k; }
-        }
-    } else {
-        for (int c = 0; c < ncand; ++c) {
-            const int k = cands[c];
-            if (best_k >= 0 && tables_->shortcuts && narrow && k == swapped(best_k) && endpoints_only(keys[1 - cur]) && smin >= tables_->end_lo[k >> 8] &&
-                smax <= tables_->end_hi[k & 255])
-                continue; // cannot win (endpoints_only)
-            entry_palette(*tables_, k, snorm_, pal[cur]);
-            const auto& p = pal[cur];
-            const float stop = best_k < 0 ? detail::kBc4Infeasible : keys[1 - cur].max_err;
-            const float inc_sum = best_k < 0 ? INFINITY : keys[1 - cur].sum;
-            // A flat block is evaluated on one texel (the same keys and sums, bc4_eval.h).
-            const bool ok = flat ? (os ? detail::bc4_keys_flat<true>(p, src, stop, inc_sum, keys[cur]) : detail::bc4_keys_flat<false>(p, src, stop, inc_sum, keys[cur]))
-                                 : (os ? keys_of<true>(*tables_, p, src, stop, inc_sum, keys[cur]) : keys_of<false>(*tables_, p, src, stop, inc_sum, keys[cur]));
-            if (ok && (best_k < 0 || detail::bc4_keys_better(keys[cur], keys[1 - cur]))) {
-                best_k = k;
-                cur = 1 - cur;
-                // An exact incumbent (key errors all 0) cannot be beaten: a later candidate
-                // returns false (max error above 0, or 0 and a sum not below 0).
-                if (keys[1 - cur].max_err == 0.0f && keys[1 - cur].sum == 0.0f) break;
+#if defined(ATLAS_BC4_AVX2)
+    // Level pairs (8-bit sources: nearly every block not flat) take the same candidates
+    // and give the same result through their line palettes (bc4_eval.h).
+    if (finite && !flat && tables_->avx2 && tables_->shortcuts && narrow && !os && qlo0 == qlo1 && qhi0 == qhi1 && qlo0 < qhi0 && smin >= -2.0f &&
+        smax <= 2.0f)
+        keyed = level_pair_search(*tables_, src, smin, smax, qlo0, qhi0, snorm_, options_.quality != Quality::Fast, best_k, best, bits);
+#endif
+    if (!keyed) {
+        auto byte_of = [&](int v) { return uint8_t(snorm_ ? uint8_t(int8_t(v)) : uint8_t(v)); };
+        // Candidate pairs (each once), evaluated in order; ties keep the earlier one.
+        int cands[32];
+        int ncand = 0;
+        auto consider = [&](int a, int b) {
+            const int k = int(byte_of(a)) * 256 + int(byte_of(b));
+            for (int c = 0; c < ncand; ++c)
+                if (cands[c] == k) return;
+            cands[ncand++] = k;
+        };
+        // Floor / ceil of the extremes, the 8-value mode first (Best and blocks missing the
+        // bound start the exhaustive search from this incumbent: the result is the same,
+        // found sooner). One-sided: also the level below the floor. The bounds are exact
+        // (widened), so a minimum that sits on a level's float value can be an ulp below the
+        // level itself, and without a lower endpoint such a texel would be left with the
+        // constant 0.
+        const int hstep = options_.quality == Quality::Fast ? std::max(1, qhi1 - qhi0) : 1;
+        const int h0 = os && qhi0 > lo_lim ? qhi0 - hstep : qhi0, l0 = os ? clampi(qlo0 - 1) : qlo0;
+        for (int h = h0; h <= qhi1; h += hstep)
+            for (int l = l0; l <= qlo1; ++l)
+                if (clampi(h) > clampi(l)) consider(clampi(h), clampi(l)); // 8 interpolated values
+        // The 6-value mode (plus exact extremes). Fast skips it, except for flat blocks
+        // (a == b) where the 8-value mode has no pair (else they would fall to the
+        // exhaustive search).
+        for (int h = h0; h <= qhi1; h += hstep)
+            for (int l = l0; l <= qlo1; ++l) {
+                const int a = clampi(h), b = clampi(l);
+                if (options_.quality != Quality::Fast || os || a == b) consider(std::min(a, b), std::max(a, b));
+            }
+        detail::Bc4Keys keys[2];
+        detail::Palette<1> pal[2];
+        int cur = 0;
+        if (!finite) { // NaN or huge texels: select_indices' comparisons, no keys
+            for (int c = 0; c < ncand; ++c) {
+                const int k = cands[c];
+                detail::Selection s = detail::select_indices(tables_->pal[size_t(k)], src, os, best.max_err);
+                if (best_k < 0 ? std::isfinite(s.max_err) : detail::better(s, best)) { best = s; best_k = k; }
+            }
+        } else {
+            for (int c = 0; c < ncand; ++c) {
+                const int k = cands[c];
+                if (best_k >= 0 && tables_->shortcuts && narrow && k == swapped(best_k) && endpoints_only(keys[1 - cur]) && smin >= tables_->end_lo[k >> 8] &&
+                    smax <= tables_->end_hi[k & 255])
+                    continue; // cannot win (endpoints_only)
+                entry_palette(*tables_, k, snorm_, pal[cur]);
+                const auto& p = pal[cur];
+                const float stop = best_k < 0 ? detail::kBc4Infeasible : keys[1 - cur].max_err;
+                const float inc_sum = best_k < 0 ? INFINITY : keys[1 - cur].sum;
+                // A flat block is evaluated on one texel (the same keys and sums, bc4_eval.h).
+                const bool ok = flat ? (os ? detail::bc4_keys_flat<true>(p, src, stop, inc_sum, keys[cur]) : detail::bc4_keys_flat<false>(p, src, stop, inc_sum, keys[cur]))
+                                     : (os ? keys_of<true>(*tables_, p, src, stop, inc_sum, keys[cur]) : keys_of<false>(*tables_, p, src, stop, inc_sum, keys[cur]));
+                if (ok && (best_k < 0 || detail::bc4_keys_better(keys[cur], keys[1 - cur]))) {
+                    best_k = k;
+                    cur = 1 - cur;
+                    // An exact incumbent (key errors all 0) cannot be beaten: a later candidate
+                    // returns false (max error above 0, or 0 and a sum not below 0).
+                    if (keys[1 - cur].max_err == 0.0f && keys[1 - cur].sum == 0.0f) break;
+                }
             }
         }
-    }
-    if (finite && best_k >= 0) {
-        const auto& p = pal[1 - cur];
-        if (flat) { // one texel stands for all 16 (the same result, bc4_eval.h)
-            if (os) detail::bc4_exact_flat<true>(p, src, keys[1 - cur], best.max_err, best.sum_sq, bits);
-            else detail::bc4_exact_flat<false>(p, src, keys[1 - cur], best.max_err, best.sum_sq, bits);
-        } else if (os) exact_selection<true>(*tables_, p, src, keys[1 - cur], best, bits);
-        else exact_selection<false>(*tables_, p, src, keys[1 - cur], best, bits);
-        keyed = true;
+        if (finite && best_k >= 0) {
+            const auto& p = pal[1 - cur];
+            if (flat) { // one texel stands for all 16 (the same result, bc4_eval.h)
+                if (os) detail::bc4_exact_flat<true>(p, src, keys[1 - cur], best.max_err, best.sum_sq, bits);
+                else detail::bc4_exact_flat<false>(p, src, keys[1 - cur], best.max_err, best.sum_sq, bits);
+            } else if (os) exact_selection<true>(*tables_, p, src, keys[1 - cur], best, bits);
+            else exact_selection<false>(*tables_, p, src, keys[1 - cur], best, bits);
+            keyed = true;
+        }
     }
     const bool missed = best_k < 0 || (options_.max_error >= 0 && best.max_err > options_.max_error);
     if (missed || options_.quality == Quality::Best) {

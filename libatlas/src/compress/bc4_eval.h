@@ -213,29 +213,15 @@ inline void bc4_exact_flat(const Palette<1>& p, const float* src, const Bc4Keys&
 #if defined(ATLAS_BC4_AVX2)
 // AVX2: 8 texels at a time, the same operations per texel; the sums are formed in the
 // portable order (lanes of texels j, 4 + j, 8 + j, 12 + j, then (0 + 1) + (2 + 3)).
-template <bool OneSided>
-__attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
+// `keys_of(s)` returns the 8 texels' least keys (bc4_full_keys_avx2 or, on a level pair,
+// bc4_line_keys_avx2: the same keys).
+template <class KeysOf>
+__attribute__((target("avx2"))) inline bool bc4_rank_avx2(const float* src, float stop, float inc_sum, Bc4Keys& out, const KeysOf& keys_of) {
     const __m256 vstop = _mm256_set1_ps(stop), vinf = _mm256_set1_ps(kBc4Infeasible);
     const __m256 clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask)));
     __m256 ek[2];
     for (int h = 0; h < 2; ++h) {
-        const __m256 s = _mm256_loadu_ps(src + 8 * h);
-        // The 8 entries' keys (p.n is always 8), then their minimum as a tree: the keys
-        // differ in their index bits and are not NaN, so any order gives the same minimum,
-        // and the tree's 3 dependent minima replace a chain of 7 (latency-bound).
-        static_assert(sizeof(p.lo) / sizeof(p.lo[0]) == 8, "BC4 palettes have 8 entries");
-        __m256 key[8];
-        for (int i = 0; i < 8; ++i) {
-            const __m256 vlo = _mm256_set1_ps(p.lo[i][0]), vhi = _mm256_set1_ps(p.hi[i][0]);
-            __m256 e = _mm256_max_ps(_mm256_sub_ps(vhi, s), _mm256_sub_ps(s, vlo));
-            if constexpr (OneSided) {
-                const __m256 above = _mm256_cmp_ps(vhi, s, _CMP_GT_OQ);
-                e = _mm256_blendv_ps(e, vinf, above);
-            }
-            key[i] = _mm256_or_ps(_mm256_and_ps(e, clear), _mm256_castsi256_ps(_mm256_set1_epi32(i)));
-        }
-        const __m256 best = _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(key[0], key[1]), _mm256_min_ps(key[2], key[3])),
-                                          _mm256_min_ps(_mm256_min_ps(key[4], key[5]), _mm256_min_ps(key[6], key[7])));
+        const __m256 best = keys_of(_mm256_loadu_ps(src + 8 * h));
         _mm256_storeu_ps(reinterpret_cast<float*>(out.key + 8 * h), best);
         ek[h] = _mm256_and_ps(best, clear);
         if (_mm256_movemask_ps(_mm256_or_ps(_mm256_cmp_ps(ek[h], vstop, _CMP_GT_OQ), _mm256_cmp_ps(ek[h], vinf, _CMP_GE_OQ)))) return false;
@@ -261,15 +247,83 @@ __attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, c
     return !(r == stop && !(out.sum < inc_sum));
 }
 
+// Every entry's key, then their minimum as a tree: the keys differ in their index bits
+// and are not NaN, so any order gives the same minimum, and the tree's 3 dependent
+// minima replace a chain of 7 (latency-bound).
+template <bool OneSided>
+struct Bc4FullKeysAvx2 {
+    const Palette<1>& p;
+    __attribute__((target("avx2"))) __m256 operator()(__m256 s) const {
+        static_assert(sizeof(p.lo) / sizeof(p.lo[0]) == 8, "BC4 palettes have 8 entries");
+        const __m256 vinf = _mm256_set1_ps(kBc4Infeasible), clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask)));
+        __m256 key[8];
+        for (int i = 0; i < 8; ++i) {
+            const __m256 vlo = _mm256_set1_ps(p.lo[i][0]), vhi = _mm256_set1_ps(p.hi[i][0]);
+            __m256 e = _mm256_max_ps(_mm256_sub_ps(vhi, s), _mm256_sub_ps(s, vlo));
+            if constexpr (OneSided) {
+                const __m256 above = _mm256_cmp_ps(vhi, s, _CMP_GT_OQ);
+                e = _mm256_blendv_ps(e, vinf, above);
+            }
+            key[i] = _mm256_or_ps(_mm256_and_ps(e, clear), _mm256_castsi256_ps(_mm256_set1_epi32(i)));
+        }
+        return _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(key[0], key[1]), _mm256_min_ps(key[2], key[3])),
+                             _mm256_min_ps(_mm256_min_ps(key[4], key[5]), _mm256_min_ps(key[6], key[7])));
+    }
+};
+
+template <bool OneSided>
+__attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
+    return bc4_rank_avx2(src, stop, inc_sum, out, Bc4FullKeysAvx2<OneSided>{p});
+}
+
+// A pair's palette in ascending order of value, for the Reference decoder alone (each
+// entry's interval is its exact value to ulps) and two-sided errors: the 8-value mode's
+// 8 evenly spaced values, or the 6-value mode's constant below, its 6 evenly spaced
+// values and the constant above. Position u of a value s on the even grid (origin: the
+// lowest grid value, `first`: its position) tells the two entries around s; no other
+// entry can hold the least key when the grid's spacing (>= 1/7 level, ~5.6e-4 UNORM) is
+// far above the keys' resolution (8 ulps of the error; texels within +-2 keep errors
+// below 3, ulps below 2.4e-7), so the two give the same least key as all 8 (test
+// Bc4Eval.LineKeysEqualFullKeys). Entries with the same value (a constant on a grid end)
+// tie on the error and the grid end, with the lower index, wins in both evaluations.
+struct Bc4LinePalette {
+    __m256 lo, hi, ref;    // ascending (used only in AVX2 functions)
+    const int32_t* index;  // BC4 index of each position
+    const int32_t* position; // position of each BC4 index
+    float origin, per_value, first;
+};
+
+struct Bc4LineKeysAvx2 {
+    const Bc4LinePalette& p;
+    __attribute__((target("avx2"))) __m256 operator()(__m256 s) const {
+        const __m256 clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask)));
+        const __m256i index = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.index));
+        // The lower entry's position, clamped to 0..6 (a truncation of u in (-1, 0) is 0:
+        // the clamp's value too; texels beyond the ends take the two end entries).
+        const __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(s, _mm256_set1_ps(p.origin)), _mm256_set1_ps(p.per_value)), _mm256_set1_ps(p.first));
+        const __m256i at = _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(u), _mm256_setzero_si256()), _mm256_set1_epi32(6));
+        const __m256i above = _mm256_add_epi32(at, _mm256_set1_epi32(1));
+        const __m256 e0 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(p.hi, at), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(p.lo, at)));
+        const __m256 e1 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(p.hi, above), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(p.lo, above)));
+        const __m256 k0 = _mm256_or_ps(_mm256_and_ps(e0, clear), _mm256_castsi256_ps(_mm256_permutevar8x32_epi32(index, at)));
+        const __m256 k1 = _mm256_or_ps(_mm256_and_ps(e1, clear), _mm256_castsi256_ps(_mm256_permutevar8x32_epi32(index, above)));
+        return _mm256_min_ps(k0, k1);
+    }
+};
+
+__attribute__((target("avx2"))) inline bool bc4_line_keys_avx2(const Bc4LinePalette& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
+    return bc4_rank_avx2(src, stop, inc_sum, out, Bc4LineKeysAvx2{p});
+}
+
 // The exact errors of the chosen entries (entry_error_t's terms; every chosen entry is
 // feasible) and the squared Reference error in double, summed in exact_selection's
 // order (lanes of texels j, 4 + j, 8 + j, 12 + j, then (0 + 1) + (2 + 3)); the block's
 // max error is the max over all texels, which equals the max over the texels whose key
 // error is the largest (bc4.cpp).
-__attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err,
-                                                           double& sum_sq, uint64_t& bits) {
-    static_assert(sizeof(p.lo) == 8 * sizeof(float), "one channel: 8 contiguous entries");
-    const __m256 lo = _mm256_loadu_ps(&p.lo[0][0]), hi = _mm256_loadu_ps(&p.hi[0][0]), ref = _mm256_loadu_ps(&p.ref[0][0]);
+// lo, hi, ref: the 8 entries in index order.
+__attribute__((target("avx2"))) inline void bc4_exact_avx2(const float* entry_lo, const float* entry_hi, const float* entry_ref, const float* src,
+                                                           const Bc4Keys& k, float& max_err, double& sum_sq, uint64_t& bits) {
+    const __m256 lo = _mm256_loadu_ps(entry_lo), hi = _mm256_loadu_ps(entry_hi), ref = _mm256_loadu_ps(entry_ref);
     const __m256 zero = _mm256_setzero_ps();
     __m256 mx = zero;
     __m256d acc = _mm256_setzero_pd();
@@ -295,6 +349,23 @@ __attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, 
     const __m128d pairs = _mm_hadd_pd(_mm256_castpd256_pd128(acc), _mm256_extractf128_pd(acc, 1)); // (0 + 1), (2 + 3)
     sum_sq = _mm_cvtsd_f64(_mm_hadd_pd(pairs, pairs));
     bits = uint64_t(half[0]) | (uint64_t(half[1]) << 24);
+}
+
+__attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err,
+                                                           double& sum_sq, uint64_t& bits) {
+    static_assert(sizeof(p.lo) == 8 * sizeof(float), "one channel: 8 contiguous entries");
+    bc4_exact_avx2(&p.lo[0][0], &p.hi[0][0], &p.ref[0][0], src, k, max_err, sum_sq, bits);
+}
+
+// The line palette's entries put back in index order first.
+__attribute__((target("avx2"))) inline void bc4_exact_avx2(const Bc4LinePalette& p, const float* src, const Bc4Keys& k, float& max_err,
+                                                           double& sum_sq, uint64_t& bits) {
+    const __m256i position = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.position));
+    alignas(32) float lo[8], hi[8], ref[8];
+    _mm256_store_ps(lo, _mm256_permutevar8x32_ps(p.lo, position));
+    _mm256_store_ps(hi, _mm256_permutevar8x32_ps(p.hi, position));
+    _mm256_store_ps(ref, _mm256_permutevar8x32_ps(p.ref, position));
+    bc4_exact_avx2(lo, hi, ref, src, k, max_err, sum_sq, bits);
 }
 
 inline bool bc4_cpu_has_avx2() { return __builtin_cpu_supports("avx2") != 0; }
