@@ -626,6 +626,28 @@ __attribute__((target("avx2"))) void line_palette(const PairTables& T, int lo, i
     p.first = eight ? 0.0f : 1.0f;
 }
 
+// Whether the 6-value pair of a level pair can hold every texel within the 8-value
+// incumbent's max error E, from the texels' distances to its even grid (in grid steps,
+// through the 8-value line's origin and spacing: the same grid value, 5 steps instead of
+// 7). The distance computed so is within ~1e-6 of the exact one (values within +-2), and
+// the 6-value pair's key errors are at least the exact distances less 8 ulps (its
+// constants lie on or beyond its grid ends and are never nearer than they), so a texel
+// more than E + 1e-5 away fails that pair: its evaluation would return false (max error
+// above the incumbent's). On 8-bit sources the two modes' errors are multiples of 1/35
+// level (1.1e-4), so every pair whose max error is the larger is skipped here.
+__attribute__((target("avx2"))) bool six_may_tie(const detail::Bc4LinePalette& eight, const float src[16], float max_err) {
+    const __m256 origin = _mm256_set1_ps(eight.origin), per_step = _mm256_set1_ps(eight.per_value * (5.0f / 7.0f));
+    const __m256 zero = _mm256_setzero_ps(), five = _mm256_set1_ps(5.0f), abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    __m256 far = zero;
+    for (int h = 0; h < 2; ++h) {
+        const __m256 u = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(src + 8 * h), origin), per_step);
+        const __m256 nearest = _mm256_round_ps(_mm256_min_ps(_mm256_max_ps(u, zero), five), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+        far = _mm256_max_ps(far, _mm256_and_ps(_mm256_sub_ps(u, nearest), abs_mask));
+    }
+    const __m256 limit = _mm256_set1_ps((max_err + 1e-5f) * eight.per_value * (5.0f / 7.0f));
+    return _mm256_movemask_ps(_mm256_cmp_ps(far, limit, _CMP_GT_OQ)) == 0;
+}
+
 // The candidate loop below for a level pair (the extremes' floor and ceiling are the
 // levels lo < hi, the Reference decoder alone, two-sided, texels within +-2): the same
 // candidates, (hi, lo) then (lo, hi) unless `with_six` is off (fast), the same
@@ -633,6 +655,14 @@ __attribute__((target("avx2"))) void line_palette(const PairTables& T, int lo, i
 // first candidate fails (it cannot: every key error is finite), leaving the loop to it.
 __attribute__((target("avx2"))) bool level_pair_search(const PairTables& T, const float src[16], float smin, float smax, int lo, int hi, bool snorm,
                                                       bool with_six, int& best_k, detail::Selection& best, uint64_t& bits) {
+    // A texel -0.0 has the error -0.0 at an entry 0 (+0 - -0 < -0 - 0 is false): two
+    // such entries (the constant 0 on the grid's end 0) would tie the other way round.
+    {
+        const __m256i negative_zero = _mm256_set1_epi32(int(0x80000000u));
+        const __m256i a = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(src)), b = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(src + 8));
+        if (!_mm256_testz_si256(_mm256_or_si256(_mm256_cmpeq_epi32(a, negative_zero), _mm256_cmpeq_epi32(b, negative_zero)), _mm256_set1_epi32(-1)))
+            return false;
+    }
     auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
     const int k8 = byte_of(hi) * 256 + byte_of(lo), k6 = swapped(k8);
     detail::Bc4LinePalette pal[2];
@@ -641,7 +671,12 @@ __attribute__((target("avx2"))) bool level_pair_search(const PairTables& T, cons
     if (!detail::bc4_line_keys_avx2(pal[0], src, detail::kBc4Infeasible, INFINITY, keys[0])) return false;
     int w = 0;
     const bool exact = keys[0].max_err == 0.0f && keys[0].sum == 0.0f;
-    if (with_six && !exact && !(endpoints_only(keys[0]) && smin >= T.end_lo[k6 >> 8] && smax <= T.end_hi[k6 & 255])) {
+    // endpoints_only, on the stored keys
+    const __m256i any = _mm256_or_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(keys[0].key)),
+                                        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(keys[0].key + 8)));
+    const bool endpoints = _mm256_testz_si256(any, _mm256_set1_epi32(6));
+    if (with_six && !exact && !(endpoints && smin >= T.end_lo[k6 >> 8] && smax <= T.end_hi[k6 & 255]) &&
+        six_may_tie(pal[0], src, keys[0].max_err)) {
         line_palette(T, lo, hi, false, pal[1]);
         if (detail::bc4_line_keys_avx2(pal[1], src, keys[0].max_err, keys[0].sum, keys[1]) && detail::bc4_keys_better(keys[1], keys[0])) w = 1;
     }
