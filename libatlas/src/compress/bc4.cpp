@@ -588,6 +588,19 @@ bool endpoints_only(const detail::Bc4Keys& keys) {
     return any == 0;
 }
 
+// A flat block on a level, from the table (its float must have the level's bits).
+bool flat_from_table(const PairTables& T, float v, bool snorm, uint8_t out[8], BlockResult& r) {
+    const float scale = snorm ? 127.0f : 255.0f;
+    const int lo_lim = snorm ? -127 : 0, hi_lim = snorm ? 127 : 255;
+    const float x = v * scale;
+    if (!(x >= float(lo_lim) && x <= float(hi_lim))) return false; // finite, so the rounding below is defined
+    const int i = int(x + (x >= 0 ? 0.5f : -0.5f)) - lo_lim;
+    if (std::memcmp(&v, &T.flat_src[i], 4) != 0) return false;
+    std::memcpy(out, T.flat_out[i], 8);
+    r = T.flat_res[i];
+    return true;
+}
+
 template <bool OneSided>
 bool keys_of(const PairTables& T, const detail::Palette<1>& p, const float src[16], float stop, float inc_sum, detail::Bc4Keys& k) {
 #if defined(ATLAS_BC4_AVX2)
@@ -606,24 +619,26 @@ __attribute__((target("avx2"))) void line_palette(const PairTables& T, int lo, i
     // 8 values: entry 1 (lo), 7, 6, .., 2, 0 (hi); 6 values: the constant below (6), 0
     // (lo), 2, .., 5, 1 (hi), the constant above (7).
     static constexpr int32_t kIndex[2][8] = {{1, 7, 6, 5, 4, 3, 2, 0}, {6, 0, 2, 3, 4, 5, 1, 7}};
-    static constexpr int32_t kPosition[2][8] = {{7, 0, 6, 5, 4, 3, 2, 1}, {1, 6, 2, 3, 4, 5, 0, 7}};
     const int m = eight ? 0 : 1, steps = eight ? 7 : 5;
     const int at = steps * lo - T.num_base[m], d = hi - lo;
-    // Eight values in registers (a vector load of scalar stores would wait for them).
+    // Eight values in registers (a vector load of scalar stores would wait for them), as
+    // a tree of shuffles: a chain of 7 inserts was on every block's critical path.
+    auto quad = [](float a, float b, float c, float e) __attribute__((target("avx2"))) {
+        return _mm_movelh_ps(_mm_unpacklo_ps(_mm_set_ss(a), _mm_set_ss(b)), _mm_unpacklo_ps(_mm_set_ss(c), _mm_set_ss(e)));
+    };
     auto line = [&](const float* v, float below, float above) __attribute__((target("avx2"))) {
         const float* x = v + at;
-        return eight ? _mm256_setr_ps(x[0], x[d], x[2 * d], x[3 * d], x[4 * d], x[5 * d], x[6 * d], x[7 * d])
-                     : _mm256_setr_ps(below, x[0], x[d], x[2 * d], x[3 * d], x[4 * d], x[5 * d], above);
+        return eight ? _mm256_set_m128(quad(x[4 * d], x[5 * d], x[6 * d], x[7 * d]), quad(x[0], x[d], x[2 * d], x[3 * d]))
+                     : _mm256_set_m128(quad(x[3 * d], x[4 * d], x[5 * d], above), quad(below, x[0], x[d], x[2 * d]));
     };
     p.lo = line(T.num_lo[m].data(), T.c_lo, T.c_hi);
     p.hi = line(T.num_hi[m].data(), T.c_lo, T.c_hi);
     p.ref = line(T.num_ref[m].data(), T.c_lo, T.c_hi);
     p.index = kIndex[m];
-    p.position = kPosition[m];
     const float* ref = T.num_ref[m].data() + at;
     p.origin = ref[0];
     p.per_value = float(steps) / (ref[steps * d] - ref[0]);
-    p.first = eight ? 0.0f : 1.0f;
+    p.offset = (eight ? 0.0f : 1.0f) - p.origin * p.per_value;
 }
 
 // Whether the 6-value pair of a level pair can hold every texel within the 8-value
@@ -655,39 +670,73 @@ __attribute__((target("avx2"))) bool six_may_tie(const detail::Bc4LinePalette& e
 // first candidate fails (it cannot: every key error is finite), leaving the loop to it.
 __attribute__((target("avx2"))) bool level_pair_search(const PairTables& T, const float src[16], float smin, float smax, int lo, int hi, bool snorm,
                                                       bool with_six, int& best_k, detail::Selection& best, uint64_t& bits) {
-    // A texel -0.0 has the error -0.0 at an entry 0 (+0 - -0 < -0 - 0 is false): two
-    // such entries (the constant 0 on the grid's end 0) would tie the other way round.
-    {
-        const __m256i negative_zero = _mm256_set1_epi32(int(0x80000000u));
-        const __m256i a = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(src)), b = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(src + 8));
-        if (!_mm256_testz_si256(_mm256_or_si256(_mm256_cmpeq_epi32(a, negative_zero), _mm256_cmpeq_epi32(b, negative_zero)), _mm256_set1_epi32(-1)))
-            return false;
-    }
     auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
     const int k8 = byte_of(hi) * 256 + byte_of(lo), k6 = swapped(k8);
     detail::Bc4LinePalette pal[2];
-    detail::Bc4Keys keys[2];
+    detail::Bc4LineResult r[2];
     line_palette(T, lo, hi, true, pal[0]);
-    if (!detail::bc4_line_keys_avx2(pal[0], src, detail::kBc4Infeasible, INFINITY, keys[0])) return false;
+    if (!detail::bc4_line_select_avx2(pal[0], src, r[0])) return false;
     int w = 0;
-    const bool exact = keys[0].max_err == 0.0f && keys[0].sum == 0.0f;
-    // endpoints_only, on the stored keys
-    const __m256i any = _mm256_or_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(keys[0].key)),
-                                        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(keys[0].key + 8)));
-    const bool endpoints = _mm256_testz_si256(any, _mm256_set1_epi32(6));
-    if (with_six && !exact && !(endpoints && smin >= T.end_lo[k6 >> 8] && smax <= T.end_hi[k6 & 255]) &&
-        six_may_tie(pal[0], src, keys[0].max_err)) {
+    const bool exact = r[0].keys.max_err == 0.0f && r[0].keys.sum == 0.0f;
+    if (with_six && !exact && !(r[0].endpoints && smin >= T.end_lo[k6 >> 8] && smax <= T.end_hi[k6 & 255]) &&
+        six_may_tie(pal[0], src, r[0].keys.max_err)) {
         line_palette(T, lo, hi, false, pal[1]);
-        if (detail::bc4_line_keys_avx2(pal[1], src, keys[0].max_err, keys[0].sum, keys[1]) && detail::bc4_keys_better(keys[1], keys[0])) w = 1;
+        if (detail::bc4_line_select_avx2(pal[1], src, r[1]) && detail::bc4_keys_better(r[1].keys, r[0].keys)) w = 1;
     }
     best_k = w ? k6 : k8;
-    detail::bc4_exact_avx2(pal[w], src, keys[w], best.max_err, best.sum_sq, bits);
+    best.max_err = r[w].max_err;
+    best.sum_sq = r[w].sum_sq;
+    bits = r[w].bits;
+    return true;
+}
+
+// encode's first steps for fast / normal under the Reference decoder alone, two-sided,
+// on AVX2: a flat block from the table, a level pair by level_pair_search, in registers
+// and without the candidate loop's bookkeeping (8-bit sources: nearly every block).
+// Returns false for any other block, and for a level pair missing the bound (encode
+// then does it all, to the same result).
+__attribute__((target("avx2"))) bool level_pair_block(const PairTables& T, const float src[16], bool snorm, bool with_six, float bound, uint8_t out[8],
+                                                     BlockResult& r) {
+    const __m256 a = _mm256_loadu_ps(src), b = _mm256_loadu_ps(src + 8);
+    const __m256i ai = _mm256_castps_si256(a), bi = _mm256_castps_si256(b);
+    const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(ai));
+    if (_mm256_movemask_epi8(_mm256_and_si256(_mm256_cmpeq_epi32(ai, first), _mm256_cmpeq_epi32(bi, first))) == -1)
+        return T.flat_ready && flat_from_table(T, src[0], snorm, out, r); // flat
+    __m256 mn = _mm256_min_ps(a, b), mx = _mm256_max_ps(a, b);
+    __m128 mn4 = _mm_min_ps(_mm256_castps256_ps128(mn), _mm256_extractf128_ps(mn, 1)), mx4 = _mm_max_ps(_mm256_castps256_ps128(mx), _mm256_extractf128_ps(mx, 1));
+    mn4 = _mm_min_ps(mn4, _mm_movehl_ps(mn4, mn4));
+    mx4 = _mm_max_ps(mx4, _mm_movehl_ps(mx4, mx4));
+    const float smin = _mm_cvtss_f32(_mm_min_ss(mn4, _mm_shuffle_ps(mn4, mn4, 1))), smax = _mm_cvtss_f32(_mm_max_ss(mx4, _mm_shuffle_ps(mx4, mx4, 1)));
+    // Finite and within +-2 (a NaN texel fails the unordered test; MINPS / MAXPS may skip it).
+    if (!(smin >= -2.0f && smax <= 2.0f) || _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_UNORD_Q)) != 0) return false;
+    // A texel -0.0 has the error -0.0 at an entry 0 (+0 - -0 < -0 - 0 is false): two
+    // such entries (the constant 0 on the grid's end 0) would tie the other way round.
+    const __m256i negative_zero = _mm256_set1_epi32(int(0x80000000u));
+    if (!_mm256_testz_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ai, negative_zero), _mm256_cmpeq_epi32(bi, negative_zero)), _mm256_set1_epi32(-1)))
+        return false;
+    // The extremes' floor and ceiling, clamped to the levels (as encode computes them).
+    const float scale = snorm ? 127.0f : 255.0f;
+    const int lo_lim = snorm ? -127 : 0, hi_lim = snorm ? 127 : 255;
+    const float xl = smin * scale, xh = smax * scale;
+    auto clampi = [&](float v) { return std::clamp(int(v), lo_lim, hi_lim); };
+    const int lo = clampi(std::floor(xl)), hi = clampi(std::floor(xh));
+    if (lo != clampi(std::ceil(xl)) || hi != clampi(std::ceil(xh)) || !(lo < hi)) return false;
+    int k = -1;
+    detail::Selection best;
+    uint64_t bits = 0;
+    if (!level_pair_search(T, src, smin, smax, lo, hi, snorm, with_six, k, best, bits)) return false;
+    if (bound >= 0 && best.max_err > bound) return false;
+    write_block_bits(uint8_t(k >> 8), uint8_t(k & 255), bits, out);
+    r = {best.max_err, best.sum_sq, true};
     return true;
 }
 #endif
 } // namespace
 
-BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
+namespace {
+// encode's candidate search for any block (the level-pair path aside), apart so that
+// encode's level-pair path does not pay this function's frame.
+__attribute__((noinline)) BlockResult encode_candidates(const PairTables& T, bool snorm, const BlockOptions& options, const float src[16], uint8_t out[8]) {
     float smin, smax;
     bool finite, flat; // flat: all 16 texels have the same bits
 #if defined(__SSE2__)
@@ -714,17 +763,11 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     flat = true;
     for (int t = 1; t < 16; ++t) flat = flat && std::memcmp(&src[t], &src[0], 4) == 0;
 #endif
-    const float scale = snorm_ ? 127.0f : 255.0f;
-    const int lo_lim = snorm_ ? -127 : 0, hi_lim = snorm_ ? 127 : 255;
-    if (flat && tables_->flat_ready && tables_->shortcuts) {
-        const float x = src[0] * scale;
-        if (x >= float(lo_lim) && x <= float(hi_lim)) { // finite, so the rounding below is defined
-            const int i = int(x + (x >= 0 ? 0.5f : -0.5f)) - lo_lim;
-            if (std::memcmp(&src[0], &tables_->flat_src[i], 4) == 0) {
-                std::memcpy(out, tables_->flat_out[i], 8);
-                return tables_->flat_res[i];
-            }
-        }
+    const float scale = snorm ? 127.0f : 255.0f;
+    const int lo_lim = snorm ? -127 : 0, hi_lim = snorm ? 127 : 255;
+    if (flat && T.flat_ready && T.shortcuts) {
+        BlockResult r;
+        if (flat_from_table(T, src[0], snorm, out, r)) return r;
     }
     auto clampi = [&](int v) { return std::clamp(v, lo_lim, hi_lim); };
     // floor / ceil of a scaled extreme, in integers (clamped first: the levels are within +-255).
@@ -733,22 +776,15 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     auto ceil_i = [&](float x) { x = in_range(x); const int i = int(x); return i + (float(i) < x ? 1 : 0); };
     const int qlo0 = clampi(floor_i(smin * scale)), qlo1 = clampi(ceil_i(smin * scale));
     const int qhi0 = clampi(floor_i(smax * scale)), qhi1 = clampi(ceil_i(smax * scale));
-    const bool os = options_.one_sided_below;
+    const bool os = options.one_sided_below;
     // The Reference decoder alone: every entry's interval is its exact value to ulps.
-    const bool narrow = options_.decoders == kReferenceOnly;
+    const bool narrow = options.decoders == kReferenceOnly;
     int best_k = -1;
     detail::Selection best;
     uint64_t bits = 0;  // the winner's index field when `keyed`
     bool keyed = false; // else best.idx (select_indices)
-#if defined(ATLAS_BC4_AVX2)
-    // Level pairs (8-bit sources: nearly every block not flat) take the same candidates
-    // and give the same result through their line palettes (bc4_eval.h).
-    if (finite && !flat && tables_->avx2 && tables_->shortcuts && narrow && !os && qlo0 == qlo1 && qhi0 == qhi1 && qlo0 < qhi0 && smin >= -2.0f &&
-        smax <= 2.0f)
-        keyed = level_pair_search(*tables_, src, smin, smax, qlo0, qhi0, snorm_, options_.quality != Quality::Fast, best_k, best, bits);
-#endif
-    if (!keyed) {
-        auto byte_of = [&](int v) { return uint8_t(snorm_ ? uint8_t(int8_t(v)) : uint8_t(v)); };
+    {
+        auto byte_of = [&](int v) { return uint8_t(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
         // Candidate pairs (each once), evaluated in order; ties keep the earlier one.
         int cands[32];
         int ncand = 0;
@@ -764,7 +800,7 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
         // (widened), so a minimum that sits on a level's float value can be an ulp below the
         // level itself, and without a lower endpoint such a texel would be left with the
         // constant 0.
-        const int hstep = options_.quality == Quality::Fast ? std::max(1, qhi1 - qhi0) : 1;
+        const int hstep = options.quality == Quality::Fast ? std::max(1, qhi1 - qhi0) : 1;
         const int h0 = os && qhi0 > lo_lim ? qhi0 - hstep : qhi0, l0 = os ? clampi(qlo0 - 1) : qlo0;
         for (int h = h0; h <= qhi1; h += hstep)
             for (int l = l0; l <= qlo1; ++l)
@@ -775,7 +811,7 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
         for (int h = h0; h <= qhi1; h += hstep)
             for (int l = l0; l <= qlo1; ++l) {
                 const int a = clampi(h), b = clampi(l);
-                if (options_.quality != Quality::Fast || os || a == b) consider(std::min(a, b), std::max(a, b));
+                if (options.quality != Quality::Fast || os || a == b) consider(std::min(a, b), std::max(a, b));
             }
         detail::Bc4Keys keys[2];
         detail::Palette<1> pal[2];
@@ -783,22 +819,22 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
         if (!finite) { // NaN or huge texels: select_indices' comparisons, no keys
             for (int c = 0; c < ncand; ++c) {
                 const int k = cands[c];
-                detail::Selection s = detail::select_indices(tables_->pal[size_t(k)], src, os, best.max_err);
+                detail::Selection s = detail::select_indices(T.pal[size_t(k)], src, os, best.max_err);
                 if (best_k < 0 ? std::isfinite(s.max_err) : detail::better(s, best)) { best = s; best_k = k; }
             }
         } else {
             for (int c = 0; c < ncand; ++c) {
                 const int k = cands[c];
-                if (best_k >= 0 && tables_->shortcuts && narrow && k == swapped(best_k) && endpoints_only(keys[1 - cur]) && smin >= tables_->end_lo[k >> 8] &&
-                    smax <= tables_->end_hi[k & 255])
+                if (best_k >= 0 && T.shortcuts && narrow && k == swapped(best_k) && endpoints_only(keys[1 - cur]) && smin >= T.end_lo[k >> 8] &&
+                    smax <= T.end_hi[k & 255])
                     continue; // cannot win (endpoints_only)
-                entry_palette(*tables_, k, snorm_, pal[cur]);
+                entry_palette(T, k, snorm, pal[cur]);
                 const auto& p = pal[cur];
                 const float stop = best_k < 0 ? detail::kBc4Infeasible : keys[1 - cur].max_err;
                 const float inc_sum = best_k < 0 ? INFINITY : keys[1 - cur].sum;
                 // A flat block is evaluated on one texel (the same keys and sums, bc4_eval.h).
                 const bool ok = flat ? (os ? detail::bc4_keys_flat<true>(p, src, stop, inc_sum, keys[cur]) : detail::bc4_keys_flat<false>(p, src, stop, inc_sum, keys[cur]))
-                                     : (os ? keys_of<true>(*tables_, p, src, stop, inc_sum, keys[cur]) : keys_of<false>(*tables_, p, src, stop, inc_sum, keys[cur]));
+                                     : (os ? keys_of<true>(T, p, src, stop, inc_sum, keys[cur]) : keys_of<false>(T, p, src, stop, inc_sum, keys[cur]));
                 if (ok && (best_k < 0 || detail::bc4_keys_better(keys[cur], keys[1 - cur]))) {
                     best_k = k;
                     cur = 1 - cur;
@@ -813,18 +849,18 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
             if (flat) { // one texel stands for all 16 (the same result, bc4_eval.h)
                 if (os) detail::bc4_exact_flat<true>(p, src, keys[1 - cur], best.max_err, best.sum_sq, bits);
                 else detail::bc4_exact_flat<false>(p, src, keys[1 - cur], best.max_err, best.sum_sq, bits);
-            } else if (os) exact_selection<true>(*tables_, p, src, keys[1 - cur], best, bits);
-            else exact_selection<false>(*tables_, p, src, keys[1 - cur], best, bits);
+            } else if (os) exact_selection<true>(T, p, src, keys[1 - cur], best, bits);
+            else exact_selection<false>(T, p, src, keys[1 - cur], best, bits);
             keyed = true;
         }
     }
-    const bool missed = best_k < 0 || (options_.max_error >= 0 && best.max_err > options_.max_error);
-    if (missed || options_.quality == Quality::Best) {
+    const bool missed = best_k < 0 || (options.max_error >= 0 && best.max_err > options.max_error);
+    if (missed || options.quality == Quality::Best) {
         // The exhaustive search's incumbent is select_indices' result for the pair (its
         // result, the lexicographic minimum over all pairs, does not depend on it).
-        if (best_k >= 0) best = detail::select_indices(tables_->pal[size_t(best_k)], src, os);
+        if (best_k >= 0) best = detail::select_indices(T.pal[size_t(best_k)], src, os);
         keyed = false;
-        best_k = search_all_pairs(*tables_, src, os, best, best_k);
+        best_k = search_all_pairs(T, src, os, best, best_k);
         if (best_k < 0) { // cannot happen for UNORM/SNORM (0 / -1 entry), kept for safety
             std::memset(out, 0, 8);
             return {std::numeric_limits<float>::infinity(), 0, false};
@@ -833,6 +869,19 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     if (keyed) write_block_bits(uint8_t(best_k >> 8), uint8_t(best_k & 255), bits, out);
     else write_block(uint8_t(best_k >> 8), uint8_t(best_k & 255), best.idx, out);
     return {best.max_err, best.sum_sq, true};
+}
+} // namespace
+
+BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
+#if defined(ATLAS_BC4_AVX2)
+    // Level pairs (8-bit sources: nearly every block not flat) take the same candidates
+    // and give the same result through their line palettes (bc4_eval.h).
+    if (tables_->avx2 && tables_->shortcuts && options_.decoders == kReferenceOnly && !options_.one_sided_below && options_.quality != Quality::Best) {
+        BlockResult r;
+        if (level_pair_block(*tables_, src, snorm_, options_.quality != Quality::Fast, options_.max_error, out, r)) return r;
+    }
+#endif
+    return encode_candidates(*tables_, snorm_, options_, src, out);
 }
 
 } // namespace atlas::compress

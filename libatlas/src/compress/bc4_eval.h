@@ -289,30 +289,77 @@ __attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, c
 struct Bc4LinePalette {
     __m256 lo, hi, ref;    // ascending (used only in AVX2 functions)
     const int32_t* index;  // BC4 index of each position
-    const int32_t* position; // position of each BC4 index
-    float origin, per_value, first;
+    float origin, per_value; // the lowest grid value, grid steps per unit value
+    float offset;            // position of value 0: the lowest grid value's (0, or 1 after a constant) - origin * per_value
 };
 
-struct Bc4LineKeysAvx2 {
-    const Bc4LinePalette& p;
-    __attribute__((target("avx2"))) __m256 operator()(__m256 s) const {
-        const __m256 clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask)));
-        const __m256i index = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.index));
+// A line palette's evaluation: its keys, largest key error and sum as bc4_keys_avx2
+// computes them for the same palette in index order (stop and inc_sum at their "none"
+// values), and bc4_exact_avx2's results for the chosen indices, in one pass.
+struct Bc4LineResult {
+    Bc4Keys keys;
+    float max_err;   // exact (bc4_exact_avx2)
+    double sum_sq;   // exact
+    uint64_t bits;   // the index field
+    bool endpoints;  // every texel took index 0 or 1 (endpoints_only)
+};
+
+// Returns false if a texel has no feasible entry (not for the Reference decoder's
+// two-sided errors, the only use). Each sum is formed in its evaluation's order.
+__attribute__((target("avx2"))) inline bool bc4_line_select_avx2(const Bc4LinePalette& p, const float* src, Bc4LineResult& out) {
+    const __m256 clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask))), zero = _mm256_setzero_ps();
+    const __m256i index = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.index)), seven = _mm256_set1_epi32(7);
+    const __m256i shifts = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
+    __m256 ek[2], mx = zero;
+    __m256d acc = _mm256_setzero_pd();
+    __m256i taken = _mm256_setzero_si256();
+    uint32_t half[2];
+    for (int h = 0; h < 2; ++h) {
+        const __m256 s = _mm256_loadu_ps(src + 8 * h);
         // The lower entry's position, clamped to 0..6 (a truncation of u in (-1, 0) is 0:
-        // the clamp's value too; texels beyond the ends take the two end entries).
-        const __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(s, _mm256_set1_ps(p.origin)), _mm256_set1_ps(p.per_value)), _mm256_set1_ps(p.first));
+        // the clamp's value too; texels beyond the ends take the two end entries). u is
+        // within ~1e-3 of the exact position (|s * per_value| < 4e3): any error below
+        // half a step brackets the nearest entry, which is all the keys need.
+        const __m256 u = _mm256_add_ps(_mm256_mul_ps(s, _mm256_set1_ps(p.per_value)), _mm256_set1_ps(p.offset));
         const __m256i at = _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(u), _mm256_setzero_si256()), _mm256_set1_epi32(6));
         const __m256i above = _mm256_add_epi32(at, _mm256_set1_epi32(1));
         const __m256 e0 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(p.hi, at), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(p.lo, at)));
         const __m256 e1 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(p.hi, above), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(p.lo, above)));
         const __m256 k0 = _mm256_or_ps(_mm256_and_ps(e0, clear), _mm256_castsi256_ps(_mm256_permutevar8x32_epi32(index, at)));
         const __m256 k1 = _mm256_or_ps(_mm256_and_ps(e1, clear), _mm256_castsi256_ps(_mm256_permutevar8x32_epi32(index, above)));
-        return _mm256_min_ps(k0, k1);
+        const __m256 best = _mm256_min_ps(k0, k1);           // k0 < k1 ? k0 : k1
+        const __m256 take1 = _mm256_cmp_ps(k0, k1, _CMP_NLT_UQ); // where the min took k1
+        _mm256_storeu_ps(reinterpret_cast<float*>(out.keys.key + 8 * h), best);
+        ek[h] = _mm256_and_ps(best, clear);
+        // bc4_exact_avx2's terms for the chosen entry: its error (the same expression) and
+        // its Reference value's squared difference in double.
+        mx = _mm256_max_ps(_mm256_max_ps(_mm256_blendv_ps(e0, e1, take1), zero), mx);
+        const __m256 r = _mm256_blendv_ps(_mm256_permutevar8x32_ps(p.ref, at), _mm256_permutevar8x32_ps(p.ref, above), take1);
+        const __m256d d0 = _mm256_sub_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(r)), _mm256_cvtps_pd(_mm256_castps256_ps128(s)));
+        const __m256d d1 = _mm256_sub_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(r, 1)), _mm256_cvtps_pd(_mm256_extractf128_ps(s, 1)));
+        acc = _mm256_add_pd(acc, _mm256_mul_pd(d0, d0));
+        acc = _mm256_add_pd(acc, _mm256_mul_pd(d1, d1));
+        const __m256i sel = _mm256_and_si256(_mm256_castps_si256(best), seven);
+        taken = _mm256_or_si256(taken, sel);
+        __m256i b = _mm256_sllv_epi32(sel, shifts);
+        b = _mm256_or_si256(b, _mm256_shuffle_epi32(b, 0x4E));
+        b = _mm256_or_si256(b, _mm256_shuffle_epi32(b, 0xB1));
+        half[h] = uint32_t(_mm_cvtsi128_si32(_mm_or_si128(_mm256_castsi256_si128(b), _mm256_extracti128_si256(b, 1))));
     }
-};
-
-__attribute__((target("avx2"))) inline bool bc4_line_keys_avx2(const Bc4LinePalette& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
-    return bc4_rank_avx2(src, stop, inc_sum, out, Bc4LineKeysAvx2{p});
+    // The keys' largest error and sum, as bc4_rank_avx2 forms them.
+    const __m256 sq0 = _mm256_mul_ps(ek[0], ek[0]), sq1 = _mm256_mul_ps(ek[1], ek[1]);
+    const __m128 ksum = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm256_castps256_ps128(sq0), _mm256_extractf128_ps(sq0, 1)), _mm256_castps256_ps128(sq1)),
+                                   _mm256_extractf128_ps(sq1, 1));
+    const __m256 m8 = _mm256_max_ps(ek[1], ek[0]);
+    out.keys.max_err = max_of_lanes(_mm_max_ps(_mm256_castps256_ps128(m8), _mm256_extractf128_ps(m8, 1)));
+    const __m128 kpairs = _mm_hadd_ps(ksum, ksum);
+    out.keys.sum = _mm_cvtss_f32(_mm_hadd_ps(kpairs, kpairs));
+    out.max_err = max_of_lanes(_mm_max_ps(_mm256_castps256_ps128(mx), _mm256_extractf128_ps(mx, 1)));
+    const __m128d pairs = _mm_hadd_pd(_mm256_castpd256_pd128(acc), _mm256_extractf128_pd(acc, 1)); // (0 + 1), (2 + 3)
+    out.sum_sq = _mm_cvtsd_f64(_mm_hadd_pd(pairs, pairs));
+    out.bits = uint64_t(half[0]) | (uint64_t(half[1]) << 24);
+    out.endpoints = _mm256_testz_si256(taken, _mm256_set1_epi32(6));
+    return out.keys.max_err < kBc4Infeasible;
 }
 
 // The exact errors of the chosen entries (entry_error_t's terms; every chosen entry is
@@ -357,16 +404,6 @@ __attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, 
     bc4_exact_avx2(&p.lo[0][0], &p.hi[0][0], &p.ref[0][0], src, k, max_err, sum_sq, bits);
 }
 
-// The line palette's entries put back in index order first.
-__attribute__((target("avx2"))) inline void bc4_exact_avx2(const Bc4LinePalette& p, const float* src, const Bc4Keys& k, float& max_err,
-                                                           double& sum_sq, uint64_t& bits) {
-    const __m256i position = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.position));
-    alignas(32) float lo[8], hi[8], ref[8];
-    _mm256_store_ps(lo, _mm256_permutevar8x32_ps(p.lo, position));
-    _mm256_store_ps(hi, _mm256_permutevar8x32_ps(p.hi, position));
-    _mm256_store_ps(ref, _mm256_permutevar8x32_ps(p.ref, position));
-    bc4_exact_avx2(lo, hi, ref, src, k, max_err, sum_sq, bits);
-}
 
 inline bool bc4_cpu_has_avx2() { return __builtin_cpu_supports("avx2") != 0; }
 #else
