@@ -663,72 +663,184 @@ __attribute__((target("avx2"))) bool six_may_tie(const detail::Bc4LinePalette& e
     return _mm256_movemask_ps(_mm256_cmp_ps(far, limit, _CMP_GT_OQ)) == 0;
 }
 
-// The candidate loop below for a level pair (the extremes' floor and ceiling are the
-// levels lo < hi, the Reference decoder alone, two-sided, texels within +-2): the same
-// candidates, (hi, lo) then (lo, hi) unless `with_six` is off (fast), the same
-// shortcuts, each evaluated by its line palette (the same keys). Returns false if the
-// first candidate fails (it cannot: every key error is finite), leaving the loop to it.
-__attribute__((target("avx2"))) bool level_pair_search(const PairTables& T, const float src[16], float smin, float smax, int lo, int hi, bool snorm,
-                                                      bool with_six, int& best_k, detail::Selection& best, uint64_t& bits) {
-    auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
-    const int k8 = byte_of(hi) * 256 + byte_of(lo), k6 = swapped(k8);
-    detail::Bc4LinePalette pal[2];
-    detail::Bc4LineResult r[2];
-    line_palette(T, lo, hi, true, pal[0]);
-    if (!detail::bc4_line_select_avx2(pal[0], src, r[0])) return false;
-    int w = 0;
-    const bool exact = r[0].keys.max_err == 0.0f && r[0].keys.sum == 0.0f;
-    if (with_six && !exact && !(r[0].endpoints && smin >= T.end_lo[k6 >> 8] && smax <= T.end_hi[k6 & 255]) &&
-        six_may_tie(pal[0], src, r[0].keys.max_err)) {
-        line_palette(T, lo, hi, false, pal[1]);
-        if (detail::bc4_line_select_avx2(pal[1], src, r[1]) && detail::bc4_keys_better(r[1].keys, r[0].keys)) w = 1;
-    }
-    best_k = w ? k6 : k8;
-    best.max_err = r[w].max_err;
-    best.sum_sq = r[w].sum_sq;
-    bits = r[w].bits;
-    return true;
-}
+BlockResult encode_candidates(const PairTables& T, bool snorm, const BlockOptions& options, const float src[16], uint8_t out[8]);
 
-// encode's first steps for fast / normal under the Reference decoder alone, two-sided,
-// on AVX2: a flat block from the table, a level pair by level_pair_search, in registers
-// and without the candidate loop's bookkeeping (8-bit sources: nearly every block).
-// Returns false for any other block, and for a level pair missing the bound (encode
-// then does it all, to the same result).
-__attribute__((target("avx2"))) bool level_pair_block(const PairTables& T, const float src[16], bool snorm, bool with_six, float bound, uint8_t out[8],
-                                                     BlockResult& r) {
+// Level pairs: the extremes' floor and ceiling (as encode computes them, clamped to the
+// levels) are the levels lo < hi, so the candidate loop's pairs are (hi, lo) then (lo,
+// hi) unless fast; the Reference decoder alone, two-sided, finite texels within +-2 and
+// none -0.0 (which has the error -0.0 at an entry 0, as +0 - -0 < -0 - 0 is false: two
+// such entries, the constant 0 on the grid's end 0, would tie the other way round).
+struct LevelPair {
+    int lo = 0, hi = 0;
+    float smin = 0, smax = 0;
+};
+enum class BlockKind { Other, Flat, LevelPair };
+
+__attribute__((target("avx2"))) BlockKind classify(const float src[16], bool snorm, LevelPair& lp) {
     const __m256 a = _mm256_loadu_ps(src), b = _mm256_loadu_ps(src + 8);
     const __m256i ai = _mm256_castps_si256(a), bi = _mm256_castps_si256(b);
     const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(ai));
-    if (_mm256_movemask_epi8(_mm256_and_si256(_mm256_cmpeq_epi32(ai, first), _mm256_cmpeq_epi32(bi, first))) == -1)
-        return T.flat_ready && flat_from_table(T, src[0], snorm, out, r); // flat
+    if (_mm256_movemask_epi8(_mm256_and_si256(_mm256_cmpeq_epi32(ai, first), _mm256_cmpeq_epi32(bi, first))) == -1) return BlockKind::Flat;
     __m256 mn = _mm256_min_ps(a, b), mx = _mm256_max_ps(a, b);
     __m128 mn4 = _mm_min_ps(_mm256_castps256_ps128(mn), _mm256_extractf128_ps(mn, 1)), mx4 = _mm_max_ps(_mm256_castps256_ps128(mx), _mm256_extractf128_ps(mx, 1));
     mn4 = _mm_min_ps(mn4, _mm_movehl_ps(mn4, mn4));
     mx4 = _mm_max_ps(mx4, _mm_movehl_ps(mx4, mx4));
-    const float smin = _mm_cvtss_f32(_mm_min_ss(mn4, _mm_shuffle_ps(mn4, mn4, 1))), smax = _mm_cvtss_f32(_mm_max_ss(mx4, _mm_shuffle_ps(mx4, mx4, 1)));
-    // Finite and within +-2 (a NaN texel fails the unordered test; MINPS / MAXPS may skip it).
-    if (!(smin >= -2.0f && smax <= 2.0f) || _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_UNORD_Q)) != 0) return false;
-    // A texel -0.0 has the error -0.0 at an entry 0 (+0 - -0 < -0 - 0 is false): two
-    // such entries (the constant 0 on the grid's end 0) would tie the other way round.
+    lp.smin = _mm_cvtss_f32(_mm_min_ss(mn4, _mm_shuffle_ps(mn4, mn4, 1)));
+    lp.smax = _mm_cvtss_f32(_mm_max_ss(mx4, _mm_shuffle_ps(mx4, mx4, 1)));
+    // A NaN texel fails the unordered test (MINPS / MAXPS may skip it).
+    if (!(lp.smin >= -2.0f && lp.smax <= 2.0f) || _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_UNORD_Q)) != 0) return BlockKind::Other;
     const __m256i negative_zero = _mm256_set1_epi32(int(0x80000000u));
     if (!_mm256_testz_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ai, negative_zero), _mm256_cmpeq_epi32(bi, negative_zero)), _mm256_set1_epi32(-1)))
-        return false;
-    // The extremes' floor and ceiling, clamped to the levels (as encode computes them).
+        return BlockKind::Other;
     const float scale = snorm ? 127.0f : 255.0f;
     const int lo_lim = snorm ? -127 : 0, hi_lim = snorm ? 127 : 255;
-    const float xl = smin * scale, xh = smax * scale;
+    const float xl = lp.smin * scale, xh = lp.smax * scale;
     auto clampi = [&](float v) { return std::clamp(int(v), lo_lim, hi_lim); };
-    const int lo = clampi(std::floor(xl)), hi = clampi(std::floor(xh));
-    if (lo != clampi(std::ceil(xl)) || hi != clampi(std::ceil(xh)) || !(lo < hi)) return false;
+    lp.lo = clampi(std::floor(xl));
+    lp.hi = clampi(std::floor(xh));
+    return lp.lo == clampi(std::ceil(xl)) && lp.hi == clampi(std::ceil(xh)) && lp.lo < lp.hi ? BlockKind::LevelPair : BlockKind::Other;
+}
+
+// A level pair's first candidate, (hi, lo), evaluated by its line palette (the same keys
+// and results as the candidate loop's evaluation). Returns false if it fails (it cannot:
+// every key error is finite), leaving the block to the loop.
+struct EightValues {
+    detail::Bc4LinePalette pal;
+    detail::Bc4LineResult r;
     int k = -1;
-    detail::Selection best;
-    uint64_t bits = 0;
-    if (!level_pair_search(T, src, smin, smax, lo, hi, snorm, with_six, k, best, bits)) return false;
-    if (bound >= 0 && best.max_err > bound) return false;
-    write_block_bits(uint8_t(k >> 8), uint8_t(k & 255), bits, out);
-    r = {best.max_err, best.sum_sq, true};
+};
+__attribute__((target("avx2"))) bool eight_values(const PairTables& T, const float src[16], const LevelPair& lp, bool snorm, EightValues& e) {
+    auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
+    e.k = byte_of(lp.hi) * 256 + byte_of(lp.lo);
+    line_palette(T, lp.lo, lp.hi, true, e.pal);
+    return detail::bc4_line_select_avx2(e.pal, src, e.r);
+}
+
+// Whether the loop would evaluate the second candidate, (lo, hi), and it could win: not
+// after an exact incumbent or endpoints_only's, nor when six_may_tie rules it out.
+__attribute__((target("avx2"))) bool six_needed(const PairTables& T, const float src[16], const LevelPair& lp, const EightValues& e) {
+    // Without branches: the keys come late in a block's chain, and a branch on them
+    // (mispredicted for about one block in six) costs more than all three tests.
+    const int k6 = swapped(e.k);
+    const bool exact = (e.r.keys.max_err == 0.0f) & (e.r.keys.sum == 0.0f);
+    const bool ends = e.r.endpoints & (lp.smin >= T.end_lo[k6 >> 8]) & (lp.smax <= T.end_hi[k6 & 255]);
+    return !exact & !ends & six_may_tie(e.pal, src, e.r.keys.max_err);
+}
+
+// The second candidate's evaluation; true when it beats the first (a lower max error,
+// or the same and a lower sum: what the loop's evaluation against the incumbent's stop
+// and sum returns, bc4_eval.h).
+__attribute__((target("avx2"))) bool six_beats(const PairTables& T, const float src[16], const LevelPair& lp, float eight_max, float eight_sum,
+                                              detail::Bc4LineResult& r6) {
+    detail::Bc4LinePalette pal;
+    line_palette(T, lp.lo, lp.hi, false, pal);
+    return detail::bc4_line_select_avx2(pal, src, r6) && (r6.keys.max_err < eight_max || (r6.keys.max_err == eight_max && r6.keys.sum < eight_sum));
+}
+
+void write_line_result(int k, const detail::Bc4LineResult& r, uint8_t out[8], BlockResult& res) {
+    write_block_bits(uint8_t(k >> 8), uint8_t(k & 255), r.bits, out);
+    res = {r.max_err, r.sum_sq, true};
+}
+
+// encode's first steps for fast / normal under the Reference decoder alone, two-sided,
+// on AVX2: a flat block from the table, a level pair on its line palettes (8-bit
+// sources: nearly every block). Returns false for any other block, and for a level pair
+// missing the bound (encode then does it all, to the same result).
+__attribute__((target("avx2"))) bool level_pair_block(const PairTables& T, const float src[16], bool snorm, bool with_six, float bound, uint8_t out[8],
+                                                     BlockResult& res) {
+    LevelPair lp;
+    const BlockKind kind = classify(src, snorm, lp);
+    if (kind == BlockKind::Flat) return T.flat_ready && flat_from_table(T, src[0], snorm, out, res);
+    EightValues e;
+    if (kind != BlockKind::LevelPair || !eight_values(T, src, lp, snorm, e)) return false;
+    detail::Bc4LineResult r6;
+    const bool six = with_six && six_needed(T, src, lp, e) && six_beats(T, src, lp, e.r.keys.max_err, e.r.keys.sum, r6);
+    const detail::Bc4LineResult& r = six ? r6 : e.r;
+    if (bound >= 0 && r.max_err > bound) return false;
+    write_line_result(six ? swapped(e.k) : e.k, r, out, res);
     return true;
+}
+
+// level_pair_block for a run of blocks, in passes over blocks of one kind, so that no
+// branch on a block's kind or on whether its 6-value pair is evaluated (both data
+// dependent, and decided late in a block's chain) throws away the work on the blocks
+// after it: the same results (test Bc4.EncodeBlocksEqualsEncode).
+__attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool snorm, const BlockOptions& options, const float* src, size_t count,
+                                                      uint8_t* out, BlockResult* res) {
+    constexpr size_t kRun = 128;
+    const bool with_six = options.quality != Quality::Fast;
+    const float bound = options.max_error;
+    for (size_t r0 = 0; r0 < count; r0 += kRun) {
+        const size_t n = std::min(kRun, count - r0);
+        const float* s = src + 16 * r0;
+        uint8_t* o = out + 8 * r0;
+        BlockResult* q = res + r0;
+        uint16_t list[3][kRun], six[kRun];
+        size_t len[3] = {0, 0, 0}, nsix = 0;
+        LevelPair lp[kRun];
+        float eight_max[kRun], eight_sum[kRun]; // the first candidate's (the second's comparison)
+        int k8[kRun];
+        bool more[kRun], redo[kRun]; // per block: no list appends in the passes' chains
+        for (size_t i = 0; i < n; ++i) {
+            const int kind = int(classify(s + 16 * i, snorm, lp[i]));
+            list[kind][len[kind]++] = uint16_t(i);
+            more[i] = redo[i] = false;
+        }
+        for (size_t j = 0; j < len[int(BlockKind::Flat)]; ++j) {
+            const size_t i = list[int(BlockKind::Flat)][j];
+            redo[i] = !(T.flat_ready && flat_from_table(T, s[16 * i], snorm, o + 8 * i, q[i]));
+        }
+        // Level pairs two at a time (bc4_line_select_avx2's interleaving).
+        const size_t npairs = len[int(BlockKind::LevelPair)];
+        constexpr int kPair = KPAIR;
+        for (size_t j = 0; j < npairs; j += kPair) {
+            const int m = int(std::min<size_t>(kPair, npairs - j));
+            size_t at[kPair];
+            EightValues e[kPair];
+            const detail::Bc4LinePalette* pal[kPair];
+            const float* in[kPair];
+            detail::Bc4LineResult* r[kPair];
+            bool ok[kPair];
+            for (int b = 0; b < kPair; ++b) {
+                at[b] = list[int(BlockKind::LevelPair)][j + size_t(b < m ? b : 0)]; // an odd run's last block twice
+                const LevelPair& x = lp[at[b]];
+                auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
+                e[b].k = byte_of(x.hi) * 256 + byte_of(x.lo);
+                line_palette(T, x.lo, x.hi, true, e[b].pal);
+                pal[b] = &e[b].pal;
+                in[b] = s + 16 * at[b];
+                r[b] = &e[b].r;
+            }
+            detail::bc4_line_select_avx2<kPair>(pal, in, r, ok);
+            for (int b = 0; b < m; ++b) {
+                const size_t i = at[b];
+                write_line_result(e[b].k, e[b].r, o + 8 * i, q[i]);
+                more[i] = ok[b] & with_six & six_needed(T, s + 16 * i, lp[i], e[b]);
+                eight_max[i] = e[b].r.keys.max_err;
+                eight_sum[i] = e[b].r.keys.sum;
+                k8[i] = e[b].k;
+                redo[i] = !ok[b] | (!more[i] & (bound >= 0) & (e[b].r.max_err > bound));
+            }
+        }
+        for (size_t i = 0; i < n; ++i) {
+            six[nsix] = uint16_t(i);
+            nsix += more[i] ? 1 : 0;
+        }
+        for (size_t j = 0; j < nsix; ++j) {
+            const size_t i = six[j];
+            detail::Bc4LineResult r6;
+            if (six_beats(T, s + 16 * i, lp[i], eight_max[i], eight_sum[i], r6)) write_line_result(swapped(k8[i]), r6, o + 8 * i, q[i]);
+            redo[i] = bound >= 0 && q[i].max_error > bound;
+        }
+        auto& other = list[int(BlockKind::Other)];
+        size_t& nother = len[int(BlockKind::Other)];
+        for (size_t i = 0; i < n; ++i)
+            if (redo[i]) other[nother++] = uint16_t(i);
+        for (size_t j = 0; j < nother; ++j) {
+            const size_t i = other[j];
+            q[i] = encode_candidates(T, snorm, options, s + 16 * i, o + 8 * i);
+        }
+    }
 }
 #endif
 } // namespace
@@ -882,6 +994,16 @@ BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
     }
 #endif
     return encode_candidates(*tables_, snorm_, options_, src, out);
+}
+
+void Bc4Encoder::encode_blocks(const float* src, size_t count, uint8_t* out, BlockResult* results) const {
+#if defined(ATLAS_BC4_AVX2)
+    if (tables_->avx2 && tables_->shortcuts && options_.decoders == kReferenceOnly && !options_.one_sided_below && options_.quality != Quality::Best) {
+        level_pair_blocks(*tables_, snorm_, options_, src, count, out, results);
+        return;
+    }
+#endif
+    for (size_t b = 0; b < count; ++b) results[b] = encode(src + 16 * b, out + 8 * b);
 }
 
 } // namespace atlas::compress

@@ -304,62 +304,86 @@ struct Bc4LineResult {
     bool endpoints;  // every texel took index 0 or 1 (endpoints_only)
 };
 
-// Returns false if a texel has no feasible entry (not for the Reference decoder's
-// two-sided errors, the only use). Each sum is formed in its evaluation's order.
-__attribute__((target("avx2"))) inline bool bc4_line_select_avx2(const Bc4LinePalette& p, const float* src, Bc4LineResult& out) {
+// N blocks at once (each with its palette), their operations interleaved: a block's
+// evaluation is one chain of dependent steps, and N independent chains keep the core
+// busy where one leaves it waiting. Returns, per block, false if a texel has no
+// feasible entry (not for the Reference decoder's two-sided errors, the only use).
+// Each sum is formed in its evaluation's order.
+template <int N>
+__attribute__((target("avx2"))) inline void bc4_line_select_avx2(const Bc4LinePalette* const p[N], const float* const src[N], Bc4LineResult* const out[N],
+                                                               bool ok[N]) {
     const __m256 clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask))), zero = _mm256_setzero_ps();
-    const __m256i index = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.index)), seven = _mm256_set1_epi32(7);
-    const __m256i shifts = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
-    __m256 ek[2], mx = zero;
-    __m256d acc = _mm256_setzero_pd();
-    __m256i taken = _mm256_setzero_si256();
-    uint32_t half[2];
-    for (int h = 0; h < 2; ++h) {
-        const __m256 s = _mm256_loadu_ps(src + 8 * h);
-        // The lower entry's position, clamped to 0..6 (a truncation of u in (-1, 0) is 0:
-        // the clamp's value too; texels beyond the ends take the two end entries). u is
-        // within ~1e-3 of the exact position (|s * per_value| < 4e3): any error below
-        // half a step brackets the nearest entry, which is all the keys need.
-        const __m256 u = _mm256_add_ps(_mm256_mul_ps(s, _mm256_set1_ps(p.per_value)), _mm256_set1_ps(p.offset));
-        const __m256i at = _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(u), _mm256_setzero_si256()), _mm256_set1_epi32(6));
-        const __m256i above = _mm256_add_epi32(at, _mm256_set1_epi32(1));
-        const __m256 e0 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(p.hi, at), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(p.lo, at)));
-        const __m256 e1 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(p.hi, above), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(p.lo, above)));
-        const __m256 k0 = _mm256_or_ps(_mm256_and_ps(e0, clear), _mm256_castsi256_ps(_mm256_permutevar8x32_epi32(index, at)));
-        const __m256 k1 = _mm256_or_ps(_mm256_and_ps(e1, clear), _mm256_castsi256_ps(_mm256_permutevar8x32_epi32(index, above)));
-        const __m256 best = _mm256_min_ps(k0, k1);           // k0 < k1 ? k0 : k1
-        const __m256 take1 = _mm256_cmp_ps(k0, k1, _CMP_NLT_UQ); // where the min took k1
-        _mm256_storeu_ps(reinterpret_cast<float*>(out.keys.key + 8 * h), best);
-        ek[h] = _mm256_and_ps(best, clear);
-        // bc4_exact_avx2's terms for the chosen entry: its error (the same expression) and
-        // its Reference value's squared difference in double.
-        mx = _mm256_max_ps(_mm256_max_ps(_mm256_blendv_ps(e0, e1, take1), zero), mx);
-        const __m256 r = _mm256_blendv_ps(_mm256_permutevar8x32_ps(p.ref, at), _mm256_permutevar8x32_ps(p.ref, above), take1);
-        const __m256d d0 = _mm256_sub_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(r)), _mm256_cvtps_pd(_mm256_castps256_ps128(s)));
-        const __m256d d1 = _mm256_sub_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(r, 1)), _mm256_cvtps_pd(_mm256_extractf128_ps(s, 1)));
-        acc = _mm256_add_pd(acc, _mm256_mul_pd(d0, d0));
-        acc = _mm256_add_pd(acc, _mm256_mul_pd(d1, d1));
-        const __m256i sel = _mm256_and_si256(_mm256_castps_si256(best), seven);
-        taken = _mm256_or_si256(taken, sel);
-        __m256i b = _mm256_sllv_epi32(sel, shifts);
-        b = _mm256_or_si256(b, _mm256_shuffle_epi32(b, 0x4E));
-        b = _mm256_or_si256(b, _mm256_shuffle_epi32(b, 0xB1));
-        half[h] = uint32_t(_mm_cvtsi128_si32(_mm_or_si128(_mm256_castsi256_si128(b), _mm256_extracti128_si256(b, 1))));
+    const __m256i seven = _mm256_set1_epi32(7), shifts = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
+    __m256 ek[N][2], mx[N];
+    __m256d acc[N];
+    __m256i taken[N];
+    uint32_t half[N][2];
+    for (int b = 0; b < N; ++b) {
+        mx[b] = zero;
+        acc[b] = _mm256_setzero_pd();
+        taken[b] = _mm256_setzero_si256();
     }
-    // The keys' largest error and sum, as bc4_rank_avx2 forms them.
-    const __m256 sq0 = _mm256_mul_ps(ek[0], ek[0]), sq1 = _mm256_mul_ps(ek[1], ek[1]);
-    const __m128 ksum = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm256_castps256_ps128(sq0), _mm256_extractf128_ps(sq0, 1)), _mm256_castps256_ps128(sq1)),
-                                   _mm256_extractf128_ps(sq1, 1));
-    const __m256 m8 = _mm256_max_ps(ek[1], ek[0]);
-    out.keys.max_err = max_of_lanes(_mm_max_ps(_mm256_castps256_ps128(m8), _mm256_extractf128_ps(m8, 1)));
-    const __m128 kpairs = _mm_hadd_ps(ksum, ksum);
-    out.keys.sum = _mm_cvtss_f32(_mm_hadd_ps(kpairs, kpairs));
-    out.max_err = max_of_lanes(_mm_max_ps(_mm256_castps256_ps128(mx), _mm256_extractf128_ps(mx, 1)));
-    const __m128d pairs = _mm_hadd_pd(_mm256_castpd256_pd128(acc), _mm256_extractf128_pd(acc, 1)); // (0 + 1), (2 + 3)
-    out.sum_sq = _mm_cvtsd_f64(_mm_hadd_pd(pairs, pairs));
-    out.bits = uint64_t(half[0]) | (uint64_t(half[1]) << 24);
-    out.endpoints = _mm256_testz_si256(taken, _mm256_set1_epi32(6));
-    return out.keys.max_err < kBc4Infeasible;
+    for (int h = 0; h < 2; ++h)
+        for (int b = 0; b < N; ++b) {
+            const Bc4LinePalette& q = *p[b];
+            const __m256i index = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(q.index));
+            const __m256 s = _mm256_loadu_ps(src[b] + 8 * h);
+            // The lower entry's position, clamped to 0..6 (a truncation of u in (-1, 0) is 0:
+            // the clamp's value too; texels beyond the ends take the two end entries). u is
+            // within ~1e-3 of the exact position (|s * per_value| < 4e3): any error below
+            // half a step brackets the nearest entry, which is all the keys need.
+            const __m256 u = _mm256_add_ps(_mm256_mul_ps(s, _mm256_set1_ps(q.per_value)), _mm256_set1_ps(q.offset));
+            const __m256i at = _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(u), _mm256_setzero_si256()), _mm256_set1_epi32(6));
+            const __m256i above = _mm256_add_epi32(at, _mm256_set1_epi32(1));
+            const __m256 e0 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(q.hi, at), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(q.lo, at)));
+            const __m256 e1 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(q.hi, above), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(q.lo, above)));
+            const __m256 k0 = _mm256_or_ps(_mm256_and_ps(e0, clear), _mm256_castsi256_ps(_mm256_permutevar8x32_epi32(index, at)));
+            const __m256 k1 = _mm256_or_ps(_mm256_and_ps(e1, clear), _mm256_castsi256_ps(_mm256_permutevar8x32_epi32(index, above)));
+            const __m256 best = _mm256_min_ps(k0, k1);           // k0 < k1 ? k0 : k1
+            const __m256 take1 = _mm256_cmp_ps(k0, k1, _CMP_NLT_UQ); // where the min took k1
+            _mm256_storeu_ps(reinterpret_cast<float*>(out[b]->keys.key + 8 * h), best);
+            ek[b][h] = _mm256_and_ps(best, clear);
+            // bc4_exact_avx2's terms for the chosen entry: its error (the same expression) and
+            // its Reference value's squared difference in double.
+            mx[b] = _mm256_max_ps(_mm256_max_ps(_mm256_blendv_ps(e0, e1, take1), zero), mx[b]);
+            const __m256 r = _mm256_blendv_ps(_mm256_permutevar8x32_ps(q.ref, at), _mm256_permutevar8x32_ps(q.ref, above), take1);
+            const __m256d d0 = _mm256_sub_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(r)), _mm256_cvtps_pd(_mm256_castps256_ps128(s)));
+            const __m256d d1 = _mm256_sub_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(r, 1)), _mm256_cvtps_pd(_mm256_extractf128_ps(s, 1)));
+            acc[b] = _mm256_add_pd(acc[b], _mm256_mul_pd(d0, d0));
+            acc[b] = _mm256_add_pd(acc[b], _mm256_mul_pd(d1, d1));
+            const __m256i sel = _mm256_and_si256(_mm256_castps_si256(best), seven);
+            taken[b] = _mm256_or_si256(taken[b], sel);
+            __m256i x = _mm256_sllv_epi32(sel, shifts);
+            x = _mm256_or_si256(x, _mm256_shuffle_epi32(x, 0x4E));
+            x = _mm256_or_si256(x, _mm256_shuffle_epi32(x, 0xB1));
+            half[b][h] = uint32_t(_mm_cvtsi128_si32(_mm_or_si128(_mm256_castsi256_si128(x), _mm256_extracti128_si256(x, 1))));
+        }
+    for (int b = 0; b < N; ++b) {
+        Bc4LineResult& o = *out[b];
+        // The keys' largest error and sum, as bc4_rank_avx2 forms them.
+        const __m256 sq0 = _mm256_mul_ps(ek[b][0], ek[b][0]), sq1 = _mm256_mul_ps(ek[b][1], ek[b][1]);
+        const __m128 ksum = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm256_castps256_ps128(sq0), _mm256_extractf128_ps(sq0, 1)), _mm256_castps256_ps128(sq1)),
+                                       _mm256_extractf128_ps(sq1, 1));
+        const __m256 m8 = _mm256_max_ps(ek[b][1], ek[b][0]);
+        o.keys.max_err = max_of_lanes(_mm_max_ps(_mm256_castps256_ps128(m8), _mm256_extractf128_ps(m8, 1)));
+        const __m128 kpairs = _mm_hadd_ps(ksum, ksum);
+        o.keys.sum = _mm_cvtss_f32(_mm_hadd_ps(kpairs, kpairs));
+        o.max_err = max_of_lanes(_mm_max_ps(_mm256_castps256_ps128(mx[b]), _mm256_extractf128_ps(mx[b], 1)));
+        const __m128d pairs = _mm_hadd_pd(_mm256_castpd256_pd128(acc[b]), _mm256_extractf128_pd(acc[b], 1)); // (0 + 1), (2 + 3)
+        o.sum_sq = _mm_cvtsd_f64(_mm_hadd_pd(pairs, pairs));
+        o.bits = uint64_t(half[b][0]) | (uint64_t(half[b][1]) << 24);
+        o.endpoints = _mm256_testz_si256(taken[b], _mm256_set1_epi32(6));
+        ok[b] = o.keys.max_err < kBc4Infeasible;
+    }
+}
+
+__attribute__((target("avx2"))) inline bool bc4_line_select_avx2(const Bc4LinePalette& p, const float* src, Bc4LineResult& out) {
+    const Bc4LinePalette* const ps[1] = {&p};
+    const float* const ss[1] = {src};
+    Bc4LineResult* const os[1] = {&out};
+    bool ok[1];
+    bc4_line_select_avx2<1>(ps, ss, os, ok);
+    return ok[0];
 }
 
 // The exact errors of the chosen entries (entry_error_t's terms; every chosen entry is

@@ -42,6 +42,10 @@ public:
     ~Bc4Encoder();
     // src: 16 texels in the normalized range (values outside are measured as is).
     BlockResult encode(const float src[16], uint8_t out[8]) const;
+    // `count` blocks (16 texels each, consecutive) into `count` 8-byte blocks and
+    // results: the same as encode() on each, faster on runs of 8-bit-like blocks (their
+    // kinds are sorted out first, so no late branch serializes the blocks).
+    void encode_blocks(const float* src, size_t count, uint8_t* out, BlockResult* results) const;
     // The exhaustive search regardless of quality (exposed for tests).
     BlockResult encode_exhaustive(const float src[16], uint8_t out[8]) const;
     const BlockOptions& options() const { return options_; }
