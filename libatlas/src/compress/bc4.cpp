@@ -197,6 +197,9 @@ struct PairTables {
     // would otherwise be an L3 or memory miss per candidate.
     float end_lo[256], end_hi[256], end_ref[256];
     std::vector<float> num_lo[2], num_hi[2], num_ref[2];
+    // The Reference decoder alone: the same floats as records {lo, hi, ref, 0} per
+    // numerator, so that line_palette loads an entry's three with one load.
+    std::vector<float> num_record[2];
     int num_base[2] = {0, 0}; // index = num - num_base
     bool avx2 = false;        // fast / normal evaluate with AVX2 (same results, bc4_eval.h)
     // fast / normal's results for flat blocks on a level: 16 texels with the bits of
@@ -292,6 +295,15 @@ void build_tables(PairTables& T, bool snorm, DecoderSet decoders) {
                 const size_t at = size_t((m == 0 ? 7 : 5) * level(uint8_t(b), snorm) - T.num_base[m]);
                 if (std::isnan(T.num_lo[m][at])) { T.num_lo[m][at] = T.end_lo[b]; T.num_hi[m][at] = T.end_hi[b]; T.num_ref[m][at] = T.end_ref[b]; }
             }
+    if (decoders == kReferenceOnly)
+        for (int m = 0; m < 2; ++m) {
+            T.num_record[m].assign(4 * T.num_lo[m].size(), 0.0f);
+            for (size_t i = 0; i < T.num_lo[m].size(); ++i) {
+                T.num_record[m][4 * i] = T.num_lo[m][i];
+                T.num_record[m][4 * i + 1] = T.num_hi[m][i];
+                T.num_record[m][4 * i + 2] = T.num_ref[m][i];
+            }
+        }
 }
 
 // fast / normal's candidate palette of pair k from the per-entry tables: the same
@@ -621,23 +633,28 @@ __attribute__((target("avx2"))) void line_palette(const PairTables& T, int lo, i
     static constexpr int32_t kIndex[2][8] = {{1, 7, 6, 5, 4, 3, 2, 0}, {6, 0, 2, 3, 4, 5, 1, 7}};
     const int m = eight ? 0 : 1, steps = eight ? 7 : 5;
     const int at = steps * lo - T.num_base[m], d = hi - lo;
-    // Eight values in registers (a vector load of scalar stores would wait for them), as
-    // a tree of shuffles: a chain of 7 inserts was on every block's critical path.
-    auto quad = [](float a, float b, float c, float e) __attribute__((target("avx2"))) {
-        return _mm_movelh_ps(_mm_unpacklo_ps(_mm_set_ss(a), _mm_set_ss(b)), _mm_unpacklo_ps(_mm_set_ss(c), _mm_set_ss(e)));
-    };
-    auto line = [&](const float* v, float below, float above) __attribute__((target("avx2"))) {
-        const float* x = v + at;
-        return eight ? _mm256_set_m128(quad(x[4 * d], x[5 * d], x[6 * d], x[7 * d]), quad(x[0], x[d], x[2 * d], x[3 * d]))
-                     : _mm256_set_m128(quad(x[3 * d], x[4 * d], x[5 * d], above), quad(below, x[0], x[d], x[2 * d]));
-    };
-    p.lo = line(T.num_lo[m].data(), T.c_lo, T.c_hi);
-    p.hi = line(T.num_hi[m].data(), T.c_lo, T.c_hi);
-    p.ref = line(T.num_ref[m].data(), T.c_lo, T.c_hi);
+    // Grid value j's record at r + j * stride; two records per load (one in each lane),
+    // then a 4 x 4 transpose within the lanes gives lo, hi and ref for the 8 positions.
+    // The 6-value mode's lanes 0 and 7 (its constants) load a grid end and are replaced.
+    const float* r = T.num_record[m].data() + 4 * size_t(at);
+    const size_t stride = 4 * size_t(d);
+    auto pair_of = [&](int j0, int j1) __attribute__((target("avx2"))) { return _mm256_loadu2_m128(r + size_t(j1) * stride, r + size_t(j0) * stride); };
+    const __m256 a0 = eight ? pair_of(0, 4) : pair_of(0, 3), a1 = eight ? pair_of(1, 5) : pair_of(0, 4);
+    const __m256 a2 = eight ? pair_of(2, 6) : pair_of(1, 5), a3 = eight ? pair_of(3, 7) : pair_of(2, 5);
+    const __m256d t0 = _mm256_castps_pd(_mm256_unpacklo_ps(a0, a1)), t1 = _mm256_castps_pd(_mm256_unpacklo_ps(a2, a3));
+    const __m256d t2 = _mm256_castps_pd(_mm256_unpackhi_ps(a0, a1)), t3 = _mm256_castps_pd(_mm256_unpackhi_ps(a2, a3));
+    p.lo = _mm256_castpd_ps(_mm256_unpacklo_pd(t0, t1));
+    p.hi = _mm256_castpd_ps(_mm256_unpackhi_pd(t0, t1));
+    p.ref = _mm256_castpd_ps(_mm256_unpacklo_pd(t2, t3));
+    if (!eight) {
+        const __m256 constants = _mm256_setr_ps(T.c_lo, 0, 0, 0, 0, 0, 0, T.c_hi);
+        p.lo = _mm256_blend_ps(p.lo, constants, 0x81);
+        p.hi = _mm256_blend_ps(p.hi, constants, 0x81);
+        p.ref = _mm256_blend_ps(p.ref, constants, 0x81);
+    }
     p.index = kIndex[m];
-    const float* ref = T.num_ref[m].data() + at;
-    p.origin = ref[0];
-    p.per_value = float(steps) / (ref[steps * d] - ref[0]);
+    p.origin = r[2];
+    p.per_value = float(steps) / (r[size_t(steps) * stride + 2] - r[2]);
     p.offset = (eight ? 0.0f : 1.0f) - p.origin * p.per_value;
 }
 
@@ -677,28 +694,37 @@ struct LevelPair {
 enum class BlockKind { Other, Flat, LevelPair };
 
 __attribute__((target("avx2"))) BlockKind classify(const float src[16], bool snorm, LevelPair& lp) {
+    // Every test computed, none branched on: blocks of different kinds alternate (flat
+    // and not on an 8-bit image's edges) and a mispredicted kind costs more than the tests.
     const __m256 a = _mm256_loadu_ps(src), b = _mm256_loadu_ps(src + 8);
     const __m256i ai = _mm256_castps_si256(a), bi = _mm256_castps_si256(b);
     const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(ai));
-    if (_mm256_movemask_epi8(_mm256_and_si256(_mm256_cmpeq_epi32(ai, first), _mm256_cmpeq_epi32(bi, first))) == -1) return BlockKind::Flat;
+    const bool flat = _mm256_movemask_epi8(_mm256_and_si256(_mm256_cmpeq_epi32(ai, first), _mm256_cmpeq_epi32(bi, first))) == -1;
     __m256 mn = _mm256_min_ps(a, b), mx = _mm256_max_ps(a, b);
     __m128 mn4 = _mm_min_ps(_mm256_castps256_ps128(mn), _mm256_extractf128_ps(mn, 1)), mx4 = _mm_max_ps(_mm256_castps256_ps128(mx), _mm256_extractf128_ps(mx, 1));
     mn4 = _mm_min_ps(mn4, _mm_movehl_ps(mn4, mn4));
     mx4 = _mm_max_ps(mx4, _mm_movehl_ps(mx4, mx4));
-    lp.smin = _mm_cvtss_f32(_mm_min_ss(mn4, _mm_shuffle_ps(mn4, mn4, 1)));
-    lp.smax = _mm_cvtss_f32(_mm_max_ss(mx4, _mm_shuffle_ps(mx4, mx4, 1)));
-    // A NaN texel fails the unordered test (MINPS / MAXPS may skip it).
-    if (!(lp.smin >= -2.0f && lp.smax <= 2.0f) || _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_UNORD_Q)) != 0) return BlockKind::Other;
+    mn4 = _mm_min_ss(mn4, _mm_shuffle_ps(mn4, mn4, 1));
+    mx4 = _mm_max_ss(mx4, _mm_shuffle_ps(mx4, mx4, 1));
+    lp.smin = _mm_cvtss_f32(mn4);
+    lp.smax = _mm_cvtss_f32(mx4);
+    // A NaN texel fails the unordered test (MINPS / MAXPS may skip it); values within +-2.
     const __m256i negative_zero = _mm256_set1_epi32(int(0x80000000u));
-    if (!_mm256_testz_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ai, negative_zero), _mm256_cmpeq_epi32(bi, negative_zero)), _mm256_set1_epi32(-1)))
-        return BlockKind::Other;
+    const bool usable = (lp.smin >= -2.0f) & (lp.smax <= 2.0f) & (_mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_UNORD_Q)) == 0) &
+                        _mm256_testz_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ai, negative_zero), _mm256_cmpeq_epi32(bi, negative_zero)),
+                                           _mm256_set1_epi32(-1));
+    // The extremes' floor and ceiling, clamped to the levels (as encode computes them; the
+    // clamp first keeps the conversion defined), in one register: smin, smax.
     const float scale = snorm ? 127.0f : 255.0f;
-    const int lo_lim = snorm ? -127 : 0, hi_lim = snorm ? 127 : 255;
-    const float xl = lp.smin * scale, xh = lp.smax * scale;
-    auto clampi = [&](float v) { return std::clamp(int(v), lo_lim, hi_lim); };
-    lp.lo = clampi(std::floor(xl));
-    lp.hi = clampi(std::floor(xh));
-    return lp.lo == clampi(std::ceil(xl)) && lp.hi == clampi(std::ceil(xh)) && lp.lo < lp.hi ? BlockKind::LevelPair : BlockKind::Other;
+    const __m128 lim_lo = _mm_set1_ps(snorm ? -127.0f : 0.0f), lim_hi = _mm_set1_ps(snorm ? 127.0f : 255.0f);
+    const __m128 x = _mm_mul_ps(_mm_unpacklo_ps(mn4, mx4), _mm_set1_ps(scale));
+    const __m128 fl = _mm_min_ps(_mm_max_ps(_mm_floor_ps(x), lim_lo), lim_hi), cl = _mm_min_ps(_mm_max_ps(_mm_ceil_ps(x), lim_lo), lim_hi);
+    const __m128i level = _mm_cvttps_epi32(fl);
+    lp.lo = _mm_cvtsi128_si32(level);
+    lp.hi = _mm_extract_epi32(level, 1);
+    const bool levels = (_mm_movemask_ps(_mm_cmpeq_ps(fl, cl)) & 3) == 3;
+    const int kind = flat ? int(BlockKind::Flat) : (usable & levels & (lp.lo < lp.hi)) ? int(BlockKind::LevelPair) : int(BlockKind::Other);
+    return BlockKind(kind);
 }
 
 // A level pair's first candidate, (hi, lo), evaluated by its line palette (the same keys
@@ -792,7 +818,7 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
         }
         // Level pairs two at a time (bc4_line_select_avx2's interleaving).
         const size_t npairs = len[int(BlockKind::LevelPair)];
-        constexpr int kPair = KPAIR;
+        constexpr int kPair = 2;
         for (size_t j = 0; j < npairs; j += kPair) {
             const int m = int(std::min<size_t>(kPair, npairs - j));
             size_t at[kPair];
@@ -819,7 +845,7 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
                 eight_max[i] = e[b].r.keys.max_err;
                 eight_sum[i] = e[b].r.keys.sum;
                 k8[i] = e[b].k;
-                redo[i] = !ok[b] | (!more[i] & (bound >= 0) & (e[b].r.max_err > bound));
+                redo[i] = (!ok[b]) | ((!more[i]) & (bound >= 0) & (e[b].r.max_err > bound));
             }
         }
         for (size_t i = 0; i < n; ++i) {
