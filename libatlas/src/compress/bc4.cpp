@@ -200,6 +200,7 @@ struct PairTables {
     // The Reference decoder alone: the same floats as records {lo, hi, ref, 0} per
     // numerator, so that line_palette loads an entry's three with one load.
     std::vector<float> num_record[2];
+    float grid_per[2][256] = {}; // steps * scale / d: grid steps per unit value, by level spread d (line_palette)
     int num_base[2] = {0, 0}; // index = num - num_base
     bool avx2 = false;        // fast / normal evaluate with AVX2 (same results, bc4_eval.h)
     // fast / normal's results for flat blocks on a level: 16 texels with the bits of
@@ -295,6 +296,8 @@ void build_tables(PairTables& T, bool snorm, DecoderSet decoders) {
                 const size_t at = size_t((m == 0 ? 7 : 5) * level(uint8_t(b), snorm) - T.num_base[m]);
                 if (std::isnan(T.num_lo[m][at])) { T.num_lo[m][at] = T.end_lo[b]; T.num_hi[m][at] = T.end_hi[b]; T.num_ref[m][at] = T.end_ref[b]; }
             }
+    for (int m = 0; m < 2; ++m)
+        for (int d = 1; d < 256; ++d) T.grid_per[m][d] = float((m == 0 ? 7.0 : 5.0) * vscale / d);
     if (decoders == kReferenceOnly)
         for (int m = 0; m < 2; ++m) {
             T.num_record[m].assign(4 * T.num_lo[m].size(), 0.0f);
@@ -653,8 +656,10 @@ __attribute__((target("avx2"))) void line_palette(const PairTables& T, int lo, i
         p.ref = _mm256_blend_ps(p.ref, constants, 0x81);
     }
     p.index = kIndex[m];
+    // The exact grid's spacing (no division on the chain; the floats' grid is within
+    // ulps of it, and the keys need the position only to within half a step).
     p.origin = r[2];
-    p.per_value = float(steps) / (r[size_t(steps) * stride + 2] - r[2]);
+    p.per_value = T.grid_per[m][d];
     p.offset = (eight ? 0.0f : 1.0f) - p.origin * p.per_value;
 }
 
@@ -807,11 +812,12 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
         float eight_max[kRun], eight_sum[kRun]; // the first candidate's (the second's comparison)
         int k8[kRun];
         bool more[kRun], redo[kRun]; // per block: no list appends in the passes' chains
+        uint8_t kind[kRun];
         for (size_t i = 0; i < n; ++i) {
-            const int kind = int(classify(s + 16 * i, snorm, lp[i]));
-            list[kind][len[kind]++] = uint16_t(i);
+            kind[i] = uint8_t(classify(s + 16 * i, snorm, lp[i]));
             more[i] = redo[i] = false;
         }
+        for (size_t i = 0; i < n; ++i) list[kind[i]][len[kind[i]]++] = uint16_t(i);
         for (size_t j = 0; j < len[int(BlockKind::Flat)]; ++j) {
             const size_t i = list[int(BlockKind::Flat)][j];
             redo[i] = !(T.flat_ready && flat_from_table(T, s[16 * i], snorm, o + 8 * i, q[i]));
@@ -852,11 +858,30 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
             six[nsix] = uint16_t(i);
             nsix += more[i] ? 1 : 0;
         }
-        for (size_t j = 0; j < nsix; ++j) {
-            const size_t i = six[j];
-            detail::Bc4LineResult r6;
-            if (six_beats(T, s + 16 * i, lp[i], eight_max[i], eight_sum[i], r6)) write_line_result(swapped(k8[i]), r6, o + 8 * i, q[i]);
-            redo[i] = bound >= 0 && q[i].max_error > bound;
+        // The second candidates, two at a time too.
+        for (size_t j = 0; j < nsix; j += kPair) {
+            const int m = int(std::min<size_t>(kPair, nsix - j));
+            size_t at[kPair];
+            detail::Bc4LinePalette pal6[kPair];
+            detail::Bc4LineResult r6[kPair];
+            const detail::Bc4LinePalette* pal[kPair];
+            const float* in[kPair];
+            detail::Bc4LineResult* r[kPair];
+            bool ok[kPair];
+            for (int b = 0; b < kPair; ++b) {
+                at[b] = six[j + size_t(b < m ? b : 0)];
+                line_palette(T, lp[at[b]].lo, lp[at[b]].hi, false, pal6[b]);
+                pal[b] = &pal6[b];
+                in[b] = s + 16 * at[b];
+                r[b] = &r6[b];
+            }
+            detail::bc4_line_select_avx2<kPair>(pal, in, r, ok);
+            for (int b = 0; b < m; ++b) {
+                const size_t i = at[b];
+                const bool beats = ok[b] && (r6[b].keys.max_err < eight_max[i] || (r6[b].keys.max_err == eight_max[i] && r6[b].keys.sum < eight_sum[i]));
+                if (beats) write_line_result(swapped(k8[i]), r6[b], o + 8 * i, q[i]);
+                redo[i] = bound >= 0 && q[i].max_error > bound;
+            }
         }
         auto& other = list[int(BlockKind::Other)];
         size_t& nother = len[int(BlockKind::Other)];
