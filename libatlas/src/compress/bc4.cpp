@@ -630,7 +630,7 @@ bool keys_of(const PairTables& T, const detail::Palette<1>& p, const float src[1
 // The line palette (bc4_eval.h) of the pair on levels lo < hi: the 8-value mode (hi, lo)
 // or the 6-value mode (lo, hi); the Reference decoder alone (build_tables' numerator
 // slots at the endpoints). Grid value j has the numerator steps * lo + j (hi - lo).
-__attribute__((target("avx2"))) void line_palette(const PairTables& T, int lo, int hi, bool eight, detail::Bc4LinePalette& p) {
+__attribute__((target("avx2"), always_inline)) inline void line_palette(const PairTables& T, int lo, int hi, bool eight, detail::Bc4LinePalette& p) {
     // 8 values: entry 1 (lo), 7, 6, .., 2, 0 (hi); 6 values: the constant below (6), 0
     // (lo), 2, .., 5, 1 (hi), the constant above (7).
     static constexpr int32_t kIndex[2][8] = {{1, 7, 6, 5, 4, 3, 2, 0}, {6, 0, 2, 3, 4, 5, 1, 7}};
@@ -672,7 +672,7 @@ __attribute__((target("avx2"))) void line_palette(const PairTables& T, int lo, i
 // more than E + 1e-5 away fails that pair: its evaluation would return false (max error
 // above the incumbent's). On 8-bit sources the two modes' errors are multiples of 1/35
 // level (1.1e-4), so every pair whose max error is the larger is skipped here.
-__attribute__((target("avx2"))) bool six_may_tie(const detail::Bc4LinePalette& eight, const float src[16], float max_err) {
+__attribute__((target("avx2"), always_inline)) inline bool six_may_tie(const detail::Bc4LinePalette& eight, const float src[16], float max_err) {
     const __m256 origin = _mm256_set1_ps(eight.origin), per_step = _mm256_set1_ps(eight.per_value * (5.0f / 7.0f));
     const __m256 zero = _mm256_setzero_ps(), five = _mm256_set1_ps(5.0f), abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
     __m256 far = zero;
@@ -749,7 +749,7 @@ __attribute__((target("avx2"))) bool eight_values(const PairTables& T, const flo
 
 // Whether the loop would evaluate the second candidate, (lo, hi), and it could win: not
 // after an exact incumbent or endpoints_only's, nor when six_may_tie rules it out.
-__attribute__((target("avx2"))) bool six_needed(const PairTables& T, const float src[16], const LevelPair& lp, const EightValues& e) {
+__attribute__((target("avx2"), always_inline)) inline bool six_needed(const PairTables& T, const float src[16], const LevelPair& lp, const EightValues& e) {
     // Without branches: the keys come late in a block's chain, and a branch on them
     // (mispredicted for about one block in six) costs more than all three tests.
     const int k6 = swapped(e.k);
