@@ -664,25 +664,17 @@ __attribute__((target("avx2"), always_inline)) inline void line_palette(const Pa
 }
 
 // Whether the 6-value pair of a level pair can hold every texel within the 8-value
-// incumbent's max error E, from the texels' distances to its even grid (in grid steps,
-// through the 8-value line's origin and spacing: the same grid value, 5 steps instead of
-// 7). The distance computed so is within ~1e-6 of the exact one (values within +-2), and
-// the 6-value pair's key errors are at least the exact distances less 8 ulps (its
-// constants lie on or beyond its grid ends and are never nearer than they), so a texel
-// more than E + 1e-5 away fails that pair: its evaluation would return false (max error
-// above the incumbent's). On 8-bit sources the two modes' errors are multiples of 1/35
-// level (1.1e-4), so every pair whose max error is the larger is skipped here.
-__attribute__((target("avx2"), always_inline)) inline bool six_may_tie(const detail::Bc4LinePalette& eight, const float src[16], float max_err) {
-    const __m256 origin = _mm256_set1_ps(eight.origin), per_step = _mm256_set1_ps(eight.per_value * (5.0f / 7.0f));
-    const __m256 zero = _mm256_setzero_ps(), five = _mm256_set1_ps(5.0f), abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-    __m256 far = zero;
-    for (int h = 0; h < 2; ++h) {
-        const __m256 u = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(src + 8 * h), origin), per_step);
-        const __m256 nearest = _mm256_round_ps(_mm256_min_ps(_mm256_max_ps(u, zero), five), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-        far = _mm256_max_ps(far, _mm256_and_ps(_mm256_sub_ps(u, nearest), abs_mask));
-    }
-    const __m256 limit = _mm256_set1_ps((max_err + 1e-5f) * eight.per_value * (5.0f / 7.0f));
-    return _mm256_movemask_ps(_mm256_cmp_ps(far, limit, _CMP_GT_OQ)) == 0;
+// incumbent's max error E, from the texels' distances to its even grid (the 8-value
+// evaluation's six_far: in grid steps, through the 8-value line's position and spacing,
+// the same grid value, 5 steps instead of 7). The distance computed so is within ~3e-7
+// of the exact one in value (values within +-2), and the 6-value pair's key errors are
+// at least the exact distances less 8 ulps (its constants lie on or beyond its grid ends
+// and are never nearer than they), so a texel more than E + 1e-5 away fails that pair:
+// its evaluation would return false (max error above the incumbent's). On 8-bit sources
+// the two modes' errors are multiples of 1/35 level (1.1e-4), so every pair whose max
+// error is the larger is skipped here.
+__attribute__((target("avx2"), always_inline)) inline bool six_may_tie(const detail::Bc4LinePalette& eight, const detail::Bc4LineResult& r) {
+    return !(r.six_far > (r.keys.max_err + 1e-5f) * eight.per_value * (5.0f / 7.0f));
 }
 
 BlockResult encode_candidates(const PairTables& T, bool snorm, const BlockOptions& options, const float src[16], uint8_t out[8]);
@@ -744,18 +736,23 @@ __attribute__((target("avx2"))) bool eight_values(const PairTables& T, const flo
     auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
     e.k = byte_of(lp.hi) * 256 + byte_of(lp.lo);
     line_palette(T, lp.lo, lp.hi, true, e.pal);
-    return detail::bc4_line_select_avx2(e.pal, src, e.r);
+    const detail::Bc4LinePalette* const ps[1] = {&e.pal};
+    const float* const ss[1] = {src};
+    detail::Bc4LineResult* const os[1] = {&e.r};
+    bool ok[1];
+    detail::bc4_line_select_avx2<1, true>(ps, ss, os, ok);
+    return ok[0];
 }
 
 // Whether the loop would evaluate the second candidate, (lo, hi), and it could win: not
 // after an exact incumbent or endpoints_only's, nor when six_may_tie rules it out.
-__attribute__((target("avx2"), always_inline)) inline bool six_needed(const PairTables& T, const float src[16], const LevelPair& lp, const EightValues& e) {
+__attribute__((target("avx2"), always_inline)) inline bool six_needed(const PairTables& T, const LevelPair& lp, const EightValues& e) {
     // Without branches: the keys come late in a block's chain, and a branch on them
     // (mispredicted for about one block in six) costs more than all three tests.
     const int k6 = swapped(e.k);
     const bool exact = (e.r.keys.max_err == 0.0f) & (e.r.keys.sum == 0.0f);
     const bool ends = e.r.endpoints & (lp.smin >= T.end_lo[k6 >> 8]) & (lp.smax <= T.end_hi[k6 & 255]);
-    return !exact & !ends & six_may_tie(e.pal, src, e.r.keys.max_err);
+    return !exact & !ends & six_may_tie(e.pal, e.r);
 }
 
 // The second candidate's evaluation; true when it beats the first (a lower max error,
@@ -785,7 +782,7 @@ __attribute__((target("avx2"))) bool level_pair_block(const PairTables& T, const
     EightValues e;
     if (kind != BlockKind::LevelPair || !eight_values(T, src, lp, snorm, e)) return false;
     detail::Bc4LineResult r6;
-    const bool six = with_six && six_needed(T, src, lp, e) && six_beats(T, src, lp, e.r.keys.max_err, e.r.keys.sum, r6);
+    const bool six = with_six && six_needed(T, lp, e) && six_beats(T, src, lp, e.r.keys.max_err, e.r.keys.sum, r6);
     const detail::Bc4LineResult& r = six ? r6 : e.r;
     if (bound >= 0 && r.max_err > bound) return false;
     write_line_result(six ? swapped(e.k) : e.k, r, out, res);
@@ -843,11 +840,11 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
                 in[b] = s + 16 * at[b];
                 r[b] = &e[b].r;
             }
-            detail::bc4_line_select_avx2<kPair>(pal, in, r, ok);
+            detail::bc4_line_select_avx2<kPair, true>(pal, in, r, ok);
             for (int b = 0; b < m; ++b) {
                 const size_t i = at[b];
                 write_line_result(e[b].k, e[b].r, o + 8 * i, q[i]);
-                more[i] = ok[b] & with_six & six_needed(T, s + 16 * i, lp[i], e[b]);
+                more[i] = ok[b] & with_six & six_needed(T, lp[i], e[b]);
                 eight_max[i] = e[b].r.keys.max_err;
                 eight_sum[i] = e[b].r.keys.sum;
                 k8[i] = e[b].k;

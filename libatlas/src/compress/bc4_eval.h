@@ -302,6 +302,7 @@ struct Bc4LineResult {
     double sum_sq;   // exact
     uint64_t bits;   // the index field
     bool endpoints;  // every texel took index 0 or 1 (endpoints_only)
+    float six_far;   // 8-value palettes, with SixGrid: the largest distance to the 6-value grid, in its steps
 };
 
 // N blocks at once (each with its palette), their operations interleaved: a block's
@@ -309,7 +310,9 @@ struct Bc4LineResult {
 // busy where one leaves it waiting. Returns, per block, false if a texel has no
 // feasible entry (not for the Reference decoder's two-sided errors, the only use).
 // Each sum is formed in its evaluation's order.
-template <int N>
+// SixGrid (8-value palettes): also each texel's distance to the 6-value grid of the same
+// ends, from the same position (5 steps for 7), for six_may_tie in bc4.cpp.
+template <int N, bool SixGrid = false>
 __attribute__((target("avx2"))) inline void bc4_line_select_avx2(const Bc4LinePalette* const p[N], const float* const src[N], Bc4LineResult* const out[N],
                                                                bool ok[N]) {
     const __m256 clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask))), zero = _mm256_setzero_ps();
@@ -317,8 +320,10 @@ __attribute__((target("avx2"))) inline void bc4_line_select_avx2(const Bc4LinePa
     __m256 ek[N][2], mx[N];
     __m256d acc[N];
     __m256i taken[N];
+    __m256 far[N];
     uint32_t half[N][2];
     for (int b = 0; b < N; ++b) {
+        far[b] = zero;
         mx[b] = zero;
         acc[b] = _mm256_setzero_pd();
         taken[b] = _mm256_setzero_si256();
@@ -335,6 +340,11 @@ __attribute__((target("avx2"))) inline void bc4_line_select_avx2(const Bc4LinePa
             const __m256 u = _mm256_add_ps(_mm256_mul_ps(s, _mm256_set1_ps(q.per_value)), _mm256_set1_ps(q.offset));
             const __m256i at = _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(u), _mm256_setzero_si256()), _mm256_set1_epi32(6));
             const __m256i above = _mm256_add_epi32(at, _mm256_set1_epi32(1));
+            if constexpr (SixGrid) {
+                const __m256 u6 = _mm256_mul_ps(u, _mm256_set1_ps(5.0f / 7.0f));
+                const __m256 n6 = _mm256_round_ps(_mm256_min_ps(_mm256_max_ps(u6, zero), _mm256_set1_ps(5.0f)), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+                far[b] = _mm256_max_ps(far[b], _mm256_andnot_ps(_mm256_set1_ps(-0.0f), _mm256_sub_ps(u6, n6)));
+            }
             const __m256 e0 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(q.hi, at), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(q.lo, at)));
             const __m256 e1 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(q.hi, above), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(q.lo, above)));
             const __m256 k0 = _mm256_or_ps(_mm256_and_ps(e0, clear), _mm256_castsi256_ps(_mm256_permutevar8x32_epi32(index, at)));
@@ -373,6 +383,7 @@ __attribute__((target("avx2"))) inline void bc4_line_select_avx2(const Bc4LinePa
         o.sum_sq = _mm_cvtsd_f64(_mm_hadd_pd(pairs, pairs));
         o.bits = uint64_t(half[b][0]) | (uint64_t(half[b][1]) << 24);
         o.endpoints = _mm256_testz_si256(taken[b], _mm256_set1_epi32(6));
+        o.six_far = SixGrid ? max_of_lanes(_mm_max_ps(_mm256_castps256_ps128(far[b]), _mm256_extractf128_ps(far[b], 1))) : 0.0f;
         ok[b] = o.keys.max_err < kBc4Infeasible;
     }
 }
