@@ -197,6 +197,75 @@ TEST(Bc4Eval, Sse2EqualsPortable) {
     }
 }
 
+// A level pair's palette values under the Reference decoder, from the public decoder:
+// v[i] for index i of the block (b0, b1).
+void reference_palette(uint8_t b0, uint8_t b1, bool snorm, float v[8]) {
+    for (int i = 0; i < 8; ++i) {
+        const uint64_t bits = uint64_t(i) * 0x249249249249ull; // i in all 16 fields
+        uint8_t blk[8] = {b0, b1, 0, 0, 0, 0, 0, 0};
+        for (int j = 0; j < 6; ++j) blk[2 + j] = uint8_t(bits >> (8 * j));
+        float out[16];
+        decode_bc4_block(blk, snorm, Decoder::Reference, out);
+        v[i] = out[0];
+    }
+}
+
+// The level-pair path (8-bit-like blocks: texels whose extremes are levels lo < hi) finds
+// each texel's least key among the two palette entries around it instead of all 8; it
+// must give the full evaluation's keys, sums, exact errors and indices for any texel
+// within +-2. The hard texels: on a palette value, at the midpoint of two, each nudged by
+// up to 8 ulps (the keys resolve ties to 8 ulps), beyond the palette's ends, on the levels.
+TEST(Bc4Eval, LineKeysEqualFullKeys) {
+    if (!detail::bc4_cpu_has_avx2()) GTEST_SKIP() << "no AVX2: the level-pair path is not used";
+    for (bool snorm : {false, true}) {
+        const float scale = snorm ? 127.0f : 255.0f;
+        const int lmin = snorm ? -127 : 0, lmax = snorm ? 127 : 255;
+        auto byte_of = [&](int v) { return uint8_t(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
+        std::vector<std::pair<int, int>> pairs = {{lmin, lmin + 1}, {lmin, lmax}, {lmax - 1, lmax}, {lmin, lmin + 2}, {lmin + 3, lmin + 8}, {0, 7}, {0, 5}};
+        if (snorm) pairs.insert(pairs.end(), {{-1, 1}, {-127, 0}, {0, 127}});
+        for (uint64_t k = 0; k < 40; ++k) {
+            const int lo = lmin + int(test::unit(k + (snorm ? 500 : 0), 1) * (lmax - lmin));
+            const int span = 1 + int(test::unit(k + (snorm ? 500 : 0), 2) * (k % 3 == 0 ? 12 : lmax - lo));
+            pairs.push_back({lo, std::min(lmax, lo + span)});
+        }
+        for (const auto& [lo, hi] : pairs) {
+            if (!(lo < hi)) continue;
+            std::vector<float> special; // palette values and midpoints of both modes
+            for (int m = 0; m < 2; ++m) {
+                float v[8];
+                reference_palette(m == 0 ? byte_of(hi) : byte_of(lo), m == 0 ? byte_of(lo) : byte_of(hi), snorm, v);
+                std::sort(v, v + 8);
+                for (int i = 0; i < 8; ++i) {
+                    special.push_back(v[i]);
+                    if (i + 1 < 8) special.push_back(0.5f * (v[i] + v[i + 1]));
+                }
+            }
+            std::vector<float> blocks;
+            for (uint64_t b = 0; b < 64; ++b)
+                for (int t = 0; t < 16; ++t) {
+                    const uint64_t seed = uint64_t(lo * 1000 + hi) * 131 + b + (snorm ? 1u << 20 : 0);
+                    const double u = test::unit(seed, uint64_t(t) + 1), w = test::unit(seed, uint64_t(t) + 100);
+                    float x;
+                    switch (int(u * 5)) {
+                    case 0:
+                    case 1: { // a palette value or midpoint, nudged by -8..8 ulps
+                        x = special[size_t(w * double(special.size())) % special.size()];
+                        const int nudge = int(test::unit(seed, uint64_t(t) + 200) * 17) - 8;
+                        for (int j = 0; j < std::abs(nudge); ++j) x = std::nextafter(x, nudge > 0 ? 2.0f : -2.0f);
+                        break;
+                    }
+                    case 2: x = float((lo - 2 + w * (hi - lo + 4)) / scale); break;              // around the pair
+                    case 3: x = float(-2.0 + 4.0 * w); break;                                     // anywhere within +-2
+                    default: x = float(lo + int(w * (hi - lo + 1))) / scale; break;               // on the levels
+                    }
+                    blocks.push_back(x == 0.0f ? 0.0f : x); // -0.0 takes the full path (bc4.cpp)
+                }
+            EXPECT_EQ(detail::bc4_line_mismatches(snorm, blocks.data(), blocks.size() / 16, lo, hi), 0)
+                << (snorm ? "snorm" : "unorm") << " pair " << lo << ", " << hi;
+        }
+    }
+}
+
 TEST(Bc4, RandomBlocksUnormAllDecoders) { run_random(false, false, Quality::Normal, kAllDecoders, kRandomBlocks); }
 TEST(Bc4, RandomBlocksSnormAllDecoders) { run_random(true, false, Quality::Normal, kAllDecoders, kRandomBlocks); }
 TEST(Bc4, RandomBlocksOneSidedEveryDecoder) { run_random(false, true, Quality::Normal, kAllDecoders, kRandomBlocks); }
@@ -488,9 +557,11 @@ namespace {
 
 // The encoder's same-bytes shortcuts change nothing but the time, for UNORM and SNORM, any
 // decoder set, one-sided or not, with a bound: flat blocks on a level (8-bit sources, maps
-// clamped at 0 or 1) come from a table fast / normal fill with their own search's results,
-// and the 6-value pair is not evaluated after an 8-value incumbent that used only its
-// endpoints (blocks a few levels wide, as 8-bit images have by the thousand).
+// clamped at 0 or 1) come from a table fast / normal fill with their own search's results;
+// the 6-value pair is not evaluated after an 8-value incumbent that used only its
+// endpoints (blocks a few levels wide, as 8-bit images have by the thousand) or when its
+// texels lie farther from its grid than the incumbent's max error; level pairs (extremes on
+// levels) are evaluated on their line palettes; encode_blocks gives encode's results.
 TEST(Bc4, ShortcutsEqualTheSearch) {
     for (bool snorm : {false, true}) {
         const float scale = snorm ? 127.0f : 255.0f;
@@ -504,6 +575,26 @@ TEST(Bc4, ShortcutsEqualTheSearch) {
                 blocks.push_back(k % 7 == 0 ? (float(l) + 0.25f) / scale : float(l) / scale);
             }
         }
+        // Level pairs (the extremes on levels lo < hi, up to the whole range) with texels
+        // between and on the grids' midpoints; texels beyond the range (clamped to the end
+        // levels) and beyond +-2; -0.0 beside 0; NaN and infinity.
+        for (uint64_t k = 0; k < 1500; ++k) {
+            const int lo = lmin + int(test::unit(k, 3) * (lmax - lmin - 1));
+            const int hi = std::min(lmax, lo + 1 + int(test::unit(k, 4) * (k % 2 ? 8 : lmax - lmin)));
+            float b[16];
+            for (int t = 0; t < 16; ++t) {
+                const double w = test::unit(k, 40 + uint64_t(t));
+                const int j = int(test::unit(k, 60 + uint64_t(t)) * 14);
+                b[t] = t % 3 == 0 ? float((lo + w * (hi - lo)) / scale) : float((lo + (hi - lo) * (j / 14.0)) / scale);
+            }
+            b[int(k % 16)] = float(lo) / scale;
+            b[int((k + 7) % 16)] = float(hi) / scale;
+            blocks.insert(blocks.end(), b, b + 16);
+        }
+        const float specials[][4] = {{-0.0f, 0.0f, 1.0f / scale, 2.0f / scale}, {-0.5f, 0.2f, 1.5f, 0.9f}, {1.9f, 1.99f, 0.5f, -1.9f},
+                                     {3.0f, 0.5f, 0.25f, 0.0f}, {NAN, 0.5f, 0.25f, 0.0f}, {INFINITY, 0.5f, 0.25f, 0.0f}};
+        for (const auto& sp : specials)
+            for (int t = 0; t < 16; ++t) blocks.push_back(sp[t % 4]);
         for (Quality q : {Quality::Fast, Quality::Normal})
             for (DecoderSet set : {kReferenceOnly, kAllDecoders})
                 for (bool os : {false, true}) {
@@ -511,7 +602,7 @@ TEST(Bc4, ShortcutsEqualTheSearch) {
                     o.quality = q;
                     o.decoders = set;
                     o.one_sided_below = os;
-                    o.max_error = os ? 0.5f / 255.0f : -1.0f;
+                    o.max_error = os ? 0.5f / 255.0f : set == kReferenceOnly ? 3.0f / scale : -1.0f; // blocks missing it take the exhaustive search
                     EXPECT_EQ(detail::bc4_shortcut_mismatches(snorm, o, blocks.data(), blocks.size() / 16), 0)
                         << "snorm " << snorm << " quality " << quality_name(q) << " decoders " << set << " one-sided " << os;
                 }

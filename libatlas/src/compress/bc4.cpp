@@ -377,17 +377,24 @@ long bc4_shortcut_mismatches(bool snorm, const BlockOptions& options, const floa
     Bc4Encoder enc(snorm, options);
     PairTables& T = *enc.tables_;
     long bad = 0;
+    auto same = [](const uint8_t* a, const BlockResult& x, const uint8_t* b, const BlockResult& y) {
+        return std::memcmp(a, b, 8) == 0 && std::memcmp(&x.max_error, &y.max_error, 4) == 0 && std::memcmp(&x.sum_sq, &y.sum_sq, 8) == 0 &&
+               x.one_sided_ok == y.one_sided_ok;
+    };
+    std::vector<uint8_t> run(8 * count);
+    std::vector<BlockResult> run_res(count);
+    enc.encode_blocks(blocks, count, run.data(), run_res.data());
     for (size_t b = 0; b < count; ++b) {
         uint8_t with[8], without[8];
         const BlockResult x = enc.encode(blocks + 16 * b, with);
         T.shortcuts = false;
         const BlockResult y = enc.encode(blocks + 16 * b, without);
         T.shortcuts = true;
-        bad += std::memcmp(with, without, 8) != 0 || std::memcmp(&x.max_error, &y.max_error, 4) != 0 ||
-               std::memcmp(&x.sum_sq, &y.sum_sq, 8) != 0 || x.one_sided_ok != y.one_sided_ok;
+        bad += !same(with, x, without, y) || !same(&run[8 * b], run_res[b], without, y);
     }
     return bad;
 }
+
 } // namespace detail
 
 namespace {
@@ -1053,5 +1060,62 @@ void Bc4Encoder::encode_blocks(const float* src, size_t count, uint8_t* out, Blo
 #endif
     for (size_t b = 0; b < count; ++b) results[b] = encode(src + 16 * b, out + 8 * b);
 }
+
+namespace detail {
+// Test hook (bc4_eval.h): the line palettes' evaluations of the level pair (lo, hi), both
+// modes, against the full evaluation of the same pairs' palettes in index order.
+#if defined(ATLAS_BC4_AVX2)
+namespace {
+__attribute__((target("avx2"))) long line_mismatches_avx2(const PairTables* T, bool snorm, const float* blocks, size_t count, int lo, int hi) {
+    auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
+    long bad = 0;
+    for (size_t b = 0; b < count; ++b) {
+        const float* src = blocks + 16 * b;
+        detail::Bc4LineResult r[2];
+        detail::Bc4Keys full[2];
+        detail::Bc4LinePalette lp[2];
+        for (int m = 0; m < 2; ++m) {
+            line_palette(*T, lo, hi, m == 0, lp[m]);
+            const detail::Bc4LinePalette* const ps[1] = {&lp[m]};
+            const float* const ss[1] = {src};
+            detail::Bc4LineResult* const os[1] = {&r[m]};
+            bool ok[1];
+            if (m == 0) detail::bc4_line_select_avx2<1, true>(ps, ss, os, ok);
+            else detail::bc4_line_select_avx2<1>(ps, ss, os, ok);
+            const int k = m == 0 ? byte_of(hi) * 256 + byte_of(lo) : byte_of(lo) * 256 + byte_of(hi);
+            const detail::Palette<1>& p = T->pal[size_t(k)];
+            const bool fok = detail::bc4_keys_portable<false>(p, src, detail::kBc4Infeasible, INFINITY, full[m]);
+            float mx;
+            double sq;
+            uint64_t bits;
+            detail::bc4_exact_portable<false>(p, src, full[m], mx, sq, bits);
+            bad += ok[0] != fok || std::memcmp(r[m].keys.key, full[m].key, sizeof full[m].key) != 0 ||
+                   std::memcmp(&r[m].keys.max_err, &full[m].max_err, 4) != 0 || std::memcmp(&r[m].keys.sum, &full[m].sum, 4) != 0 ||
+                   std::memcmp(&r[m].max_err, &mx, 4) != 0 || std::memcmp(&r[m].sum_sq, &sq, 8) != 0 || r[m].bits != bits ||
+                   r[m].endpoints != endpoints_only(full[m]);
+            // six_may_tie's skip: the 6-value pair's evaluation against the 8-value incumbent returns false.
+            if (m == 1 && !six_may_tie(lp[0], r[0])) {
+                detail::Bc4Keys tied;
+                bad += detail::bc4_keys_portable<false>(p, src, full[0].max_err, full[0].sum, tied) ? 1 : 0;
+            }
+        }
+    }
+    return bad;
+}
+} // namespace
+#endif
+
+long bc4_line_mismatches(bool snorm, const float* blocks, size_t count, int lo, int hi) {
+#if defined(ATLAS_BC4_AVX2)
+    if (!bc4_cpu_has_avx2()) return 0;
+    auto T = std::make_unique<PairTables>();
+    build_tables(*T, snorm, kReferenceOnly);
+    return line_mismatches_avx2(T.get(), snorm, blocks, count, lo, hi);
+#else
+    (void)snorm, (void)blocks, (void)count, (void)lo, (void)hi;
+    return 0;
+#endif
+}
+} // namespace detail
 
 } // namespace atlas::compress

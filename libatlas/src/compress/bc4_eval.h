@@ -459,4 +459,12 @@ inline bool bc4_keys(const Palette<1>& p, const float* src, float stop, float in
 // assemble from the per-entry tables; 0 when they are the same floats.
 long bc4_entry_table_mismatches(bool snorm, DecoderSet set);
 
+// Test hook (bc4.cpp): for each block (texels finite, within +-2, none -0.0), the level
+// pair (lo, hi)'s line-palette evaluations (8-value and 6-value mode) against the full
+// evaluation and exact pass of the same pairs' palettes: keys, key max and sum, exact max
+// error, squared error, index field, endpoints_only; and that six_may_tie skips only
+// 6-value pairs whose evaluation against the 8-value result returns false. Returns the
+// number of differences (0 also without AVX2, where there is no line path).
+long bc4_line_mismatches(bool snorm, const float* blocks, size_t count, int lo, int hi);
+
 } // namespace atlas::compress::detail
