@@ -591,10 +591,17 @@ TEST(Bc4, ShortcutsEqualTheSearch) {
             b[int((k + 7) % 16)] = float(hi) / scale;
             blocks.insert(blocks.end(), b, b + 16);
         }
-        const float specials[][4] = {{-0.0f, 0.0f, 1.0f / scale, 2.0f / scale}, {-0.5f, 0.2f, 1.5f, 0.9f}, {1.9f, 1.99f, 0.5f, -1.9f},
-                                     {3.0f, 0.5f, 0.25f, 0.0f}, {NAN, 0.5f, 0.25f, 0.0f}, {INFINITY, 0.5f, 0.25f, 0.0f}};
+        // (-0.0 on levels 0..5, where the 6-value pair wins: its entry 0 and its constant 0
+        // tie on the error -0.0, and the keys' order of negative floats picks the constant.)
+        const std::vector<std::vector<float>> specials = {{-0.0f, 0.0f, 1.0f / scale, 2.0f / scale},
+                                                          {-0.0f, 0.0f, 1.0f / scale, 2.0f / scale, 3.0f / scale, 4.0f / scale, 5.0f / scale, 5.0f / scale},
+                                                          {-0.5f, 0.2f, 1.5f, 0.9f},
+                                                          {1.9f, 1.99f, 0.5f, -1.9f},
+                                                          {3.0f, 0.5f, 0.25f, 0.0f},
+                                                          {NAN, 0.5f, 0.25f, 0.0f},
+                                                          {INFINITY, 0.5f, 0.25f, 0.0f}};
         for (const auto& sp : specials)
-            for (int t = 0; t < 16; ++t) blocks.push_back(sp[t % 4]);
+            for (size_t t = 0; t < 16; ++t) blocks.push_back(sp[t % sp.size()]);
         for (Quality q : {Quality::Fast, Quality::Normal})
             for (DecoderSet set : {kReferenceOnly, kAllDecoders})
                 for (bool os : {false, true}) {
