@@ -242,8 +242,11 @@ double run_bc4(const Image& im, Codec codec, Errors& err) {
             for (int t = 0; t < 16; ++t) texels[(size_t(by) * size_t(bw) + size_t(bx)) * 16 + size_t(t)] = grey(bx, by, t);
     std::vector<float> texels_f(texels.size());
     for (size_t i = 0; i < texels.size(); ++i) texels_f[i] = texels[i] / 255.0f;
+    std::vector<BlockResult> results(enc ? size_t(bw) * size_t(bh) : 0);
     const double t0 = cpu_now();
-    for (int by = 0; by < bh; ++by)
+    // Atlas: the run API the texture encoder uses (encode() per block gives the same bytes).
+    if (enc) enc->encode_blocks(texels_f.data(), results.size(), blocks.data(), results.data());
+    for (int by = 0; by < bh && !enc; ++by)
         for (int bx = 0; bx < bw; ++bx) {
             uint8_t* out = &blocks[(size_t(by) * size_t(bw) + size_t(bx)) * 8];
             const uint8_t* g8 = &texels[(size_t(by) * size_t(bw) + size_t(bx)) * 16];
@@ -254,13 +257,9 @@ double run_bc4(const Image& im, Codec codec, Errors& err) {
                 continue;
             }
 #endif
-            if (enc) {
-                enc->encode(&texels_f[(size_t(by) * size_t(bw) + size_t(bx)) * 16], out);
-            } else {
-                uint8_t rgba[64] = {};
-                for (int t = 0; t < 16; ++t) rgba[4 * t] = g8[t]; // squish's BC4 reads red
-                squish::Compress(rgba, out, squish::kBc4);
-            }
+            uint8_t rgba[64] = {};
+            for (int t = 0; t < 16; ++t) rgba[4 * t] = g8[t]; // squish's BC4 reads red
+            squish::Compress(rgba, out, squish::kBc4);
         }
     const double s = cpu_now() - t0;
     for (int by = 0; by < bh; ++by)

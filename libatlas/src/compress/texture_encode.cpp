@@ -112,6 +112,17 @@ void encode_plain(const LevelData& L, int layer, DxgiFormat f, bool one_sided, u
     }
 }
 
+// Block b's 16 texels (edge replicated), ch channels interleaved.
+template <class Planes>
+void gather_block(const LevelData& L, const Planes& P, size_t b, int bw, int bh, int ch, float* src) {
+    const int bx = int(b % size_t(bw)), by = int((b / size_t(bw)) % size_t(bh)), z = int(b / (size_t(bw) * size_t(bh)));
+    for (int t = 0; t < 16; ++t) {
+        const int x = std::min(bx * 4 + t % 4, L.w - 1), y = std::min(by * 4 + t / 4, L.h - 1); // edge replicate
+        const size_t at = (size_t(z) * size_t(L.h) + size_t(y)) * size_t(L.w) + size_t(x);
+        for (int c = 0; c < ch; ++c) src[ch * t + c] = P[size_t(c)][at];
+    }
+}
+
 // Encodes one BC level of one layer.
 void encode_bc(const LevelData& L, int layer, Format fmt, const BlockOptions& bo, const Bc4Encoder* bc4,
                const ScalarUnpack& unpack, uint8_t* out, std::vector<BlockOutcome>& blocks, int bw, int bh,
@@ -122,21 +133,26 @@ void encode_bc(const LevelData& L, int layer, Format fmt, const BlockOptions& bo
     const size_t unit = bc6h ? 16 : 8;
     parallel_blocks(nblocks, 64, [&](size_t b0, size_t b1) {
         if (progress) progress->poll();
-        for (size_t b = b0; b != b1; ++b) {
-            const int bx = int(b % size_t(bw)), by = int((b / size_t(bw)) % size_t(bh)), z = int(b / (size_t(bw) * size_t(bh)));
-            float src[48];
-            const int ch = (fmt == Format::Bc1 || bc6h) ? 3 : 1;
-            for (int t = 0; t < 16; ++t) {
-                const int x = std::min(bx * 4 + t % 4, L.w - 1), y = std::min(by * 4 + t / 4, L.h - 1); // edge replicate
-                const size_t at = (size_t(z) * size_t(L.h) + size_t(y)) * size_t(L.w) + size_t(x);
-                for (int c = 0; c < ch; ++c) src[ch * t + c] = P[size_t(c)][at];
+        if (bc4) { // gathered 64 at a time for encode_blocks (the same results as encode())
+            constexpr size_t kRun = 64;
+            float src[16 * kRun];
+            BlockResult res[kRun];
+            for (size_t r0 = b0; r0 < b1; r0 += kRun) {
+                const size_t n = std::min(kRun, b1 - r0);
+                for (size_t i = 0; i < n; ++i) gather_block(L, P, r0 + i, bw, bh, 1, src + 16 * i);
+                bc4->encode_blocks(src, n, out + r0 * unit, res);
+                for (size_t i = 0; i < n; ++i) blocks[r0 + i] = {res[i].max_error, res[i].one_sided_ok};
             }
+            return;
+        }
+        for (size_t b = b0; b != b1; ++b) {
+            float src[48];
+            gather_block(L, P, b, bw, bh, (fmt == Format::Bc1 || bc6h) ? 3 : 1, src);
             BlockResult res;
             uint8_t* dst = out + b * unit;
             if (bc6h) res = encode_bc6h_block(src, fmt == Format::Bc6hSf16, bo, dst);
             else if (fmt == Format::Bc1) res = encode_bc1_block(src, bo, dst);
-            else if (fmt == Format::Bc1Scalar) res = encode_bc1_scalar_block(src, unpack, bo, dst);
-            else res = bc4->encode(src, dst);
+            else res = encode_bc1_scalar_block(src, unpack, bo, dst); // bc1-scalar (BC4 took the run path above)
             blocks[b] = {res.max_error, res.one_sided_ok};
         }
     });
