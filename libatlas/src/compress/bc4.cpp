@@ -138,9 +138,10 @@ void interval_palette(uint8_t b0, uint8_t b1, bool snorm, DecoderSet set, detail
 }
 
 void write_block_bits(uint8_t b0, uint8_t b1, uint64_t bits, uint8_t out[8]) {
-    out[0] = b0;
-    out[1] = b1;
-    for (int i = 0; i < 6; ++i) out[2 + i] = uint8_t(bits >> (8 * i));
+    // One 8-byte store, little-endian: b0, b1, then the 48 index bits from the lowest.
+    uint8_t block[8] = {b0, b1};
+    for (int i = 0; i < 6; ++i) block[2 + i] = uint8_t(bits >> (8 * i));
+    std::memcpy(out, block, 8);
 }
 
 void write_block(uint8_t b0, uint8_t b1, const uint8_t idx[16], uint8_t out[8]) {
