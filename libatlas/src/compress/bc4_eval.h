@@ -341,8 +341,11 @@ __attribute__((target("avx2"))) inline void bc4_line_select_avx2(const Bc4LinePa
             const __m256i at = _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(u), _mm256_setzero_si256()), _mm256_set1_epi32(6));
             const __m256i above = _mm256_add_epi32(at, _mm256_set1_epi32(1));
             if constexpr (SixGrid) {
+                // Nearest grid step, unclamped: beyond the grid's ends this finds a step that
+                // does not exist, nearer than the true end, so the test only errs toward
+                // evaluating the 6-value pair.
                 const __m256 u6 = _mm256_mul_ps(u, _mm256_set1_ps(5.0f / 7.0f));
-                const __m256 n6 = _mm256_round_ps(_mm256_min_ps(_mm256_max_ps(u6, zero), _mm256_set1_ps(5.0f)), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+                const __m256 n6 = _mm256_round_ps(u6, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
                 far[b] = _mm256_max_ps(far[b], _mm256_andnot_ps(_mm256_set1_ps(-0.0f), _mm256_sub_ps(u6, n6)));
             }
             const __m256 e0 = _mm256_max_ps(_mm256_sub_ps(_mm256_permutevar8x32_ps(q.hi, at), s), _mm256_sub_ps(s, _mm256_permutevar8x32_ps(q.lo, at)));
