@@ -699,8 +699,8 @@ struct LevelPair {
 enum class BlockKind { Other, Flat, LevelPair };
 
 __attribute__((target("avx2"))) BlockKind classify(const float src[16], bool snorm, LevelPair& lp) {
-    // Every test computed, none branched on: blocks of different kinds alternate (flat
-    // and not on an 8-bit image's edges) and a mispredicted kind costs more than the tests.
+    // Flat blocks leave early (they need none of the rest); the other tests are combined
+    // without branches.
     const __m256 a = _mm256_loadu_ps(src), b = _mm256_loadu_ps(src + 8);
     const __m256i ai = _mm256_castps_si256(a), bi = _mm256_castps_si256(b);
     const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(ai));
@@ -732,24 +732,44 @@ __attribute__((target("avx2"))) BlockKind classify(const float src[16], bool sno
     return BlockKind(kind);
 }
 
-// A level pair's first candidate, (hi, lo), evaluated by its line palette (the same keys
-// and results as the candidate loop's evaluation). Returns false if it fails (it cannot:
-// every key error is finite), leaving the block to the loop.
+// The byte of a level (SNORM: its two's complement).
+int level_byte(int v, bool snorm) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); }
+
+// N level pairs' first candidates, (hi, lo), each evaluated by its line palette (the same
+// keys and results as the candidate loop's evaluation); ok[b] false if one fails (it
+// cannot: every key error is finite), which leaves that block to the loop.
 struct EightValues {
     detail::Bc4LinePalette pal;
     detail::Bc4LineResult r;
     int k = -1;
 };
-__attribute__((target("avx2"))) bool eight_values(const PairTables& T, const float src[16], const LevelPair& lp, bool snorm, EightValues& e) {
-    auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
-    e.k = byte_of(lp.hi) * 256 + byte_of(lp.lo);
-    line_palette(T, lp.lo, lp.hi, true, e.pal);
-    const detail::Bc4LinePalette* const ps[1] = {&e.pal};
-    const float* const ss[1] = {src};
-    detail::Bc4LineResult* const os[1] = {&e.r};
-    bool ok[1];
-    detail::bc4_line_select_avx2<1, true>(ps, ss, os, ok);
-    return ok[0];
+template <int N>
+__attribute__((target("avx2"), always_inline)) inline void eight_values(const PairTables& T, const float* const src[N], const LevelPair* const lp[N],
+                                                                       bool snorm, EightValues e[N], bool ok[N]) {
+    const detail::Bc4LinePalette* pal[N];
+    detail::Bc4LineResult* r[N];
+    for (int b = 0; b < N; ++b) {
+        e[b].k = level_byte(lp[b]->hi, snorm) * 256 + level_byte(lp[b]->lo, snorm);
+        line_palette(T, lp[b]->lo, lp[b]->hi, true, e[b].pal);
+        pal[b] = &e[b].pal;
+        r[b] = &e[b].r;
+    }
+    detail::bc4_line_select_avx2<N, true>(pal, src, r, ok);
+}
+
+// N level pairs' second candidates, (lo, hi).
+template <int N>
+__attribute__((target("avx2"), always_inline)) inline void six_values(const PairTables& T, const float* const src[N], const LevelPair* const lp[N],
+                                                                     detail::Bc4LineResult r6[N], bool ok[N]) {
+    detail::Bc4LinePalette pal6[N];
+    const detail::Bc4LinePalette* pal[N];
+    detail::Bc4LineResult* r[N];
+    for (int b = 0; b < N; ++b) {
+        line_palette(T, lp[b]->lo, lp[b]->hi, false, pal6[b]);
+        pal[b] = &pal6[b];
+        r[b] = &r6[b];
+    }
+    detail::bc4_line_select_avx2<N>(pal, src, r, ok);
 }
 
 // Whether the loop would evaluate the second candidate, (lo, hi), and it could win: not
@@ -763,14 +783,10 @@ __attribute__((target("avx2"), always_inline)) inline bool six_needed(const Pair
     return !exact & !ends & six_may_tie(e.pal, e.r);
 }
 
-// The second candidate's evaluation; true when it beats the first (a lower max error,
-// or the same and a lower sum: what the loop's evaluation against the incumbent's stop
-// and sum returns, bc4_eval.h).
-__attribute__((target("avx2"))) bool six_beats(const PairTables& T, const float src[16], const LevelPair& lp, float eight_max, float eight_sum,
-                                              detail::Bc4LineResult& r6) {
-    detail::Bc4LinePalette pal;
-    line_palette(T, lp.lo, lp.hi, false, pal);
-    return detail::bc4_line_select_avx2(pal, src, r6) && (r6.keys.max_err < eight_max || (r6.keys.max_err == eight_max && r6.keys.sum < eight_sum));
+// The second candidate beats the first: a lower max error, or the same and a lower sum
+// (what the loop's evaluation against the incumbent's stop and sum returns, bc4_eval.h).
+bool six_beats(bool ok, const detail::Bc4Keys& six, float eight_max, float eight_sum) {
+    return ok && (six.max_err < eight_max || (six.max_err == eight_max && six.sum < eight_sum));
 }
 
 void write_line_result(int k, const detail::Bc4LineResult& r, uint8_t out[8], BlockResult& res) {
@@ -787,20 +803,29 @@ __attribute__((target("avx2"))) bool level_pair_block(const PairTables& T, const
     LevelPair lp;
     const BlockKind kind = classify(src, snorm, lp);
     if (kind == BlockKind::Flat) return T.flat_ready && flat_from_table(T, src[0], snorm, out, res);
-    EightValues e;
-    if (kind != BlockKind::LevelPair || !eight_values(T, src, lp, snorm, e)) return false;
-    detail::Bc4LineResult r6;
-    const bool six = with_six && six_needed(T, lp, e) && six_beats(T, src, lp, e.r.keys.max_err, e.r.keys.sum, r6);
-    const detail::Bc4LineResult& r = six ? r6 : e.r;
+    if (kind != BlockKind::LevelPair) return false;
+    const float* const in[1] = {src};
+    const LevelPair* const pairs[1] = {&lp};
+    EightValues e[1];
+    detail::Bc4LineResult r6[1];
+    bool ok[1], ok6[1];
+    eight_values<1>(T, in, pairs, snorm, e, ok);
+    if (!ok[0]) return false;
+    bool six = with_six && six_needed(T, lp, e[0]);
+    if (six) {
+        six_values<1>(T, in, pairs, r6, ok6);
+        six = six_beats(ok6[0], r6[0].keys, e[0].r.keys.max_err, e[0].r.keys.sum);
+    }
+    const detail::Bc4LineResult& r = six ? r6[0] : e[0].r;
     if (bound >= 0 && r.max_err > bound) return false;
-    write_line_result(six ? swapped(e.k) : e.k, r, out, res);
+    write_line_result(six ? swapped(e[0].k) : e[0].k, r, out, res);
     return true;
 }
 
 // level_pair_block for a run of blocks, in passes over blocks of one kind, so that no
 // branch on a block's kind or on whether its 6-value pair is evaluated (both data
 // dependent, and decided late in a block's chain) throws away the work on the blocks
-// after it: the same results (test Bc4.EncodeBlocksEqualsEncode).
+// after it: the same results (test Bc4.ShortcutsEqualTheSearch).
 __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool snorm, const BlockOptions& options, const float* src, size_t count,
                                                       uint8_t* out, BlockResult* res) {
     constexpr size_t kRun = 128;
@@ -833,22 +858,16 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
         for (size_t j = 0; j < npairs; j += kPair) {
             const int m = int(std::min<size_t>(kPair, npairs - j));
             size_t at[kPair];
-            EightValues e[kPair];
-            const detail::Bc4LinePalette* pal[kPair];
             const float* in[kPair];
-            detail::Bc4LineResult* r[kPair];
-            bool ok[kPair];
+            const LevelPair* pairs[kPair];
             for (int b = 0; b < kPair; ++b) {
                 at[b] = list[int(BlockKind::LevelPair)][j + size_t(b < m ? b : 0)]; // an odd run's last block twice
-                const LevelPair& x = lp[at[b]];
-                auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
-                e[b].k = byte_of(x.hi) * 256 + byte_of(x.lo);
-                line_palette(T, x.lo, x.hi, true, e[b].pal);
-                pal[b] = &e[b].pal;
                 in[b] = s + 16 * at[b];
-                r[b] = &e[b].r;
+                pairs[b] = &lp[at[b]];
             }
-            detail::bc4_line_select_avx2<kPair, true>(pal, in, r, ok);
+            EightValues e[kPair];
+            bool ok[kPair];
+            eight_values<kPair>(T, in, pairs, snorm, e, ok);
             for (int b = 0; b < m; ++b) {
                 const size_t i = at[b];
                 write_line_result(e[b].k, e[b].r, o + 8 * i, q[i]);
@@ -867,24 +886,19 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
         for (size_t j = 0; j < nsix; j += kPair) {
             const int m = int(std::min<size_t>(kPair, nsix - j));
             size_t at[kPair];
-            detail::Bc4LinePalette pal6[kPair];
-            detail::Bc4LineResult r6[kPair];
-            const detail::Bc4LinePalette* pal[kPair];
             const float* in[kPair];
-            detail::Bc4LineResult* r[kPair];
-            bool ok[kPair];
+            const LevelPair* pairs[kPair];
             for (int b = 0; b < kPair; ++b) {
                 at[b] = six[j + size_t(b < m ? b : 0)];
-                line_palette(T, lp[at[b]].lo, lp[at[b]].hi, false, pal6[b]);
-                pal[b] = &pal6[b];
                 in[b] = s + 16 * at[b];
-                r[b] = &r6[b];
+                pairs[b] = &lp[at[b]];
             }
-            detail::bc4_line_select_avx2<kPair>(pal, in, r, ok);
+            detail::Bc4LineResult r6[kPair];
+            bool ok[kPair];
+            six_values<kPair>(T, in, pairs, r6, ok);
             for (int b = 0; b < m; ++b) {
                 const size_t i = at[b];
-                const bool beats = ok[b] && (r6[b].keys.max_err < eight_max[i] || (r6[b].keys.max_err == eight_max[i] && r6[b].keys.sum < eight_sum[i]));
-                if (beats) write_line_result(swapped(k8[i]), r6[b], o + 8 * i, q[i]);
+                if (six_beats(ok[b], r6[b].keys, eight_max[i], eight_sum[i])) write_line_result(swapped(k8[i]), r6[b], o + 8 * i, q[i]);
                 redo[i] = bound >= 0 && q[i].max_error > bound;
             }
         }
@@ -1068,7 +1082,6 @@ namespace detail {
 #if defined(ATLAS_BC4_AVX2)
 namespace {
 __attribute__((target("avx2"))) long line_mismatches_avx2(const PairTables* T, bool snorm, const float* blocks, size_t count, int lo, int hi) {
-    auto byte_of = [&](int v) { return int(snorm ? uint8_t(int8_t(v)) : uint8_t(v)); };
     long bad = 0;
     for (size_t b = 0; b < count; ++b) {
         const float* src = blocks + 16 * b;
@@ -1083,7 +1096,7 @@ __attribute__((target("avx2"))) long line_mismatches_avx2(const PairTables* T, b
             bool ok[1];
             if (m == 0) detail::bc4_line_select_avx2<1, true>(ps, ss, os, ok);
             else detail::bc4_line_select_avx2<1>(ps, ss, os, ok);
-            const int k = m == 0 ? byte_of(hi) * 256 + byte_of(lo) : byte_of(lo) * 256 + byte_of(hi);
+            const int k = m == 0 ? level_byte(hi, snorm) * 256 + level_byte(lo, snorm) : level_byte(lo, snorm) * 256 + level_byte(hi, snorm);
             const detail::Palette<1>& p = T->pal[size_t(k)];
             const bool fok = detail::bc4_keys_portable<false>(p, src, detail::kBc4Infeasible, INFINITY, full[m]);
             float mx;
