@@ -713,11 +713,12 @@ __attribute__((target("avx2"))) BlockKind classify(const float src[16], bool sno
     mx4 = _mm_max_ss(mx4, _mm_shuffle_ps(mx4, mx4, 1));
     lp.smin = _mm_cvtss_f32(mn4);
     lp.smax = _mm_cvtss_f32(mx4);
-    // A NaN texel fails the unordered test (MINPS / MAXPS may skip it); values within +-2.
-    const __m256i negative_zero = _mm256_set1_epi32(int(0x80000000u));
-    const bool usable = (lp.smin >= -2.0f) & (lp.smax <= 2.0f) & (_mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_UNORD_Q)) == 0) &
-                        _mm256_testz_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ai, negative_zero), _mm256_cmpeq_epi32(bi, negative_zero)),
-                                           _mm256_set1_epi32(-1));
+    // Every texel within +-2 (its magnitude's bits at most 2.0f's: NaN and infinities fail,
+    // which MINPS / MAXPS may skip) and none -0.0, on the bits.
+    const __m256i magnitude = _mm256_set1_epi32(0x7fffffff), two = _mm256_set1_epi32(0x40000000), negative_zero = _mm256_set1_epi32(int(0x80000000u));
+    const __m256i bad = _mm256_or_si256(_mm256_or_si256(_mm256_cmpgt_epi32(_mm256_and_si256(ai, magnitude), two), _mm256_cmpgt_epi32(_mm256_and_si256(bi, magnitude), two)),
+                                        _mm256_or_si256(_mm256_cmpeq_epi32(ai, negative_zero), _mm256_cmpeq_epi32(bi, negative_zero)));
+    const bool usable = _mm256_testz_si256(bad, bad);
     // The extremes' floor and ceiling, clamped to the levels (as encode computes them; the
     // clamp first keeps the conversion defined), in one register: smin, smax.
     const float scale = snorm ? 127.0f : 255.0f;
