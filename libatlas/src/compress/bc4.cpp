@@ -704,7 +704,7 @@ __attribute__((target("avx2"))) BlockKind classify(const float src[16], bool sno
     const __m256 a = _mm256_loadu_ps(src), b = _mm256_loadu_ps(src + 8);
     const __m256i ai = _mm256_castps_si256(a), bi = _mm256_castps_si256(b);
     const __m256i first = _mm256_broadcastd_epi32(_mm256_castsi256_si128(ai));
-    const bool flat = _mm256_movemask_epi8(_mm256_and_si256(_mm256_cmpeq_epi32(ai, first), _mm256_cmpeq_epi32(bi, first))) == -1;
+    if (_mm256_movemask_epi8(_mm256_and_si256(_mm256_cmpeq_epi32(ai, first), _mm256_cmpeq_epi32(bi, first))) == -1) return BlockKind::Flat;
     __m256 mn = _mm256_min_ps(a, b), mx = _mm256_max_ps(a, b);
     __m128 mn4 = _mm_min_ps(_mm256_castps256_ps128(mn), _mm256_extractf128_ps(mn, 1)), mx4 = _mm_max_ps(_mm256_castps256_ps128(mx), _mm256_extractf128_ps(mx, 1));
     mn4 = _mm_min_ps(mn4, _mm_movehl_ps(mn4, mn4));
@@ -729,8 +729,7 @@ __attribute__((target("avx2"))) BlockKind classify(const float src[16], bool sno
     lp.lo = _mm_cvtsi128_si32(level);
     lp.hi = _mm_extract_epi32(level, 1);
     const bool levels = (_mm_movemask_ps(_mm_cmpeq_ps(fl, cl)) & 3) == 3;
-    const int kind = flat ? int(BlockKind::Flat) : (usable & levels & (lp.lo < lp.hi)) ? int(BlockKind::LevelPair) : int(BlockKind::Other);
-    return BlockKind(kind);
+    return usable & levels & (lp.lo < lp.hi) ? BlockKind::LevelPair : BlockKind::Other;
 }
 
 // The byte of a level (SNORM: its two's complement).
