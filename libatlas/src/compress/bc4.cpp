@@ -852,24 +852,33 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
             const size_t i = list[int(BlockKind::Flat)][j];
             redo[i] = !(T.flat_ready && flat_from_table(T, s[16 * i], snorm, o + 8 * i, q[i]));
         }
-        // Level pairs two at a time (bc4_line_select_avx2's interleaving).
-        const size_t npairs = len[int(BlockKind::LevelPair)];
+        // Level pairs two at a time (bc4_line_select_avx2's interleaving): a group's blocks
+        // from position j of a list of `listed` (an odd list's last block twice).
         constexpr int kPair = 2;
-        for (size_t j = 0; j < npairs; j += kPair) {
-            const int m = int(std::min<size_t>(kPair, npairs - j));
+        struct Group {
+            int m;
             size_t at[kPair];
             const float* in[kPair];
             const LevelPair* pairs[kPair];
+        };
+        auto group = [&](const uint16_t* ids, size_t j, size_t listed) {
+            Group g;
+            g.m = int(std::min<size_t>(kPair, listed - j));
             for (int b = 0; b < kPair; ++b) {
-                at[b] = list[int(BlockKind::LevelPair)][j + size_t(b < m ? b : 0)]; // an odd run's last block twice
-                in[b] = s + 16 * at[b];
-                pairs[b] = &lp[at[b]];
+                g.at[b] = ids[j + size_t(b < g.m ? b : 0)];
+                g.in[b] = s + 16 * g.at[b];
+                g.pairs[b] = &lp[g.at[b]];
             }
+            return g;
+        };
+        const size_t npairs = len[int(BlockKind::LevelPair)];
+        for (size_t j = 0; j < npairs; j += kPair) {
+            const Group g = group(list[int(BlockKind::LevelPair)], j, npairs);
             EightValues e[kPair];
             bool ok[kPair];
-            eight_values<kPair>(T, in, pairs, snorm, e, ok);
-            for (int b = 0; b < m; ++b) {
-                const size_t i = at[b];
+            eight_values<kPair>(T, g.in, g.pairs, snorm, e, ok);
+            for (int b = 0; b < g.m; ++b) {
+                const size_t i = g.at[b];
                 write_line_result(e[b].k, e[b].r, o + 8 * i, q[i]);
                 more[i] = ok[b] & with_six & six_needed(T, lp[i], e[b]);
                 eight_max[i] = e[b].r.keys.max_err;
@@ -884,20 +893,12 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
         }
         // The second candidates, two at a time too.
         for (size_t j = 0; j < nsix; j += kPair) {
-            const int m = int(std::min<size_t>(kPair, nsix - j));
-            size_t at[kPair];
-            const float* in[kPair];
-            const LevelPair* pairs[kPair];
-            for (int b = 0; b < kPair; ++b) {
-                at[b] = six[j + size_t(b < m ? b : 0)];
-                in[b] = s + 16 * at[b];
-                pairs[b] = &lp[at[b]];
-            }
+            const Group g = group(six, j, nsix);
             detail::Bc4LineResult r6[kPair];
             bool ok[kPair];
-            six_values<kPair>(T, in, pairs, r6, ok);
-            for (int b = 0; b < m; ++b) {
-                const size_t i = at[b];
+            six_values<kPair>(T, g.in, g.pairs, r6, ok);
+            for (int b = 0; b < g.m; ++b) {
+                const size_t i = g.at[b];
                 if (six_beats(ok[b], r6[b].keys, eight_max[i], eight_sum[i])) write_line_result(swapped(k8[i]), r6[b], o + 8 * i, q[i]);
                 redo[i] = bound >= 0 && q[i].max_error > bound;
             }
