@@ -729,7 +729,7 @@ __attribute__((target("avx2"))) BlockKind classify(const float src[16], bool sno
     lp.lo = _mm_cvtsi128_si32(level);
     lp.hi = _mm_extract_epi32(level, 1);
     const bool levels = (_mm_movemask_ps(_mm_cmpeq_ps(fl, cl)) & 3) == 3;
-    return usable & levels & (lp.lo < lp.hi) ? BlockKind::LevelPair : BlockKind::Other;
+    return (usable & levels & (lp.lo < lp.hi)) ? BlockKind::LevelPair : BlockKind::Other;
 }
 
 // The byte of a level (SNORM: its two's complement).
