@@ -698,7 +698,7 @@ struct LevelPair {
 };
 enum class BlockKind { Other, Flat, LevelPair };
 
-__attribute__((target("avx2"))) BlockKind classify(const float src[16], bool snorm, LevelPair& lp) {
+__attribute__((target("avx2"), always_inline)) inline BlockKind classify(const float src[16], bool snorm, LevelPair& lp) {
     // Flat blocks leave early (they need none of the rest); the other tests are combined
     // without branches.
     const __m256 a = _mm256_loadu_ps(src), b = _mm256_loadu_ps(src + 8);
