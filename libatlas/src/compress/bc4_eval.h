@@ -279,13 +279,15 @@ __attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, c
 // A pair's palette in ascending order of value, for the Reference decoder alone (each
 // entry's interval is its exact value to ulps) and two-sided errors: the 8-value mode's
 // 8 evenly spaced values, or the 6-value mode's constant below, its 6 evenly spaced
-// values and the constant above. Position u of a value s on the even grid (origin: the
-// lowest grid value, `first`: its position) tells the two entries around s; no other
+// values and the constant above. Position u = s * per_value + offset of a value s on the
+// even grid (the lowest grid value at position 0, or 1 after a constant) tells the two
+// entries around s; no other
 // entry can hold the least key when the grid's spacing (>= 1/7 level, ~5.6e-4 UNORM) is
 // far above the keys' resolution (8 ulps of the error; texels within +-2 keep errors
 // below 3, ulps below 2.4e-7), so the two give the same least key as all 8 (test
 // Bc4Eval.LineKeysEqualFullKeys). Entries with the same value (a constant on a grid end)
-// tie on the error and the grid end, with the lower index, wins in both evaluations.
+// tie on the error and the grid end, with the lower index, wins in both evaluations
+// (texels -0.0 excepted: bc4.cpp keeps them off this path).
 struct Bc4LinePalette {
     __m256 lo, hi, ref;    // ascending (used only in AVX2 functions)
     const int32_t* index;  // BC4 index of each position
