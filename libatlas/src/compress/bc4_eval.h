@@ -213,15 +213,29 @@ inline void bc4_exact_flat(const Palette<1>& p, const float* src, const Bc4Keys&
 #if defined(ATLAS_BC4_AVX2)
 // AVX2: 8 texels at a time, the same operations per texel; the sums are formed in the
 // portable order (lanes of texels j, 4 + j, 8 + j, 12 + j, then (0 + 1) + (2 + 3)).
-// `keys_of(s)` returns the 8 texels' least keys (bc4_full_keys_avx2 or, on a level pair,
-// bc4_line_keys_avx2: the same keys).
-template <class KeysOf>
-__attribute__((target("avx2"))) inline bool bc4_rank_avx2(const float* src, float stop, float inc_sum, Bc4Keys& out, const KeysOf& keys_of) {
+template <bool OneSided>
+__attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
     const __m256 vstop = _mm256_set1_ps(stop), vinf = _mm256_set1_ps(kBc4Infeasible);
     const __m256 clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask)));
     __m256 ek[2];
     for (int h = 0; h < 2; ++h) {
-        const __m256 best = keys_of(_mm256_loadu_ps(src + 8 * h));
+        const __m256 s = _mm256_loadu_ps(src + 8 * h);
+        // The 8 entries' keys (p.n is always 8), then their minimum as a tree: the keys
+        // differ in their index bits and are not NaN, so any order gives the same minimum,
+        // and the tree's 3 dependent minima replace a chain of 7 (latency-bound).
+        static_assert(sizeof(p.lo) / sizeof(p.lo[0]) == 8, "BC4 palettes have 8 entries");
+        __m256 key[8];
+        for (int i = 0; i < 8; ++i) {
+            const __m256 vlo = _mm256_set1_ps(p.lo[i][0]), vhi = _mm256_set1_ps(p.hi[i][0]);
+            __m256 e = _mm256_max_ps(_mm256_sub_ps(vhi, s), _mm256_sub_ps(s, vlo));
+            if constexpr (OneSided) {
+                const __m256 above = _mm256_cmp_ps(vhi, s, _CMP_GT_OQ);
+                e = _mm256_blendv_ps(e, vinf, above);
+            }
+            key[i] = _mm256_or_ps(_mm256_and_ps(e, clear), _mm256_castsi256_ps(_mm256_set1_epi32(i)));
+        }
+        const __m256 best = _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(key[0], key[1]), _mm256_min_ps(key[2], key[3])),
+                                          _mm256_min_ps(_mm256_min_ps(key[4], key[5]), _mm256_min_ps(key[6], key[7])));
         _mm256_storeu_ps(reinterpret_cast<float*>(out.key + 8 * h), best);
         ek[h] = _mm256_and_ps(best, clear);
         if (_mm256_movemask_ps(_mm256_or_ps(_mm256_cmp_ps(ek[h], vstop, _CMP_GT_OQ), _mm256_cmp_ps(ek[h], vinf, _CMP_GE_OQ)))) return false;
@@ -247,44 +261,15 @@ __attribute__((target("avx2"))) inline bool bc4_rank_avx2(const float* src, floa
     return !(r == stop && !(out.sum < inc_sum));
 }
 
-// Every entry's key, then their minimum as a tree: the keys differ in their index bits
-// and are not NaN, so any order gives the same minimum, and the tree's 3 dependent
-// minima replace a chain of 7 (latency-bound).
-template <bool OneSided>
-struct Bc4FullKeysAvx2 {
-    const Palette<1>& p;
-    __attribute__((target("avx2"))) __m256 operator()(__m256 s) const {
-        static_assert(sizeof(p.lo) / sizeof(p.lo[0]) == 8, "BC4 palettes have 8 entries");
-        const __m256 vinf = _mm256_set1_ps(kBc4Infeasible), clear = _mm256_castsi256_ps(_mm256_set1_epi32(int(kBc4KeyMask)));
-        __m256 key[8];
-        for (int i = 0; i < 8; ++i) {
-            const __m256 vlo = _mm256_set1_ps(p.lo[i][0]), vhi = _mm256_set1_ps(p.hi[i][0]);
-            __m256 e = _mm256_max_ps(_mm256_sub_ps(vhi, s), _mm256_sub_ps(s, vlo));
-            if constexpr (OneSided) {
-                const __m256 above = _mm256_cmp_ps(vhi, s, _CMP_GT_OQ);
-                e = _mm256_blendv_ps(e, vinf, above);
-            }
-            key[i] = _mm256_or_ps(_mm256_and_ps(e, clear), _mm256_castsi256_ps(_mm256_set1_epi32(i)));
-        }
-        return _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(key[0], key[1]), _mm256_min_ps(key[2], key[3])),
-                             _mm256_min_ps(_mm256_min_ps(key[4], key[5]), _mm256_min_ps(key[6], key[7])));
-    }
-};
-
-template <bool OneSided>
-__attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
-    return bc4_rank_avx2(src, stop, inc_sum, out, Bc4FullKeysAvx2<OneSided>{p});
-}
-
 // A pair's palette in ascending order of value, for the Reference decoder alone (each
 // entry's interval is its exact value to ulps) and two-sided errors: the 8-value mode's
 // 8 evenly spaced values, or the 6-value mode's constant below, its 6 evenly spaced
 // values and the constant above. Position u = s * per_value + offset of a value s on the
 // even grid (the lowest grid value at position 0, or 1 after a constant) tells the two
-// entries around s; no other
-// entry can hold the least key when the grid's spacing (>= 1/7 level, ~5.6e-4 UNORM) is
-// far above the keys' resolution (8 ulps of the error; texels within +-2 keep errors
-// below 3, ulps below 2.4e-7), so the two give the same least key as all 8 (test
+// entries around s; no other entry can hold the least key when the grid's spacing (>= 1/7
+// level, ~5.6e-4 UNORM) is far above the keys' resolution (8 ulps of the error; texels
+// within +-2 keep errors below 3, ulps below 2.4e-7), so the two give the same least key
+// as all 8 (test
 // Bc4Eval.LineKeysEqualFullKeys). Entries with the same value (a constant on a grid end)
 // tie on the error and the grid end, with the lower index, wins in both evaluations
 // (texels -0.0 excepted: bc4.cpp keeps them off this path).
@@ -407,10 +392,10 @@ __attribute__((target("avx2"))) inline bool bc4_line_select_avx2(const Bc4LinePa
 // order (lanes of texels j, 4 + j, 8 + j, 12 + j, then (0 + 1) + (2 + 3)); the block's
 // max error is the max over all texels, which equals the max over the texels whose key
 // error is the largest (bc4.cpp).
-// lo, hi, ref: the 8 entries in index order.
-__attribute__((target("avx2"))) inline void bc4_exact_avx2(const float* entry_lo, const float* entry_hi, const float* entry_ref, const float* src,
-                                                           const Bc4Keys& k, float& max_err, double& sum_sq, uint64_t& bits) {
-    const __m256 lo = _mm256_loadu_ps(entry_lo), hi = _mm256_loadu_ps(entry_hi), ref = _mm256_loadu_ps(entry_ref);
+__attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err,
+                                                           double& sum_sq, uint64_t& bits) {
+    static_assert(sizeof(p.lo) == 8 * sizeof(float), "one channel: 8 contiguous entries");
+    const __m256 lo = _mm256_loadu_ps(&p.lo[0][0]), hi = _mm256_loadu_ps(&p.hi[0][0]), ref = _mm256_loadu_ps(&p.ref[0][0]);
     const __m256 zero = _mm256_setzero_ps();
     __m256 mx = zero;
     __m256d acc = _mm256_setzero_pd();
@@ -437,13 +422,6 @@ __attribute__((target("avx2"))) inline void bc4_exact_avx2(const float* entry_lo
     sum_sq = _mm_cvtsd_f64(_mm_hadd_pd(pairs, pairs));
     bits = uint64_t(half[0]) | (uint64_t(half[1]) << 24);
 }
-
-__attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err,
-                                                           double& sum_sq, uint64_t& bits) {
-    static_assert(sizeof(p.lo) == 8 * sizeof(float), "one channel: 8 contiguous entries");
-    bc4_exact_avx2(&p.lo[0][0], &p.hi[0][0], &p.ref[0][0], src, k, max_err, sum_sq, bits);
-}
-
 
 inline bool bc4_cpu_has_avx2() { return __builtin_cpu_supports("avx2") != 0; }
 #else
