@@ -201,7 +201,7 @@ struct PairTables {
     // The Reference decoder alone: the same floats as records {lo, hi, ref, 0} per
     // numerator, so that line_palette loads an entry's three with one load.
     std::vector<float> num_record[2];
-    float grid_per[2][256] = {}; // steps * scale / d: grid steps per unit value, by level spread d (line_palette)
+    float grid_per[2][256] = {}; // the same: steps * scale / d, grid steps per unit value by level spread d
     int num_base[2] = {0, 0}; // index = num - num_base
     bool avx2 = false;        // fast / normal evaluate with AVX2 (same results, bc4_eval.h)
     // fast / normal's results for flat blocks on a level: 16 texels with the bits of
@@ -291,23 +291,20 @@ void build_tables(PairTables& T, bool snorm, DecoderSet decoders) {
     // steps * e (the same exact value, num / steps = e exactly), so the numerator tables
     // hold both and line_palette reads a pair's whole grid from one of them. (Under the
     // Conformant model interpolated entries are wider than endpoints: not filled there.)
-    if (decoders == kReferenceOnly)
-        for (int b = 0; b < 256; ++b)
-            for (int m = 0; m < 2; ++m) {
-                const size_t at = size_t((m == 0 ? 7 : 5) * level(uint8_t(b), snorm) - T.num_base[m]);
-                if (std::isnan(T.num_lo[m][at])) { T.num_lo[m][at] = T.end_lo[b]; T.num_hi[m][at] = T.end_hi[b]; T.num_ref[m][at] = T.end_ref[b]; }
-            }
-    for (int m = 0; m < 2; ++m)
-        for (int d = 1; d < 256; ++d) T.grid_per[m][d] = float((m == 0 ? 7.0 : 5.0) * vscale / d);
-    if (decoders == kReferenceOnly)
-        for (int m = 0; m < 2; ++m) {
-            T.num_record[m].assign(4 * T.num_lo[m].size(), 0.0f);
-            for (size_t i = 0; i < T.num_lo[m].size(); ++i) {
-                T.num_record[m][4 * i] = T.num_lo[m][i];
-                T.num_record[m][4 * i + 1] = T.num_hi[m][i];
-                T.num_record[m][4 * i + 2] = T.num_ref[m][i];
-            }
+    if (decoders != kReferenceOnly) return;
+    for (int m = 0; m < 2; ++m) {
+        for (int b = 0; b < 256; ++b) {
+            const size_t at = size_t((m == 0 ? 7 : 5) * level(uint8_t(b), snorm) - T.num_base[m]);
+            if (std::isnan(T.num_lo[m][at])) { T.num_lo[m][at] = T.end_lo[b]; T.num_hi[m][at] = T.end_hi[b]; T.num_ref[m][at] = T.end_ref[b]; }
         }
+        T.num_record[m].assign(4 * T.num_lo[m].size(), 0.0f);
+        for (size_t i = 0; i < T.num_lo[m].size(); ++i) {
+            T.num_record[m][4 * i] = T.num_lo[m][i];
+            T.num_record[m][4 * i + 1] = T.num_hi[m][i];
+            T.num_record[m][4 * i + 2] = T.num_ref[m][i];
+        }
+        for (int d = 1; d < 256; ++d) T.grid_per[m][d] = float((m == 0 ? 7.0 : 5.0) * vscale / d);
+    }
 }
 
 // fast / normal's candidate palette of pair k from the per-entry tables: the same
@@ -692,9 +689,9 @@ BlockResult encode_candidates(const PairTables& T, bool snorm, const BlockOption
 // hi) unless fast; the Reference decoder alone, two-sided, finite texels within +-2 and
 // none -0.0 (which has the error -0.0 at an entry 0, as +0 - -0 < -0 - 0 is false: two
 // such entries, the constant 0 on the grid's end 0, would tie the other way round).
-struct LevelPair {
-    int lo = 0, hi = 0;
-    float smin = 0, smax = 0;
+struct LevelPair { // classify's, read only for its level pairs (no initializers: runs hold 128)
+    int lo, hi;
+    float smin, smax;
 };
 enum class BlockKind { Other, Flat, LevelPair };
 
@@ -794,10 +791,10 @@ void write_line_result(int k, const detail::Bc4LineResult& r, uint8_t out[8], Bl
     res = {r.max_err, r.sum_sq, true};
 }
 
-// encode's first steps for fast / normal under the Reference decoder alone, two-sided,
-// on AVX2: a flat block from the table, a level pair on its line palettes (8-bit
-// sources: nearly every block). Returns false for any other block, and for a level pair
-// missing the bound (encode then does it all, to the same result).
+// level_pair_blocks (below) for one block, with branches: encode's path (a run of one
+// through those passes took 1.3-1.6x this one's time). Returns false for any other block,
+// and for a level pair missing the bound (encode_candidates then does it all, to the same
+// result).
 __attribute__((target("avx2"))) bool level_pair_block(const PairTables& T, const float src[16], bool snorm, bool with_six, float bound, uint8_t out[8],
                                                      BlockResult& res) {
     LevelPair lp;
@@ -822,10 +819,13 @@ __attribute__((target("avx2"))) bool level_pair_block(const PairTables& T, const
     return true;
 }
 
-// level_pair_block for a run of blocks, in passes over blocks of one kind, so that no
-// branch on a block's kind or on whether its 6-value pair is evaluated (both data
-// dependent, and decided late in a block's chain) throws away the work on the blocks
-// after it: the same results (test Bc4.ShortcutsEqualTheSearch).
+// encode's first steps for fast / normal under the Reference decoder alone, two-sided,
+// on AVX2, for a run of blocks: flat blocks from the table, level pairs on their line
+// palettes (8-bit sources: nearly every block), everything else and level pairs missing
+// the bound by encode_candidates, to the same results (test Bc4.ShortcutsEqualTheSearch).
+// In passes over blocks of one kind, so that no branch on a block's kind or on whether
+// its 6-value pair is evaluated (both data dependent, and decided late in a block's
+// chain) throws away the work on the blocks after it.
 __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool snorm, const BlockOptions& options, const float* src, size_t count,
                                                       uint8_t* out, BlockResult* res) {
     constexpr size_t kRun = 128;
@@ -853,7 +853,7 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
             redo[i] = !(T.flat_ready && flat_from_table(T, s[16 * i], snorm, o + 8 * i, q[i]));
         }
         // Level pairs two at a time (bc4_line_select_avx2's interleaving): a group's blocks
-        // from position j of a list of `listed` (an odd list's last block twice).
+        // from position j of a list of `listed` (the last of an odd list alone).
         constexpr int kPair = 2;
         struct Group {
             int m;
@@ -864,8 +864,8 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
         auto group = [&](const uint16_t* ids, size_t j, size_t listed) {
             Group g;
             g.m = int(std::min<size_t>(kPair, listed - j));
-            for (int b = 0; b < kPair; ++b) {
-                g.at[b] = ids[j + size_t(b < g.m ? b : 0)];
+            for (int b = 0; b < g.m; ++b) {
+                g.at[b] = ids[j + size_t(b)];
                 g.in[b] = s + 16 * g.at[b];
                 g.pairs[b] = &lp[g.at[b]];
             }
@@ -876,7 +876,8 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
             const Group g = group(list[int(BlockKind::LevelPair)], j, npairs);
             EightValues e[kPair];
             bool ok[kPair];
-            eight_values<kPair>(T, g.in, g.pairs, snorm, e, ok);
+            if (g.m == kPair) eight_values<kPair>(T, g.in, g.pairs, snorm, e, ok);
+            else eight_values<1>(T, g.in, g.pairs, snorm, e, ok); // a single block (encode) or an odd run's last
             for (int b = 0; b < g.m; ++b) {
                 const size_t i = g.at[b];
                 write_line_result(e[b].k, e[b].r, o + 8 * i, q[i]);
@@ -896,7 +897,8 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
             const Group g = group(six, j, nsix);
             detail::Bc4LineResult r6[kPair];
             bool ok[kPair];
-            six_values<kPair>(T, g.in, g.pairs, r6, ok);
+            if (g.m == kPair) six_values<kPair>(T, g.in, g.pairs, r6, ok);
+            else six_values<1>(T, g.in, g.pairs, r6, ok);
             for (int b = 0; b < g.m; ++b) {
                 const size_t i = g.at[b];
                 if (six_beats(ok[b], r6[b].keys, eight_max[i], eight_sum[i])) write_line_result(swapped(k8[i]), r6[b], o + 8 * i, q[i]);
@@ -914,6 +916,11 @@ __attribute__((target("avx2"))) void level_pair_blocks(const PairTables& T, bool
     }
 }
 #endif
+
+// Where level_pair_blocks applies (the CPU and the options; a block's kind aside).
+bool level_pairs_apply(const PairTables& T, const BlockOptions& o) {
+    return T.avx2 && T.shortcuts && o.decoders == kReferenceOnly && !o.one_sided_below && o.quality != Quality::Best;
+}
 } // namespace
 
 namespace {
@@ -1057,24 +1064,23 @@ __attribute__((noinline)) BlockResult encode_candidates(const PairTables& T, boo
 
 BlockResult Bc4Encoder::encode(const float src[16], uint8_t out[8]) const {
 #if defined(ATLAS_BC4_AVX2)
-    // Level pairs (8-bit sources: nearly every block not flat) take the same candidates
-    // and give the same result through their line palettes (bc4_eval.h).
-    if (tables_->avx2 && tables_->shortcuts && options_.decoders == kReferenceOnly && !options_.one_sided_below && options_.quality != Quality::Best) {
-        BlockResult r;
-        if (level_pair_block(*tables_, src, snorm_, options_.quality != Quality::Fast, options_.max_error, out, r)) return r;
-    }
+    BlockResult r;
+    if (level_pairs_apply(*tables_, options_) && level_pair_block(*tables_, src, snorm_, options_.quality != Quality::Fast, options_.max_error, out, r))
+        return r;
 #endif
     return encode_candidates(*tables_, snorm_, options_, src, out);
 }
 
 void Bc4Encoder::encode_blocks(const float* src, size_t count, uint8_t* out, BlockResult* results) const {
 #if defined(ATLAS_BC4_AVX2)
-    if (tables_->avx2 && tables_->shortcuts && options_.decoders == kReferenceOnly && !options_.one_sided_below && options_.quality != Quality::Best) {
+    // Level pairs (8-bit sources: nearly every block not flat) take the same candidates
+    // and give the same result through their line palettes (bc4_eval.h).
+    if (level_pairs_apply(*tables_, options_)) {
         level_pair_blocks(*tables_, snorm_, options_, src, count, out, results);
         return;
     }
 #endif
-    for (size_t b = 0; b < count; ++b) results[b] = encode(src + 16 * b, out + 8 * b);
+    for (size_t b = 0; b < count; ++b) results[b] = encode_candidates(*tables_, snorm_, options_, src + 16 * b, out + 8 * b);
 }
 
 namespace detail {
@@ -1084,34 +1090,32 @@ namespace detail {
 namespace {
 __attribute__((target("avx2"))) long line_mismatches_avx2(const PairTables* T, bool snorm, const float* blocks, size_t count, int lo, int hi) {
     long bad = 0;
+    const LevelPair pair{lo, hi, 0.0f, 0.0f};
+    const LevelPair* const pairs[1] = {&pair};
     for (size_t b = 0; b < count; ++b) {
-        const float* src = blocks + 16 * b;
-        detail::Bc4LineResult r[2];
+        const float* const in[1] = {blocks + 16 * b};
+        EightValues e[1];
+        detail::Bc4LineResult six[1];
+        bool ok[2];
+        eight_values<1>(*T, in, pairs, snorm, e, ok);
+        six_values<1>(*T, in, pairs, six, ok + 1);
+        const detail::Bc4LineResult* r[2] = {&e[0].r, &six[0]};
         detail::Bc4Keys full[2];
-        detail::Bc4LinePalette lp[2];
         for (int m = 0; m < 2; ++m) {
-            line_palette(*T, lo, hi, m == 0, lp[m]);
-            const detail::Bc4LinePalette* const ps[1] = {&lp[m]};
-            const float* const ss[1] = {src};
-            detail::Bc4LineResult* const os[1] = {&r[m]};
-            bool ok[1];
-            if (m == 0) detail::bc4_line_select_avx2<1, true>(ps, ss, os, ok);
-            else detail::bc4_line_select_avx2<1>(ps, ss, os, ok);
-            const int k = m == 0 ? level_byte(hi, snorm) * 256 + level_byte(lo, snorm) : level_byte(lo, snorm) * 256 + level_byte(hi, snorm);
-            const detail::Palette<1>& p = T->pal[size_t(k)];
-            const bool fok = detail::bc4_keys_portable<false>(p, src, detail::kBc4Infeasible, INFINITY, full[m]);
+            const detail::Palette<1>& p = T->pal[size_t(m == 0 ? e[0].k : swapped(e[0].k))];
+            const bool fok = detail::bc4_keys_portable<false>(p, in[0], detail::kBc4Infeasible, INFINITY, full[m]);
             float mx;
             double sq;
             uint64_t bits;
-            detail::bc4_exact_portable<false>(p, src, full[m], mx, sq, bits);
-            bad += ok[0] != fok || std::memcmp(r[m].keys.key, full[m].key, sizeof full[m].key) != 0 ||
-                   std::memcmp(&r[m].keys.max_err, &full[m].max_err, 4) != 0 || std::memcmp(&r[m].keys.sum, &full[m].sum, 4) != 0 ||
-                   std::memcmp(&r[m].max_err, &mx, 4) != 0 || std::memcmp(&r[m].sum_sq, &sq, 8) != 0 || r[m].bits != bits ||
-                   r[m].endpoints != endpoints_only(full[m]);
+            detail::bc4_exact_portable<false>(p, in[0], full[m], mx, sq, bits);
+            bad += ok[m] != fok || std::memcmp(r[m]->keys.key, full[m].key, sizeof full[m].key) != 0 ||
+                   std::memcmp(&r[m]->keys.max_err, &full[m].max_err, 4) != 0 || std::memcmp(&r[m]->keys.sum, &full[m].sum, 4) != 0 ||
+                   std::memcmp(&r[m]->max_err, &mx, 4) != 0 || std::memcmp(&r[m]->sum_sq, &sq, 8) != 0 || r[m]->bits != bits ||
+                   r[m]->endpoints != endpoints_only(full[m]);
             // six_may_tie's skip: the 6-value pair's evaluation against the 8-value incumbent returns false.
-            if (m == 1 && !six_may_tie(lp[0], r[0])) {
+            if (m == 1 && !six_may_tie(e[0].pal, e[0].r)) {
                 detail::Bc4Keys tied;
-                bad += detail::bc4_keys_portable<false>(p, src, full[0].max_err, full[0].sum, tied) ? 1 : 0;
+                bad += detail::bc4_keys_portable<false>(p, in[0], full[0].max_err, full[0].sum, tied) ? 1 : 0;
             }
         }
     }

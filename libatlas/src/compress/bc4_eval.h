@@ -378,14 +378,6 @@ __attribute__((target("avx2"))) inline void bc4_line_select_avx2(const Bc4LinePa
     }
 }
 
-__attribute__((target("avx2"))) inline bool bc4_line_select_avx2(const Bc4LinePalette& p, const float* src, Bc4LineResult& out) {
-    const Bc4LinePalette* const ps[1] = {&p};
-    const float* const ss[1] = {src};
-    Bc4LineResult* const os[1] = {&out};
-    bool ok[1];
-    bc4_line_select_avx2<1>(ps, ss, os, ok);
-    return ok[0];
-}
 
 // The exact errors of the chosen entries (entry_error_t's terms; every chosen entry is
 // feasible) and the squared Reference error in double, summed in exact_selection's
