@@ -11,6 +11,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <iostream>
 
 namespace atlas::cli {
@@ -70,6 +71,10 @@ int run_compress(const Args& a) {
     // Usage errors before the (possibly long) read of the input.
     if (!a.has("--sweep") && !a.has("--out")) throw UsageError{"-o OUT.dds is required", "compress"};
     compress::CompressOptions o = parse_compress_options(a);
+    // No written file may replace the input (or be a link or a device), checked before the read.
+    const std::vector<ProtectedFile> input = {{in, "the input file"}};
+    for (const char* flag : {"--out", "--report", "--csv"})
+        if (a.has(flag)) check_destination(a.get(flag), input, std::string(flag + 2) + " file");
     const MemoryBudget budget(a.has("--memory-budget") ? parse_byte_size(a.get("--memory-budget")) : MemoryBudget::kDefaultLimit);
     Field3DPtr field = io::as_field3d(io::read_field_file(in, &budget));
     resolve_channels(o, *field);
@@ -79,11 +84,12 @@ int run_compress(const Args& a) {
         std::printf("quality,max_error,rmse,seconds\n");
         for (const auto& r : rows) std::printf("%s,%.8g,%.8g,%.6f\n", compress::quality_name(r.quality), r.max_error, r.rmse, r.seconds);
         if (a.has("--csv")) {
-            write_file_atomic(a.get("--csv"), [&](const fs::path& tmp) {
-                std::ofstream f(tmp);
-                f << "quality,max_error,rmse,seconds\n";
-                for (const auto& r : rows) f << compress::quality_name(r.quality) << "," << r.max_error << "," << r.rmse << "," << r.seconds << "\n";
-            });
+            std::ostringstream csv;
+            csv << "quality,max_error,rmse,seconds\n";
+            for (const auto& r : rows) csv << compress::quality_name(r.quality) << "," << r.max_error << "," << r.rmse << "," << r.seconds << "\n";
+            const std::string text = csv.str();
+            // write_file_checked: a full disk says why, where an ofstream said nothing.
+            write_file_atomic(a.get("--csv"), [&](const fs::path& tmp) { write_file_checked(tmp, text.data(), text.size()); }, input);
         }
         return 0;
     }
@@ -105,10 +111,8 @@ int run_compress(const Args& a) {
     if ((bounded && !a.has("--no-verify")) || a.has("--verify")) print_verify(io::verify_dds(out, *field, o.decoders, o.channels));
     if (a.has("--report")) {
         std::string json = r.to_json();
-        write_file_atomic(a.get("--report"), [&](const fs::path& tmp) {
-            std::ofstream f(tmp);
-            f << json;
-        });
+        write_file_atomic(a.get("--report"), [&](const fs::path& tmp) { write_file_checked(tmp, json.data(), json.size()); },
+                          {{in, "the input file"}, {out, "the compressed texture"}});
     }
     return 0;
 }
@@ -117,6 +121,8 @@ int run_decompress(const Args& a) {
     if (a.positional.size() != 1) throw UsageError{"expected one input .dds file", "decompress"};
     if (!a.has("--out")) throw UsageError{"-o OUT.exr is required", "decompress"};
     const compress::Decoder decoder = a.has("--decoder") ? compress::parse_decoder(a.get("--decoder")) : compress::Decoder::Reference;
+    const std::vector<ProtectedFile> input = {{a.positional[0], "the input file"}};
+    check_destination(a.get("--out"), input, "output");
     auto field = std::make_shared<Field3D>(io::read_dds(a.positional[0], decoder));
     const fs::path out = a.get("--out");
     Value v = Field3DPtr(field);
@@ -128,7 +134,7 @@ int run_decompress(const Args& a) {
         v = Field2DPtr(f2);
     }
     const std::string format = io::output_format_for_path(out);
-    write_file_atomic(out, [&](const fs::path& tmp) { io::write_value(v, tmp, format, {}); });
+    write_file_atomic(out, [&](const fs::path& tmp) { io::write_value(v, tmp, format, {}); }, input);
     std::printf("%s\n", out.string().c_str());
     return 0;
 }

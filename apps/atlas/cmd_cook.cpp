@@ -48,14 +48,41 @@ std::string depfile_escape(const std::string& path) {
     return out;
 }
 
-void write_text_atomic(const std::string& path, const std::string& text, const std::string& what) {
-    write_file_atomic(path, [&](const std::filesystem::path& tmp) {
-        try {
-            write_file_checked(tmp, text.data(), text.size());
-        } catch (const Error& e) {
-            throw Error(path + ": cannot write " + what + " (" + e.what() + ")");
-        }
-    });
+// What a report or depfile must never replace: the graph files, every input
+// the cooks read and every file they wrote (checked as files: links caught).
+std::vector<ProtectedFile> cook_files(const Args& a, const std::vector<std::pair<std::string, CookResult>>& cooks) {
+    std::vector<ProtectedFile> v;
+    for (const auto& g : a.positional) v.push_back({g, "a graph file of the cook"});
+    for (const auto& [file, r] : cooks) {
+        for (const auto& in : r.inputs) v.push_back({in.path, "an input file of the cook"});
+        for (const auto& out : r.outputs)
+            for (const auto& f : out.files) v.push_back({f.path, "an output of the cook"});
+    }
+    return v;
+}
+
+// --report and --depfile: a name of Atlas's own, a link, a device or a file
+// of the cook is refused (before the cook with what is known then, and again
+// when written).
+void check_side_file(const Args& a, const std::string& flag, const std::vector<ProtectedFile>& protect) {
+    if (!a.has(flag)) return;
+    const std::filesystem::path p = a.get(flag);
+    if (is_reserved_name(p.filename().string()))
+        throw Error(p.string() + ": " + flag + " names a file Atlas keeps for its own records ('.atlas-...'); choose another name");
+    check_destination(p, protect, flag.substr(2) + " file");
+}
+
+void write_text_atomic(const std::string& path, const std::string& text, const std::string& what, const std::vector<ProtectedFile>& protect) {
+    write_file_atomic(
+        path,
+        [&](const std::filesystem::path& tmp) {
+            try {
+                write_file_checked(tmp, text.data(), text.size());
+            } catch (const Error& e) {
+                throw Error(path + ": cannot write " + what + " (" + e.what() + ")");
+            }
+        },
+        protect);
 }
 } // namespace
 
@@ -75,6 +102,13 @@ Vec2i parse_pair(const Args& a, const std::string& flag, int min) {
     }
 }
 
+// The tiled cook's files a report must not replace: the graph and every file written.
+std::vector<ProtectedFile> tiled_files(const Args& a, const TiledCookResult& r) {
+    std::vector<ProtectedFile> v = cook_files(a, {});
+    for (const auto& p : r.written) v.push_back({p, "an output of the cook"});
+    return v;
+}
+
 // atlas cook GRAPH --tiles NX,NY [--tile I,J] [--assemble] (docs/scale.md).
 int run_cook_tiled(const Args& a, CookOptions o) {
     if (a.positional.size() != 1) throw UsageError{"--tiles cooks one graph file, got " + std::to_string(a.positional.size()), "cook"};
@@ -86,6 +120,7 @@ int run_cook_tiled(const Args& a, CookOptions o) {
     t.assemble = a.has("--assemble");
     if (t.only && t.assemble) throw UsageError{"--assemble needs every tile: it cannot be combined with --tile", "cook"};
     t.graph_name = a.positional[0];
+    check_side_file(a, "--report", cook_files(a, {}));
     Session session(builtin_nodes());
     session.load(a.positional[0]);
     apply_sets(session, a, "cook");
@@ -101,11 +136,11 @@ int run_cook_tiled(const Args& a, CookOptions o) {
         if (a.has("--report"))
             write_text_atomic(a.get("--report"),
                               tiled_report_json(r, a.positional[0], dynamic_cast<const CancelledError*>(&e) ? "cancelled" : "failed", e.what()),
-                              "the report");
+                              "the report", tiled_files(a, r));
         throw;
     }
     bar.finish();
-    if (a.has("--report")) write_text_atomic(a.get("--report"), tiled_report_json(r, a.positional[0], "ok", ""), "the report");
+    if (a.has("--report")) write_text_atomic(a.get("--report"), tiled_report_json(r, a.positional[0], "ok", ""), "the report", tiled_files(a, r));
     size_t cooked = 0;
     for (const auto& tr : r.tiles_done) cooked += tr.status == "cooked";
     std::cout << "cooked " << cooked << " of " << r.tiles_done.size() << " tiles (" << r.tiles[0] << " x " << r.tiles[1] << " over " << r.grid[0]
@@ -142,6 +177,10 @@ int run_cook(const Args& a) {
     }
 
     if (a.has("--tiles") || a.has("--tile") || a.has("--assemble")) return run_cook_tiled(a, o);
+    if (a.has("--report") && a.has("--depfile") && std::filesystem::path(a.get("--report")).lexically_normal() == std::filesystem::path(a.get("--depfile")).lexically_normal())
+        throw UsageError{"--report and --depfile name one file", "cook"};
+    check_side_file(a, "--report", cook_files(a, {}));
+    check_side_file(a, "--depfile", cook_files(a, {}));
 
     // Every graph cooks in its own session (one graph's nodes never see
     // another's) with the same options, so they share the disk cache.
@@ -196,7 +235,7 @@ int run_cook(const Args& a) {
 
     if (a.has("--report")) {
         const std::string json = cooks.size() == 1 && a.positional.size() == 1 ? cooks[0].second.to_json(cooks[0].first) : combined_report_json(cooks);
-        write_text_atomic(a.get("--report"), json, "the report");
+        write_text_atomic(a.get("--report"), json, "the report", cook_files(a, cooks));
     }
     if (cancelled) throw CancelledError();
     if (!failure.empty()) throw Error(failure);
@@ -212,7 +251,9 @@ int run_cook(const Args& a) {
             for (const auto& d : r.depends(file))
                 if (seen_d.insert(d.string()).second) deps += " \\\n  " + depfile_escape(d.string());
         }
-        write_text_atomic(a.get("--depfile"), targets + ":" + deps + "\n", "the depfile");
+        auto protect = cook_files(a, cooks);
+        if (a.has("--report")) protect.push_back({a.get("--report"), "the report"});
+        write_text_atomic(a.get("--depfile"), targets + ":" + deps + "\n", "the depfile", protect);
     }
 
     size_t files = 0, current = 0;
@@ -238,10 +279,9 @@ int run_cook(const Args& a) {
     for (const auto& [file, r] : cooks)
         for (const auto& out : r.outputs)
             for (const auto& p : out.written) std::cout << p.string() << "\n";
-    if (!quiet) {
-        if (current) std::cerr << current << " file" << (current == 1 ? "" : "s") << " already up to date (not rewritten)\n";
-        for (const auto& w : warnings) std::cerr << w << "\n";
-    }
+    if (!quiet && current) std::cerr << current << " file" << (current == 1 ? "" : "s") << " already up to date (not rewritten)\n";
+    // Warnings are not a summary: --quiet keeps them (a broken cache entry must be seen).
+    for (const auto& w : warnings) std::cerr << w << "\n";
     return 0;
 }
 

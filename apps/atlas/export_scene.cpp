@@ -1,5 +1,7 @@
 #include "export_scene.h"
 
+#include "atlas/core/files.h"
+
 #include "atlas/core/error.h"
 #include "atlas/io/vdb.h"
 #include "atlas/render/layer.h"
@@ -82,9 +84,8 @@ void write_scene(const std::filesystem::path& dir, Field3D& density, const rende
       << ", \"mode\": \"" << (s.mode == render::RenderMode::Fast ? "fast" : "reference") << "\"}\n"
       << "}\n";
     const std::filesystem::path json = dir / "scene.json";
-    std::ofstream f(json);
-    f << j.str();
-    if (!f) throw Error(json.string() + ": cannot write the scene description");
+    const std::string text = j.str();
+    write_file_atomic(json, [&](const std::filesystem::path& tmp) { write_file_checked(tmp, text.data(), text.size()); });
 }
 
 } // namespace

@@ -4,11 +4,15 @@
 #include "atlas/core/error.h"
 #include "atlas/graph/graph.h"
 
+#include <csignal>
 #include <iostream>
 
 int main(int argc, char** argv) {
     using namespace atlas::cli;
     std::vector<std::string> args(argv + 1, argv + argc);
+    // Past a file-size limit (ulimit -f) a write fails with EFBIG and the writer
+    // says so, instead of the default SIGXFSZ killing the program mid-write.
+    std::signal(SIGXFSZ, SIG_IGN);
     try {
         if (args.empty() || args[0] == "-h" || args[0] == "--help" || args[0] == "help") {
             if (args.size() >= 2) {

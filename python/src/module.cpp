@@ -4,6 +4,8 @@
 
 #include "atlas/graph/node_docs.h"
 
+#include <pybind11/numpy.h>
+
 #include <atomic>
 #include <cmath>
 
@@ -315,6 +317,14 @@ using namespace atlas::python;
 PYBIND11_MODULE(_atlas, m) {
     m.doc() = "Atlas: node graphs cooked into volumetric cloud data (bindings over libatlas).";
     m.attr("__version__") = ATLAS_VERSION_STRING;
+    // pybind11 looks numpy's C API up in a function-local static on first use;
+    // two threads reaching it at once (each with its own Session) deadlocked:
+    // one inside the static's guard imports numpy and yields the GIL, the
+    // other holds the GIL and waits on the guard. Done here, once, under the
+    // import lock.
+    py::module_::import("numpy");
+    (void)py::dtype::of<float>();
+    (void)py::array_t<float>(std::vector<py::ssize_t>{0});
 
     g_error = PyErr_NewExceptionWithDoc("atlas.Error", "Any Atlas failure; str(e) is the full message (file:line:col, node, parameter).",
                                         PyExc_RuntimeError, nullptr);

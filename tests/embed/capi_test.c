@@ -5,7 +5,7 @@
 #ifdef __cplusplus
 #error "this test must be compiled as C"
 #endif
-#define _POSIX_C_SOURCE 200809L /* popen */
+#define _POSIX_C_SOURCE 200809L /* popen, nanosleep */
 #include "atlas/atlas.h"
 
 #include <math.h>
@@ -13,6 +13,7 @@
 #include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 static int failures = 0;
 static int checks = 0;
@@ -461,6 +462,37 @@ static void test_one_call_at_a_time(void) {
     atlas_session_destroy(h.s);
 }
 
+/* Destroying a session while another thread cooks on it waits for the cook
+ * (it was a use-after-free that ASan reported). The cook is released only
+ * after destroy has begun; destroy must not return before the cook did. */
+static void* release_later(void* user) {
+    struct Hold* h = (struct Hold*)user;
+    struct timespec ts = {0, 50 * 1000 * 1000};
+    nanosleep(&ts, NULL);
+    atomic_store(&h->release, 1);
+    return NULL;
+}
+
+static void test_destroy_during_a_cook(void) {
+    struct Hold h;
+    atomic_init(&h.started, 0);
+    atomic_init(&h.release, 0);
+    h.s = NULL;
+    h.status = ATLAS_ERROR;
+    CHECK(atlas_session_create(&h.s) == ATLAS_OK);
+    CHECK_OK(h.s, atlas_session_load_text(h.s, kGraph, "destroy.yaml", NULL));
+    pthread_t cook, releaser;
+    CHECK(pthread_create(&cook, NULL, hold_cook, &h) == 0);
+    while (!atomic_load(&h.started)) {
+    }
+    CHECK(pthread_create(&releaser, NULL, release_later, &h) == 0);
+    atlas_session_destroy(h.s); /* waits for the cook */
+    CHECK(atomic_load(&h.release) == 1);
+    pthread_join(cook, NULL);
+    pthread_join(releaser, NULL);
+    CHECK(h.status == ATLAS_OK);
+}
+
 /* Runs the CLI and returns its combined output (static buffer). */
 static const char* run_cli(const char* command) {
     static char out[8192];
@@ -516,6 +548,7 @@ int main(int argc, char** argv) {
     test_errors();
     test_quickstart(argv[1]);
     test_one_call_at_a_time();
+    test_destroy_during_a_cook();
     test_mesh_and_points();
     test_c_node_types();
     if (argc == 4) test_same_messages_as_the_cli(argv[2], argv[3]);

@@ -181,3 +181,80 @@ TEST(BadInput, ImageWithTooManyChannelsForSlicesIsNamed) {
     write_image(big, dir / "s.002.tga");
     expect_error_containing([&] { read_tga_slices(dir / "s.001.tga", Box3d{{{0, 0, 0}}, {{1, 1, 1}}}); }, {"s.002.tga", "4x2"});
 }
+
+namespace {
+// A small EXR whose header claims `height` rows of one float channel: only the
+// header and a few bytes, nowhere near the line-offset table it implies.
+std::string exr_claiming(int32_t height) {
+    std::string b;
+    auto i32 = [&](int32_t v) { b.append(reinterpret_cast<const char*>(&v), 4); };
+    auto f32 = [&](float v) { b.append(reinterpret_cast<const char*>(&v), 4); };
+    auto attr = [&](const char* name, const char* type, int32_t size) {
+        b += name;
+        b += '\0';
+        b += type;
+        b += '\0';
+        i32(size);
+    };
+    i32(20000630);
+    i32(2);
+    attr("channels", "chlist", 18 + 1);
+    b += "R";
+    b += '\0';
+    i32(2); // FLOAT
+    b += std::string(4, '\0'); // pLinear, reserved
+    i32(1);
+    i32(1);
+    b += '\0';
+    attr("compression", "compression", 1);
+    b += '\0';
+    attr("dataWindow", "box2i", 16);
+    i32(0), i32(0), i32(0), i32(height - 1);
+    attr("displayWindow", "box2i", 16);
+    i32(0), i32(0), i32(0), i32(height - 1);
+    attr("lineOrder", "lineOrder", 1);
+    b += '\0';
+    attr("pixelAspectRatio", "float", 4);
+    f32(1);
+    attr("screenWindowCenter", "v2f", 8);
+    f32(0), f32(0);
+    attr("screenWindowWidth", "float", 4);
+    f32(1);
+    b += '\0';
+    b += std::string(16, '\0'); // the start of an offset table
+    return b;
+}
+} // namespace
+
+// Issue 48: a 274-byte EXR made every read allocate about 2 GB whatever the
+// budget (OpenEXR sizes its offset table by the header's claim). The claim is
+// now held against the file's size before OpenEXR sees the file.
+TEST(BadInput, ExrHeaderClaimingMoreThanTheFileHoldsIsRefusedBeforeAllocating) {
+    TempDir dir;
+    const fs::path p = dir / "claims.exr";
+    const std::string bytes = exr_claiming(1 << 28);
+    { std::ofstream(p, std::ios::binary) << bytes; }
+    const MemoryBudget budget(64ull << 20);
+    try {
+        read_exr(p, &budget);
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("larger than the file"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+    }
+    // The same header with a claim the file can hold reaches OpenEXR (and fails
+    // there for the missing pixels, with an error, not a crash).
+    { std::ofstream(p, std::ios::binary | std::ios::trunc) << exr_claiming(1); }
+    EXPECT_THROW(read_exr(p, &budget), Error);
+    // An opaque attribute claiming 2 GB in a tiny file.
+    std::string opaque = bytes.substr(0, 8) + std::string("junk\0mytype\0", 12);
+    const int32_t huge = 0x7fff0000;
+    opaque.append(reinterpret_cast<const char*>(&huge), 4);
+    { std::ofstream(p, std::ios::binary | std::ios::trunc) << opaque << std::string(64, 'x'); }
+    try {
+        read_exr(p, &budget);
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("more than the file holds"), std::string::npos) << e.what();
+    }
+}

@@ -2,6 +2,7 @@
 import gc
 import os
 import subprocess
+import sys
 import threading
 import time
 
@@ -303,3 +304,30 @@ def test_one_call_at_a_time_per_session(small_graph):
         t.join()
     assert not errors
     s.set("coverage", "in_min", 0.5)  # free again
+
+
+def test_two_sessions_in_two_threads_before_numpy_is_imported(small_graph, tmp_path):
+    """Issue 48: with numpy not yet imported, two threads with their own Sessions
+    deadlocked on their first field access (3 of 3). A fresh interpreter, so
+    nothing here has imported numpy first."""
+    script = tmp_path / "two_threads.py"
+    script.write_text(
+        "import sys, threading\n"
+        "assert 'numpy' not in sys.modules\n"
+        "import atlas\n"
+        f"GRAPH = {small_graph!r}\n"
+        "out = []\n"
+        "def work(i):\n"
+        "    s = atlas.Session()\n"
+        "    s.load_text(GRAPH, f'g{i}.yaml')\n"
+        "    out.append(float(s.get('coverage').channel(0).sum()))\n"
+        "ts = [threading.Thread(target=work, args=(i,)) for i in range(2)]\n"
+        "[t.start() for t in ts]\n"
+        "[t.join() for t in ts]\n"
+        "assert len(out) == 2 and out[0] == out[1], out\n"
+        "print('ok')\n")
+    env = dict(os.environ)
+    for _ in range(3):
+        r = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=env)
+        assert r.returncode == 0, r.stderr
+        assert r.stdout.strip() == "ok"

@@ -64,7 +64,9 @@ typedef struct AtlasField AtlasField;
 /* A session over the built-in node types, with no graph loaded yet. */
 ATLAS_API AtlasStatus atlas_session_create(AtlasSession** out);
 /* Frees the session and its in-memory cache (NULL is allowed). Fields got
- * from it stay valid. */
+ * from it stay valid. A call running on the session in another thread is
+ * waited for first (cancel it through its progress callback to make that
+ * quick); the handle must not be used once this was called. */
 ATLAS_API void atlas_session_destroy(AtlasSession* session);
 
 /* The message of the last call on this session that failed, or "" when the

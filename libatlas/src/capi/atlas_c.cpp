@@ -22,6 +22,8 @@
 #include <stdexcept>
 #include <string>
 #include <variant>
+#include <chrono>
+#include <thread>
 
 struct AtlasSession {
     AtlasSession() = default;
@@ -225,7 +227,13 @@ const char* atlas_version(void) { return ATLAS_VERSION_STRING; }
 
 AtlasStatus atlas_session_create(AtlasSession** out) { return create_handle(out); }
 
-void atlas_session_destroy(AtlasSession* session) { delete session; }
+void atlas_session_destroy(AtlasSession* session) {
+    if (!session) return;
+    // A call running on another thread still uses the session: wait for it to
+    // return (a host cancels it through its progress callback to make that quick).
+    while (session->busy.exchange(true)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    delete session;
+}
 
 const char* atlas_session_error(const AtlasSession* session) { return session ? session->error.c_str() : "no session"; }
 

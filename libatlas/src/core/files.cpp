@@ -14,6 +14,8 @@
 #include <cstring>
 #include <fcntl.h>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <sstream>
 #include <sys/stat.h>
 #include <system_error>
@@ -58,6 +60,62 @@ uint64_t tree_bytes(const fs::path& dir) {
 }
 } // namespace
 
+namespace {
+// Inside a staging folder: the marker that Atlas made it, the journal of a
+// commit that has begun, and the files a commit replaced.
+constexpr char kMarkerName[] = ".atlas-staging";
+constexpr char kJournalName[] = ".atlas-commit";
+constexpr char kReplacedName[] = ".atlas-replaced";
+
+bool is_staging_record(const std::string& name) {
+    return name == kMarkerName || name == kJournalName || name == std::string(kJournalName) + ".tmp" || name == kReplacedName;
+}
+
+// The journal: one relative path a line, hex-encoded (a name may hold any byte).
+std::string hex_encode(const std::string& s) {
+    static const char* d = "0123456789abcdef";
+    std::string out;
+    for (unsigned char c : s) out += d[c >> 4], out += d[c & 15];
+    return out;
+}
+std::optional<std::string> hex_decode(const std::string& h) {
+    if (h.size() % 2) return std::nullopt;
+    std::string out;
+    for (size_t i = 0; i < h.size(); i += 2) {
+        int v = 0;
+        for (size_t k = i; k < i + 2; ++k) {
+            const char c = h[k];
+            v = v * 16 + (c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1000);
+        }
+        if (v < 0) return std::nullopt;
+        out += char(v);
+    }
+    return out;
+}
+
+// Completes a commit that a killed process began: every file the journal
+// names that is still staged moves into place (roll forward; the journal was
+// written only once every file was complete). A destination that is now
+// something Atlas may not replace is left alone.
+void complete_commit(const fs::path& root, const fs::path& staging) {
+    std::ifstream in(staging / kJournalName);
+    std::string line;
+    while (std::getline(in, line)) {
+        const auto rel = hex_decode(line);
+        if (!rel || rel->empty()) continue;
+        const fs::path r(*rel);
+        if (r.is_absolute() || (!r.empty() && r.lexically_normal().begin()->string() == "..")) continue;
+        std::error_code ec;
+        const fs::path src = staging / r, dst = root / r;
+        if (!fs::is_regular_file(fs::symlink_status(src, ec))) continue;
+        const auto st = fs::symlink_status(dst, ec);
+        if (fs::exists(st) && !fs::is_regular_file(st)) continue;
+        fs::create_directories(dst.parent_path(), ec);
+        fs::rename(src, dst, ec);
+    }
+}
+} // namespace
+
 uint64_t remove_stale_staging(const fs::path& dir) {
     uint64_t removed = 0;
     std::error_code ec;
@@ -67,7 +125,9 @@ uint64_t remove_stale_staging(const fs::path& dir) {
         const std::string name = it->path().filename().string();
         if (name.rfind(kStagingPrefix, 0) != 0) continue;
         std::error_code e2;
-        if (!it->is_directory(e2)) continue;
+        if (!it->is_directory(e2) || it->is_symlink(e2)) continue;
+        // Only a folder Atlas made: a user's folder that happens to have the name is theirs.
+        if (!fs::is_regular_file(fs::symlink_status(it->path() / kMarkerName, e2))) continue;
         bool stale = false;
         // HOST-PID-HEX: parts from the end (older names have only HEX).
         const std::string rest = name.substr(sizeof kStagingPrefix - 1);
@@ -82,11 +142,31 @@ uint64_t remove_stale_staging(const fs::path& dir) {
             stale = !e2 && now - t > std::chrono::hours(24);
         }
         if (!stale) continue;
+        if (fs::exists(it->path() / kJournalName, e2)) complete_commit(dir, it->path());
         const uint64_t bytes = tree_bytes(it->path());
         fs::remove_all(it->path(), e2);
         if (!e2) removed += bytes;
     }
     return removed;
+}
+
+bool is_reserved_name(const std::string& name) { return name.rfind(".atlas-", 0) == 0; }
+
+void check_destination(const fs::path& path, const std::vector<ProtectedFile>& protect, const std::string& what) {
+    std::error_code ec;
+    const auto st = fs::symlink_status(path, ec);
+    if (fs::is_symlink(st))
+        throw Error(path.string() + ": the " + what + " path is a symbolic link; Atlas does not replace or write through links (remove it or choose another path)");
+    if (fs::exists(st) && !fs::is_regular_file(st))
+        throw Error(path.string() + ": the " + what + " path is " +
+                    (fs::is_directory(st) ? "a directory" : fs::is_character_file(st) || fs::is_block_file(st) ? "a device" : fs::is_fifo(st) ? "a FIFO" : "a socket or other special file") +
+                    "; Atlas only replaces regular files");
+    if (!fs::exists(st)) return;
+    for (const auto& p : protect) {
+        std::error_code e2;
+        if (!p.path.empty() && fs::equivalent(path, p.path, e2) && !e2)
+            throw Error(path.string() + ": the " + what + " would overwrite " + p.what + " ('" + p.path.string() + "'); choose another path");
+    }
 }
 
 void write_file_checked(const fs::path& path, const void* data, size_t size) { write_file_checked(path, {BytePiece{data, size}}); }
@@ -187,11 +267,24 @@ StagedOutputs::StagedOutputs(fs::path root) : root_(std::move(root)) {
     staging_ = root_ / staging_name();
     fs::create_directories(staging_, ec);
     if (ec) throw Error("cannot create staging directory in '" + root_.string() + "': " + ec.message());
+    // The marker says Atlas made this folder (remove_stale_staging touches no other).
+    static const char marker[] = "atlas staging folder: removed or completed by the next Atlas run in this directory\n";
+    try {
+        write_file_checked(staging_ / kMarkerName, marker, sizeof marker - 1);
+    } catch (...) {
+        fs::remove_all(staging_, ec);
+        throw;
+    }
 }
 
 StagedOutputs::~StagedOutputs() {
     std::error_code ec;
     fs::remove_all(staging_, ec); // best effort; never throws from a destructor
+}
+
+fs::path StagedOutputs::stage_last(const fs::path& relative) {
+    last_.push_back(relative.lexically_normal());
+    return stage(relative);
 }
 
 fs::path StagedOutputs::stage(const fs::path& relative) {
@@ -206,18 +299,31 @@ fs::path StagedOutputs::stage(const fs::path& relative) {
 std::vector<fs::path> StagedOutputs::staged_files() const {
     std::vector<fs::path> files;
     std::error_code ec;
-    for (auto it = fs::recursive_directory_iterator(staging_, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+    for (auto it = fs::recursive_directory_iterator(staging_, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        if (it.depth() == 0 && is_staging_record(it->path().filename().string())) {
+            it.disable_recursion_pending();
+            continue;
+        }
         if (it->is_regular_file()) files.push_back(fs::relative(it->path(), staging_));
+    }
     std::sort(files.begin(), files.end());
+    // Records last: whoever reads one finds the files it names in place.
+    std::stable_partition(files.begin(), files.end(), [&](const fs::path& f) { return std::find(last_.begin(), last_.end(), f) == last_.end(); });
     return files;
 }
 
 fs::path StagedOutputs::final_path(const fs::path& staged) const { return root_ / staged.lexically_relative(staging_); }
 
-std::vector<fs::path> StagedOutputs::commit() {
+void StagedOutputs::prepare() {
+    if (prepared_) return;
+    if (committed_) throw Error("internal: StagedOutputs used after commit");
     const std::vector<fs::path> files = staged_files();
     // 1. Every destination directory first: a path component that is a file
-    //    fails here, before anything moved.
+    //    fails here, before anything moved. Then every destination is one
+    //    Atlas may replace, inside the root, and reached by one file only.
+    std::error_code rec;
+    const fs::path canonical_root = fs::weakly_canonical(fs::absolute(root_), rec);
+    std::map<fs::path, fs::path> reached; // canonical destination -> the staged name that reaches it
     for (const auto& rel : files) {
         const fs::path dst = root_ / rel;
         std::error_code ec;
@@ -225,16 +331,45 @@ std::vector<fs::path> StagedOutputs::commit() {
         if (ec || !fs::is_directory(dst.parent_path()))
             throw Error("cannot move '" + rel.string() + "' into '" + root_.string() + "': cannot create directory '" +
                         dst.parent_path().string() + "'" + (ec ? ": " + ec.message() : ": a file is in the way"));
+        check_destination(dst, protect_);
+        const fs::path canonical = fs::weakly_canonical(fs::absolute(dst.parent_path()), ec) / dst.filename();
+        const auto m = std::mismatch(canonical_root.begin(), canonical_root.end(), canonical.begin(), canonical.end());
+        if (rec || ec || m.first != canonical_root.end())
+            throw Error(dst.string() + ": a symlinked folder leads this file outside '" + root_.string() + "' (to '" + canonical.string() +
+                        "'); Atlas does not write through it (nothing was changed)");
+        if (const auto [it, fresh] = reached.emplace(canonical, rel); !fresh)
+            throw Error("'" + it->second.string() + "' and '" + rel.string() + "' in '" + root_.string() + "' are one file ('" + canonical.string() +
+                        "', through a symlinked folder): one would be lost (nothing was changed)");
     }
-    // 2. Move; the files replaced are kept in the staging area until every
+    // 2. The journal: from here on the commit is decided. A process killed
+    //    during the moves has them completed by the next run (complete_commit).
+    {
+        std::string journal;
+        for (const auto& rel : files) journal += hex_encode(rel.generic_string()) + "\n";
+        const fs::path tmp = staging_ / (std::string(kJournalName) + ".tmp");
+        write_file_checked(tmp, journal.data(), journal.size());
+        std::error_code ec;
+        fs::rename(tmp, staging_ / kJournalName, ec);
+        if (ec) throw Error("cannot write the commit journal in '" + staging_.string() + "': " + ec.message() + " (nothing was changed)");
+    }
+    files_ = files;
+    prepared_ = true;
+}
+
+std::vector<fs::path> StagedOutputs::commit() {
+    prepare();
+    const std::vector<fs::path>& files = files_;
+    // 3. Move; the files replaced are kept in the staging area until every
     //    move succeeded, so a failure puts the old files back.
-    const fs::path old_dir = staging_ / ".atlas-replaced";
+    const fs::path old_dir = staging_ / kReplacedName;
     struct Move {
         fs::path rel;
         bool replaced;
     };
     std::vector<Move> moved;
     auto undo = [&] {
+        std::error_code je;
+        fs::remove(staging_ / kJournalName, je); // undone, not to be completed
         for (auto it = moved.rbegin(); it != moved.rend(); ++it) {
             std::error_code e;
             fs::rename(root_ / it->rel, staging_ / it->rel, e);
@@ -268,9 +403,23 @@ std::vector<fs::path> StagedOutputs::commit() {
     return done;
 }
 
+void check_output_name(const std::string& relative) {
+    if (relative.empty()) throw Error("output path is empty");
+    const fs::path rel(relative);
+    for (unsigned char c : relative)
+        if (c < 0x20 || c == 0x7f) {
+            std::string shown;
+            for (unsigned char d : relative) shown += d < 0x20 || d == 0x7f ? "\\x" + std::string(1, "0123456789abcdef"[d >> 4]) + "0123456789abcdef"[d & 15] : std::string(1, char(d));
+            throw Error("output path '" + shown + "' holds a control character (a NUL or a line break); output names must be plain text");
+        }
+    for (const auto& part : rel)
+        if (is_reserved_name(part.string()))
+            throw Error("output path '" + relative + "': names starting with '.atlas-' are kept for Atlas's own records and staging; choose another name");
+}
+
 fs::path resolve_output_path(const fs::path& out_dir, const std::string& relative, bool allow_outside) {
     fs::path rel(relative);
-    if (relative.empty()) throw Error("output path is empty");
+    check_output_name(relative);
     if (rel.is_absolute()) {
         if (!allow_outside)
             throw Error("output path '" + relative + "' is absolute; paths are relative to --out (pass --allow-outside-out to permit this)");
@@ -293,19 +442,20 @@ fs::path resolve_output_path(const fs::path& out_dir, const std::string& relativ
 }
 
 std::string read_file_bytes(const fs::path& path) {
+    // By type before opening: a FIFO would block the open, a directory opens
+    // and claims an absurd size, a device never ends.
+    std::error_code ec;
+    const auto st = fs::status(path, ec);
+    if (!ec && fs::exists(st) && !fs::is_regular_file(st))
+        throw Error(path.string() + ": not a regular file (" + (fs::is_directory(st) ? "a directory" : "a device, FIFO or socket") +
+                    "); Atlas reads regular files only");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path.string() + ": cannot open file for reading");
     in.seekg(0, std::ios::end);
     // One allocation of the file's size and one read (cache entries reach
     // hundreds of MB; a stringstream would copy them twice).
     const std::streamoff size = in.tellg();
-    if (size < 0) { // a pipe or device (e.g. /dev/stdin): no size, read it as a stream
-        in.clear();
-        std::ostringstream ss;
-        ss << in.rdbuf();
-        if (in.bad()) throw Error(path.string() + ": read error");
-        return ss.str();
-    }
+    if (size < 0) throw Error(path.string() + ": cannot tell the file's size");
     std::string bytes(size_t(size), '\0');
     in.seekg(0);
     in.read(bytes.data(), size);

@@ -303,6 +303,10 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     };
     std::vector<OutputPlan> plans;
     std::map<std::filesystem::path, std::unique_ptr<OutputRecords>> records;
+    // What no output may replace: the graph file and every file the cook reads.
+    std::vector<ProtectedFile> protect;
+    if (!g.file.empty()) protect.push_back({g.file, "the graph file"});
+    for (const auto& in : result.inputs) protect.push_back({in.path, "an input file of the cook (node '" + in.node + "')"});
     if (opt.write_outputs && !outputs.empty()) {
         if (opt.cache_dir) remove_stale_staging(*opt.cache_dir);
         for (const GraphOutput* o : outputs) {
@@ -310,6 +314,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             p.out = o;
             try {
                 std::filesystem::path final_path = resolve_output_path(opt.out_dir, o->file, opt.allow_outside_out);
+                check_destination(final_path, protect);
                 p.root = opt.out_dir;
                 p.rel = std::filesystem::path(o->file).lexically_normal();
                 if (std::filesystem::path(o->file).is_absolute() || p.rel.begin()->string() == "..") {
@@ -340,7 +345,18 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 } else if (opt.cache_dir && kCachedOutputFormats.count(o->format) &&
                            std::filesystem::exists(disk_cache::files_entry_path(*opt.cache_dir, p.key))) {
                     std::string why;
-                    if ((p.cached = disk_cache::load_files(*opt.cache_dir, p.key, &why))) {
+                    p.cached = disk_cache::load_files(*opt.cache_dir, p.key, &why);
+                    // Only the files this output writes: its own name and its sidecars beside it.
+                    if (p.cached)
+                        for (const auto& [name, bytes] : p.cached->files) {
+                            const std::filesystem::path f(name);
+                            if (f.parent_path() != p.rel.parent_path() || f.filename().string().rfind(p.rel.filename().string(), 0) != 0) {
+                                why = "it holds '" + name + "', not a file of this output";
+                                p.cached.reset();
+                                break;
+                            }
+                        }
+                    if (p.cached) {
                         p.action = OutputPlan::restore;
                     } else {
                         std::error_code ec;
@@ -374,7 +390,16 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             s.cache_source = "memory cache";
         } else if (opt.cache_dir && disk_cache::contains(*opt.cache_dir, s.hash)) {
             std::string why;
-            if (auto loaded = disk_cache::load(*opt.cache_dir, s.hash, &why)) {
+            auto loaded = disk_cache::load(*opt.cache_dir, s.hash, &why);
+            // Every port the node declares, or the entry is not this node's.
+            if (loaded)
+                for (const auto& out : s.type->decl.outputs())
+                    if (!loaded->count(out.name)) {
+                        why = "it has no output '" + out.name + "'";
+                        loaded.reset();
+                        break;
+                    }
+            if (loaded) {
                 s.cached = held_outputs(std::move(*loaded), ledger);
                 s.cache_source = "disk cache";
                 cache_->put(s.hash, s.cached);
@@ -474,7 +499,11 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                     CookContext ctx(n.name, n.type, s.type->decl, params, std::move(inputs), node_budget, node_progress);
                     report_progress(n.name, 0.0);
                     const auto t0 = std::chrono::steady_clock::now();
-                    s.type->cook(ctx);
+                    {
+                        // The node's parallel loops poll Ctrl-C between blocks.
+                        const detail::CancelScope cancel_scope(&opt.progress.is_cancelled);
+                        s.type->cook(ctx);
+                    }
                     reports[i].seconds = seconds_since(t0);
                     for (const auto& out : s.type->decl.outputs())
                         if (!ctx.outputs().count(out.name))
@@ -616,7 +645,10 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             try {
                 opt.progress.poll();
                 auto& st = staging[p.root];
-                if (!st) st = std::make_unique<StagedOutputs>(p.root);
+                if (!st) {
+                    st = std::make_unique<StagedOutputs>(p.root);
+                    st->protect(protect);
+                }
                 progress_step("writing " + o->file, "", 0.0, false);
                 Written w{result.outputs.size(), &p, st.get(), {}};
                 if (p.action == OutputPlan::restore) {
@@ -673,6 +705,8 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             }
         }
         // Everything written: move it into place.
+        // Every root's destinations checked and journaled before any file moves.
+        for (auto& [root, st] : staging) st->prepare();
         for (auto& [root, st] : staging) st->commit();
         // Record what is on disk now (renames keep the mtime).
         for (auto& [plan, rec] : rekeyed) records.at(plan->root)->set(plan->name, std::move(rec));

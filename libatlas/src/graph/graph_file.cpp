@@ -340,6 +340,11 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
         if (!o["file"]) p.fail(o, "output: missing 'file'");
         out.node = p.scalar(o["node"], "output node");
         out.file = p.scalar(o["file"], "output file");
+        try {
+            check_output_name(out.file);
+        } catch (const Error& e) {
+            p.fail(o["file"], e.what());
+        }
         if (o["port"]) out.port = p.scalar(o["port"], "output port");
         if (o["format"]) out.format = p.scalar(o["format"], "output format");
         if (const YAML::Node opts = o["options"]) {
@@ -433,7 +438,9 @@ Graph load_graph(const std::filesystem::path& file, const NodeRegistry& registry
     std::string text;
     try {
         text = read_file_bytes(file);
-    } catch (const Error&) {
+    } catch (const Error& e) {
+        std::error_code ec;
+        if (std::filesystem::exists(file, ec)) throw Error(std::string(e.what()) + " (the graph file)");
         throw Error(file.string() + ": cannot read graph file (does it exist?)");
     }
     Graph g = parse_graph(text, file.string(), file.parent_path().empty() ? std::filesystem::path(".") : file.parent_path(), registry);

@@ -72,8 +72,15 @@ void hash_param_value(Hasher& h, const ParamValue& v) {
 }
 
 std::string ParamDecl::check(const ParamValue& v) const {
+    // A float parameter without bounds of its own still has one: 3.5e38 is
+    // infinity as a float and 1e30 squared overflows, so a field would be
+    // infinities. 1e9 is far past any length, rate or weight Atlas uses.
+    constexpr double kFloatLimit = 1e9;
+    const bool floating = type == ParamType::Float || type == ParamType::Float2 || type == ParamType::Float3;
     auto in_range = [&](double d) -> std::string {
         if (!std::isfinite(d)) return "must be a finite number";
+        if (floating && std::abs(d) > kFloatLimit && !(min && max))
+            return "value " + format_number(d) + " is beyond +-1e9, where float fields overflow to infinity";
         if (min && max && (d < *min || d > *max))
             return "value " + format_number(d) + " is out of range [" + format_number(*min) + ", " + format_number(*max) + "]";
         if (min && d < *min) return "value " + format_number(d) + " is below the minimum " + format_number(*min);

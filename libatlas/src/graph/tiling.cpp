@@ -620,6 +620,7 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
 
             // Write the tile: every output in its format, the exact values, the fragment.
             StagedOutputs st(root);
+            if (!g.file.empty()) st.protect({{g.file, "the graph file"}});
             json frag = {{"atlas_tile", kTileFormatVersion}, {"key", tile_key(t)}, {"tile", {t[0], t[1]}},
                          {"tiles", {tiles[0], tiles[1]}}, {"texels", {tr.x0, tr.y0, tr.x1, tr.y1}}, {"grid", grid_json(grid)},
                          {"outputs", json::array()}};
@@ -648,7 +649,8 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
                                            {"files", files}, {"raw", file_entry(root, st.final_path(raw), raw)}});
             }
             const std::string text = frag.dump(2) + "\n";
-            write_file_checked(st.stage(fragment_rel(t)), text.data(), text.size());
+            // The fragment is the tile's record: it lands after the files it names.
+            write_file_checked(st.stage_last(fragment_rel(t)), text.data(), text.size());
             for (const auto& p : st.commit()) result.written.push_back(p);
             fragments[{t[0], t[1]}] = std::move(frag);
         } catch (const std::exception& e) {
@@ -756,7 +758,10 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
                     rel = final_path.filename();
                 }
                 auto& st = staging[out_root];
-                if (!st) st = std::make_unique<StagedOutputs>(out_root);
+                if (!st) {
+                    st = std::make_unique<StagedOutputs>(out_root);
+                    if (!g.file.empty()) st->protect({{g.file, "the graph file"}});
+                }
                 const Value full = full2 ? Value(Field2DPtr(full2)) : Value(Field3DPtr(full3));
                 for (const auto& f : io::write_value(full, st->stage(rel), o->format, o->options, nullptr))
                     result.assembled.push_back(st->final_path(f));
@@ -766,6 +771,7 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
                 throw Error(o->where.str() + ": assembling output '" + o->file + "': " + e.what());
             }
         }
+        for (auto& [r, st] : staging) st->prepare(); // every root checked before any file moves
         for (auto& [r, st] : staging)
             for (const auto& p : st->commit()) result.written.push_back(p);
     }

@@ -77,6 +77,11 @@ struct Writer {
         out->write(reinterpret_cast<const char*>(&h.hi), 8);
         out->write(reinterpret_cast<const char*>(&h.lo), 8);
     }
+    // Binds the entry to its key: the key enters the checksum (not the file),
+    // so an entry copied or forged under another key's name fails its check.
+    void bind(const Hash128* key) {
+        if (key) sum.add(key, sizeof *key);
+    }
     void u64(uint64_t v) { bytes(&v, 8); }
     void f64(double v) { bytes(&v, 8); }
     void str(const std::string& s) { u64(s.size()); bytes(s.data(), s.size()); }
@@ -89,6 +94,9 @@ struct Reader {
     uint64_t pos = 0;
     bool ok = true;
     ContentHasher sum{};
+    void bind(const Hash128* key) {
+        if (key) sum.add(key, sizeof *key);
+    }
     bool take(void* dst, size_t n) {
         if (!ok || size - pos < n) return ok = false;
         in.read(static_cast<char*>(dst), std::streamsize(n));
@@ -147,8 +155,9 @@ bool read_storage(Reader& r, detail::FieldStorage& f, int channels) {
 
 void write_value(Writer& w, const Value& v);
 
-void serialize_to(std::ostream& out, const NodeOutputs& outputs) {
+void serialize_to(std::ostream& out, const NodeOutputs& outputs, const Hash128* key = nullptr) {
     Writer w{&out};
+    w.bind(key);
     w.bytes(kMagic, kMagicSize);
     w.u64(outputs.size());
     for (const auto& [port, v] : outputs) {
@@ -180,13 +189,15 @@ void write_value(Writer& w, const Value& v) {
     }
 }
 
-std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std::string* why_not) {
+// With `key`, the entry must have been stored under it (Writer::bind).
+std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std::string* why_not, const Hash128* key = nullptr) {
     auto fail = [&](const char* why) -> std::optional<NodeOutputs> {
         if (why_not) *why_not = why;
         return std::nullopt;
     };
     if (size < kMagicSize + kChecksumSize) return fail("truncated");
     Reader r{in, size - kChecksumSize};
+    r.bind(key);
     char magic[kMagicSize];
     if (!r.take(magic, kMagicSize) || std::memcmp(magic, kMagic, kMagicSize) != 0) return fail("not an Atlas cache file of this version");
     NodeOutputs out;
@@ -247,7 +258,8 @@ std::optional<NodeOutputs> deserialize_from(std::istream& in, uint64_t size, std
     }
     if (!r.ok) return fail("truncated");
     if (r.pos != r.size) return fail("trailing bytes");
-    if (!r.checksum_matches()) return fail("checksum mismatch (the entry is corrupt)");
+    if (!r.checksum_matches())
+        return fail(key ? "checksum mismatch (the entry is corrupt, or was stored under another key: swapped or forged)" : "checksum mismatch (the entry is corrupt)");
     return out;
 }
 } // namespace
@@ -285,7 +297,7 @@ std::optional<NodeOutputs> load(const std::filesystem::path& dir, const Hash128&
         if (why_not) *why_not = path.string() + ": cannot open cache entry";
         return std::nullopt;
     }
-    auto v = deserialize_from(in, size, why_not);
+    auto v = deserialize_from(in, size, why_not, &h);
     if (v) touch(path);
     return v;
 }
@@ -298,7 +310,7 @@ void touch(const std::filesystem::path& entry) {
 void store(const std::filesystem::path& dir, const Hash128& h, const NodeOutputs& outputs) {
     write_file_atomic(entry_path(dir, h), [&](const std::filesystem::path& tmp) {
         std::ofstream f(tmp, std::ios::binary);
-        serialize_to(f, outputs);
+        serialize_to(f, outputs, &h);
         f.close();
         if (!f) throw Error(tmp.string() + ": cannot write cache entry (disk full?)");
     });
@@ -318,6 +330,7 @@ void store_files(const std::filesystem::path& dir, const Hash128& key,
     write_file_atomic(files_entry_path(dir, key), [&](const std::filesystem::path& tmp) {
         std::ofstream f(tmp, std::ios::binary);
         Writer w{&f};
+        w.bind(&key);
         w.bytes(kFilesMagic, kFilesMagicSize);
         w.u64(metrics.size());
         for (const auto& [k, v] : metrics) { w.str(k); w.f64(v); }
@@ -344,6 +357,7 @@ std::optional<CachedFiles> load_files(const std::filesystem::path& dir, const Ha
     if (ec || !in) return fail("cannot open cache entry");
     if (size < kFilesMagicSize + kChecksumSize) return fail("truncated");
     Reader r{in, size - kChecksumSize};
+    r.bind(&key);
     char magic[kFilesMagicSize];
     if (!r.take(magic, kFilesMagicSize) || std::memcmp(magic, kFilesMagic, kFilesMagicSize) != 0) return fail("not an Atlas output cache entry");
     CachedFiles out;
@@ -361,11 +375,17 @@ std::optional<CachedFiles> load_files(const std::filesystem::path& dir, const Ha
     }
     if (!r.ok) return fail("truncated");
     if (r.pos != r.size) return fail("trailing bytes");
-    if (!r.checksum_matches()) return fail("checksum mismatch (the entry is corrupt)");
-    // Names come from the file: only plain relative paths inside the output.
+    if (!r.checksum_matches()) return fail("checksum mismatch (the entry is corrupt, or was stored under another key: swapped or forged)");
+    // Names come from the file: only plain relative paths inside the output,
+    // none of Atlas's own names (the commit refuses a symlinked folder).
     for (const auto& [name, bytes] : out.files) {
         const std::filesystem::path p(name);
         if (p.empty() || p.is_absolute() || p.lexically_normal().begin()->string() == "..") return fail("corrupt file name");
+        try {
+            check_output_name(name);
+        } catch (const Error&) {
+            return fail("corrupt file name");
+        }
     }
     touch(path);
     return out;

@@ -16,9 +16,16 @@
 #include <Imath/half.h>
 
 #include <algorithm>
+#include <cstring>
+#include <cerrno>
+#include <unistd.h>
+#include <fcntl.h>
 #include <cctype>
 #include <cmath>
+#include <fstream>
 #include <functional>
+#include <stdexcept>
+#include <string_view>
 #include <vector>
 
 namespace atlas::io {
@@ -68,6 +75,55 @@ Imf::Header base_header(int width, int height, const std::vector<std::string>& n
 // fill(channel, file row, destination) (file row 0 = top of the image), so
 // the writer holds a few MiB besides the value instead of a whole copy of it
 // (and another in half): a 512x512x64 NVDF is 256 MiB a copy.
+// An OpenEXR output stream whose every write is checked. OpenEXR's own file
+// stream writes the line-offset table from ~OutputFile, where a full disk is
+// swallowed: a preview wrote a 0-byte EXR and exited 0. Errors are kept (a
+// destructor must not throw) and raised by close().
+class CheckedOStream : public Imf::OStream {
+public:
+    explicit CheckedOStream(const fs::path& path) : Imf::OStream(path.c_str()), path_(path) {
+        fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (fd_ < 0) throw Error(path.string() + ": cannot create the file: " + std::strerror(errno));
+    }
+    ~CheckedOStream() override {
+        if (fd_ >= 0) ::close(fd_);
+    }
+    void write(const char c[], int n) override {
+        while (n > 0 && !error_) {
+            const ssize_t k = ::pwrite(fd_, c, size_t(n), off_t(pos_));
+            if (k < 0 && errno == EINTR) continue;
+            if (k <= 0) {
+                error_ = k < 0 ? errno : ENOSPC;
+                break;
+            }
+            c += k, n -= int(k), pos_ += uint64_t(k);
+        }
+        // Stop OpenEXR early while it can still take an exception, once (not
+        // again from its destructor while that one unwinds).
+        if (error_ && !closing_) {
+            closing_ = true;
+            throw std::runtime_error(std::strerror(error_));
+        }
+    }
+    uint64_t tellp() override { return pos_; }
+    void seekp(uint64_t pos) override { pos_ = pos; }
+    void closing() { closing_ = true; }
+    // Throws atlas::Error naming the file when any write or the close failed.
+    void close() {
+        const int fd = fd_;
+        fd_ = -1;
+        if (::close(fd) != 0 && !error_) error_ = errno;
+        if (error_) throw Error(path_.string() + ": cannot write EXR: " + std::strerror(error_));
+    }
+
+private:
+    fs::path path_;
+    int fd_ = -1;
+    uint64_t pos_ = 0;
+    int error_ = 0;
+    bool closing_ = false;
+};
+
 void write_rows(const fs::path& path, int width, int height, const std::vector<std::string>& names, bool half, Imf::Header header,
                 const std::function<void(int, int, float*)>& fill) {
     for (const auto& n : names) header.channels().insert(n, Imf::Channel(half ? Imf::HALF : Imf::FLOAT));
@@ -78,10 +134,11 @@ void write_rows(const fs::path& path, int width, int height, const std::vector<s
     // OpenEXR converts pixel types when reading, not when writing: half
     // channels need half buffers (rounded to nearest even by Imath).
     std::vector<std::vector<::half>> halves(half ? nc : 0, std::vector<::half>(half ? rows[0].size() : 0));
+    CheckedOStream stream(path);
     try {
         // One thread: OpenEXR's output is the same bytes either way, and the
         // caller decides the parallelism.
-        Imf::OutputFile file(path.string().c_str(), header, 1);
+        Imf::OutputFile file(stream, header, 1);
         for (int y0 = 0; y0 < height; y0 += strip) {
             const int n = std::min(strip, height - y0);
             Imf::FrameBuffer fb;
@@ -98,9 +155,11 @@ void write_rows(const fs::path& path, int width, int height, const std::vector<s
             file.setFrameBuffer(fb);
             file.writePixels(n);
         }
+        stream.closing(); // ~OutputFile writes the offset table: errors are kept for close()
     } catch (const std::exception& e) {
         throw Error(path.string() + ": cannot write EXR: " + e.what());
     }
+    stream.close();
 }
 
 // Rank of a standard channel name within its layer (OpenEXR's conventions):
@@ -264,11 +323,89 @@ void write_exr(const Field3D& f, const fs::path& path, const ExrOptions& o) {
     });
 }
 
+namespace {
+// OpenEXR allocates what a header claims before reading pixels: an opaque
+// attribute of its stated size, a line-offset table of one entry per block of
+// the data window. A 274-byte file claimed about 2 GB. The header is walked
+// here first, and its claims held against the file's size and the budget.
+void check_exr_claims(const fs::path& path, const MemoryBudget& budget) {
+    std::ifstream in(path, std::ios::binary);
+    std::error_code ec;
+    const uint64_t file_size = fs::file_size(path, ec);
+    if (!in || ec) throw Error("cannot open the file");
+    // Headers are small; 16 MiB is far past any real one.
+    std::string head(size_t(std::min<uint64_t>(file_size, 16u << 20)), '\0');
+    in.read(head.data(), std::streamsize(head.size()));
+    size_t pos = 0;
+    auto need = [&](size_t n) {
+        if (head.size() - pos < n) throw Error("the header is truncated");
+    };
+    auto i32 = [&] {
+        need(4);
+        int32_t v;
+        std::memcpy(&v, head.data() + pos, 4);
+        pos += 4;
+        return v;
+    };
+    auto cstr = [&] {
+        const size_t end = head.find('\0', pos);
+        if (end == std::string::npos || end - pos > 255) throw Error("an attribute name is not terminated");
+        std::string v = head.substr(pos, end - pos);
+        pos = end + 1;
+        return v;
+    };
+    if (i32() != 20000630) throw Error("not an OpenEXR file (bad magic number)");
+    const int32_t version = i32();
+    const bool tiled = version & 0x200;
+    int64_t x0 = 0, y0 = 0, x1 = -1, y1 = -1, channels = 0, tile_w = 0, tile_h = 0;
+    int compression = 0;
+    for (;;) {
+        const std::string name = cstr();
+        if (name.empty()) break;
+        const std::string type = cstr();
+        const int32_t size = i32();
+        if (size < 0 || uint64_t(size) > file_size - pos)
+            throw Error("attribute '" + name + "' claims " + std::to_string(size) + " bytes, more than the file holds");
+        need(size_t(size));
+        const char* d = head.data() + pos;
+        auto at = [&](int k) {
+            int32_t v;
+            std::memcpy(&v, d + 4 * k, 4);
+            return int64_t(v);
+        };
+        if (name == "dataWindow" && type == "box2i" && size == 16) x0 = at(0), y0 = at(1), x1 = at(2), y1 = at(3);
+        if (name == "compression" && size == 1) compression = static_cast<unsigned char>(d[0]);
+        if (name == "tiles" && type == "tiledesc" && size >= 8) tile_w = uint32_t(at(0)), tile_h = uint32_t(at(1));
+        if (name == "channels" && type == "chlist")
+            for (size_t q = 0; q < size_t(size) && d[q];) {
+                const size_t end = std::string_view(d + q, size_t(size) - q).find('\0');
+                if (end == std::string_view::npos) break;
+                q += end + 1 + 16; // pixel type, pLinear, reserved, x and y sampling
+                ++channels;
+            }
+        pos += size_t(size);
+    }
+    const int64_t w = x1 - x0 + 1, h = y1 - y0 + 1;
+    if (w < 1 || h < 1 || w > (int64_t(1) << 30) || h > (int64_t(1) << 30))
+        throw Error("the data window " + std::to_string(w) + "x" + std::to_string(h) + " is empty or absurd");
+    // One offset per line block (scanlines) or per tile of the first level, 8 bytes each.
+    static const int kLinesPerBlock[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+    const int64_t lines = compression >= 0 && compression < 10 ? kLinesPerBlock[compression] : 256;
+    const int64_t blocks = tiled && tile_w > 0 && tile_h > 0 ? ((w + tile_w - 1) / tile_w) * ((h + tile_h - 1) / tile_h) : (h + lines - 1) / lines;
+    if (uint64_t(blocks) * 8 > file_size)
+        throw Error("the header claims " + std::to_string(w) + "x" + std::to_string(h) + " pixels, whose offset table alone (" + std::to_string(blocks * 8) +
+                    " bytes) is larger than the file (" + std::to_string(file_size) + " bytes)");
+    budget.check(field_bytes(uint64_t(w) * uint64_t(h), int(std::max<int64_t>(channels, 1))) * 2,
+                 "a " + std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(channels) + " EXR image");
+}
+} // namespace
+
 Value read_exr(const fs::path& path, const MemoryBudget* budget) {
     detail::require_regular_file(path, "EXR");
     const MemoryBudget fallback;
     const MemoryBudget& bud = detail::budget_or_default(budget, fallback);
     try {
+        check_exr_claims(path, bud);
         Imf::InputFile file(path.string().c_str(), 1);
         const Imf::Header& hd = file.header();
         const std::vector<std::string> names = channel_order(hd);

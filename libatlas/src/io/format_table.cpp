@@ -64,10 +64,13 @@ std::vector<fs::path> write_json_output(const Value& v, const fs::path& p, const
             rows.push_back(std::move(row));
         }
     const std::string text = j.dump(1) + "\n";
+    // write_file_checked names the system's reason (a full disk, a size limit).
     write_file_atomic(p, [&](const fs::path& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        if (!out.flush()) throw Error(o.prefix() + "cannot write " + p.filename().string());
+        try {
+            write_file_checked(tmp, text.data(), text.size());
+        } catch (const Error& e) {
+            throw Error(o.prefix() + "cannot write " + p.filename().string() + ": " + e.what());
+        }
     });
     return {p};
 }

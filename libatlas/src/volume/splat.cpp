@@ -73,8 +73,9 @@ Field3D splat_points(const Points& pts, Vec3i res, Box3d bounds, const SplatOpti
             if (std::abs(dz) >= s.support) continue;
             int lo[2], hi[2];
             for (int a = 0; a < 2; ++a) {
-                lo[a] = std::max(0, int(std::floor((s.c[a] - s.support - bounds.min[a]) / h[a] - 0.5)));
-                hi[a] = std::min(res[a] - 1, int(std::ceil((s.c[a] + s.support - bounds.min[a]) / h[a] - 0.5)));
+                // Clamped as doubles: a radius of 1e30 would overflow the int conversion (UB).
+                lo[a] = int(std::clamp(std::floor((s.c[a] - s.support - bounds.min[a]) / h[a] - 0.5), 0.0, double(res[a])));
+                hi[a] = int(std::clamp(std::ceil((s.c[a] + s.support - bounds.min[a]) / h[a] - 0.5), -1.0, double(res[a] - 1)));
             }
             for (int y = lo[1]; y <= hi[1]; ++y) {
                 const double dy = bounds.min[1] + (y + 0.5) * h[1] - s.c[1];

@@ -5,6 +5,14 @@
 // may write dozens) in a hidden staging directory beside the destination and
 // moves them into place only when all of them were written; if anything
 // fails, or the object is destroyed without commit(), nothing is touched.
+//
+// Atlas never replaces or writes through what it did not create: a
+// destination that is a symbolic link, a directory, a device, a FIFO or a
+// socket is refused, as is one that is a protected file (the graph, an input
+// of the cook) or that a symlinked folder leads outside the root. The commit
+// is all-or-nothing: a journal names every move before the first one, and a
+// process killed during the moves has them completed by the next Atlas run in
+// that directory (remove_stale_staging), so no mix of old and new remains.
 #pragma once
 
 #include "atlas/core/hash.h"
@@ -19,6 +27,23 @@ namespace atlas {
 
 namespace fs = std::filesystem;
 
+// A file Atlas must not write over, and what it is ("the graph file").
+struct ProtectedFile {
+    fs::path path;
+    std::string what;
+};
+
+// Throws atlas::Error naming `path` when Atlas may not write a file there: it
+// is a symbolic link or not a regular file, or it is one of `protect`
+// (compared as files, so hard links and other spellings of one path are
+// caught). Names given by a user are checked with is_reserved_name as well. `what` names the
+// file's role in the message ("the report").
+void check_destination(const fs::path& path, const std::vector<ProtectedFile>& protect = {}, const std::string& what = "output");
+
+// True for a file or folder name Atlas keeps for its own records and staging
+// (".atlas-outputs.json", ".atlas-staging-...": every name starting ".atlas-").
+bool is_reserved_name(const std::string& name);
+
 class StagedOutputs {
 public:
     // Files will be committed under `root` (created on commit if missing).
@@ -30,34 +55,57 @@ public:
     // A path in the staging area for `relative` (its parent directories are
     // created). Write the file there; it is moved to root/relative on commit.
     fs::path stage(const fs::path& relative);
-    // Moves every staged file into place (rename within one file system).
-    // Returns the final paths.
+    // The same for a record that describes the other files (a tile's
+    // fragment): it is moved into place after every other file.
+    fs::path stage_last(const fs::path& relative);
+    // Files the commit must refuse to replace (the graph, the cook's inputs).
+    void protect(std::vector<ProtectedFile> files) { protect_ = std::move(files); }
+    // Moves every staged file into place (rename within one file system),
+    // after checking every destination (check_destination, no two staged
+    // files reaching one file, none leaving the root through a symlinked
+    // folder) and writing the journal. Returns the final paths.
     std::vector<fs::path> commit();
+    // The checks and the journal of commit() alone: a caller committing
+    // several StagedOutputs prepares them all first, so that a refused
+    // destination in one changes nothing in any. Throws atlas::Error.
+    void prepare();
     // Where a file staged at `staged` (a path under the staging area) lands on commit.
     fs::path final_path(const fs::path& staged) const;
-    // Every file the writers produced in the staging area, as relative paths.
+    // Every file the writers produced in the staging area, as relative paths,
+    // in commit order (sorted; the stage_last files at the end).
     std::vector<fs::path> staged_files() const;
 
 private:
     fs::path root_;
     fs::path staging_;
+    std::vector<fs::path> last_;
+    std::vector<ProtectedFile> protect_;
+    std::vector<fs::path> files_; // what prepare() checked and journaled
+    bool prepared_ = false;
     bool committed_ = false;
 };
 
 // Writes one file atomically: `write` is called with a temporary path in the
 // same directory, which is renamed over `path` when it returns normally and
 // removed if it throws.
+// The destination is checked first (check_destination with `protect`).
 template <typename WriteFn>
-void write_file_atomic(const fs::path& path, WriteFn&& write) {
+void write_file_atomic(const fs::path& path, WriteFn&& write, const std::vector<ProtectedFile>& protect = {}) {
+    check_destination(path, protect, "file");
     StagedOutputs out(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+    out.protect(protect);
     write(out.stage(path.filename()));
     out.commit();
 }
 
 // Resolves an output path from a graph against the output directory. Throws
 // atlas::Error when it is absolute or climbs out of `out_dir` (through `..`
-// or a symlink), unless `allow_outside` is true.
+// or a symlink), unless `allow_outside` is true, and always when it holds a
+// control character (a NUL would cut the name short) or a name Atlas keeps
+// for itself (is_reserved_name).
 fs::path resolve_output_path(const fs::path& out_dir, const std::string& relative, bool allow_outside);
+// The name checks alone (the graph parser's, so that `validate` reports them).
+void check_output_name(const std::string& relative);
 
 // Reads a whole file; throws atlas::Error naming the file on failure.
 std::string read_file_bytes(const fs::path& path);
@@ -98,7 +146,10 @@ Hash128 file_content_hash(const fs::path& path);
 
 // Staging directories (".atlas-staging-HOST-PID-N") that a killed process
 // left in `dir`: those of this host whose process no longer runs, and any
-// older than a day. Removes them and returns how many bytes they held.
+// older than a day. One whose commit had begun (its journal is there) is
+// completed first: the files it had not yet moved are moved into place.
+// Removes them and returns how many bytes they held. Only folders that
+// Atlas made (they hold its marker file) are touched, whatever their name.
 // Never throws (a directory that cannot be listed holds nothing to clean).
 uint64_t remove_stale_staging(const fs::path& dir);
 

@@ -13,6 +13,8 @@
 // out of the loop (TBB cancels the remaining blocks).
 #pragma once
 
+#include "atlas/core/progress.h"
+
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -31,14 +33,22 @@ constexpr size_t block_count(size_t n, size_t block) { return (n + block - 1) / 
 // Calls fn(begin, end) for each fixed block [b * block, min(n, (b + 1) * block)) of
 // [0, n), in parallel when there is more than one block (a single block runs on the
 // calling thread). block >= 1.
+// Between blocks the loop polls the cook's cancellation check (progress.h), so
+// every long loop stops on Ctrl-C; blocks never split differently for it.
 template <typename Fn>
 void parallel_blocks(size_t n, size_t block, Fn&& fn) {
     const size_t blocks = block_count(n, block);
+    const auto* cancel = detail::current_cancel();
     if (blocks <= 1) {
+        detail::poll_cancel(cancel);
         if (n > 0) fn(size_t(0), n);
         return;
     }
-    tbb::parallel_for(size_t(0), blocks, [&](size_t b) { fn(b * block, std::min(n, (b + 1) * block)); });
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+        const detail::CancelScope scope(cancel); // nested loops on this thread see it too
+        detail::poll_cancel(cancel);
+        fn(b * block, std::min(n, (b + 1) * block));
+    });
 }
 
 // Calls fn(i) for every i in [0, n), in fixed blocks of `block` indices.
@@ -54,7 +64,12 @@ void parallel_for_each(size_t n, size_t block, Fn&& fn) {
 template <typename Fn>
 void parallel_for_index(int n, Fn&& fn) {
     if (n <= 0) return;
-    tbb::parallel_for(0, n, [&](int k) { fn(k); });
+    const auto* cancel = detail::current_cancel();
+    tbb::parallel_for(0, n, [&](int k) {
+        const detail::CancelScope scope(cancel);
+        detail::poll_cancel(cancel);
+        fn(k);
+    });
 }
 
 // Deterministic reduction: partial = fn(begin, end) per fixed block, combined as

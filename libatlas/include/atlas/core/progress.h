@@ -28,4 +28,26 @@ struct ProgressSink {
     void poll() const;
 };
 
+namespace detail {
+// The cancellation check of the cook running on this thread, seen by the
+// parallel loops it starts (parallel.h polls it between blocks and hands it to
+// the threads that run them), so a long loop stops on Ctrl-C without polling
+// of its own. Null when none.
+const std::function<bool()>* current_cancel();
+// Makes `check` the current one on this thread while alive (null: none).
+class CancelScope {
+public:
+    explicit CancelScope(const std::function<bool()>* check);
+    ~CancelScope();
+    CancelScope(const CancelScope&) = delete;
+    CancelScope& operator=(const CancelScope&) = delete;
+
+private:
+    const std::function<bool()>* previous_;
+};
+// Throws CancelledError when `check` says stop. Asks at most every 20 ms per
+// thread: a host's check may take a lock (Python's takes the GIL).
+void poll_cancel(const std::function<bool()>* check);
+} // namespace detail
+
 } // namespace atlas

@@ -1,0 +1,281 @@
+// Issue 48: a cook never replaces or writes through what Atlas did not create
+// (links, devices, FIFOs, the graph, its inputs, Atlas's own records), and a
+// forged or swapped cache entry is a warned re-cook, never an output.
+#include "atlas/core/files.h"
+#include "atlas/core/hash.h"
+#include "../../libatlas/src/graph/value_cache.h"
+
+#include "../support/cli_run.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <chrono>
+#include <csignal>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using atlas::read_file_bytes;
+using atlas::test::CliRun;
+
+namespace {
+fs::path fresh(const std::string& name) {
+    fs::path d = fs::temp_directory_path() / ("atlas_nothing_lost_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+CliRun run(const std::string& args) {
+    const fs::path dir = atlas::test::process_dir("atlas_nothing_lost");
+    return atlas::test::run_shell(atlas::test::atlas_program() + " " + args + " 2>" + (dir / "err").string(), dir / "err");
+}
+
+void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+const std::string kNoise = "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params: {resolution: [16, 16, 4], seed: 3}\noutputs:\n";
+} // namespace
+
+TEST(CliNothingLost, ReportAndDepfileRefuseLinksFifosAndTheGraph) {
+    const fs::path d = fresh("side_files");
+    const fs::path g = d / "g.yaml";
+    const std::string graph = kNoise + "  - {node: n, file: v.exr}\n";
+    put(g, graph);
+    put(d / "target.txt", "precious");
+    fs::create_symlink(d / "target.txt", d / "link.json");
+    ASSERT_EQ(::mkfifo((d / "pipe").c_str(), 0600), 0);
+    for (const std::string flag : {"--report", "--depfile"})
+        for (const fs::path& dest : {d / "link.json", d / "pipe", g, d / ".atlas-outputs.json"}) {
+            CliRun r = run("cook " + g.string() + " --out " + (d / "out").string() + " --no-cache --quiet " + flag + " " + dest.string());
+            EXPECT_EQ(r.status, 1) << flag << " " << dest;
+            EXPECT_NE(r.err.find(dest.string()), std::string::npos) << flag << " " << dest << ": " << r.err;
+        }
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(d / "link.json")));
+    EXPECT_EQ(read_file_bytes(d / "target.txt"), "precious");
+    EXPECT_TRUE(fs::is_fifo(d / "pipe"));
+    EXPECT_EQ(read_file_bytes(g), graph);
+    EXPECT_FALSE(fs::exists(d / ".atlas-outputs.json"));
+    // A report may not replace the cook's own output either.
+    CliRun r = run("cook " + g.string() + " --out " + (d / "out").string() + " --no-cache --quiet --report " + (d / "out" / "v.exr").string());
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("an output of the cook"), std::string::npos) << r.err;
+}
+
+TEST(CliNothingLost, OutputsNeverReplaceTheGraphOrAnInputFile) {
+    const fs::path d = fresh("outputs_protected");
+    put(d / "src.yaml", kNoise + "  - {node: n, file: in.exr}\n");
+    ASSERT_EQ(run("cook " + (d / "src.yaml").string() + " --out " + d.string() + " --no-cache --quiet").status, 0);
+    const std::string input = read_file_bytes(d / "in.exr");
+    // An import whose output is its own input file.
+    const std::string loop = "atlas: 1\nnodes:\n  i:\n    type: import/exr\n    params: {file: in.exr}\noutputs:\n  - {node: i, file: in.exr}\n";
+    put(d / "loop.yaml", loop);
+    CliRun r = run("cook " + (d / "loop.yaml").string() + " --out " + d.string() + " --no-cache --quiet");
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("would overwrite an input file of the cook"), std::string::npos) << r.err;
+    EXPECT_EQ(read_file_bytes(d / "in.exr"), input);
+    // An output named as the graph file.
+    const std::string self = kNoise + "  - {node: n, file: self.yaml, format: exr}\n";
+    put(d / "self.yaml", self);
+    r = run("cook " + (d / "self.yaml").string() + " --out " + d.string() + " --no-cache --quiet");
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("would overwrite the graph file"), std::string::npos) << r.err;
+    EXPECT_EQ(read_file_bytes(d / "self.yaml"), self);
+}
+
+TEST(CliNothingLost, AtlasOwnNamesAndControlCharactersAreRefusedAtLoad) {
+    const fs::path d = fresh("names");
+    for (const std::string& file : {std::string(".atlas-outputs.json"), std::string(".atlas-staging-x/v.exr"), std::string("\"o.exr\\0.png\"")}) {
+        const fs::path g = d / "g.yaml";
+        put(g, kNoise + "  - {node: n, file: " + file + ", format: exr}\n");
+        CliRun v = run("validate " + g.string());
+        EXPECT_EQ(v.status, 1) << file << ": " << v.out;
+        EXPECT_NE(v.err.find(g.string() + ":7:"), std::string::npos) << file << ": " << v.err;
+        CliRun r = run("cook " + g.string() + " --out " + (d / "out").string() + " --no-cache --quiet");
+        EXPECT_EQ(r.status, 1) << file;
+    }
+    EXPECT_FALSE(fs::exists(d / "out" / "o.exr"));
+    EXPECT_FALSE(fs::exists(d / "out" / ".atlas-staging-x"));
+}
+
+// An output that once sat in a folder named like a staging folder is never
+// deleted by a later cook (only folders Atlas made, with its marker, are).
+TEST(CliNothingLost, AUserFolderNamedLikeStagingSurvivesACook) {
+    const fs::path d = fresh("staging_named");
+    const fs::path mine = d / "out" / ".atlas-staging-host-1-0123456789abcdef";
+    fs::create_directories(mine);
+    put(mine / "keep.exr", "mine");
+    fs::last_write_time(mine, fs::file_time_type::clock::now() - std::chrono::hours(48));
+    put(d / "g.yaml", kNoise + "  - {node: n, file: v.exr}\n");
+    CliRun r = run("cook " + (d / "g.yaml").string() + " --out " + (d / "out").string() + " --no-cache --quiet");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(read_file_bytes(mine / "keep.exr"), "mine");
+}
+
+TEST(CliNothingLost, TwoOutputsReachingOneFileThroughALinkedFolderFail) {
+    const fs::path d = fresh("linked_folder");
+    fs::create_directories(d / "out" / "real");
+    fs::create_directory_symlink(d / "out" / "real", d / "out" / "alias");
+    put(d / "g.yaml", kNoise + "  - {node: n, file: real/v.exr}\n  - {node: n, file: alias/v.exr}\n");
+    CliRun r = run("cook " + (d / "g.yaml").string() + " --out " + (d / "out").string() + " --no-cache --quiet");
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("are one file"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(d / "out" / "real" / "v.exr"));
+}
+
+// A team cache is untrusted: entries swapped between keys, or forged with a
+// valid checksum to write through a link, are warned re-cooks.
+TEST(CliNothingLost, SwappedAndForgedCacheEntriesAreWarnedRecooks) {
+    const fs::path d = fresh("cache_entries");
+    const std::string graph = "atlas: 1\nnodes:\n  a:\n    type: noise/value\n    params: {resolution: [16, 16, 4], seed: 1}\n"
+                              "  b:\n    type: noise/value\n    params: {resolution: [16, 16, 4], seed: 2}\noutputs:\n"
+                              "  - {node: a, file: a.dds, options: {encoding: bc4}}\n  - {node: b, file: b.dds, options: {encoding: bc4}}\n";
+    put(d / "g.yaml", graph);
+    const std::string cook = "cook " + (d / "g.yaml").string() + " --cache " + (d / "cache").string() + " --quiet --out ";
+    ASSERT_EQ(run(cook + (d / "o1").string()).status, 0);
+    std::vector<fs::path> entries;
+    for (const auto& e : fs::directory_iterator(d / "cache"))
+        if (e.path().extension() == ".atlasout") entries.push_back(e.path());
+    ASSERT_EQ(entries.size(), 2u);
+    // Swap the two outputs' encoded files.
+    fs::rename(entries[0], d / "tmp");
+    fs::rename(entries[1], entries[0]);
+    fs::rename(d / "tmp", entries[1]);
+    CliRun r = run(cook + (d / "o2").string());
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("unusable"), std::string::npos) << r.err;
+    for (const char* f : {"a.dds", "b.dds"}) EXPECT_EQ(read_file_bytes(d / "o2" / f), read_file_bytes(d / "o1" / f)) << f;
+
+    // A forger who can compute the keyed checksum: names through a link in --out.
+    fs::create_directories(d / "o3");
+    fs::create_directories(d / "elsewhere");
+    fs::create_directory_symlink(d / "elsewhere", d / "o3" / "link");
+    for (const auto& e : fs::directory_iterator(d / "cache"))
+        if (e.path().extension() == ".atlasout") {
+            const std::string hex = e.path().stem().string();
+            atlas::Hash128 key;
+            key.hi = std::stoull(hex.substr(0, 16), nullptr, 16);
+            key.lo = std::stoull(hex.substr(16, 16), nullptr, 16);
+            ASSERT_EQ(key.hex(), hex);
+            put(d / "evil.dds", "not a texture");
+            atlas::disk_cache::store_files(d / "cache", key, {{"link/a.dds", d / "evil.dds"}}, {});
+        }
+    r = run(cook + (d / "o3").string());
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("not a file of this output"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::is_empty(d / "elsewhere"));
+    for (const char* f : {"a.dds", "b.dds"}) EXPECT_EQ(read_file_bytes(d / "o3" / f), read_file_bytes(d / "o1" / f)) << f;
+}
+
+// ------------------------------------------------------ crashes and unclear messages
+
+TEST(CliNothingLost, ADirectoryOrAFifoAsTheGraphIsNamedNotABadAlloc) {
+    const fs::path d = fresh("special_graph");
+    ASSERT_EQ(::mkfifo((d / "pipe.yaml").c_str(), 0600), 0);
+    for (const fs::path& g : {d, d / "pipe.yaml"}) {
+        // timeout: the FIFO used to block the open for ever.
+        CliRun r = atlas::test::run_shell("timeout 20 " + atlas::test::atlas_program() + " cook " + g.string() + " --out " + (d / "out").string() +
+                                              " 2>" + (d / "err").string(),
+                                          d / "err");
+        EXPECT_EQ(r.status, 1) << g;
+        EXPECT_NE(r.err.find("not a regular file"), std::string::npos) << g << ": " << r.err;
+        EXPECT_EQ(r.err.find("bad_alloc"), std::string::npos) << r.err;
+    }
+    CliRun r = atlas::test::run_shell("timeout 20 " + atlas::test::atlas_program() + " decompress " + d.string() + " -o " + (d / "x.exr").string() +
+                                          " 2>" + (d / "err").string(),
+                                      d / "err");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("not a regular file"), std::string::npos) << r.err;
+}
+
+TEST(CliNothingLost, FloatParametersPastFloatRangeAreRefused) {
+    const fs::path d = fresh("huge_floats");
+    for (const std::string v : {"3.5e38", "1e308", "-1e30"}) {
+        // bounds_max has no range of its own: the general float limit applies.
+        put(d / "g.yaml", "atlas: 1\nnodes:\n  m:\n    type: volume/metaballs\n    params: {resolution: [8, 8, 2], bounds_max: [" + v +
+                              ", 8, 8]}\noutputs:\n  - {node: m, file: v.exr}\n");
+        CliRun r = run("validate " + (d / "g.yaml").string());
+        EXPECT_EQ(r.status, 1) << v;
+        EXPECT_NE(r.err.find(":5:"), std::string::npos) << v << ": " << r.err;
+        EXPECT_NE(r.err.find("beyond +-1e9"), std::string::npos) << v << ": " << r.err;
+    }
+}
+
+// A sphere of radius 1e30 was a float-to-int overflow (UBSan) in the splatter.
+TEST(CliNothingLost, AHugeSplatRadiusCooks) {
+    const fs::path d = fresh("huge_radius");
+    put(d / "g.yaml", "atlas: 1\nnodes:\n  m:\n    type: volume/metaballs\n    params: {resolution: [8, 8, 4], bounds_max: [8, 8, 4], spheres: '4 4 2 1e30'}\n"
+                      "outputs:\n  - {node: m, file: m.exr}\n");
+    CliRun r = run("cook " + (d / "g.yaml").string() + " --out " + (d / "out").string() + " --no-cache --quiet");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(fs::exists(d / "out" / "m.exr"));
+}
+
+// Under `ulimit -f` with SIGXFSZ at its default (a shell's), a writer used to
+// die by the signal; now it exits 1 naming the file.
+TEST(CliNothingLost, AFileSizeLimitIsAnErrorNotASignal) {
+    const fs::path d = fresh("ulimit");
+    put(d / "g.yaml", kNoise + "  - {node: n, file: v.exr}\n");
+    const std::string cmd = atlas::test::atlas_program() + " cook " + (d / "g.yaml").string() + " --out " + (d / "out").string() +
+                            " --no-cache --quiet >/dev/null 2>" + (d / "err").string();
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        ::signal(SIGXFSZ, SIG_DFL);
+        struct rlimit lim{rlim_t(2000), rlim_t(2000)};
+        ::setrlimit(RLIMIT_FSIZE, &lim);
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    int st = 0;
+    ASSERT_EQ(::waitpid(pid, &st, 0), pid);
+    ASSERT_TRUE(WIFEXITED(st)) << "killed by signal " << (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+    EXPECT_EQ(WEXITSTATUS(st), 1);
+    const std::string err = read_file_bytes(d / "err");
+    EXPECT_NE(err.find("File too large"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(d / "out" / "v.exr"));
+}
+
+// A deeply nested graph cost about 230 bytes of memory per input byte.
+TEST(CliNothingLost, DeeplyNestedYamlIsRefusedAtOnce) {
+    const fs::path d = fresh("nested");
+    for (const std::string& body : {std::string(200000, '['), [] {
+             std::string s;
+             for (int i = 0; i < 100000; ++i) s += "- ";
+             return s + "x\n";
+         }()}) {
+        put(d / "g.yaml", "atlas: 1\nnodes:\n" + body);
+        CliRun r = run("validate " + (d / "g.yaml").string());
+        EXPECT_EQ(r.status, 1);
+        EXPECT_NE(r.err.find("nested more than 64 levels deep"), std::string::npos) << r.err.substr(0, 400);
+    }
+}
+
+// Ctrl-C reached ndf/cirrus (and every node whose loops never polled) only when
+// the node ended. The parallel loops poll now: the cook stops within a second.
+TEST(CliNothingLost, CtrlCStopsALongNodeWithinASecond) {
+    const fs::path d = fresh("ctrl_c");
+    put(d / "g.yaml", "atlas: 1\nnodes:\n  c:\n    type: ndf/cirrus\n    params: {resolution: [6144, 6144]}\noutputs:\n  - {node: c, file: c.exr}\n");
+    const std::string cmd = "exec " + atlas::test::atlas_program() + " cook " + (d / "g.yaml").string() + " --out " + (d / "out").string() +
+                            " --no-cache --quiet >/dev/null 2>" + (d / "err").string();
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    ::usleep(1500 * 1000); // inside the node (it takes far longer than this)
+    ASSERT_EQ(::kill(pid, SIGINT), 0);
+    const auto t0 = std::chrono::steady_clock::now();
+    int st = 0;
+    ASSERT_EQ(::waitpid(pid, &st, 0), pid);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_TRUE(WIFEXITED(st));
+    EXPECT_EQ(WEXITSTATUS(st), 130) << read_file_bytes(d / "err");
+    // A second in the issue; a sanitized build on a loaded 2-core machine gets slack.
+    EXPECT_LT(seconds, 3.0);
+    EXPECT_FALSE(fs::exists(d / "out" / "c.exr"));
+}
