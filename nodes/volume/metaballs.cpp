@@ -1,10 +1,8 @@
 // volume/metaballs: density from spheres given as parameters and/or points with per-point radius.
 #include "atlas/volume/splat.h"
 #include "grid_params.h"
+#include "spheres_param.h"
 
-#include <cmath>
-#include <cstdlib>
-#include <sstream>
 
 namespace {
 using namespace atlas;
@@ -16,7 +14,7 @@ void declare(NodeDeclaration& d) {
     d.input("points", PortType::Points, "optional sphere centres; attributes 'radius' (m) and 'weight'").optional = true;
     d.output("out", PortType::Field3D, "density, channel 'density'");
     volume_nodes::declare_grid(d);
-    d.param_string("spheres", "").describe("spheres as 'x y z radius' in metres, separated by ';' (may be empty)");
+    volume_nodes::declare_spheres(d);
     d.param_enum("kernel", {"metaball", "sphere", "linear", "gaussian"}, "metaball").describe("falloff of each sphere");
     d.param_enum("blend", {"add", "max"}, "add").describe("how overlapping spheres combine");
     d.param_float("default_radius", 64).range(1e-6, 1e9).with_unit("m").describe("radius of points without a 'radius' attribute");
@@ -30,27 +28,9 @@ void cook(CookContext& ctx) {
     volume_nodes::check_grid_memory(ctx, res, 1);
     Points pts;
     if (ctx.has_input("points")) pts = *ctx.input_points("points");
-    std::stringstream all(ctx.get_string("spheres"));
     std::vector<float> radius = pts.attributes.count("radius") ? pts.attributes["radius"]
                                                                : std::vector<float>(pts.positions.size(), float(ctx.get_float("default_radius")));
-    const bool had_weight = pts.attributes.count("weight") > 0;
-    for (std::string item; std::getline(all, item, ';');) {
-        std::stringstream one(item);
-        std::vector<std::string> tok;
-        for (std::string t; one >> t;) tok.push_back(t);
-        if (tok.empty()) continue;
-        double v[4];
-        bool ok = tok.size() == 4;
-        for (size_t i = 0; ok && i < 4; ++i) {
-            char* end = nullptr;
-            v[i] = std::strtod(tok[i].c_str(), &end);
-            ok = end != tok[i].c_str() && *end == '\0' && std::isfinite(v[i]);
-        }
-        if (!ok) ctx.fail("spheres: expected 'x y z radius' (finite numbers) separated by ';', got '" + item + "'");
-        pts.positions.push_back({{float(v[0]), float(v[1]), float(v[2])}});
-        radius.push_back(float(v[3]));
-        if (had_weight) pts.attributes["weight"].push_back(1.0f);
-    }
+    volume_nodes::append_spheres(ctx, pts, radius);
     pts.attributes["radius"] = std::move(radius);
     volume::SplatOptions o;
     o.kernel = volume::parse_splat_kernel(ctx.get_string("kernel"));

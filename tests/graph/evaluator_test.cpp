@@ -682,7 +682,9 @@ TEST_F(Fixture, StagingLeftByAKilledCookIsRemoved) {
     for (const fs::path& root : {dir / "out", dir / "cache"}) {
         fs::create_directories(root / killed / "nvdf");
         std::ofstream(root / killed / "nvdf" / "big.tga") << std::string(10000, 'k');
+        std::ofstream(root / killed / ".atlas-staging") << "atlas staging folder"; // Atlas's marker: only marked folders are removed
         fs::create_directories(root / alive);
+        std::ofstream(root / alive / ".atlas-staging") << "atlas staging folder";
     }
     CookOptions o = options();
     o.cache_dir = dir / "cache";

@@ -242,10 +242,14 @@ TEST(BadInput, ExrHeaderClaimingMoreThanTheFileHoldsIsRefusedBeforeAllocating) {
         EXPECT_NE(std::string(e.what()).find("larger than the file"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
     }
-    // The same header with a claim the file can hold reaches OpenEXR (and fails
-    // there for the missing pixels, with an error, not a crash).
+    // The same header with a claim the file can hold passes the check and
+    // reaches OpenEXR (which reconstructs the one missing line).
     { std::ofstream(p, std::ios::binary | std::ios::trunc) << exr_claiming(1); }
-    EXPECT_THROW(read_exr(p, &budget), Error);
+    try {
+        read_exr(p, &budget);
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()).find("larger than the file"), std::string::npos) << e.what();
+    }
     // An opaque attribute claiming 2 GB in a tiny file.
     std::string opaque = bytes.substr(0, 8) + std::string("junk\0mytype\0", 12);
     const int32_t huge = 0x7fff0000;

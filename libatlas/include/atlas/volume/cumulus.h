@@ -1,0 +1,72 @@
+// atlas/volume/cumulus.h - cumulus anatomy from coarse shapes (issue 41).
+//
+// A coarse shape (a few metaballs, points, an interior fill) is smooth at
+// one scale: splatted and turned into a profile it reads as cotton balls.
+// Real cumulus (the Nubis pack's two clouds, docs/look.md) has lobes of
+// 25-80 m on lobes, facing up and out, towers where the shape rises, a flat
+// base at the condensation height with a thin skirt, billowy detail on the
+// tops and wispy detail below. Two steps give it:
+//   billow_spheres  adds generations of smaller spheres on the exposed,
+//                   up- and out-facing surface of the shape, and towers
+//                   (stacks of tapering spheres) on its highest spheres, in
+//                   the manner of Houdini's Cloud Shape Replicate;
+//   cumulus_channels paints detail type and density scale from the cloud's
+//                   SDF as the pack has them: detail type 1 on up-facing
+//                   surfaces fading to 0 some 60 m below them and on
+//                   undersides; density scale 0 at the base rising to 1.
+// Deterministic (hash_coords only), thread-count independent.
+#pragma once
+
+#include "atlas/core/field.h"
+#include "atlas/core/geometry.h"
+
+namespace atlas {
+class MemoryBudget;
+}
+
+namespace atlas::volume {
+
+struct BillowSpec {
+    int levels = 2;            // generations of smaller spheres (0: the shape as it is)
+    int children = 10;         // spheres tried per sphere of the previous generation
+    double ratio = 0.45;       // child radius / parent radius
+    double jitter = 0.3;       // relative spread of child radii (0..1)
+    double up_bias = 0.6;      // 0: children all round; 1: all on the upper half
+    double min_up = -0.3;      // no child where the direction's z is below this (undersides stay smooth)
+    double sink = 0.75;        // child centre at this fraction of the parent radius from its centre
+    double min_radius = 8;     // metres: smaller children are not made (a voxel or two)
+    double base_height = -1e9; // metres: no child below the condensation height
+    int towers = 0;            // stacks of spheres rising from the highest spheres
+    double tower_height = 200; // metres a tower rises above its sphere's top
+    double tower_taper = 0.85; // radius ratio from one tower sphere to the next
+    double tower_lean = 0.15;  // lateral drift per step, in radii
+    uint32_t seed = 1;
+};
+
+// The shape's spheres (positions and attribute 'radius', metres), then the
+// towers, then each generation of billows. A child is kept only where its
+// outer tip is not inside another sphere (billows grow on the exposed
+// surface). Throws atlas::Error on bad settings or a shape without radii.
+Points billow_spheres(const Points& shape, const BillowSpec& spec);
+
+struct CumulusPaintSpec {
+    double base_height = 0;     // metres: the condensation height (flat base)
+    double billow_depth = 60;   // metres below an up-facing surface where detail type reaches 0
+    double facing_low = -0.2;   // upward component of the surface normal where detail type starts
+    double facing_high = 0.7;   // ... and where it is full
+    double skirt = 40;          // metres above the base kept wispy (detail type 0)
+    double scale_floor = 0.05;  // density scale at the base
+    double scale_ramp = 180;    // metres over which density scale rises to 1
+};
+
+struct CumulusChannels {
+    Field3D detail_type;
+    Field3D density_scale;
+};
+
+// Detail type and density scale on the SDF's grid (one channel each, named
+// so), defined everywhere (also outside the cloud, so that filtering at the
+// edge reads the cloud's values). Throws atlas::Error on bad settings.
+CumulusChannels cumulus_channels(const Field3D& sdf, const CumulusPaintSpec& spec, const MemoryBudget* budget = nullptr);
+
+} // namespace atlas::volume

@@ -1,0 +1,46 @@
+// volume/cumulus_paint: detail type and density scale from a cloud's SDF, as the Nubis pack has them.
+#include "atlas/volume/cumulus.h"
+#include "atlas/graph/node.h"
+
+namespace {
+using namespace atlas;
+
+void declare(NodeDeclaration& d) {
+    d.doc("Paints a cumulus's detail type and density scale from its SDF, as Guerrilla's voxel pack has them "
+          "(docs/look.md): detail type 1 (billowy) on up-facing surfaces, fading to 0 (wispy) `billow_depth` below them, "
+          "0 on undersides and in the skirt above the base; density scale from `scale_floor` at the condensation height "
+          "to 1 over `scale_ramp`. Defined outside the cloud too, so filtering at its edge reads its values. Connect the "
+          "outputs to volume/nvdf's detail_type and density_scale.");
+    d.input("sdf", PortType::Field3D, "the cloud's signed distance (m, negative inside)");
+    d.output("detail_type", PortType::Field3D, "channel 'detail_type' (0 wispy .. 1 billowy)");
+    d.output("density_scale", PortType::Field3D, "channel 'density_scale'");
+    d.param_float("base_height", 0).range(-1e9, 1e9).with_unit("m").describe("condensation height (the flat base)");
+    d.param_float("billow_depth", 60).range(1e-3, 1e9).with_unit("m").describe("depth below an up-facing surface where detail type reaches 0");
+    d.param_float("facing_low", -0.2).range(-1, 1).describe("upward normal component where detail type starts");
+    d.param_float("facing_high", 0.7).range(-1, 1).describe("upward normal component where detail type is full");
+    d.param_float("skirt", 40).range(0, 1e9).with_unit("m").describe("height above the base kept wispy");
+    d.param_float("scale_floor", 0.05).range(0, 1).describe("density scale at the base");
+    d.param_float("scale_ramp", 180).range(0, 1e9).with_unit("m").describe("height over which density scale rises to 1");
+}
+
+void cook(CookContext& ctx) {
+    auto sdf = ctx.input_field3d("sdf");
+    ctx.check_memory(field_bytes(sdf->voxel_count(), 2), "the detail type and density scale grids");
+    volume::CumulusPaintSpec s;
+    s.base_height = ctx.get_float("base_height");
+    s.billow_depth = ctx.get_float("billow_depth");
+    s.facing_low = ctx.get_float("facing_low");
+    s.facing_high = ctx.get_float("facing_high");
+    if (!(s.facing_high > s.facing_low)) ctx.fail("'facing_high' must be above 'facing_low'");
+    s.skirt = ctx.get_float("skirt");
+    s.scale_floor = ctx.get_float("scale_floor");
+    s.scale_ramp = ctx.get_float("scale_ramp");
+    volume::CumulusChannels c = volume::cumulus_channels(*sdf, s, &ctx.budget());
+    ctx.set_output("detail_type", Field3DPtr(std::make_shared<Field3D>(std::move(c.detail_type))));
+    ctx.set_output("density_scale", Field3DPtr(std::make_shared<Field3D>(std::move(c.density_scale))));
+}
+} // namespace
+
+ATLAS_REGISTER_NODE(registry) {
+    registry.add({.name = "volume/cumulus_paint", .version = 1, .declare = declare, .cook = cook});
+}
