@@ -87,7 +87,7 @@ const std::vector<Command>& commands() {
         {"preview", "(GRAPH | FILES...) -o OUT.png [options]",
          "render what a graph writes (NDF set: 2.5D cloud layer over a curved Earth; NVDF set: voxel clouds; both: composited) or NVDF files",
          with_preview_flags({{"--out", "OUT.png", "output picture (also -o): PNG tone-mapped, .exr linear radiance + transmittance"}}, {
-          {"--noise", "FILE|auto|none", "voxel up-rez noise: a 4-channel volume file, auto (default: noise/nubis_set 128^3 cooked through the cache) or none"},
+          {"--noise", "FILE|auto|nubis|none", "voxel up-rez noise: a 4-channel volume file, nubis (noise/nubis_set 128^3 cooked through the cache), auto (default: nubis for an NVDF set, none for a plain density grid, which has its own detail) or none"},
           {"--voxel", "M", "voxel size in metres for files without bounds (TGA stacks)"},
           {"--sweep", "", "print fast-mode time and RMSE vs the reference per quality as CSV; -o writes the reference"},
           {"--turntable", "N", "N frames around the volume: OUT_000.png .."},

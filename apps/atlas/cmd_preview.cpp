@@ -310,7 +310,7 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
 
     Field3DPtr noise;
     const std::string noise_opt = a.has("--noise") ? a.get("--noise") : "auto";
-    if (noise_opt != "auto" && noise_opt != "none") noise = io::as_field3d(io::read_field_file(noise_opt));
+    if (noise_opt != "auto" && noise_opt != "none" && noise_opt != "nubis") noise = io::as_field3d(io::read_field_file(noise_opt));
     if (a.has("--cache") && a.has("--no-cache")) throw UsageError{"--cache and --no-cache contradict each other", "preview"};
     std::optional<std::filesystem::path> cache_dir;
     if (a.has("--cache")) cache_dir = a.get("--cache");
@@ -375,9 +375,13 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
         have_voxel = true;
     }
     if (have_voxel) {
-        // Voxel up-rez by default: the Nubis noise set (noise/nubis_set 128^3),
-        // cooked through the same cache as the graph.
-        if (noise_opt == "auto") noise = cook_voxel_noise(jobs, cache_dir, sink, quiet);
+        // Voxel up-rez by default for modelled clouds (an NVDF set): the Nubis
+        // noise set (noise/nubis_set 128^3), cooked through the same cache as
+        // the graph. A plain density grid (a sim, a production cloud) has its
+        // own detail: eroding it made foam, so it is drawn as it is.
+        if (noise_opt == "nubis" || (noise_opt == "auto" && !scene.density_grid_max)) noise = cook_voxel_noise(jobs, cache_dir, sink, quiet);
+        if (noise_opt == "auto" && scene.density_grid_max && !quiet)
+            std::fprintf(stderr, "noise: none for a plain density grid (its own detail is kept); --noise nubis or FILE up-rezzes it anyway\n");
         scene.noise = noise;
     }
     if (po.lightning && !have_layer) throw UsageError{"--lightning places flashes over a 2.5D layer; this preview has no NDF set", "preview"};

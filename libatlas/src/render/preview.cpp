@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <numbers>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -173,13 +174,19 @@ std::vector<PointLight> parse_point_lights(const std::string& text) {
 
 
 Box3d cloud_bounds(const CloudScene& scene) {
+    // Where the profile is positive (an NVDF's profile is positive exactly
+    // inside its SDF; a density grid's SDF is a conservative bound several
+    // voxels wider, which made its clouds look small in the frame).
     const Field3D& sdf = *scene.sdf;
-    const int c = std::max(0, sdf.find_channel("sdf"));
+    const bool profile = scene.modeling && scene.modeling->resolution() == sdf.resolution() && scene.modeling->channels() > 0;
+    const Field3D& f = profile ? *scene.modeling : sdf;
+    const int c = profile ? std::max(0, f.find_channel("dimensional_profile")) : std::max(0, sdf.find_channel("sdf")); // as the sampler picks them
+    auto inside = [&](int x, int y, int z) { return profile ? f.at(c, x, y, z) > 0 : f.at(c, x, y, z) < 0; };
     Vec3i lo{{sdf.nx(), sdf.ny(), sdf.nz()}}, hi{{-1, -1, -1}};
     for (int z = 0; z < sdf.nz(); ++z)
         for (int y = 0; y < sdf.ny(); ++y)
             for (int x = 0; x < sdf.nx(); ++x)
-                if (sdf.at(c, x, y, z) < 0) {
+                if (inside(x, y, z)) {
                     lo = {{std::min(lo[0], x), std::min(lo[1], y), std::min(lo[2], z)}};
                     hi = {{std::max(hi[0], x), std::max(hi[1], y), std::max(hi[2], z)}};
                 }
@@ -200,19 +207,88 @@ namespace {
 Camera voxel_camera(const CloudScene& scene, PreviewView view, double aspect, double azimuth, double elevation) {
     const Box3d b = cloud_bounds(scene);
     if (view == PreviewView::Ground || view == PreviewView::Auto) {
-        // From the ground at the south edge of the clouds, 2 m up (or under the
-        // lowest base when the clouds float high), pitched up so the bases and
-        // the lit flanks fill the frame: how cumulus is seen and photographed.
+        // From the ground south of the clouds, 2 m up (or under the lowest base
+        // when the clouds float high), pitched up at the bases and the lit
+        // flanks: how cumulus is seen and photographed. Far enough back that the
+        // clouds fill about half the frame height (issue 41: a third to two
+        // thirds; it was 0.1 of their depth, and a cloud overflowed the frame).
         Camera c;
         c.fov_deg = 60;
         const Vec3d size = b.max - b.min;
         const double ground = scene.modeling->bounds().min[2];
-        c.position = {{0.5 * (b.min[0] + b.max[0]), b.min[1] - 0.1 * size[1], std::max(ground + 2.0, b.min[2] - 0.25 * size[2])}};
-        c.look_at = {{0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), b.max[2] + 0.25 * size[2]}};
+        const double cz = std::max(ground + 2.0, b.min[2] - 0.25 * size[2]);
+        const double half = 0.5 * c.fov_deg * std::numbers::pi / 180;
+        const double target = half; // the clouds' angular height: half the field of view
+        auto extent = [&](double d) { return std::atan2(b.max[2] - cz, d) - std::atan2(b.min[2] - cz, d); };
+        double lo = 1e-3, hi = 1e7; // extent falls as the distance grows
+        for (int i = 0; i < 100; ++i) {
+            const double mid = std::sqrt(lo * hi);
+            (extent(mid) > target ? lo : hi) = mid;
+        }
+        // Measured to the clouds' nearest side (a field's near clouds fill the
+        // frame, the far ones rise behind them). A field wider than the frame
+        // runs past its sides, as a sky photographed from the ground does.
+        (void)aspect;
+        const double d = hi;
+        const double pitch = 0.5 * (std::atan2(b.max[2] - cz, d) + std::atan2(b.min[2] - cz, d));
+        const double x = 0.5 * (b.min[0] + b.max[0]);
+        c.position = {{x, b.min[1] - d, cz}};
+        c.look_at = {{x, b.min[1], cz + d * std::tan(pitch)}};
         return c;
     }
     if (view == PreviewView::Aerial) return framing_camera(b, aspect, 30, 55);
     return framing_camera(b, aspect, azimuth, elevation);
+}
+
+// A plain density grid's units: cloud water (kg/kg) becomes density for the
+// preview's extinction; a picture that would be nearly empty says why.
+void density_grid_units(CloudScene& scene, const PreviewOptions& o, std::vector<std::string>& notes) {
+    const double dmax = *scene.density_grid_max;
+    const bool kgkg = o.density_units == DensityUnits::KgPerKg || (o.density_units == DensityUnits::Auto && dmax > 0 && dmax < 0.02);
+    double densest = dmax;
+    if (kgkg && dmax > 0 && o.extinction > 0) {
+        // Liquid water content = mixing ratio x air density (1 kg/m3 declared); extinction
+        // 3 LWC / (2 rho_water r_eff) = 150 LWC per metre for 10 um droplets.
+        const double k = 150.0 / o.extinction;
+        // density_grid_scene renders (profile x S)^0.6: scaling S by k^(1/0.6) scales the density by k.
+        scene.uniform_density_scale = static_cast<float>(double(*scene.uniform_density_scale) * std::pow(k, 1.0 / 0.6));
+        densest = dmax * k;
+        char buf[256];
+        std::snprintf(buf, sizeof buf, "density units: kg/kg cloud water (densest voxel %.3g%s): extinction 150 x mixing ratio per metre (%s)", dmax,
+                      o.density_units == DensityUnits::Auto ? ", under 0.02" : "",
+                      o.density_units == DensityUnits::Auto ? "--density-units density reads the values as density" : "--density-units kg/kg");
+        notes.push_back(buf);
+    }
+    // The largest optical depth straight through the grid along an axis: the
+    // densities density_grid_scene renders, (profile x S)^0.6, summed per line.
+    const Field3D& m = *scene.modeling;
+    const int cp = std::max(0, m.find_channel("dimensional_profile"));
+    const double S = *scene.uniform_density_scale;
+    const Vec3i r = m.resolution();
+    const Vec3d h = m.voxel_size();
+    std::vector<double> sx(size_t(r[1]) * r[2], 0.0), sy(size_t(r[0]) * r[2], 0.0), sz(size_t(r[0]) * r[1], 0.0);
+    for (int z = 0; z < r[2]; ++z)
+        for (int y = 0; y < r[1]; ++y)
+            for (int x = 0; x < r[0]; ++x) {
+                const double p = m.at(cp, x, y, z);
+                if (!(p > 0)) continue;
+                const double d = std::pow(p * S, 0.6);
+                sx[size_t(z) * r[1] + y] += d * h[0];
+                sy[size_t(z) * r[0] + x] += d * h[1];
+                sz[size_t(y) * r[0] + x] += d * h[2];
+            }
+    double line = 0;
+    for (const auto* v : {&sx, &sy, &sz})
+        for (double t : *v) line = std::max(line, t);
+    const double tau = o.extinction * line;
+    if (tau < 0.1) {
+        char buf[320];
+        std::snprintf(buf, sizeof buf,
+                      "density: the picture will be nearly empty: the densest line through the grid has an optical depth of %.3g at --extinction %g "
+                      "(densest voxel %.3g); raise --extinction or set --density-units",
+                      tau, o.extinction, densest);
+        notes.push_back(buf);
+    }
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
@@ -251,6 +327,7 @@ PreviewJob prepare_preview(std::optional<CloudScene> voxel, std::optional<LayerS
     if (voxel) {
         voxel->noise_tile = o.noise_tile;
         validate_scene(*voxel);
+        if (voxel->density_grid_max) density_grid_units(*voxel, o, job.notes);
     }
     if (layer) {
         layer->time = o.time;
@@ -274,7 +351,8 @@ PreviewJob prepare_preview(std::optional<CloudScene> voxel, std::optional<LayerS
     } else if (o.view != PreviewView::Auto || look == PreviewLook::Graph) {
         s.camera = voxel_camera(*voxel, o.view, aspect, o.azimuth, o.elevation);
     } else {
-        s.camera = framing_camera(bounds, aspect, o.azimuth, o.elevation);
+        // The clouds, not the volume: a cloud in a 4-8 km box was a speck.
+        s.camera = framing_camera(cloud_bounds(*voxel), aspect, o.azimuth, o.elevation);
     }
     s.threads = threads;
     // A graph's voxel clouds get the 2.5D mode's daylight.

@@ -26,7 +26,7 @@ bool PreviewOptions::operator==(const PreviewOptions& o) const {
            mode == o.mode && quality == o.quality && extinction == o.extinction && noise_tile == o.noise_tile && artistic == o.artistic &&
            ms_octaves == o.ms_octaves && ms_diffusion == o.ms_diffusion && ms_diffusion_sweeps == o.ms_diffusion_sweeps && light_grid == o.light_grid &&
            time == o.time && wind == o.wind && earth_radius == o.earth_radius &&
-           edge == o.edge && envelope == o.envelope;
+           edge == o.edge && envelope == o.envelope && density_units == o.density_units;
 }
 
 namespace {
@@ -243,6 +243,14 @@ std::vector<TextOption<P>> make_preview_options() {
              -inf, inf, {"auto", "on", "off"}},
             "auto", "",
             [](P& p, const V& v) { p.envelope = v.word == "on" ? PreviewEnvelope::On : v.word == "off" ? PreviewEnvelope::Off : PreviewEnvelope::Auto; }),
+        opt({"density_units", "--density-units", "auto|density|kg/kg", K::Choice,
+             "a plain density grid's values: density (x extinction per metre), or cloud water in kg/kg (a solver's; extinction 150 x "
+             "mixing ratio per metre, air 1 kg/m3, droplets 10 um); auto = kg/kg when the densest voxel is under 0.02",
+             -inf, inf, {"auto", "density", "kg/kg"}},
+            "auto", "",
+            [](P& p, const V& v) {
+                p.density_units = v.word == "density" ? DensityUnits::Density : v.word == "kg/kg" ? DensityUnits::KgPerKg : DensityUnits::Auto;
+            }),
     };
     return table;
 }

@@ -176,6 +176,7 @@ CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
     s.sdf = std::move(sdf);
     s.uniform_detail_type = 0.0f;
     s.uniform_density_scale = static_cast<float>(S);
+    s.density_grid_max = dmax;
     validate_scene(s);
     return s;
 }

@@ -25,6 +25,10 @@ namespace atlas::render {
 // whole volume (voxels) or the layer orbit (2.5D).
 enum class PreviewView { Auto, Orbit, Ground, Aerial };
 enum class PreviewEnvelope { Auto, On, Off };
+// What a plain density grid's values are (a file previewed as it is, not an NVDF).
+// Auto: density, unless the densest voxel is under 0.02, which no density grid
+// has and cloud water does (a solver's mixing ratio peaks near 0.003 kg/kg).
+enum class DensityUnits { Auto, Density, KgPerKg };
 
 // Every option of a preview; the member initializers are the schema's default_text
 // (a test checks they agree).
@@ -61,6 +65,7 @@ struct PreviewOptions {
     double earth_radius = 6360e3;
     std::optional<MapEdge> edge; // unset: layer_preview_scene's choice
     PreviewEnvelope envelope = PreviewEnvelope::Auto;
+    DensityUnits density_units = DensityUnits::Auto;
 
     bool operator==(const PreviewOptions&) const;
 };

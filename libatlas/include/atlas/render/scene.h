@@ -36,6 +36,11 @@ struct CloudScene {
     double noise_tile = 256; // metres per noise period, > 0
     std::optional<float> uniform_detail_type;
     std::optional<float> uniform_density_scale;
+    // Set for a plain density grid (measured or simulated data, not a modelled
+    // NVDF): its densest voxel. Such data is previewed as it is (no up-rez by
+    // default: it has its own detail, and erosion made foam of it) and its
+    // units are read (PreviewOptions::density_units).
+    std::optional<float> density_grid_max;
 };
 
 // A scene from one 4-channel "vdb_set" field (volume/nvdf's output, or
