@@ -209,14 +209,21 @@ Camera voxel_camera(const CloudScene& scene, PreviewView view, double aspect, do
     if (view == PreviewView::Ground || view == PreviewView::Auto) {
         // From the ground south of the clouds, 2 m up (or under the lowest base
         // when the clouds float high), pitched up at the bases and the lit
-        // flanks: how cumulus is seen and photographed. Far enough back that the
-        // clouds fill about half the frame height (issue 41: a third to two
-        // thirds; it was 0.1 of their depth, and a cloud overflowed the frame).
+        // flanks: how cumulus is seen and photographed. A cloud (not a field):
+        // far enough back that it fills about half the frame height (issue 41:
+        // a third to two thirds; at 0.1 of its depth it overflowed the frame).
         Camera c;
         c.fov_deg = 60;
         const Vec3d size = b.max - b.min;
         const double ground = scene.modeling->bounds().min[2];
         const double cz = std::max(ground + 2.0, b.min[2] - 0.25 * size[2]);
+        if (std::max(size[0], size[1]) > 4 * size[2]) {
+            // A field of clouds (far wider than tall): stand at its south edge
+            // and look up across it, the sky photographed from under it.
+            c.position = {{0.5 * (b.min[0] + b.max[0]), b.min[1] - 0.1 * size[1], cz}};
+            c.look_at = {{0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), b.max[2] + 0.25 * size[2]}};
+            return c;
+        }
         const double half = 0.5 * c.fov_deg * std::numbers::pi / 180;
         const double target = half; // the clouds' angular height: half the field of view
         auto extent = [&](double d) { return std::atan2(b.max[2] - cz, d) - std::atan2(b.min[2] - cz, d); };

@@ -52,11 +52,15 @@ Points billow_spheres(const Points& shape, const BillowSpec& spec);
 struct CumulusPaintSpec {
     double base_height = 0;     // metres: the condensation height (flat base)
     double billow_depth = 60;   // metres below an up-facing surface where detail type reaches 0
-    double facing_low = -0.2;   // upward component of the surface normal where detail type starts
-    double facing_high = 0.7;   // ... and where it is full
+    // The pack's own values are about -0.2 / 0.7 (sides 0.3), a floor near 0
+    // and a 180 m ramp (docs/look.md); under Atlas's preview up-rez (256 m
+    // noise tiles) those sides and that thin base shred, so the defaults keep
+    // more of the surface billowy and the base denser (a darker flat base).
+    double facing_low = -0.9;   // upward component of the surface normal where detail type starts
+    double facing_high = 0.2;   // ... and where it is full
     double skirt = 40;          // metres above the base kept wispy (detail type 0)
-    double scale_floor = 0.05;  // density scale at the base
-    double scale_ramp = 180;    // metres over which density scale rises to 1
+    double scale_floor = 0.6;   // density scale at the base
+    double scale_ramp = 120;    // metres over which density scale rises to 1
 };
 
 struct CumulusChannels {
