@@ -14,6 +14,8 @@ P() { "$ATLAS" preview "$@" --size 640x360 --quiet; }
 
 P examples/quickstart.yaml -o "$OUT/look_quickstart.png"
 P graphs/cloudscape.yaml --camera 1900,400,2,1800,1800,300 -o "$OUT/look_cloudscape.png"
+P graphs/cloudscape.yaml --camera 1100,700,60,1050,1400,330 --fov 55 -o "$OUT/look_cloudscape_cumulus.png"
+P graphs/towering_cumulus.yaml -o "$OUT/look_towering_cumulus.png"
 P graphs/hzd_weather.yaml -o "$OUT/look_hzd_weather.png"
 P graphs/hzd_weather.yaml --camera 30000,-20000,20000,30000,60000,33000 --fov 90 -o "$OUT/look_hzd_horizon.png"
 P graphs/hzd_weather.yaml --set type.out_max=0 -o "$OUT/look_hzd_stratus.png"
