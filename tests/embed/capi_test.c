@@ -349,6 +349,12 @@ static void test_c_node_types(void) {
                                   cook_broken, NULL) == ATLAS_INVALID_ARGUMENT);
     CHECK(strstr(atlas_registry_error(reg), "unknown port type 'volume'") != NULL);
     CHECK(atlas_registry_add_node(reg, "{not json", cook_broken, NULL) == ATLAS_INVALID_ARGUMENT);
+    /* An int3 default past int's range was a float-to-int overflow (UBSan): refused by name. */
+    CHECK(atlas_registry_add_node(reg,
+                                  "{\"name\": \"host/big\", \"outputs\": [{\"name\": \"out\", \"type\": \"field3d\"}], "
+                                  "\"params\": [{\"name\": \"res\", \"type\": \"int3\", \"default\": [1e20, 1, 1]}]}",
+                                  cook_broken, NULL) == ATLAS_INVALID_ARGUMENT);
+    CHECK(strstr(atlas_registry_error(reg), "within +-2^31") != NULL);
     CHECK(atlas_registry_add_node(reg, "{\"name\": \"host/broken\", \"outputs\": [{\"name\": \"out\", \"type\": \"field3d\"}]}",
                                   cook_broken, NULL) == ATLAS_OK);
 

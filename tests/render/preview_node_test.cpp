@@ -51,9 +51,11 @@ TEST(RenderPreviewNode, MatchesLibraryRender) {
     ASSERT_EQ(image->height(), 12);
     ASSERT_EQ(image->channels(), 4);
     ASSERT_EQ(preview->channels(), 3);
-    // Same as the library with the node's defaults (auto camera, the preview sun of preview_settings).
+    // Same as the library with the node's defaults (auto camera: the orbit framing
+    // the clouds, not the whole volume; the preview sun of preview_settings).
     auto scene = render::scene_from_nvdf_set(set);
     auto s = render::preview_settings(set->bounds(), 20, 12);
+    s.camera = render::framing_camera(render::cloud_bounds(scene), 20.0 / 12.0);
     auto r = render::render_clouds(scene, s);
     EXPECT_TRUE(r.image == *image);
     EXPECT_TRUE(render::tone_map(r.image, 1.5) == *preview);
@@ -80,6 +82,7 @@ TEST(RenderPreviewNode, LightsSkyAndFlashParamsReachTheRenderer) {
     // The same through the library.
     auto scene = render::scene_from_nvdf_set(set);
     auto s = render::preview_settings(set->bounds(), 20, 12);
+    s.camera = render::framing_camera(render::cloud_bounds(scene), 20.0 / 12.0);
     s.sky_horizon = Vec3f{{0.9f, 0.8f, 0.6f}};
     s.lights = {{{{50, 50, 50}}, {{1, 0.5f, 0.2f}}, 2e4, 0}, {{{10, 20, 30}}, {{0, 0, 1}}, 1e3, 40}};
     auto r = render::render_clouds(scene, s);

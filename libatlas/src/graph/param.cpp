@@ -122,6 +122,9 @@ std::string ParamDecl::check(const ParamValue& v) const {
         if (int(xs.size()) != n) return expect + ", got " + std::to_string(xs.size());
         for (double d : xs) {
             if (integral && std::isfinite(d) && d != std::floor(d)) return expect + ", got " + format_number(d);
+            // Int2/Int3 components become ints: past int's range the conversion is undefined behaviour.
+            if (integral && std::isfinite(d) && (d < -2147483648.0 || d > 2147483647.0))
+                return expect + " within +-2^31, got " + format_number(d);
             if (auto e = in_range(d); !e.empty()) return e;
         }
         return "";
