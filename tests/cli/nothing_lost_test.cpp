@@ -279,3 +279,23 @@ TEST(CliNothingLost, CtrlCStopsALongNodeWithinASecond) {
     EXPECT_LT(seconds, 3.0);
     EXPECT_FALSE(fs::exists(d / "out" / "c.exr"));
 }
+
+// A large junk file named .png was offered to every OpenImageIO reader when the
+// PNG reader refused it (DICOM read all of 1 GiB in 410 s, Ctrl-C ignored). Only
+// the reader the extension names is tried now: refused at once, naming the file.
+TEST(CliNothingLost, AJunkPngIsRefusedByThePngReaderAlone) {
+    const fs::path d = fresh("junk_png");
+    {
+        std::ofstream f(d / "junk.png", std::ios::binary);
+        std::string block(1 << 20, '\0');
+        for (size_t i = 0; i < block.size(); ++i) block[i] = char((i * 2654435761u) >> 13);
+        for (int k = 0; k < 64; ++k) f << block; // 64 MiB
+    }
+    put(d / "g.yaml", "atlas: 1\nnodes:\n  i:\n    type: import/image\n    params: {file: junk.png}\noutputs:\n  - {node: i, file: o.exr}\n");
+    const auto t0 = std::chrono::steady_clock::now();
+    CliRun r = run("cook " + (d / "g.yaml").string() + " --out " + (d / "out").string() + " --no-cache --quiet");
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("junk.png"), std::string::npos) << r.err;
+    EXPECT_LT(seconds, 15.0); // the hash of 64 MiB is most of it; every reader took minutes
+}
