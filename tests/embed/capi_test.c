@@ -442,18 +442,23 @@ static void* hold_cook(void* user) {
     return NULL;
 }
 
+/* A session cooking kGraph on thread *t, held in its cancel callback until h->release. */
+static void start_held_cook(struct Hold* h, const char* name, pthread_t* t) {
+    atomic_init(&h->started, 0);
+    atomic_init(&h->release, 0);
+    h->s = NULL;
+    h->status = ATLAS_ERROR;
+    CHECK(atlas_session_create(&h->s) == ATLAS_OK);
+    CHECK_OK(h->s, atlas_session_load_text(h->s, kGraph, name, NULL));
+    CHECK(pthread_create(t, NULL, hold_cook, h) == 0);
+    while (!atomic_load(&h->started)) {
+    }
+}
+
 static void test_one_call_at_a_time(void) {
     struct Hold h;
-    atomic_init(&h.started, 0);
-    atomic_init(&h.release, 0);
-    h.s = NULL;
-    h.status = ATLAS_ERROR;
-    CHECK(atlas_session_create(&h.s) == ATLAS_OK);
-    CHECK_OK(h.s, atlas_session_load_text(h.s, kGraph, "busy.yaml", NULL));
     pthread_t t;
-    CHECK(pthread_create(&t, NULL, hold_cook, &h) == 0);
-    while (!atomic_load(&h.started)) {
-    }
+    start_held_cook(&h, "busy.yaml", &t);
     CHECK(atlas_session_set_float(h.s, "coverage", "in_min", 0.5) == ATLAS_BUSY);
     CHECK(strcmp(atlas_status_name(ATLAS_BUSY), "busy") == 0);
     AtlasSession* other = NULL;
@@ -481,16 +486,8 @@ static void* release_later(void* user) {
 
 static void test_destroy_during_a_cook(void) {
     struct Hold h;
-    atomic_init(&h.started, 0);
-    atomic_init(&h.release, 0);
-    h.s = NULL;
-    h.status = ATLAS_ERROR;
-    CHECK(atlas_session_create(&h.s) == ATLAS_OK);
-    CHECK_OK(h.s, atlas_session_load_text(h.s, kGraph, "destroy.yaml", NULL));
     pthread_t cook, releaser;
-    CHECK(pthread_create(&cook, NULL, hold_cook, &h) == 0);
-    while (!atomic_load(&h.started)) {
-    }
+    start_held_cook(&h, "destroy.yaml", &cook);
     CHECK(pthread_create(&releaser, NULL, release_later, &h) == 0);
     atlas_session_destroy(h.s); /* waits for the cook */
     CHECK(atomic_load(&h.release) == 1);
