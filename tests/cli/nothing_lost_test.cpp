@@ -299,3 +299,71 @@ TEST(CliNothingLost, AJunkPngIsRefusedByThePngReaderAlone) {
     EXPECT_NE(r.err.find("junk.png"), std::string::npos) << r.err;
     EXPECT_LT(seconds, 15.0); // the hash of 64 MiB is most of it; every reader took minutes
 }
+
+namespace {
+// Runs an atlas command line under a file-size limit with SIGXFSZ at its default.
+int run_under_file_limit(const std::string& args, long bytes, const fs::path& err) {
+    const std::string cmd = atlas::test::atlas_program() + " " + args + " >/dev/null 2>" + err.string();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::signal(SIGXFSZ, SIG_DFL);
+        struct rlimit lim{rlim_t(bytes), rlim_t(bytes)};
+        ::setrlimit(RLIMIT_FSIZE, &lim);
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    int st = 0;
+    ::waitpid(pid, &st, 0);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+} // namespace
+
+// `preview -o X.exr` on a full disk exited 0 with a 0-byte file (OpenEXR wrote its
+// offset table from a destructor that swallowed the error); a JSON table gave no reason.
+TEST(CliNothingLost, FullDiskPreviewExrAndJsonTableFailWithTheReason) {
+    const fs::path d = fresh("full_exr_json");
+    put(d / "g.yaml", kNoise + "  - {node: n, file: v.exr}\n");
+    ASSERT_EQ(run("cook " + (d / "g.yaml").string() + " --out " + d.string() + " --no-cache --quiet").status, 0);
+    const int st = run_under_file_limit("preview " + (d / "v.exr").string() + " -o " + (d / "pic.exr").string() + " --size 96x54 --quiet", 4000,
+                                        d / "err");
+    EXPECT_EQ(st, 1) << read_file_bytes(d / "err");
+    EXPECT_NE(read_file_bytes(d / "err").find("pic"), std::string::npos) << read_file_bytes(d / "err");
+    EXPECT_FALSE(fs::exists(d / "pic.exr"));
+    // Without the limit the same preview writes the picture (the test fails for the right reason).
+    ASSERT_EQ(run("preview " + (d / "v.exr").string() + " -o " + (d / "pic.exr").string() + " --size 96x54 --quiet").status, 0);
+    EXPECT_GT(fs::file_size(d / "pic.exr"), 4000u);
+
+    put(d / "t.yaml", "atlas: 1\nnodes:\n  n:\n    type: ndf/noise\n    params: {resolution: [64, 64]}\noutputs:\n  - {node: n, file: t.json}\n");
+    ASSERT_EQ(run("cook " + (d / "t.yaml").string() + " --out " + (d / "ok").string() + " --no-cache --quiet").status, 0);
+    EXPECT_EQ(run_under_file_limit("cook " + (d / "t.yaml").string() + " --out " + (d / "full").string() + " --no-cache --quiet", 4000, d / "err"), 1);
+    EXPECT_NE(read_file_bytes(d / "err").find("File too large"), std::string::npos) << read_file_bytes(d / "err");
+}
+
+// A node result entry whose ports are not the node's (a forger's, or another
+// version's) was a `map::at` error; it is a warned re-cook.
+TEST(CliNothingLost, ACacheEntryWithTheWrongPortIsAWarnedRecook) {
+    const fs::path d = fresh("wrong_port");
+    put(d / "g.yaml", kNoise + "  - {node: n, file: v.exr}\n");
+    const std::string cook = "cook " + (d / "g.yaml").string() + " --cache " + (d / "cache").string() + " --quiet --out ";
+    ASSERT_EQ(run(cook + (d / "o1").string()).status, 0);
+    int rewritten = 0;
+    for (const auto& e : fs::directory_iterator(d / "cache"))
+        if (e.path().extension() == ".atlascache") {
+            const std::string hex = e.path().stem().string();
+            atlas::Hash128 key;
+            key.hi = std::stoull(hex.substr(0, 16), nullptr, 16);
+            key.lo = std::stoull(hex.substr(16, 16), nullptr, 16);
+            auto v = atlas::disk_cache::load(d / "cache", key);
+            ASSERT_TRUE(v.has_value());
+            atlas::NodeOutputs renamed;
+            for (auto& [port, value] : *v) renamed["not_" + port] = value;
+            atlas::disk_cache::store(d / "cache", key, renamed); // bound to the right key: only the ports are wrong
+            ++rewritten;
+        }
+    ASSERT_GT(rewritten, 0);
+    CliRun r = run(cook + (d / "o2").string());
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("it has no output 'out'"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("map::at"), std::string::npos) << r.err;
+    EXPECT_EQ(read_file_bytes(d / "o2" / "v.exr"), read_file_bytes(d / "o1" / "v.exr"));
+}
