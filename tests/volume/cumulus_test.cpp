@@ -125,3 +125,36 @@ TEST(CumulusPaint, UpFacingTopsBillowyUndersidesWispyDensityRisesFromTheBase) {
     s.billow_depth = 0;
     EXPECT_THROW(volume::cumulus_channels(sdf, s), Error);
 }
+
+// A capsule's SDF filled with spheres: the deepest ball first (the capsule's
+// radius), a stack along its axis, every voxel deep enough claimed, and the
+// balls inside the shape (issue 41: a solver's cloud becomes coarse spheres).
+TEST(SdfSpheres, FillAShapeDeepestFirstAndStayInside) {
+    const Vec3i res{{32, 32, 64}};
+    Field3D sdf(res, 1, Box3d{{{0, 0, 0}}, {{320, 320, 640}}}, {"sdf"});
+    auto capsule = [](const Vec3d& p) {
+        const double z = std::clamp(p[2], 200.0, 440.0);
+        return std::sqrt((p[0] - 160) * (p[0] - 160) + (p[1] - 160) * (p[1] - 160) + (p[2] - z) * (p[2] - z)) - 80;
+    };
+    for (int z = 0; z < 64; ++z)
+        for (int y = 0; y < 32; ++y)
+            for (int x = 0; x < 32; ++x) sdf.at(0, x, y, z) = float(capsule(sdf.voxel_center(x, y, z)));
+    volume::SphereFillSpec s;
+    s.min_radius = 20;
+    const Points p = volume::spheres_from_sdf(sdf, s);
+    const auto& r = p.attributes.at("radius");
+    ASSERT_GE(p.positions.size(), 3u);
+    EXPECT_GT(r[0], 70); // the capsule's own radius, less half a voxel
+    for (size_t i = 1; i < r.size(); ++i) EXPECT_LE(r[i], r[i - 1] + 1e-3); // deepest first
+    double zmin = 1e9, zmax = -1e9;
+    for (size_t i = 0; i < r.size(); ++i) {
+        const Vec3f& c = p.positions[i];
+        EXPECT_LE(capsule({{c[0], c[1], c[2]}}) + r[i], 10.0) << i; // inside, within a voxel
+        if (r[i] > 60) zmin = std::min(zmin, double(c[2])), zmax = std::max(zmax, double(c[2]));
+    }
+    EXPECT_LT(zmin, 260); // a stack along the axis, end to end
+    EXPECT_GT(zmax, 380);
+    EXPECT_EQ(volume::spheres_from_sdf(sdf, s), p); // deterministic
+    s.cover = 0;
+    EXPECT_THROW(volume::spheres_from_sdf(sdf, s), Error);
+}

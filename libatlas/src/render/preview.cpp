@@ -203,6 +203,21 @@ Box3d cloud_bounds(const CloudScene& scene) {
 
 namespace {
 
+// The centre of the voxel column (x, y) holding the most cloud (profile > 0),
+// at the height of its middle; the first such column in index order on ties.
+Vec3d heaviest_column(const CloudScene& scene) {
+    const Field3D& f = *scene.modeling;
+    const int c = std::max(0, f.find_channel("dimensional_profile"));
+    const Vec3i r = f.resolution();
+    std::vector<int> count(size_t(r[0]) * r[1], 0);
+    for (int z = 0; z < r[2]; ++z)
+        for (int y = 0; y < r[1]; ++y)
+            for (int x = 0; x < r[0]; ++x)
+                if (f.at(c, x, y, z) > 0) ++count[size_t(y) * r[0] + x];
+    const size_t best = size_t(std::max_element(count.begin(), count.end()) - count.begin());
+    return f.voxel_center(int(best % size_t(r[0])), int(best / size_t(r[0])), r[2] / 2);
+}
+
 // The voxel view presets (ground, aerial, orbit) over the clouds' box.
 Camera voxel_camera(const CloudScene& scene, PreviewView view, double aspect, double azimuth, double elevation) {
     const Box3d b = cloud_bounds(scene);
@@ -217,11 +232,13 @@ Camera voxel_camera(const CloudScene& scene, PreviewView view, double aspect, do
         const Vec3d size = b.max - b.min;
         const double ground = scene.modeling->bounds().min[2];
         const double cz = std::max(ground + 2.0, b.min[2] - 0.25 * size[2]);
+        const Vec3d heavy = heaviest_column(scene); // the biggest cloud: the column holding the most cloud
         if (std::max(size[0], size[1]) > 4 * size[2]) {
             // A field of clouds (far wider than tall): stand at its south edge
-            // and look up across it, the sky photographed from under it.
-            c.position = {{0.5 * (b.min[0] + b.max[0]), b.min[1] - 0.1 * size[1], cz}};
-            c.look_at = {{0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), b.max[2] + 0.25 * size[2]}};
+            // and look up across it toward its biggest cloud, the sky
+            // photographed from under it (the field fills a third or more).
+            c.position = {{heavy[0], b.min[1] - 0.1 * size[1], cz}};
+            c.look_at = {{heavy[0], 0.5 * (b.min[1] + b.max[1]), b.max[2] + 0.25 * size[2]}};
             return c;
         }
         const double half = 0.5 * c.fov_deg * std::numbers::pi / 180;
@@ -232,15 +249,14 @@ Camera voxel_camera(const CloudScene& scene, PreviewView view, double aspect, do
             const double mid = std::sqrt(lo * hi);
             (extent(mid) > target ? lo : hi) = mid;
         }
-        // Measured to the clouds' nearest side (a field's near clouds fill the
-        // frame, the far ones rise behind them). A field wider than the frame
-        // runs past its sides, as a sky photographed from the ground does.
-        (void)aspect;
+        (void)aspect; // a field wider than the frame runs past its sides, as a photographed sky does
         const double d = hi;
         const double pitch = 0.5 * (std::atan2(b.max[2] - cz, d) + std::atan2(b.min[2] - cz, d));
-        const double x = 0.5 * (b.min[0] + b.max[0]);
-        c.position = {{x, b.min[1] - d, cz}};
-        c.look_at = {{x, b.min[1], cz + d * std::tan(pitch)}};
+        // Facing the biggest cloud from the south, at that distance from it;
+        // nearer clouds stand in front of it. The box's centre line missed
+        // sparse scenes (two towers and a puff 4 km apart).
+        c.position = {{heavy[0], heavy[1] - d, cz}};
+        c.look_at = {{heavy[0], heavy[1], cz + d * std::tan(pitch)}};
         return c;
     }
     if (view == PreviewView::Aerial) return framing_camera(b, aspect, 30, 55);

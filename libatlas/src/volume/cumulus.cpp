@@ -134,6 +134,51 @@ Points billow_spheres(const Points& shape, const BillowSpec& spec) {
     return out;
 }
 
+Points spheres_from_sdf(const Field3D& sdf, const SphereFillSpec& s) {
+    if (!(s.min_radius > 0) || !std::isfinite(s.min_radius)) throw Error("spheres_from_sdf: 'min_radius' must be finite and > 0");
+    if (!(s.max_radius >= s.min_radius)) throw Error("spheres_from_sdf: 'max_radius' must be at least 'min_radius'");
+    if (!(s.cover > 0 && s.cover <= 1)) throw Error("spheres_from_sdf: 'cover' must be in (0, 1]");
+    if (s.max_spheres < 1) throw Error("spheres_from_sdf: 'max_spheres' must be >= 1");
+    if (sdf.channels() < 1) throw Error("spheres_from_sdf: the SDF has no channel");
+    const Vec3i r = sdf.resolution();
+    const Vec3d h = sdf.voxel_size();
+    auto d = sdf.channel(0);
+    std::vector<size_t> order;
+    for (size_t i = 0; i < d.size(); ++i)
+        if (std::isfinite(d[i]) && -double(d[i]) >= s.min_radius) order.push_back(i);
+    // Deepest first; ties by index, so the result never depends on the sort's stability.
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return d[a] != d[b] ? d[a] < d[b] : a < b; });
+    std::vector<uint8_t> claimed(d.size(), 0);
+    Points out;
+    std::vector<float> radius;
+    const size_t sx = 1, sy = size_t(r[0]), sz = size_t(r[0]) * size_t(r[1]);
+    for (size_t i : order) {
+        if (claimed[i]) continue;
+        const int x = int(i % sy), y = int((i / sy) % size_t(r[1])), z = int(i / sz);
+        const double rad = std::min(-double(d[i]), s.max_radius);
+        const Vec3d c = sdf.voxel_center(x, y, z);
+        out.positions.push_back({{float(c[0]), float(c[1]), float(c[2])}});
+        radius.push_back(float(rad));
+        if (int(out.positions.size()) >= s.max_spheres) break;
+        const double claim = s.cover * rad;
+        int lo[3], hi[3];
+        const int at[3] = {x, y, z};
+        for (int a = 0; a < 3; ++a) {
+            const int k = int(std::ceil(claim / h[a]));
+            lo[a] = std::max(0, at[a] - k);
+            hi[a] = std::min(r[a] - 1, at[a] + k);
+        }
+        for (int zz = lo[2]; zz <= hi[2]; ++zz)
+            for (int yy = lo[1]; yy <= hi[1]; ++yy)
+                for (int xx = lo[0]; xx <= hi[0]; ++xx) {
+                    const double dx = (xx - x) * h[0], dy = (yy - y) * h[1], dz = (zz - z) * h[2];
+                    if (dx * dx + dy * dy + dz * dz <= claim * claim) claimed[size_t(zz) * sz + size_t(yy) * sy + size_t(xx) * sx] = 1;
+                }
+    }
+    out.attributes["radius"] = std::move(radius);
+    return out;
+}
+
 CumulusChannels cumulus_channels(const Field3D& sdf, const CumulusPaintSpec& s, const MemoryBudget* budget) {
     for (double v : {s.base_height, s.billow_depth, s.facing_low, s.facing_high, s.skirt, s.scale_floor, s.scale_ramp})
         if (!std::isfinite(v)) throw Error("cumulus_channels: every setting must be finite");

@@ -49,6 +49,20 @@ struct BillowSpec {
 // surface). Throws atlas::Error on bad settings or a shape without radii.
 Points billow_spheres(const Points& shape, const BillowSpec& spec);
 
+struct SphereFillSpec {
+    double min_radius = 16;   // metres: thinner parts get no sphere of their own
+    double max_radius = 1e9;  // metres: larger inscribed balls are capped (a tall tower becomes a stack)
+    double cover = 0.7;       // a sphere claims the voxels within this fraction of its radius
+    int max_spheres = 4096;
+};
+
+// Spheres that fill a shape given as an SDF (negative inside): the deepest
+// uncovered voxel first, its inscribed ball (radius -sdf, capped), until every
+// voxel at least min_radius deep is claimed. Turns a solver's cloud, a mesh or
+// any field into the coarse spheres billow_spheres grows (issue 41: solver to
+// cloud). Points with attribute 'radius'. Deterministic (ties by voxel index).
+Points spheres_from_sdf(const Field3D& sdf, const SphereFillSpec& spec);
+
 struct CumulusPaintSpec {
     double base_height = 0;     // metres: the condensation height (flat base)
     double billow_depth = 60;   // metres below an up-facing surface where detail type reaches 0
