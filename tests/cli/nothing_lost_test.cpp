@@ -8,6 +8,7 @@
 #include "../support/cli_run.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -366,4 +367,26 @@ TEST(CliNothingLost, ACacheEntryWithTheWrongPortIsAWarnedRecook) {
     EXPECT_NE(r.err.find("it has no output 'out'"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("map::at"), std::string::npos) << r.err;
     EXPECT_EQ(read_file_bytes(d / "o2" / "v.exr"), read_file_bytes(d / "o1" / "v.exr"));
+}
+
+// A failed cook commits nothing; its report listed the outputs it had staged as
+// "written", with sizes and hashes of files that were never written (issue 44).
+TEST(CliNothingLost, AFailedCooksReportListsNothingAsWritten) {
+    const fs::path d = fresh("failed_report");
+    put(d / "g.yaml", kNoise + "  - {node: n, file: a.exr}\n  - {node: n, file: b.dds, options: {encoding: bc4, max_error: 0.00001}}\n");
+    CliRun r = run("cook " + (d / "g.yaml").string() + " --out " + (d / "out").string() + " --no-cache --quiet --report " + (d / "r.json").string());
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_FALSE(fs::exists(d / "out" / "a.exr"));
+    const auto j = nlohmann::json::parse(read_file_bytes(d / "r.json"));
+    EXPECT_EQ(j.at("status"), "failed");
+    bool saw_a = false;
+    for (const auto& o : j.at("outputs")) {
+        EXPECT_NE(o.value("status", ""), "written") << o.dump();
+        EXPECT_TRUE(o.at("written").empty()) << o.dump();
+        if (o.at("file") == "a.exr") {
+            saw_a = true;
+            EXPECT_EQ(o.value("status", ""), "not written") << o.dump();
+        }
+    }
+    EXPECT_TRUE(saw_a) << j.dump();
 }

@@ -153,15 +153,27 @@ std::map<std::string, Hash128> Session::node_hashes() const {
 }
 
 CookResult Session::cook(const CookOptions& options) {
+    // A failed cook commits nothing: outputs it had encoded and staged were
+    // never moved into place, so the report must not call them written.
+    auto nothing_written = [&] {
+        for (OutputReport& o : last_.outputs)
+            if (o.status == "written" || o.status == "restored") {
+                o.status = "not written";
+                o.written.clear();
+                o.files.clear();
+            }
+    };
     try {
         return run(options, nullptr, nullptr);
     } catch (const CancelledError& e) {
         last_.status = "cancelled";
         last_.error = e.what();
+        nothing_written();
         throw;
     } catch (const std::exception& e) {
         last_.status = "failed";
         last_.error = e.what();
+        nothing_written();
         if (!last_.error_node.empty()) {
             NodeReport& r = last_.nodes[last_.error_node];
             if (graph_)

@@ -67,7 +67,8 @@ struct OutputReport {
     std::map<std::string, double> metrics; // what the writer measured, e.g. a DDS encode's errors
     // "written" (encoded and written), "restored" (copied from the disk
     // cache's encoded files), "up to date" (the files on disk already held
-    // it: not touched); empty when outputs are not written.
+    // it: not touched), "not written" (a failed or cancelled cook had
+    // encoded it, but committed nothing); empty when outputs are not written.
     std::string status;
     std::vector<OutputFileReport> files; // every file of the output, written or not
 };
