@@ -2,6 +2,9 @@
 #include "atlas/volume/cumulus.h"
 #include "atlas/graph/node.h"
 
+#include <algorithm>
+#include <string>
+
 namespace {
 using namespace atlas;
 
@@ -35,6 +38,15 @@ void cook(CookContext& ctx) {
     s.skirt = ctx.get_float("skirt");
     s.scale_floor = ctx.get_float("scale_floor");
     s.scale_ramp = ctx.get_float("scale_ramp");
+    // A condensation height at or above the cloud's top leaves no cloud above its base.
+    double top = -1e300;
+    for (int z = 0; z < sdf->nz(); ++z)
+        for (int y = 0; y < sdf->ny(); ++y)
+            for (int x = 0; x < sdf->nx(); ++x)
+                if (sdf->at(0, x, y, z) < 0) top = std::max(top, sdf->voxel_center(x, y, z)[2]);
+    if (top > -1e300 && s.base_height >= top)
+        ctx.fail("'base_height' " + std::to_string(s.base_height) + " m is at or above the cloud's top (" + std::to_string(top) +
+                 " m): the condensation height must lie below the cloud");
     volume::CumulusChannels c = volume::cumulus_channels(*sdf, s, &ctx.budget());
     ctx.set_output("detail_type", Field3DPtr(std::make_shared<Field3D>(std::move(c.detail_type))));
     ctx.set_output("density_scale", Field3DPtr(std::make_shared<Field3D>(std::move(c.density_scale))));

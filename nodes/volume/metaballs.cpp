@@ -3,6 +3,8 @@
 #include "grid_params.h"
 #include "spheres_param.h"
 
+#include <cstdio>
+
 
 namespace {
 using namespace atlas;
@@ -39,6 +41,33 @@ void cook(CookContext& ctx) {
     o.radius_scale = ctx.get_float("radius_scale");
     o.weight = ctx.get_float("weight");
     ctx.metric("spheres", double(pts.positions.size()));
+    // Spheres that miss the grid add nothing; cut ones are clipped clouds.
+    size_t outside = 0, cut = 0;
+    std::string first_cut;
+    for (size_t i = 0; i < pts.positions.size(); ++i) {
+        const double r = double(pts.attributes["radius"][i]) * o.radius_scale;
+        bool misses = false, crosses = false;
+        for (int a = 0; a < 3; ++a) {
+            const double c = pts.positions[i][a];
+            misses = misses || c + r <= box.min[a] || c - r >= box.max[a];
+            crosses = crosses || c - r < box.min[a] || c + r > box.max[a];
+        }
+        outside += misses;
+        if (!misses && crosses && cut++ == 0) {
+            char b[128];
+            std::snprintf(b, sizeof b, " (the first: %g %g %g radius %g)", pts.positions[i][0], pts.positions[i][1], pts.positions[i][2], r);
+            first_cut = b;
+        }
+    }
+    auto where = [&] {
+        char b[160];
+        std::snprintf(b, sizeof b, "the grid [%g, %g, %g] - [%g, %g, %g] m", box.min[0], box.min[1], box.min[2], box.max[0], box.max[1], box.max[2]);
+        return std::string(b);
+    };
+    if (!pts.positions.empty() && outside == pts.positions.size())
+        ctx.fail("every sphere lies outside " + where() + ": check 'spheres' (or the points) against 'bounds_min' and 'bounds_max'");
+    if (outside) ctx.warn(std::to_string(outside) + " of " + std::to_string(pts.positions.size()) + " spheres lie outside " + where() + " and add nothing");
+    if (cut) ctx.warn(std::to_string(cut) + " spheres cross the faces of " + where() + first_cut + ": the cloud is cut there ('bounds_min', 'bounds_max')");
     ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(volume::splat_points(pts, res, box, o, &ctx.budget()))));
 }
 } // namespace

@@ -14,7 +14,7 @@ import pytest
 
 SOURCE = pathlib.Path(os.environ.get("ATLAS_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
 VOXEL = 8.0
-RES = (128, 128, 64)
+RES = (128, 128, 96)
 BASE = 170.0
 
 
