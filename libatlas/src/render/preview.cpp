@@ -281,6 +281,11 @@ void density_grid_units(CloudScene& scene, const PreviewOptions& o, std::vector<
                       o.density_units == DensityUnits::Auto ? ", under 0.02" : "",
                       o.density_units == DensityUnits::Auto ? "--density-units density reads the values as density" : "--density-units kg/kg");
         notes.push_back(buf);
+        // Optical depth per voxel past ~5: the artistic multiple-scattering terms
+        // draw such cores as dark blotches, the physical model does not.
+        const Vec3d v = scene.modeling->voxel_size();
+        if (densest * o.extinction * std::min({v[0], v[1], v[2]}) > 5 && o.artistic)
+            notes.push_back("density: the densest voxels are optically very thick (over 5 per voxel): --artistic off draws them best");
     }
     // The largest optical depth straight through the grid along an axis: the
     // densities density_grid_scene renders, (profile x S)^0.6, summed per line.
