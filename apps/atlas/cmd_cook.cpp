@@ -179,8 +179,9 @@ int run_cook(const Args& a) {
     if (a.has("--tiles") || a.has("--tile") || a.has("--assemble")) return run_cook_tiled(a, o);
     if (a.has("--report") && a.has("--depfile") && std::filesystem::path(a.get("--report")).lexically_normal() == std::filesystem::path(a.get("--depfile")).lexically_normal())
         throw UsageError{"--report and --depfile name one file", "cook"};
-    check_side_file(a, "--report", cook_files(a, {}));
-    check_side_file(a, "--depfile", cook_files(a, {}));
+    const std::vector<ProtectedFile> graphs = cook_files(a, {});
+    check_side_file(a, "--report", graphs);
+    check_side_file(a, "--depfile", graphs);
 
     // Every graph cooks in its own session (one graph's nodes never see
     // another's) with the same options, so they share the disk cache.

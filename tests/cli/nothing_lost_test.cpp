@@ -39,6 +39,24 @@ CliRun run(const std::string& args) {
 void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
 const std::string kNoise = "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params: {resolution: [16, 16, 4], seed: 3}\noutputs:\n";
+
+// Runs `atlas ARGS` under a file-size limit with SIGXFSZ at its default (a
+// shell's), stderr to `err`; returns the wait status.
+int run_under_file_limit(const std::string& args, long bytes, const fs::path& err) {
+    const std::string cmd = atlas::test::atlas_program() + " " + args + " >/dev/null 2>" + err.string();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::signal(SIGXFSZ, SIG_DFL);
+        struct rlimit lim{rlim_t(bytes), rlim_t(bytes)};
+        ::setrlimit(RLIMIT_FSIZE, &lim);
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    int st = -1;
+    if (pid < 0 || ::waitpid(pid, &st, 0) != pid) return -1;
+    return st;
+}
+int exit_code(int wait_status) { return WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : -1; }
 } // namespace
 
 TEST(CliNothingLost, ReportAndDepfileRefuseLinksFifosAndTheGraph) {
@@ -220,19 +238,7 @@ TEST(CliNothingLost, AHugeSplatRadiusCooks) {
 TEST(CliNothingLost, AFileSizeLimitIsAnErrorNotASignal) {
     const fs::path d = fresh("ulimit");
     put(d / "g.yaml", kNoise + "  - {node: n, file: v.exr}\n");
-    const std::string cmd = atlas::test::atlas_program() + " cook " + (d / "g.yaml").string() + " --out " + (d / "out").string() +
-                            " --no-cache --quiet >/dev/null 2>" + (d / "err").string();
-    const pid_t pid = ::fork();
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-        ::signal(SIGXFSZ, SIG_DFL);
-        struct rlimit lim{rlim_t(2000), rlim_t(2000)};
-        ::setrlimit(RLIMIT_FSIZE, &lim);
-        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-        ::_exit(127);
-    }
-    int st = 0;
-    ASSERT_EQ(::waitpid(pid, &st, 0), pid);
+    const int st = run_under_file_limit("cook " + (d / "g.yaml").string() + " --out " + (d / "out").string() + " --no-cache --quiet", 2000, d / "err");
     ASSERT_TRUE(WIFEXITED(st)) << "killed by signal " << (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
     EXPECT_EQ(WEXITSTATUS(st), 1);
     const std::string err = read_file_bytes(d / "err");
@@ -301,23 +307,6 @@ TEST(CliNothingLost, AJunkPngIsRefusedByThePngReaderAlone) {
     EXPECT_LT(seconds, 15.0); // the hash of 64 MiB is most of it; every reader took minutes
 }
 
-namespace {
-// Runs an atlas command line under a file-size limit with SIGXFSZ at its default.
-int run_under_file_limit(const std::string& args, long bytes, const fs::path& err) {
-    const std::string cmd = atlas::test::atlas_program() + " " + args + " >/dev/null 2>" + err.string();
-    const pid_t pid = ::fork();
-    if (pid == 0) {
-        ::signal(SIGXFSZ, SIG_DFL);
-        struct rlimit lim{rlim_t(bytes), rlim_t(bytes)};
-        ::setrlimit(RLIMIT_FSIZE, &lim);
-        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-        ::_exit(127);
-    }
-    int st = 0;
-    ::waitpid(pid, &st, 0);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-} // namespace
 
 // `preview -o X.exr` on a full disk exited 0 with a 0-byte file (OpenEXR wrote its
 // offset table from a destructor that swallowed the error); a JSON table gave no reason.
@@ -325,8 +314,8 @@ TEST(CliNothingLost, FullDiskPreviewExrAndJsonTableFailWithTheReason) {
     const fs::path d = fresh("full_exr_json");
     put(d / "g.yaml", kNoise + "  - {node: n, file: v.exr}\n");
     ASSERT_EQ(run("cook " + (d / "g.yaml").string() + " --out " + d.string() + " --no-cache --quiet").status, 0);
-    const int st = run_under_file_limit("preview " + (d / "v.exr").string() + " -o " + (d / "pic.exr").string() + " --size 96x54 --quiet", 4000,
-                                        d / "err");
+    const int st = exit_code(run_under_file_limit("preview " + (d / "v.exr").string() + " -o " + (d / "pic.exr").string() + " --size 96x54 --quiet",
+                                                  4000, d / "err"));
     EXPECT_EQ(st, 1) << read_file_bytes(d / "err");
     EXPECT_NE(read_file_bytes(d / "err").find("pic"), std::string::npos) << read_file_bytes(d / "err");
     EXPECT_FALSE(fs::exists(d / "pic.exr"));
@@ -336,7 +325,7 @@ TEST(CliNothingLost, FullDiskPreviewExrAndJsonTableFailWithTheReason) {
 
     put(d / "t.yaml", "atlas: 1\nnodes:\n  n:\n    type: ndf/noise\n    params: {resolution: [64, 64]}\noutputs:\n  - {node: n, file: t.json}\n");
     ASSERT_EQ(run("cook " + (d / "t.yaml").string() + " --out " + (d / "ok").string() + " --no-cache --quiet").status, 0);
-    EXPECT_EQ(run_under_file_limit("cook " + (d / "t.yaml").string() + " --out " + (d / "full").string() + " --no-cache --quiet", 4000, d / "err"), 1);
+    EXPECT_EQ(exit_code(run_under_file_limit("cook " + (d / "t.yaml").string() + " --out " + (d / "full").string() + " --no-cache --quiet", 4000, d / "err")), 1);
     EXPECT_NE(read_file_bytes(d / "err").find("File too large"), std::string::npos) << read_file_bytes(d / "err");
 }
 

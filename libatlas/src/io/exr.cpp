@@ -333,12 +333,23 @@ void check_exr_claims(const fs::path& path, const MemoryBudget& budget) {
     std::error_code ec;
     const uint64_t file_size = fs::file_size(path, ec);
     if (!in || ec) throw Error("cannot open the file");
-    // Headers are small; 16 MiB is far past any real one.
-    std::string head(size_t(std::min<uint64_t>(file_size, 16u << 20)), '\0');
-    in.read(head.data(), std::streamsize(head.size()));
+    // Headers are small: read as far as the walk goes (every EXR read passes
+    // here before OpenEXR reads the file again), never past 16 MiB, which is
+    // far past any real header.
+    const size_t cap = size_t(std::min<uint64_t>(file_size, 16u << 20));
+    std::string head;
+    auto more = [&] {
+        if (head.size() >= cap) return false;
+        const size_t old = head.size();
+        head.resize(std::min(cap, std::max<size_t>(4096, 2 * old)));
+        in.read(head.data() + old, std::streamsize(head.size() - old));
+        head.resize(old + size_t(in.gcount()));
+        return head.size() > old;
+    };
     size_t pos = 0;
     auto need = [&](size_t n) {
-        if (head.size() - pos < n) throw Error("the header is truncated");
+        while (head.size() - pos < n)
+            if (!more()) throw Error("the header is truncated");
     };
     auto i32 = [&] {
         need(4);
@@ -348,7 +359,9 @@ void check_exr_claims(const fs::path& path, const MemoryBudget& budget) {
         return v;
     };
     auto cstr = [&] {
-        const size_t end = head.find('\0', pos);
+        size_t end;
+        while ((end = head.find('\0', pos)) == std::string::npos && head.size() - pos <= 255 && more()) {
+        }
         if (end == std::string::npos || end - pos > 255) throw Error("an attribute name is not terminated");
         std::string v = head.substr(pos, end - pos);
         pos = end + 1;

@@ -173,7 +173,23 @@ std::vector<PointLight> parse_point_lights(const std::string& text) {
 }
 
 
-Box3d cloud_bounds(const CloudScene& scene) {
+namespace {
+
+// The clouds' occupied box and, when asked, the centre of the voxel column
+// (x, y) holding the most cloud (profile > 0) at the height of its middle,
+// the first such column in index order on ties. One pass over the grid serves
+// both where the profile decides the box (its grid is the SDF's).
+struct CloudExtent {
+    Box3d bounds;
+    Vec3d heaviest{{0, 0, 0}};
+};
+
+Vec3d heaviest_of(const Field3D& f, const std::vector<int>& count) {
+    const size_t best = size_t(std::max_element(count.begin(), count.end()) - count.begin());
+    return f.voxel_center(int(best % size_t(f.nx())), int(best / size_t(f.nx())), f.nz() / 2);
+}
+
+CloudExtent scan_clouds(const CloudScene& scene, bool want_column) {
     // Where the profile is positive (an NVDF's profile is positive exactly
     // inside its SDF; a density grid's SDF is a conservative bound several
     // voxels wider, which made its clouds look small in the frame).
@@ -182,6 +198,7 @@ Box3d cloud_bounds(const CloudScene& scene) {
     const Field3D& f = profile ? *scene.modeling : sdf;
     const int c = profile ? std::max(0, f.find_channel("dimensional_profile")) : std::max(0, sdf.find_channel("sdf")); // as the sampler picks them
     auto inside = [&](int x, int y, int z) { return profile ? f.at(c, x, y, z) > 0 : f.at(c, x, y, z) < 0; };
+    std::vector<int> count(want_column && profile ? size_t(sdf.nx()) * sdf.ny() : 0, 0);
     Vec3i lo{{sdf.nx(), sdf.ny(), sdf.nz()}}, hi{{-1, -1, -1}};
     for (int z = 0; z < sdf.nz(); ++z)
         for (int y = 0; y < sdf.ny(); ++y)
@@ -189,39 +206,47 @@ Box3d cloud_bounds(const CloudScene& scene) {
                 if (inside(x, y, z)) {
                     lo = {{std::min(lo[0], x), std::min(lo[1], y), std::min(lo[2], z)}};
                     hi = {{std::max(hi[0], x), std::max(hi[1], y), std::max(hi[2], z)}};
+                    if (!count.empty()) ++count[size_t(y) * sdf.nx() + x];
                 }
+    CloudExtent e;
     const Box3d b = sdf.bounds();
-    if (hi[0] < 0) return b;
-    const Vec3d v = sdf.voxel_size();
-    Box3d r;
-    for (int a = 0; a < 3; ++a) {
-        r.min[a] = b.min[a] + lo[a] * v[a];
-        r.max[a] = b.min[a] + (hi[a] + 1) * v[a];
+    if (hi[0] < 0) {
+        e.bounds = b;
+    } else {
+        const Vec3d v = sdf.voxel_size();
+        for (int a = 0; a < 3; ++a) {
+            e.bounds.min[a] = b.min[a] + lo[a] * v[a];
+            e.bounds.max[a] = b.min[a] + (hi[a] + 1) * v[a];
+        }
     }
-    return r;
+    if (want_column && profile) {
+        e.heaviest = heaviest_of(f, count);
+    } else if (want_column) {
+        // The modeling grid differs from the SDF's: count its own profile.
+        const Field3D& m = *scene.modeling;
+        const int cp = std::max(0, m.find_channel("dimensional_profile"));
+        std::vector<int> mc(size_t(m.nx()) * m.ny(), 0);
+        for (int z = 0; z < m.nz(); ++z)
+            for (int y = 0; y < m.ny(); ++y)
+                for (int x = 0; x < m.nx(); ++x)
+                    if (m.at(cp, x, y, z) > 0) ++mc[size_t(y) * m.nx() + x];
+        e.heaviest = heaviest_of(m, mc);
+    }
+    return e;
 }
+
+} // namespace
+
+Box3d cloud_bounds(const CloudScene& scene) { return scan_clouds(scene, false).bounds; }
 
 namespace {
 
-// The centre of the voxel column (x, y) holding the most cloud (profile > 0),
-// at the height of its middle; the first such column in index order on ties.
-Vec3d heaviest_column(const CloudScene& scene) {
-    const Field3D& f = *scene.modeling;
-    const int c = std::max(0, f.find_channel("dimensional_profile"));
-    const Vec3i r = f.resolution();
-    std::vector<int> count(size_t(r[0]) * r[1], 0);
-    for (int z = 0; z < r[2]; ++z)
-        for (int y = 0; y < r[1]; ++y)
-            for (int x = 0; x < r[0]; ++x)
-                if (f.at(c, x, y, z) > 0) ++count[size_t(y) * r[0] + x];
-    const size_t best = size_t(std::max_element(count.begin(), count.end()) - count.begin());
-    return f.voxel_center(int(best % size_t(r[0])), int(best / size_t(r[0])), r[2] / 2);
-}
-
 // The voxel view presets (ground, aerial, orbit) over the clouds' box.
 Camera voxel_camera(const CloudScene& scene, PreviewView view, double aspect, double azimuth, double elevation) {
-    const Box3d b = cloud_bounds(scene);
-    if (view == PreviewView::Ground || view == PreviewView::Auto) {
+    const bool ground_view = view == PreviewView::Ground || view == PreviewView::Auto;
+    const CloudExtent clouds = scan_clouds(scene, ground_view);
+    const Box3d& b = clouds.bounds;
+    if (ground_view) {
         // From the ground south of the clouds, 2 m up (or under the lowest base
         // when the clouds float high), pitched up at the bases and the lit
         // flanks: how cumulus is seen and photographed. A cloud (not a field):
@@ -232,7 +257,7 @@ Camera voxel_camera(const CloudScene& scene, PreviewView view, double aspect, do
         const Vec3d size = b.max - b.min;
         const double ground = scene.modeling->bounds().min[2];
         const double cz = std::max(ground + 2.0, b.min[2] - 0.25 * size[2]);
-        const Vec3d heavy = heaviest_column(scene); // the biggest cloud: the column holding the most cloud
+        const Vec3d& heavy = clouds.heaviest; // the biggest cloud: the column holding the most cloud
         if (std::max(size[0], size[1]) > 4 * size[2]) {
             // A field of clouds (far wider than tall): stand at its south edge
             // and look up across it toward its biggest cloud, the sky
