@@ -28,6 +28,10 @@ std::span<const NumberOption<SuperstormStencil>> superstorm_options() {
         {"noise_scale", &S::noise_scale, 1e-6, 1e6, "", "noise cells across the radius"},
         {"anvil", &S::anvil, 0, 1, "", "anvil spread at the centre (the anvil map only)"},
         {"anvil_lift", &S::anvil_lift, 0, 20000, "m", "how far the anvil rises above max_height at bias 1 (the anvil map only)"},
+        {"height_core", &S::height_core, -1, 0.999, "", "fraction of the radius where the heights are the storm's (a flat base that wide); -1 = core"},
+        {"edge_noise", &S::edge_noise, 0, 0.999, "", "wobble of the footprint's edge (coverage and types); 0 = round"},
+        {"stretch", &S::stretch, 1, 100, "", "downwind radius over radius: 1 a disc, > 1 a plume spreading downwind"},
+        {"wind_direction", &S::wind_direction, -360, 360, "deg", "direction the plume spreads toward (0: +x, 90: +y)"},
     };
     return options;
 }
@@ -39,10 +43,26 @@ void validate(const SuperstormStencil& s) {
 }
 
 bool stencil_touches(const SuperstormStencil& s, const Box2d& b) {
+    // The plume lies inside the disc of its downwind radius (a cheap, safe test).
+    const double reach = s.radius * s.stretch;
     const double dx = std::max({b.min[0] - s.center[0], 0.0, s.center[0] - b.max[0]});
     const double dy = std::max({b.min[1] - s.center[1], 0.0, s.center[1] - b.max[1]});
-    return dx * dx + dy * dy < s.radius * s.radius;
+    return dx * dx + dy * dy < reach * reach;
 }
+
+namespace {
+// The footprint's radial distance of offset d: the plain length for a disc
+// (bit-identical to before plumes), the downwind half squeezed by stretch.
+double footprint_radius(const SuperstormStencil& s, Vec2d d) {
+    if (s.stretch == 1) return length(d);
+    const double t = s.wind_direction * (3.14159265358979323846 / 180.0);
+    const double ca = std::cos(t), sa = std::sin(t);
+    double a = d[0] * ca + d[1] * sa;
+    const double c = -d[0] * sa + d[1] * ca;
+    if (a > 0) a /= s.stretch;
+    return std::sqrt(a * a + c * c);
+}
+} // namespace
 
 Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const MemoryBudget* budget) {
     check_ndf_set(set);
@@ -54,25 +74,45 @@ Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const M
     parallel_for_index(set.height(), [&](int y) {
         for (int x = 0; x < set.width(); ++x) {
             const Vec2d d = set.texel_center(x, y) - s.center;
-            const double r = length(d);
+            const double r = footprint_radius(s, d);
             if (!(r < s.radius)) continue; // beyond the radius: unchanged
-            const double g = 1.0 - smoothstep(s.core * s.radius, s.radius, r);
-            const double w = s.blend * g;
             const size_t i = set.index(x, y);
             auto mix = [&](int c, double target, double weight) {
                 out.channel(c)[i] = float(lerp(double(set.channel(c)[i]), target, weight));
             };
+            // Distorted radius: the wobble vanishes at the centre and at the rim.
+            const double k = s.noise_scale / s.radius;
+            const double n = noise::value_noise(d[0] * k + 4096.0, d[1] * k + 4096.0, 0.0, period, s.seed);
+            const double rd = r * (1.0 + s.distortion * (2.0 * n - 1.0) * (1.0 - r / s.radius));
+            // The footprint's own wobble (edge_noise, a second octave at twice
+            // the frequency): 0 keeps the round footprint, bit-identical.
+            double rc = r;
+            if (s.edge_noise > 0) {
+                const double n2 = noise::value_noise(d[0] * 2 * k + 8192.0, d[1] * 2 * k + 8192.0, 0.0, period, s.seed + 1);
+                rc = r * (1.0 + s.edge_noise * ((2.0 * n - 1.0) * 0.6 + (2.0 * n2 - 1.0) * 0.4) * (1.0 - r / s.radius));
+            }
+            const double g = 1.0 - smoothstep(s.core * s.radius, s.radius, rc);
+            const double w = s.blend * g;
+            const double hc = s.height_core >= 0 ? s.height_core : s.core;
+            const double wh = s.blend * (1.0 - smoothstep(hc * s.radius, s.radius, rd));
+            if (s.sheet) {
+                // The anvil sheet: flat top, underside rising to the ragged rim.
+                if (!(wh > 0)) continue;
+                out.channel(Coverage)[i] = float(s.coverage * wh);
+                mix(Type, s.storm_type, wh);
+                mix(TopType, s.storm_type, wh);
+                mix(BottomType, std::max(double(set.channel(BottomType)[i]), s.bottom_type), wh);
+                out.channel(SuperstormCoverage)[i] = float(std::max(double(set.channel(SuperstormCoverage)[i]), w));
+                out.channel(MaxHeight)[i] = float(s.max_height);
+                out.channel(MinHeight)[i] = float(s.max_height - (s.max_height - s.min_height) * wh);
+                continue;
+            }
             const double cov = set.channel(Coverage)[i];
             mix(Coverage, std::max(cov, s.coverage), w);
             mix(Type, s.storm_type, w);
             mix(TopType, s.storm_type, w);
             mix(BottomType, std::max(double(set.channel(BottomType)[i]), s.bottom_type), w);
             out.channel(SuperstormCoverage)[i] = float(std::max(double(set.channel(SuperstormCoverage)[i]), w));
-            // Distorted radius: the wobble vanishes at the centre and at the rim.
-            const double k = s.noise_scale / s.radius;
-            const double n = noise::value_noise(d[0] * k + 4096.0, d[1] * k + 4096.0, 0.0, period, s.seed);
-            const double rd = r * (1.0 + s.distortion * (2.0 * n - 1.0) * (1.0 - r / s.radius));
-            const double wh = s.blend * (1.0 - smoothstep(s.core * s.radius, s.radius, rd));
             mix(MinHeight, s.min_height, wh);
             mix(MaxHeight, s.max_height, wh);
         }
@@ -95,7 +135,7 @@ Field2D superstorm_anvil(const Field2D& set, const SuperstormStencil& s, const F
     if (s.blend == 0 || s.anvil == 0) return out;
     parallel_for_index(set.height(), [&](int y) {
         for (int x = 0; x < set.width(); ++x) {
-            const double r = length(set.texel_center(x, y) - s.center);
+            const double r = footprint_radius(s, set.texel_center(x, y) - s.center);
             if (!(r < s.radius)) continue;
             const double w = s.anvil * s.blend * (1.0 - smoothstep(s.core * s.radius, s.radius, r));
             const size_t i = set.index(x, y);

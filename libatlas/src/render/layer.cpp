@@ -306,6 +306,11 @@ Vec2d diffusion_patch_centre(const LayerModel& m, const Camera& cam, double eart
     return {{cam.position[0], cam.position[1]}};
 }
 
+// The march's optical-depth bound per step in cloud, and the shortest step it asks for.
+constexpr double kMaxStepTau = 1.0;
+constexpr double kMinCappedStep = 2.0; // metres
+constexpr int kEntryBisections = 4;
+
 struct LayerIntegrator {
     const LayerModel& m;
     const LayerScene& sc;
@@ -423,6 +428,11 @@ struct LayerIntegrator {
             const double t_end = seg[2 * si + 1];
             bool first = true, searching = true;
             int zero_run = 0;
+            // In cloud, a step is at most kMaxStepTau / quality optical depths
+            // (set from the last sample's extinction): a 700 m step into a
+            // storm whose mean free path is 25 m put each pixel's surface at a
+            // random depth, a grain that 16x the samples did not show.
+            double tau_cap = std::numeric_limits<double>::infinity();
             while (t < t_end && steps < kMaxSteps) {
                 ++steps;
                 // Capped at max_step near the camera; beyond 20 km the cap grows
@@ -441,8 +451,29 @@ struct LayerIntegrator {
                     if (use_envelope) {
                         const double skip = m.skip_distance(p, dir, h);
                         if (skip > 2 * dt) {
-                            t += skip;
+                            // Walk the search's own strides over the empty stretch
+                            // without sampling: every stride whose sample point lies
+                            // in it would have found nothing, so the march goes on
+                            // exactly where it would have without the envelope (same
+                            // picture; jumping straight to the skip's end followed the
+                            // smooth envelope and carved terraces into cloud tops).
+                            const double end = t + skip;
                             ++skipped;
+                            bool ended = false;
+                            for (;;) {
+                                const double len = std::min(2 * dt, t_end - t);
+                                if (!(t + 0.5 * len < end)) break; // this stride's sample may see cloud
+                                t += len;
+                                if (!(t < t_end && steps < kMaxSteps)) {
+                                    ended = true; // where the march would have ended
+                                    break;
+                                }
+                                ++steps;
+                                const double tn = s.artistic ? t : t - seg[0];
+                                dt = std::min(std::max(max_step, 0.02 * tn / step_quality), base_step * (1 + tn / grow));
+                            }
+                            if (ended) break;
+                            --steps; // the next pass counts the stride it takes
                             continue;
                         }
                     }
@@ -452,6 +483,19 @@ struct LayerIntegrator {
                     if (m.density(q, m.altitude(q), false) > 0) {
                         searching = false;
                         zero_run = 0;
+                        // Find where the stride entered the cloud (bisection on the
+                        // cheap shape, to 1/16 of the half stride): the full march then
+                        // starts at the surface instead of up to a stride deep, which
+                        // at the far steps put each pixel's surface sample at a random
+                        // depth (grain).
+                        double a = t, b = t + 0.5 * len;
+                        for (int k = 0; k < kEntryBisections; ++k) {
+                            const double mid = 0.5 * (a + b);
+                            const Vec3d r = o + dir * mid;
+                            ++cheap;
+                            (m.density(r, m.altitude(r), false) > 0 ? b : a) = mid;
+                        }
+                        t = a;
                         continue; // re-march this stretch with full samples
                     }
                     t += len;
@@ -459,6 +503,7 @@ struct LayerIntegrator {
                 }
                 // Optically deep (under 10 % of the view left): what lies further
                 // adds at most that much, so it is marched at twice the step.
+                dt = std::min(dt, tau_cap);
                 if (trans < 0.1) dt *= 2;
                 dt = std::min(dt, t_end - t);
                 const double tm = t + 0.5 * dt;
@@ -471,6 +516,12 @@ struct LayerIntegrator {
                 if (d > 0) {
                     zero_run = 0;
                     const double sigma = ext * d;
+                    const double cap = std::max(kMinCappedStep, kMaxStepTau / (s.quality * sigma));
+                    if (dt > 1.5 * cap && tau_cap > cap && trans >= 0.1) {
+                        tau_cap = cap; // too deep a step: retake it shorter
+                        continue;
+                    }
+                    tau_cap = cap;
                     const double rain = 1 + sc.rain_absorption * col.precip;
                     // Physical mode: the step is lit where its light comes from,
                     // the mean optical depth into it under the e^-tau weight
@@ -510,6 +561,7 @@ struct LayerIntegrator {
                     if (trans < s.min_transmittance) return;
                 } else if (++zero_run >= 6) {
                     searching = true; // six empty full samples: back to the cheap search
+                    tau_cap = std::numeric_limits<double>::infinity();
                 }
                 t += dt;
             }

@@ -367,7 +367,16 @@ Field3DPtr layer_lightning_probability(const Field2D& set) {
     for (int y = 0; y < set.height(); ++y)
         for (int x = 0; x < set.width(); ++x)
             if (set.at(ch, x, y) > 0) lo = std::min(lo, double(set.at(cmn, x, y))), hi = std::max(hi, double(set.at(cmx, x, y)));
-    return layer_flash_probability(set, ch, lo + 0.2 * (hi - lo), lo + 0.6 * (hi - lo) + 1e-3);
+    const double z0 = lo + 0.2 * (hi - lo), z1 = lo + 0.6 * (hi - lo) + 1e-3;
+    // Only columns whose cloud reaches down through the flash band: an anvil
+    // sheet spread at 8.5-11 km drew flashes into the clear air under it.
+    Field2D masked = set;
+    for (int y = 0; y < set.height(); ++y)
+        for (int x = 0; x < set.width(); ++x)
+            if (set.at(cmn, x, y) > z0 || set.at(cmx, x, y) < z1) masked.at(ch, x, y) = 0;
+    auto d = masked.channel(ch);
+    if (std::any_of(d.begin(), d.end(), [](float v) { return v > 0; })) return layer_flash_probability(masked, ch, z0, z1);
+    return layer_flash_probability(set, ch, z0, z1);
 }
 
 } // namespace
@@ -439,6 +448,8 @@ PreviewJob prepare_preview(std::optional<CloudScene> voxel, std::optional<LayerS
     s.sun_direction = sun_direction(o.sun_azimuth, o.sun_elevation);
     if (o.sun_colour) s.sun_colour = *o.sun_colour;
     s.quality = o.quality;
+    s.skip_empty_space = o.sdf_skipping;
+    s.use_light_grid = o.light_lookup_grid;
     s.extinction = o.extinction;
     s.mode = o.mode;
     if (o.sky_colour) s.sky_colour = *o.sky_colour;

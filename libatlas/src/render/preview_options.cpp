@@ -26,7 +26,8 @@ bool PreviewOptions::operator==(const PreviewOptions& o) const {
            mode == o.mode && quality == o.quality && extinction == o.extinction && noise_tile == o.noise_tile && artistic == o.artistic &&
            ms_octaves == o.ms_octaves && ms_diffusion == o.ms_diffusion && ms_diffusion_sweeps == o.ms_diffusion_sweeps && light_grid == o.light_grid &&
            time == o.time && wind == o.wind && earth_radius == o.earth_radius &&
-           edge == o.edge && envelope == o.envelope && density_units == o.density_units;
+           edge == o.edge && envelope == o.envelope && density_units == o.density_units && sdf_skipping == o.sdf_skipping &&
+           light_lookup_grid == o.light_lookup_grid;
 }
 
 namespace {
@@ -243,6 +244,13 @@ std::vector<TextOption<P>> make_preview_options() {
              -inf, inf, {"auto", "on", "off"}},
             "auto", "",
             [](P& p, const V& v) { p.envelope = v.word == "on" ? PreviewEnvelope::On : v.word == "off" ? PreviewEnvelope::Off : PreviewEnvelope::Auto; }),
+        opt({"sdf_skipping", "--sdf-skipping", "on|off", K::Choice,
+             "voxel: cross the SDF's empty space without sampling it (the same picture, faster); off to compare", -inf, inf, {"on", "off"}},
+            "on", "", [](P& p, const V& v) { p.sdf_skipping = v.word == "on"; }),
+        opt({"light_lookup", "--light-lookup", "grid|marched", K::Choice,
+             "voxel: sun and sky optical depths from the light grid (fast) or marched along each light ray (as --reference does)", -inf, inf,
+             {"grid", "marched"}},
+            "grid", "", [](P& p, const V& v) { p.light_lookup_grid = v.word == "grid"; }),
         opt({"density_units", "--density-units", "auto|density|kg/kg", K::Choice,
              "a plain density grid's values: density (x extinction per metre), or cloud water in kg/kg (a solver's; extinction 150 x "
              "mixing ratio per metre, air 1 kg/m3, droplets 10 um); auto = kg/kg when the densest voxel is under 0.02",

@@ -163,7 +163,25 @@ void point_light_radiance(const RenderSettings& s, const std::vector<PointLight>
         // At the light itself the direction is undefined: isotropic there.
         const Vec3d dir = r > 0 ? to / r : view;
         const double cos_theta = r > 0 ? dot(view, dir) : 0.0;
-        const double beer = r > 0 ? std::exp(-s.extinction * depth(p, dir, r)) : 1.0;
+        double beer = 1.0;
+        if (r > 0) {
+            const double tau = s.extinction * depth(p, dir, r);
+            beer = std::exp(-tau);
+            if (s.artistic) {
+                // The look: light from a flash inside a storm diffuses out
+                // through the cloud instead of dying as exp(-tau) (the
+                // octaves of the sun's physical term, each added above the
+                // Beer term so optically thin glow keeps its closed form).
+                // Beer alone left a storm's in-cloud flashes invisible.
+                double a = 1, b = 1, extra = 0;
+                for (int n = 1; n <= kPhysicalMsOctaves; ++n) {
+                    a *= s.ms_energy;
+                    b *= s.ms_extinction;
+                    extra += a * std::max(0.0, std::exp(-b * tau) - beer);
+                }
+                beer += extra;
+            }
+        }
         const double w = energy * beer * dual_hg(s, cos_theta);
         for (int c = 0; c < 3; ++c) out[c] += w * l.colour[c];
     }

@@ -96,7 +96,8 @@ std::optional<std::pair<double, double>> clip_ray(const Box3d& b, const Vec3d& o
 
 struct Integrator {
     const detail::CloudSampler& cloud;
-    const detail::LightGrid* grid; // null in reference mode
+    const detail::LightGrid* grid; // null in reference mode and without use_light_grid
+    bool fast;                     // fast mode's adaptive steps (and skipping, with skip_empty_space)
     const detail::DiffusionGrid* diffusion; // null without ms_diffusion
     const RenderSettings& s;
     Vec3d sun;       // unit, toward the sun
@@ -180,21 +181,24 @@ struct Integrator {
         const double t_end = hit->second;
         bool first = true;
         while (t < t_end) {
-            double dt;
-            if (grid) {
-                dt = base_step * (1 + t / grow);
-                // Sphere tracing: skip the SDF's empty ball when it is longer than the step.
-                const Vec3d p = o + dir * t;
-                const float sdf = cloud.sdf(p[0], p[1], p[2]);
-                if (sdf > dt) {
-                    t += sdf;
-                    continue;
-                }
-            } else {
-                dt = ref_step;
-            }
+            double dt = fast ? base_step * (1 + t / grow) : ref_step;
             if (first) dt *= 0.5 + 0.5 * jitter; // jittered start decorrelates banding
             first = false;
+            if (fast && s.skip_empty_space) {
+                // Sphere tracing: the SDF's empty ball, when longer than the step,
+                // is crossed by walking the march's own steps without sampling
+                // (each one's sample point lies in the ball, outside the cloud):
+                // the march goes on exactly where it would have, the same picture.
+                const Vec3d p = o + dir * t;
+                const double end = t + cloud.sdf(p[0], p[1], p[2]);
+                if (end - t > dt) {
+                    while (t + 0.5 * std::min(dt, t_end - t) < end && t < t_end) {
+                        t += std::min(dt, t_end - t);
+                        dt = base_step * (1 + t / grow);
+                    }
+                    if (!(t < t_end)) break;
+                }
+            }
             dt = std::min(dt, t_end - t);
             const double tm = t + 0.5 * dt;
             const Vec3d p = o + dir * tm;
@@ -250,8 +254,8 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     report.sky_gradient = settings.sky_horizon.has_value();
     report.noise_uprez = cloud.has_noise();
     report.billowy = cloud.has_noise() && cloud.billowy();
-    report.sdf_skipping = fast;
-    report.light_grid = fast;
+    report.sdf_skipping = fast && settings.skip_empty_space;
+    report.light_grid = fast && settings.use_light_grid;
     report.physical = !settings.artistic;
     {
         // Near-camera detail only matters when the camera is within its 198 m range.
@@ -270,6 +274,14 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     std::unique_ptr<detail::LightGrid> grid;
     // The light grid never needs to be finer than the volume itself.
     Vec3i grid_res = settings.light_grid;
+    // Nor coarser vertically than horizontally: a tall volume (a towering
+    // cumulus 768 m high on 32 levels) read its light off 24 m cells and
+    // differed from marched light by 6/255 at the 99.9th percentile.
+    {
+        const Box3d& b = cloud.bounds();
+        const double ex = std::max(b.max[0] - b.min[0], b.max[1] - b.min[1]), ez = b.max[2] - b.min[2];
+        if (ex > 0 && ez > 0) grid_res[2] = std::max(grid_res[2], int(std::ceil(double(std::max(grid_res[0], grid_res[1])) * ez / ex)));
+    }
     for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], scene.modeling->resolution()[a]);
     // The diffusion term needs the grid in reference mode too (its source is
     // the grid's sun transmittance); the march there still uses marched light.
@@ -285,13 +297,14 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     report.diffusion = diffusion != nullptr;
 
     Integrator in{cloud,
-                  fast ? grid.get() : nullptr,
+                  fast && settings.use_light_grid ? grid.get() : nullptr,
+                  fast,
                   diffusion.get(),
                   settings,
                   sun,
                   0.5 * vmin / settings.quality,
                   128 * vmin, // the step doubles every 128 voxels of distance
-                  fast ? 0.5 * grid->voxel_min() : 0.0,
+                  fast ? 0.5 * grid->voxel_min() : 0.0, // the light grid's explicit near samples
                   settings.reference_step > 0 ? settings.reference_step : 0.25 * vmin,
                   report.near_camera_detail,
                   sky,

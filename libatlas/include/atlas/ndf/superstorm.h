@@ -7,11 +7,27 @@
 //   type', top_type' = lerp(x, storm_type, w)
 //   bottom_type' = lerp(x, max(x, bottom_type), w)
 //   superstorm_coverage' = max(x, w)
-//   min/max_height' = lerp(x, storm min/max height, blend * g(r_d)) where the
+//   min/max_height' = lerp(x, storm min/max height, blend * g_h(r_d)) (g_h: g
+//   with height_core in place of core when height_core >= 0) where the
 //   distorted radius r_d = r * (1 + distortion * (2 n - 1) * (1 - r / radius))
 //   for r < radius (n: tileable value noise), r_d = r beyond: unchanged at the
 //   centre and beyond the radius, wobbly in between.
 // Beyond the radius the map is unchanged; blend 0 leaves it bit-identical.
+//
+// Downwind stretch: with stretch > 1 the footprint is a plume, not a disc.
+// Along `wind_direction` (degrees from +x toward +y) the downwind half's
+// radius is stretch * radius (the upwind half keeps radius): r is measured
+// as length(a / s, c) with a the downwind and c the crosswind offset, s =
+// stretch where a > 0, else 1. stretch 1 is the disc, bit-identical.
+//
+// Sheet heights (an anvil, 000's "flattens at the top and spreads in the
+// wind direction"): instead of blending the map's heights radially, every
+// column inside the distorted footprint (w_d = blend * g(r_d) > 0) becomes
+// the stencil's sheet: max_height' = max_height (a flat top), min_height' =
+// max_height - (max_height - min_height) * w_d (the underside rises toward
+// the rim), coverage' = coverage * w_d (the map's own cloud in those
+// columns is replaced: one layer per column), types as above. Chain a
+// radial stencil after it for the tower that feeds the sheet.
 // Pure, thread-safe, deterministic.
 #pragma once
 
@@ -47,6 +63,18 @@ struct SuperstormStencil {
     // the anvil map's bias is 1 (lift = anvil_lift * bias, so 0 where the
     // bias is 0); [0, 20000] m. The anvil map only.
     double anvil_lift = 1500;
+    // Fraction of the radius inside which the heights are the storm's (the
+    // height blend's core; a flat base that wide); < 0 = core.
+    double height_core = -1;
+    // Wobble of the footprint itself ([0, 1)): coverage and types use
+    // r_c = r * (1 + edge_noise * (0.6 (2 n - 1) + 0.4 (2 n2 - 1)) * (1 - r / radius)),
+    // n2 a second value-noise octave at twice the frequency. 0 = round.
+    double edge_noise = 0;
+    // Plume: downwind radius = stretch * radius (>= 1; 1 = disc).
+    double stretch = 1.0;
+    double wind_direction = 0; // degrees from +x toward +y
+    // Sheet heights (an anvil) instead of the radial height blend.
+    bool sheet = false;
 };
 
 // The numeric options' schema (ranges, units, docs; defaults are the struct's):
@@ -57,7 +85,8 @@ std::span<const NumberOption<SuperstormStencil>> superstorm_options();
 // Throws atlas::Error naming the parameter: an option outside its schema range or not
 // finite, center not finite, min_height > max_height.
 void validate(const SuperstormStencil& s);
-// True when the stencil's disc overlaps the map's bounds at all.
+// True when the stencil's footprint (its disc, or plume with stretch > 1)
+// overlaps the map's bounds at all.
 bool stencil_touches(const SuperstormStencil& s, const Box2d& bounds);
 // The stencil applied to an NDF set (see the formulas above).
 Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const MemoryBudget* budget);

@@ -66,6 +66,9 @@ struct PreviewOptions {
     std::optional<MapEdge> edge; // unset: layer_preview_scene's choice
     PreviewEnvelope envelope = PreviewEnvelope::Auto;
     DensityUnits density_units = DensityUnits::Auto;
+    // Voxel accelerations (RenderSettings::skip_empty_space, use_light_grid).
+    bool sdf_skipping = true;
+    bool light_lookup_grid = true;
 
     bool operator==(const PreviewOptions&) const;
 };

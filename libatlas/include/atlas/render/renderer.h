@@ -70,6 +70,13 @@ struct RenderSettings {
     // Voxel light grid resolution (fast mode), capped per axis at the volume's
     // resolution; the talk's is 256x256x32.
     Vec3i light_grid{{128, 128, 32}};
+    // Fast mode's accelerations, each switchable so that a test can show what
+    // it changes: skip_empty_space, the SDF's sphere tracing (it walks the
+    // march's own steps over the empty ball, so the picture is the same
+    // bytes); use_light_grid, sun and sky optical depths looked up in the
+    // light grid (off: marched light rays, as the reference mode does).
+    bool skip_empty_space = true;
+    bool use_light_grid = true;
     // Reference mode step (metres); 0 = a quarter of the smallest voxel.
     double reference_step = 0;
     // Stop a ray once its transmittance falls below this, [0, 1).
