@@ -76,6 +76,94 @@ TEST(Superstorm, BlendZeroIsBitIdentical) {
     EXPECT_FALSE(apply_superstorm(set, s, nullptr) == set);
 }
 
+TEST(Superstorm, PlumeReachesDownwindOnly) {
+    // stretch 3 toward +y (wind_direction 90): the footprint reaches 3 radii
+    // downwind, one radius upwind and across; beyond that the map is unchanged.
+    const Box2d box{{{0, 0}}, {{20000, 20000}}};
+    Field2D set = random_set({{101, 101}}, box);
+    SuperstormStencil s;
+    s.center = set.texel_center(50, 25);
+    s.radius = 2000;
+    s.stretch = 3;
+    s.wind_direction = 90;
+    const Field2D out = apply_superstorm(set, s, nullptr);
+    const Vec2d texel = set.voxel_size();
+    auto changed = [&](Vec2d p) {
+        const int x = int((p[0] - box.min[0]) / texel[0]), y = int((p[1] - box.min[1]) / texel[1]);
+        return out.at(Type, x, y) != set.at(Type, x, y);
+    };
+    EXPECT_TRUE(changed(s.center + Vec2d{{0, 5000}}));   // 2.5 radii downwind: inside the plume
+    EXPECT_FALSE(changed(s.center + Vec2d{{0, -2600}})); // 1.3 radii upwind: outside
+    EXPECT_FALSE(changed(s.center + Vec2d{{2600, 0}}));  // 1.3 radii across: outside
+    EXPECT_FALSE(changed(s.center + Vec2d{{0, 6400}}));  // 3.2 radii downwind: outside
+    EXPECT_TRUE(stencil_touches(s, Box2d{{{9000, 10000}}, {{11000, 11000}}})); // the plume's tip reaches 11 km
+    // stretch 1 is the disc, bit-identical whatever the wind direction.
+    s.stretch = 1;
+    const Field2D disc = apply_superstorm(set, s, nullptr);
+    s.wind_direction = 0;
+    EXPECT_TRUE(apply_superstorm(set, s, nullptr) == disc);
+}
+
+TEST(Superstorm, SheetHasAFlatTopAndARisingUnderside) {
+    const Box2d box{{{0, 0}}, {{10000, 10000}}};
+    Field2D set = random_set({{101, 101}}, box);
+    SuperstormStencil s;
+    s.center = set.texel_center(50, 50);
+    s.radius = 4000;
+    s.core = 0.3;
+    s.distortion = 0;
+    s.sheet = true;
+    s.min_height = 8500;
+    s.max_height = 11000;
+    s.coverage = 0.9;
+    const Field2D out = apply_superstorm(set, s, nullptr);
+    double previous_base = 0;
+    for (int x = 50; x < 101; ++x) {
+        const double r = length(set.texel_center(x, 50) - s.center);
+        if (r >= s.radius) {
+            EXPECT_EQ(out.at(MaxHeight, x, 50), set.at(MaxHeight, x, 50)) << x; // the map beyond the rim
+            continue;
+        }
+        EXPECT_EQ(out.at(MaxHeight, x, 50), 11000.0f) << x; // flat top
+        const double base = out.at(MinHeight, x, 50);
+        EXPECT_GE(base, previous_base) << x; // the underside rises toward the rim
+        EXPECT_GE(base, 8500.0 - 1e-3);
+        EXPECT_LE(base, 11000.0);
+        // The map's own cloud in the column is replaced by the sheet's.
+        const double w = 1.0 - smoothstep(s.core * s.radius, s.radius, r);
+        EXPECT_NEAR(out.at(Coverage, x, 50), 0.9 * w, 1e-6) << x;
+        previous_base = base;
+    }
+    EXPECT_EQ(out.at(MinHeight, 50, 50), 8500.0f); // full thickness in the core
+}
+
+TEST(Superstorm, HeightCoreWidensTheFlatBaseAndEdgeNoiseZeroIsRound) {
+    const Box2d box{{{0, 0}}, {{10000, 10000}}};
+    Field2D set = random_set({{101, 101}}, box);
+    SuperstormStencil s;
+    s.center = set.texel_center(50, 50);
+    s.radius = 4000;
+    s.core = 0.2;
+    s.distortion = 0;
+    const Field2D plain = apply_superstorm(set, s, nullptr);
+    s.height_core = s.core; // the same core: the same bytes
+    EXPECT_TRUE(apply_superstorm(set, s, nullptr) == plain);
+    s.height_core = 0.75;
+    const Field2D wide = apply_superstorm(set, s, nullptr);
+    // 0.6 radii out the base is the storm's with height_core 0.75, not yet with core 0.2.
+    const int x = 50 + int(std::lround(0.6 * 4000 / set.voxel_size()[0]));
+    EXPECT_EQ(wide.at(MinHeight, x, 50), float(s.min_height));
+    EXPECT_NE(plain.at(MinHeight, x, 50), float(s.min_height));
+    EXPECT_EQ(wide.at(Coverage, x, 50), plain.at(Coverage, x, 50)); // coverage keeps `core`
+    s.height_core = -1;
+    s.edge_noise = 0.8; // a ragged footprint: some texels differ, none beyond the radius
+    const Field2D ragged = apply_superstorm(set, s, nullptr);
+    EXPECT_FALSE(ragged == plain);
+    for (int y = 0; y < 101; ++y)
+        for (int xx = 0; xx < 101; ++xx)
+            if (length(set.texel_center(xx, y) - s.center) >= s.radius) ASSERT_EQ(ragged.at(Coverage, xx, y), set.at(Coverage, xx, y));
+}
+
 TEST(Superstorm, BadInput) {
     const Box2d box{{{0, 0}}, {{1000, 1000}}};
     Field2D set = make_ndf_set({{8, 8}}, box, 0, 1, nullptr);

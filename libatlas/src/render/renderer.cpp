@@ -272,7 +272,10 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     const Vec3d vox = cloud.voxel_size();
     const double vmin = std::min({vox[0], vox[1], vox[2]});
     std::unique_ptr<detail::LightGrid> grid;
-    // The light grid never needs to be finer than the volume itself.
+    // The light grid need not be finer than twice the volume: trilinear
+    // density changes within a voxel, and a grid at the volume's own
+    // resolution blurred the quickstart's sunlit surfaces (its depth-64 m
+    // profile) 7% darker than Cycles; at twice it is within 3%.
     Vec3i grid_res = settings.light_grid;
     // Nor coarser vertically than horizontally: a tall volume (a towering
     // cumulus 768 m high on 32 levels) read its light off 24 m cells and
@@ -282,7 +285,7 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
         const double ex = std::max(b.max[0] - b.min[0], b.max[1] - b.min[1]), ez = b.max[2] - b.min[2];
         if (ex > 0 && ez > 0) grid_res[2] = std::max(grid_res[2], int(std::ceil(double(std::max(grid_res[0], grid_res[1])) * ez / ex)));
     }
-    for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], scene.modeling->resolution()[a]);
+    for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], 2 * scene.modeling->resolution()[a]);
     // The diffusion term needs the grid in reference mode too (its source is
     // the grid's sun transmittance); the march there still uses marched light.
     const bool diffuse = detail::diffusion_wanted(settings);
