@@ -20,7 +20,10 @@ P graphs/hzd_weather.yaml -o "$OUT/look_hzd_weather.png"
 P graphs/hzd_weather.yaml --camera 30000,-20000,20000,30000,60000,33000 --fov 90 -o "$OUT/look_hzd_horizon.png"
 P graphs/hzd_weather.yaml --set type.out_max=0 -o "$OUT/look_hzd_stratus.png"
 P graphs/superstorm.yaml -o "$OUT/look_superstorm.png"
+P graphs/superstorm.yaml --camera 14000,-17000,2,14000,20000,5500 --fov 40 -o "$OUT/look_superstorm_35km.png"
 P graphs/superstorm.yaml --view orbit:20,10 -o "$OUT/look_superstorm_anvil.png"
+P graphs/superstorm.yaml --camera 14000,-17000,2,14000,20000,5500 --fov 40 --lightning 6,3e7,6000 --flash 0 --sun-colour 0.05,0.05,0.07 \
+    --sky 0.01,0.012,0.03,0.03,0.035,0.05 --exposure 4 -o "$OUT/look_superstorm_lightning.png"
 P graphs/fc6_forecast.yaml -o "$OUT/look_fc6_forecast.png"
 # cumulus_cloudscape composites the solver's tower: grow it (64^3 quick cook) first.
 "$ATLAS" cook graphs/cumulus_growth.yaml --out "$WORK/cumulus_out" --set 'cloud.resolution=[64,64,64]' --set cloud.dx=62.5 --quiet >/dev/null

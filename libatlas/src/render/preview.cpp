@@ -319,7 +319,8 @@ void density_grid_units(CloudScene& scene, const PreviewOptions& o, std::vector<
     const double S = *scene.uniform_density_scale;
     const Vec3i r = m.resolution();
     const Vec3d h = m.voxel_size();
-    std::vector<double> sx(size_t(r[1]) * r[2], 0.0), sy(size_t(r[0]) * r[2], 0.0), sz(size_t(r[0]) * r[1], 0.0);
+    const size_t nx = static_cast<size_t>(r[0]), ny = static_cast<size_t>(r[1]), nz = static_cast<size_t>(r[2]);
+    std::vector<double> sx(ny * nz, 0.0), sy(nx * nz, 0.0), sz(nx * ny, 0.0);
     for (int z = 0; z < r[2]; ++z)
         for (int y = 0; y < r[1]; ++y)
             for (int x = 0; x < r[0]; ++x) {
