@@ -321,6 +321,12 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
     int slice0 = 0;
     render::CloudScene scene;
     render::LayerScene layer;
+    if (a.positional.size() > 1)
+        for (const std::string& f : a.positional)
+            if (is_graph(f))
+                throw UsageError{"a graph is previewed alone: '" + f + "' was given with " + std::to_string(a.positional.size() - 1) +
+                                     " more file(s); preview the graph, or the files it writes",
+                                 "preview"};
     if (a.positional.size() == 1 && is_graph(a.positional[0])) {
         const std::string file = a.positional[0];
         Session session(builtin_nodes());

@@ -108,6 +108,16 @@ TEST(Texture, BoundFailureThrowsAndWritesNothing) {
     } catch (const BoundError& e) {
         EXPECT_FALSE(e.report().blocks_over_bound.empty());
         EXPECT_NE(std::string(e.what()).find("block at"), std::string::npos);
+        // It says what bound is reachable, and that bound does pass.
+        const std::string what = e.what();
+        const std::string key = "this encoding reaches max_error ";
+        const size_t at = what.find(key);
+        ASSERT_NE(at, std::string::npos) << what;
+        const float reach = std::stof(what.substr(at + key.size()));
+        EXPECT_GT(reach, 1e-6f);
+        CompressOptions ok = o;
+        ok.max_error = reach;
+        EXPECT_NO_THROW(compress_to_dds(sdf_field(16, 16, 1, 0), dir / "reach.dds", ok)) << what;
     }
     EXPECT_FALSE(fs::exists(dir / "fail.dds"));
     EXPECT_FALSE(fs::exists(dir / "fail.dds.json"));

@@ -81,6 +81,12 @@ TEST(PreviewCli, SecondPreviewOfAGraphComesFromTheDiskCache) {
     ASSERT_EQ(nocache.status, 0) << nocache.err;
     EXPECT_NE(nocache.err.find("graph: cooked 4, cached 0"), std::string::npos) << nocache.err;
     EXPECT_EQ(run_atlas("preview tiny.yaml --noise none --cache c --no-cache -o x.png").status, 2);
+    // A graph with another positional argument is a usage error that says so (it was read as a
+    // file list: "unknown file type '.yaml'").
+    CliRun two = run_atlas("preview tiny.yaml stray -o y.png");
+    EXPECT_EQ(two.status, 2) << two.err;
+    EXPECT_NE(two.err.find("a graph is previewed alone: 'tiny.yaml' was given with 1 more file(s)"), std::string::npos) << two.err;
+    EXPECT_FALSE(fs::exists(work_dir() / "y.png"));
 }
 
 TEST(PreviewCli, FailedRenderOrWriteLeavesNoPartialFile) {

@@ -6,6 +6,8 @@
 #include "atlas/core/files.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace atlas::io {
@@ -51,6 +53,18 @@ CompressReport compress_to_dds(const Field3D& field, const fs::path& path, const
             const BlockMiss& b = enc.report.blocks_over_bound[i];
             msg << " [mip " << b.mip << " layer " << b.array_index << " block at (" << b.x << ", " << b.y << ", " << b.z
                 << ") best error " << b.best_error << (b.one_sided_failed ? ", one-sided failed" : "") << "]";
+        }
+        // What the format does reach here: its worst block over every decoder model
+        // (the guaranteed figure of the file it would have written).
+        double reach = enc.report.bound_max_error;
+        for (const BlockMiss& b : enc.report.blocks_over_bound) reach = std::max(reach, double(b.best_error));
+        if (o.max_error && reach > 0 && std::isfinite(reach)) {
+            // Rounded up to three significant digits, so the number printed passes.
+            const double unit = std::pow(10.0, std::floor(std::log10(reach)) - 2);
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "; this encoding reaches max_error %.3g here (its worst block), so a bound of at least that passes",
+                          std::ceil(reach / unit) * unit);
+            msg << buf;
         }
         msg << " (allow_over_bound writes the file anyway)";
         throw BoundError(msg.str(), enc.report);

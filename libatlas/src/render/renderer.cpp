@@ -277,18 +277,22 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     // resolution blurred the quickstart's sunlit surfaces (its depth-64 m
     // profile) 7% darker than Cycles; at twice it is within 3%.
     Vec3i grid_res = settings.light_grid;
-    // Nor coarser vertically than horizontally: a tall volume (a towering
-    // cumulus 768 m high on 32 levels) read its light off 24 m cells and
-    // differed from marched light by 6/255 at the 99.9th percentile.
-    {
-        const Box3d& b = cloud.bounds();
-        const double ex = std::max(b.max[0] - b.min[0], b.max[1] - b.min[1]), ez = b.max[2] - b.min[2];
-        if (ex > 0 && ez > 0) grid_res[2] = std::max(grid_res[2], int(std::ceil(double(std::max(grid_res[0], grid_res[1])) * ez / ex)));
-    }
-    for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], 2 * scene.modeling->resolution()[a]);
     // The diffusion term needs the grid in reference mode too (its source is
     // the grid's sun transmittance); the march there still uses marched light.
     const bool diffuse = detail::diffusion_wanted(settings);
+    if (diffuse) {
+        // The diffusion solves on this grid, calibrated (docs/render.md) at
+        // the light_grid setting capped at the volume's resolution: kept.
+        for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], scene.modeling->resolution()[a]);
+    } else {
+        // Nor coarser vertically than horizontally: a tall volume (a towering
+        // cumulus 768 m high on 32 levels) read its light off 24 m cells and
+        // differed from marched light by 6/255 at the 99.9th percentile.
+        const Box3d& b = cloud.bounds();
+        const double ex = std::max(b.max[0] - b.min[0], b.max[1] - b.min[1]), ez = b.max[2] - b.min[2];
+        if (ex > 0 && ez > 0) grid_res[2] = std::max(grid_res[2], int(std::ceil(double(std::max(grid_res[0], grid_res[1])) * ez / ex)));
+        for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], 2 * scene.modeling->resolution()[a]);
+    }
     std::unique_ptr<detail::DiffusionGrid> diffusion;
     if (fast || diffuse)
         with_thread_limit(settings.threads, [&] {
