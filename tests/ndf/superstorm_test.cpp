@@ -161,7 +161,9 @@ TEST(Superstorm, HeightCoreWidensTheFlatBaseAndEdgeNoiseZeroIsRound) {
     EXPECT_FALSE(ragged == plain);
     for (int y = 0; y < 101; ++y)
         for (int xx = 0; xx < 101; ++xx)
-            if (length(set.texel_center(xx, y) - s.center) >= s.radius) ASSERT_EQ(ragged.at(Coverage, xx, y), set.at(Coverage, xx, y));
+            if (length(set.texel_center(xx, y) - s.center) >= s.radius) {
+                ASSERT_EQ(ragged.at(Coverage, xx, y), set.at(Coverage, xx, y));
+            }
 }
 
 TEST(Superstorm, BadInput) {
