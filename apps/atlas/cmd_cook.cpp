@@ -292,7 +292,12 @@ int run_validate(const Args& a) {
     session.load(file);
     apply_sets(session, a, "validate");
     const Graph& g = session.graph();
-    std::cout << file << ": ok (" << g.nodes.size() << " nodes, " << g.outputs.size() << " outputs)\n";
+    const auto missing = session.missing_inputs();
+    for (const auto& m : missing)
+        std::cerr << file << ":" << m.line << ": warning: node '" << m.node << "' (" << m.type << ") parameter '" << m.param << "': " << m.path.string()
+                  << " does not exist: the cook will fail unless something writes it first\n";
+    std::cout << file << ": ok (" << g.nodes.size() << " nodes, " << g.outputs.size() << " outputs"
+              << (missing.empty() ? std::string() : ", " + std::to_string(missing.size()) + " input file(s) missing") << ")\n";
     return 0;
 }
 

@@ -76,6 +76,24 @@ TEST(Cli, ValidateReportsLocatedErrors) {
     EXPECT_TRUE(r.out.empty());
 }
 
+TEST(Cli, ValidateWarnsOfMissingInputFiles) {
+    // A graph reading a file nothing has written yet is well formed (exit 0), but validate says
+    // the cook will fail (cumulus_cloudscape.yaml on a fresh clone read as "ok").
+    auto g = write_graph("reads.yaml", "atlas: 1\nnodes:\n  tower:\n    type: import/vdb\n    params:\n      file: not_yet/cloud.vdb\noutputs: []\n");
+    CliRun r = run("validate " + g.string());
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("1 input file(s) missing"), std::string::npos) << r.out;
+    EXPECT_NE(r.err.find(g.string() + ":6: warning: node 'tower' (import/vdb) parameter 'file': "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("does not exist: the cook will fail unless something writes it first"), std::string::npos) << r.err;
+    // Once the file exists, nothing is said.
+    fs::create_directories(g.parent_path() / "not_yet");
+    std::ofstream(g.parent_path() / "not_yet" / "cloud.vdb") << "x";
+    CliRun ok = run("validate " + g.string());
+    EXPECT_EQ(ok.status, 0);
+    EXPECT_EQ(ok.out.find("missing"), std::string::npos) << ok.out;
+    EXPECT_EQ(ok.err.find("warning"), std::string::npos) << ok.err;
+}
+
 TEST(Cli, UsageErrorsExitTwo) {
     CliRun r = run("cook --jbos 2 x.yaml");
     EXPECT_EQ(r.status, 2);

@@ -99,6 +99,27 @@ const Graph& Session::graph() const {
     return *graph_;
 }
 
+std::vector<Session::MissingInput> Session::missing_inputs() const {
+    const Graph& g = graph();
+    std::vector<MissingInput> missing;
+    for (const GraphNode& n : g.nodes) {
+        const NodeType* type = registry_.find(n.type);
+        if (!type) continue;
+        for (const ParamDecl& p : type->decl.params()) {
+            if (p.type != ParamType::Path) continue;
+            const auto it = n.params.find(p.name);
+            const ParamValue& v = it != n.params.end() ? it->second.value : p.default_value;
+            const std::string* text = std::get_if<std::string>(&v);
+            if (!text || text->empty()) continue;
+            const std::filesystem::path path = std::filesystem::path(*text).is_absolute() ? std::filesystem::path(*text) : g.base_dir / *text;
+            std::error_code ec;
+            if (std::filesystem::exists(n.type == "import/tga_slices" ? path.parent_path() : path, ec)) continue;
+            missing.push_back({n.name, n.type, p.name, path, it != n.params.end() ? it->second.where.line : n.where.line});
+        }
+    }
+    return missing;
+}
+
 void Session::set(const std::string& node, const std::string& param, const ParamValue& value) {
     if (!graph_) throw Error("no graph loaded");
     set_param(*graph_, registry_, node, param, value);

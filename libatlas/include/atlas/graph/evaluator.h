@@ -124,6 +124,16 @@ public:
     const Graph& graph() const;
     const NodeRegistry& registry() const { return registry_; }
 
+    // Input files (Path parameters) that do not exist now: the graph is well
+    // formed, but its cook will fail unless something writes them first.
+    // A slice stack's parameter (a pattern or DIR/NAME) needs its folder.
+    struct MissingInput {
+        std::string node, type, param;
+        std::filesystem::path path; // resolved against the graph's folder
+        int line = 0;               // of the parameter, else of the node
+    };
+    std::vector<MissingInput> missing_inputs() const;
+
     // Parameter overrides (validated; throw atlas::Error).
     void set(const std::string& node, const std::string& param, const ParamValue& value);
     void set_text(const std::string& node, const std::string& param, const std::string& text);
