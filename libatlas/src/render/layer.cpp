@@ -412,6 +412,17 @@ struct LayerIntegrator {
         return acc * 0.5 * len;
     }
 
+    // The march's step at distance t along a ray entering the shell at t0.
+    // Capped at max_step near the camera; beyond 20 km the cap grows with
+    // distance (2 %), where haze and size hide the step noise. Physical mode:
+    // distance counts from where the ray enters the shell, not from the
+    // camera (an orbit camera 50 km out would otherwise step 600 m through
+    // kilometre cumulus).
+    double step_at(double t, double t0) const {
+        const double td = s.artistic ? t : t - t0;
+        return std::min(std::max(max_step, 0.02 * td / step_quality), base_step * (1 + td / grow));
+    }
+
     void trace(const Vec3d& o, const Vec3d& dir, float jitter, double rgb[3], double& trans, double& bg_weight_t, uint64_t& cheap,
                uint64_t& full, uint64_t& skipped) const {
         rgb[0] = rgb[1] = rgb[2] = 0;
@@ -435,13 +446,7 @@ struct LayerIntegrator {
             double tau_cap = std::numeric_limits<double>::infinity();
             while (t < t_end && steps < kMaxSteps) {
                 ++steps;
-                // Capped at max_step near the camera; beyond 20 km the cap grows
-                // with distance (2 %), where haze and size hide the step noise.
-                // Physical mode: distance counts from where the ray enters the
-                // shell, not from the camera (an orbit camera 50 km out would
-                // otherwise step 600 m through kilometre cumulus).
-                const double td = s.artistic ? t : t - seg[0];
-                double dt = std::min(std::max(max_step, 0.02 * td / step_quality), base_step * (1 + td / grow));
+                double dt = step_at(t, seg[0]);
                 if (first) dt *= 0.5 + 0.5 * jitter; // jittered start
                 first = false;
                 if (searching) {
@@ -469,8 +474,7 @@ struct LayerIntegrator {
                                     break;
                                 }
                                 ++steps;
-                                const double tn = s.artistic ? t : t - seg[0];
-                                dt = std::min(std::max(max_step, 0.02 * tn / step_quality), base_step * (1 + tn / grow));
+                                dt = step_at(t, seg[0]);
                             }
                             if (ended) break;
                             --steps; // the next pass counts the stride it takes

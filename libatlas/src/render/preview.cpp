@@ -370,14 +370,18 @@ Field3DPtr layer_lightning_probability(const Field2D& set) {
             if (set.at(ch, x, y) > 0) lo = std::min(lo, double(set.at(cmn, x, y))), hi = std::max(hi, double(set.at(cmx, x, y)));
     const double z0 = lo + 0.2 * (hi - lo), z1 = lo + 0.6 * (hi - lo) + 1e-3;
     // Only columns whose cloud reaches down through the flash band: an anvil
-    // sheet spread at 8.5-11 km drew flashes into the clear air under it.
-    Field2D masked = set;
+    // sheet spread at 8.5-11 km drew flashes into the clear air under it
+    // (unless no column does: then every column with a storm, as before).
+    Field3DPtr all = layer_flash_probability(set, ch, z0, z1);
+    auto spanning = std::make_shared<Field3D>(*all); // one channel, texel (x, y) at set.index(x, y)
+    bool any = false;
     for (int y = 0; y < set.height(); ++y)
-        for (int x = 0; x < set.width(); ++x)
-            if (set.at(cmn, x, y) > z0 || set.at(cmx, x, y) < z1) masked.at(ch, x, y) = 0;
-    auto d = masked.channel(ch);
-    if (std::any_of(d.begin(), d.end(), [](float v) { return v > 0; })) return layer_flash_probability(masked, ch, z0, z1);
-    return layer_flash_probability(set, ch, z0, z1);
+        for (int x = 0; x < set.width(); ++x) {
+            float& v = spanning->channel(0)[set.index(x, y)];
+            if (set.at(cmn, x, y) > z0 || set.at(cmx, x, y) < z1) v = 0;
+            any = any || v > 0;
+        }
+    return any ? Field3DPtr(spanning) : all;
 }
 
 } // namespace

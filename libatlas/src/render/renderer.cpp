@@ -111,6 +111,8 @@ struct Integrator {
     double light_core2;               // squared core radius of the inverse-square falloff
 
     double phase(double cos_theta) const { return detail::dual_hg(s, cos_theta); }
+    // Fast mode's step at distance t: base_step, doubling every `grow` metres.
+    double fast_step(double t) const { return base_step * (1 + t / grow); }
 
     double march_density(const Vec3d& p, const Vec3d& dir, double step, double max_len = 1e300) const {
         const double len = std::min(max_len, detail::exit_distance(cloud.bounds(), p, dir));
@@ -181,7 +183,7 @@ struct Integrator {
         const double t_end = hit->second;
         bool first = true;
         while (t < t_end) {
-            double dt = fast ? base_step * (1 + t / grow) : ref_step;
+            double dt = fast ? fast_step(t) : ref_step;
             if (first) dt *= 0.5 + 0.5 * jitter; // jittered start decorrelates banding
             first = false;
             if (fast && s.skip_empty_space) {
@@ -194,7 +196,7 @@ struct Integrator {
                 if (end - t > dt) {
                     while (t + 0.5 * std::min(dt, t_end - t) < end && t < t_end) {
                         t += std::min(dt, t_end - t);
-                        dt = base_step * (1 + t / grow);
+                        dt = fast_step(t);
                     }
                     if (!(t < t_end)) break;
                 }
@@ -272,10 +274,6 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     const Vec3d vox = cloud.voxel_size();
     const double vmin = std::min({vox[0], vox[1], vox[2]});
     std::unique_ptr<detail::LightGrid> grid;
-    // The light grid need not be finer than twice the volume: trilinear
-    // density changes within a voxel, and a grid at the volume's own
-    // resolution blurred the quickstart's sunlit surfaces (its depth-64 m
-    // profile) 7% darker than Cycles; at twice it is within 3%.
     Vec3i grid_res = settings.light_grid;
     // The diffusion term needs the grid in reference mode too (its source is
     // the grid's sun transmittance); the march there still uses marched light.
@@ -285,16 +283,22 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
         // the light_grid setting capped at the volume's resolution: kept.
         for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], scene.modeling->resolution()[a]);
     } else {
-        // Nor coarser vertically than horizontally: a tall volume (a towering
+        // Not coarser vertically than horizontally: a tall volume (a towering
         // cumulus 768 m high on 32 levels) read its light off 24 m cells and
-        // differed from marched light by 6/255 at the 99.9th percentile.
+        // differed from marched light by 6/255 at the 99.9th percentile. Not
+        // finer than twice the volume: trilinear density changes within a
+        // voxel, and a grid at the volume's own resolution blurred the
+        // quickstart's sunlit surfaces (at NVDF depth 64 m) 7% darker than
+        // Cycles; at twice it is within 3%.
         const Box3d& b = cloud.bounds();
         const double ex = std::max(b.max[0] - b.min[0], b.max[1] - b.min[1]), ez = b.max[2] - b.min[2];
         if (ex > 0 && ez > 0) grid_res[2] = std::max(grid_res[2], int(std::ceil(double(std::max(grid_res[0], grid_res[1])) * ez / ex)));
         for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], 2 * scene.modeling->resolution()[a]);
     }
     std::unique_ptr<detail::DiffusionGrid> diffusion;
-    if (fast || diffuse)
+    // Built only when something reads it: the march's light lookups or the diffusion.
+    const bool lookup = fast && settings.use_light_grid;
+    if (lookup || diffuse)
         with_thread_limit(settings.threads, [&] {
             grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun);
             if (diffuse)
@@ -304,14 +308,14 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     report.diffusion = diffusion != nullptr;
 
     Integrator in{cloud,
-                  fast && settings.use_light_grid ? grid.get() : nullptr,
+                  lookup ? grid.get() : nullptr,
                   fast,
                   diffusion.get(),
                   settings,
                   sun,
                   0.5 * vmin / settings.quality,
                   128 * vmin, // the step doubles every 128 voxels of distance
-                  fast ? 0.5 * grid->voxel_min() : 0.0, // the light grid's explicit near samples
+                  lookup ? 0.5 * grid->voxel_min() : 0.0, // the light grid's explicit near samples
                   settings.reference_step > 0 ? settings.reference_step : 0.25 * vmin,
                   report.near_camera_detail,
                   sky,

@@ -67,8 +67,10 @@ struct RenderSettings {
     double hg_forward = 0.6, hg_back = -0.3, hg_forward_weight = 0.7;
     double ambient_strength = 1.0;  // >= 0
     double multiple_scattering = 0.5; // strength of the profile-based term, >= 0
-    // Voxel light grid resolution (fast mode), capped per axis at the volume's
-    // resolution; the talk's is 256x256x32.
+    // Voxel light grid resolution (fast mode; the talk's is 256x256x32). Its
+    // z is raised so cells are no taller than wide, and each axis capped at
+    // twice the volume's resolution (at the volume's own where the diffusion
+    // term solves on the grid).
     Vec3i light_grid{{128, 128, 32}};
     // Fast mode's accelerations, each switchable so that a test can show what
     // it changes: skip_empty_space, the SDF's sphere tracing (it walks the
