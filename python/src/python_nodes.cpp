@@ -151,10 +151,15 @@ public:
             if (out->type == PortType::Mesh || out->type == PortType::Points)
                 throw Error("node '" + node_name() + "': output '" + port + "' is a " + std::string(port_type_name(out->type)) +
                             "; Python nodes produce fields");
+            const py::array array(value);
+            const int d = dims == 0 ? array.ndim() == 2 ? 2 : 3 : dims;
+            const int channels = array.ndim() == d + 1 ? int(array.shape(0)) : 1;
             py::object b = bounds;
-            if (b.is_none()) b = first_input_bounds(dims == 0 ? py::array(value).ndim() == 2 ? 2 : 3 : dims);
+            if (b.is_none()) b = first_input_bounds(d);
             // Still none: field_from_array checks the shape first, then asks for bounds.
-            v = field_from_array(py::array(value), dims, b, channel_names, &c.budget());
+            py::object names = channel_names;
+            if (names.is_none()) names = first_input_channel_names(d, channels);
+            v = field_from_array(array, dims, b, names, &c.budget());
         }
         if (!port_accepts(out->type, value_type(v)))
             throw Error("node '" + node_name() + "': output '" + port + "' is a " + std::string(port_type_name(out->type)) +
@@ -180,6 +185,19 @@ private:
             if (auto* f = std::get_if<Field2DPtr>(&v); f && dims == 2)
                 return py::make_tuple(py::make_tuple((*f)->bounds().min[0], (*f)->bounds().min[1]),
                                       py::make_tuple((*f)->bounds().max[0], (*f)->bounds().max[1]));
+        }
+        return py::none();
+    }
+    // Channel names default to those of the first field input of the same
+    // dimensionality and channel count (docs/embedding.md), else r, g, b, a.
+    py::object first_input_channel_names(int dims, int channels) const {
+        for (const PortDecl& p : decl_->inputs()) {
+            if (!ctx().has_input(p.name)) continue;
+            const Value& v = ctx().input(p.name);
+            const std::vector<std::string>* names = nullptr;
+            if (auto* f = std::get_if<Field3DPtr>(&v); f && dims == 3) names = &(*f)->channel_names();
+            if (auto* f = std::get_if<Field2DPtr>(&v); f && dims == 2) names = &(*f)->channel_names();
+            if (names && int(names->size()) == channels) return py::cast(*names);
         }
         return py::none();
     }

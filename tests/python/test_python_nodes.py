@@ -193,3 +193,28 @@ def test_python_nodes_in_parallel():
     base = s.get("base")[0]
     for i in range(6):
         np.testing.assert_allclose(s.get(f"p{i}")[0], base + 1.0, rtol=1e-6)
+
+
+def test_python_node_output_keeps_the_input_channel_names():
+    # The docs' own example (docs/embedding.md) passes no channel_names: the output is named
+    # after the first field input of the same dimensionality and channel count.
+    def gain(ctx):
+        ctx.set_output("out", ctx.input("in")["density"] * ctx.params["gain"])
+
+    def split(ctx):  # two channels from a one-channel input: no name to inherit
+        d = ctx.input("in")["density"]
+        ctx.set_output("out", np.stack([d, 1 - d]))
+
+    reg = atlas.builtin_nodes()
+    reg.add_python_node("py/gain", gain, version=1, **GAIN_DECL)
+    reg.add_python_node("py/split", split, version=1, **{**GAIN_DECL, "doc": "Splits a field in two."})
+    s = atlas.Session(reg)
+    s.load_text(GRAPH.replace("outputs:", """  two:
+    type: py/split
+    inputs: {in: base}
+outputs:
+  - {node: two, file: two.exr}""", 1), "names.yaml")
+    s.cook(jobs=1)
+    assert s.get("gained").channel_names == ["density"]
+    assert s.get("shaped").channel_names == ["density"]
+    assert s.get("two").channel_names == ["r", "g"]
