@@ -212,6 +212,13 @@ int run_cook(const Args& a) {
                 cooks.back().second.status = "ok";
                 continue; // nothing requested from this graph
             }
+            // Inputs another graph writes (the graph's requires:): cooked first when missing.
+            for (auto& rc : session.cook_requirements(go, [&](const GraphRequirement& r) {
+                     if (!quiet)
+                         std::cerr << "atlas: " << file << " reads files " << r.graph.string() << " writes: cooking it into " << r.out.string()
+                                   << " first\n";
+                 }))
+                cooks.push_back(std::move(rc));
             cooks.emplace_back(file, session.cook(go));
         } catch (const UsageError&) {
             throw;
@@ -295,7 +302,11 @@ int run_validate(const Args& a) {
     const auto missing = session.missing_inputs();
     for (const auto& m : missing)
         std::cerr << file << ":" << m.line << ": warning: node '" << m.node << "' (" << m.type << ") parameter '" << m.param << "': " << m.path.string()
-                  << " does not exist: the cook will fail unless something writes it first\n";
+                  << " does not exist: "
+                  << (m.written_by ? "`atlas cook` will cook " + m.written_by->graph.string() + " into " + m.written_by->out.string() +
+                                         " first (the graph's requires:)"
+                                   : std::string("the cook will fail unless something writes it first"))
+                  << "\n";
     std::cout << file << ": ok (" << g.nodes.size() << " nodes, " << g.outputs.size() << " outputs"
               << (missing.empty() ? std::string() : ", " + std::to_string(missing.size()) + " input file(s) missing") << ")\n";
     return 0;

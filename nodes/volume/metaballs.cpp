@@ -12,7 +12,10 @@ using namespace atlas;
 void declare(NodeDeclaration& d) {
     d.doc("Metaballs, spheres or particle splats: each sphere (from `spheres` and/or the `points` input, radius from the "
           "points' 'radius' attribute) adds a kernel into a density grid. Kernels: metaball (1-s^2)^3, sphere (solid, "
-          "one-voxel edge), linear 1-s, gaussian exp(-4.5 s^2); s = distance / radius.");
+          "one-voxel edge), linear 1-s, gaussian exp(-4.5 s^2); s = distance / radius. The visible size: a lone ball's 0.5 "
+          "surface (what volume/sdf iso 0.5 and the preview draw) lies at 0.45 of the radius for metaball, 1.0 for sphere, "
+          "0.5 for linear and 0.39 for gaussian; overlapping balls with blend add grow past it. For clouds of a given "
+          "size use sphere, or a metaball radius 2.2 times the size wanted.");
     d.input("points", PortType::Points, "optional sphere centres; attributes 'radius' (m) and 'weight'").optional = true;
     d.output("out", PortType::Field3D, "density, channel 'density'");
     volume_nodes::declare_grid(d);

@@ -400,6 +400,24 @@ per Session (cook releases the GIL, so other Python threads run meanwhile).)doc"
 write_outputs=True also writes the output files into out_dir (atomically). The GIL is released while
 cooking; progress(fraction, task, done, total) and cancel() -> bool are called from worker threads
 with the GIL taken. Raises atlas.CancelledError when cancel() returns true.)doc")
+        .def("cook_requirements", [](PySession& ps, int jobs, const py::object& cache_dir, const py::object& memory_budget,
+                                     const py::object& progress, const py::object& cancel) {
+                 BusyGuard guard(ps);
+                 CookOptions o = make_options(py::none(), jobs, true, py::none(), cache_dir, false, memory_budget, progress, cancel);
+                 std::vector<std::pair<std::string, CookResult>> done;
+                 {
+                     py::gil_scoped_release nogil;
+                     done = ps.session.cook_requirements(o);
+                 }
+                 py::list l;
+                 for (const auto& [file, r] : done) l.append(py::make_tuple(file, result_to_python(r)));
+                 return l;
+             },
+             py::arg("jobs") = 0, py::arg("cache_dir") = py::none(), py::arg("memory_budget") = py::none(),
+             py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+             R"doc(Cooks and writes every graph the loaded graph's `requires:` names whose output this graph reads
+and is missing (into that requirement's `out` folder), as `atlas cook` does first. Returns a list of
+(graph file, report dict) in cook order; [] when every input is there.)doc")
         .def("get", [](PySession& ps, const std::string& node, const py::object& port, int jobs, const py::object& cache_dir,
                        const py::object& memory_budget, const py::object& progress, const py::object& cancel) {
                  BusyGuard guard(ps);

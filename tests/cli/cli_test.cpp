@@ -94,6 +94,51 @@ TEST(Cli, ValidateWarnsOfMissingInputFiles) {
     EXPECT_EQ(ok.err.find("warning"), std::string::npos) << ok.err;
 }
 
+TEST(Cli, CookCooksTheGraphsItRequiresFirst) {
+    // A graph that reads another graph's output declares it (requires:): on a fresh clone the
+    // cook grows the input first, validate says so, and a present input is not cooked again.
+    const fs::path dir = fs::temp_directory_path() / ("atlas_cli_requires_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    std::ofstream(dir / "maker.yaml") << "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params: {resolution: [8, 8, 8], bounds_max: [80, 80, 80]}\n"
+                                         "outputs:\n  - {node: n, file: cloud.vdb}\n";
+    std::ofstream(dir / "reader.yaml") << "atlas: 1\nrequires:\n  - {graph: maker.yaml, out: made}\nnodes:\n  in:\n    type: import/vdb\n"
+                                          "    params: {file: made/cloud.vdb, grids: density}\n  r:\n    type: math/remap\n    inputs: {in: in}\n"
+                                          "outputs:\n  - {node: r, file: r.exr}\n";
+    CliRun v = run("validate " + (dir / "reader.yaml").string());
+    EXPECT_EQ(v.status, 0) << v.err;
+    EXPECT_NE(v.err.find("`atlas cook` will cook " + (dir / "maker.yaml").string() + " into " + (dir / "made").string() + " first"), std::string::npos)
+        << v.err;
+    CliRun c = run("cook " + (dir / "reader.yaml").string() + " --out " + (dir / "out").string() + " --no-cache --report " + (dir / "r.json").string());
+    ASSERT_EQ(c.status, 0) << c.err;
+    EXPECT_NE(c.err.find("reads files " + (dir / "maker.yaml").string() + " writes: cooking it into " + (dir / "made").string() + " first"),
+              std::string::npos) << c.err;
+    EXPECT_TRUE(fs::exists(dir / "made" / "cloud.vdb"));
+    EXPECT_TRUE(fs::exists(dir / "out" / "r.exr"));
+    nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "r.json"));
+    ASSERT_TRUE(report.contains("graphs")) << report.dump(); // both cooks in one report
+    EXPECT_EQ(report["graphs"].size(), 2u);
+    // Present now: not cooked again.
+    CliRun again = run("cook " + (dir / "reader.yaml").string() + " --out " + (dir / "out").string() + " --no-cache");
+    ASSERT_EQ(again.status, 0) << again.err;
+    EXPECT_EQ(again.err.find("cooking it into"), std::string::npos) << again.err;
+    // A cycle is refused with the requirement's line.
+    std::ofstream(dir / "a.yaml") << "atlas: 1\nrequires:\n  - {graph: b.yaml, out: bo}\nnodes:\n  in:\n    type: import/vdb\n"
+                                     "    params: {file: bo/x.vdb}\noutputs:\n  - {node: in, file: a.vdb}\n";
+    std::ofstream(dir / "b.yaml") << "atlas: 1\nrequires:\n  - {graph: a.yaml, out: ao}\nnodes:\n  in:\n    type: import/vdb\n"
+                                     "    params: {file: ao/a.vdb}\noutputs:\n  - {node: in, file: x.vdb}\n";
+    CliRun cyc = run("cook " + (dir / "a.yaml").string() + " --out " + (dir / "out").string() + " --no-cache");
+    EXPECT_EQ(cyc.status, 1);
+    EXPECT_NE(cyc.err.find("b.yaml:3:5: error: requirement '" + (dir / "a.yaml").string() + "' leads back to a graph that requires it (a cycle)"),
+              std::string::npos) << cyc.err;
+    // A malformed requirement names what is expected.
+    std::ofstream(dir / "bad.yaml") << "atlas: 1\nrequires:\n  - {graph: maker.yaml}\nnodes: {}\noutputs: []\n";
+    CliRun bad = run("validate " + (dir / "bad.yaml").string());
+    EXPECT_EQ(bad.status, 1);
+    EXPECT_NE(bad.err.find("bad.yaml:3:5: error: requirement: missing 'out'"), std::string::npos) << bad.err;
+    fs::remove_all(dir);
+}
+
 TEST(Cli, UsageErrorsExitTwo) {
     CliRun r = run("cook --jbos 2 x.yaml");
     EXPECT_EQ(r.status, 2);

@@ -68,4 +68,12 @@ run("${host}/atlas_embed_c" "${SOURCE_DIR}/examples/quickstart.yaml" coverage)
 if(NOT run_output MATCHES "coverage: 128x128x32, 1 channel\\(s\\), 'density' in \\[0, 1\\]")
   message(FATAL_ERROR "install_test: unexpected output of atlas_embed_c:\n${run_output}")
 endif()
-message(STATUS "install_test: built and ran examples/embed against ${prefix}")
+# A C-only host project: the same C program, with only C enabled by the host.
+run("${CMAKE_COMMAND}" -S "${SOURCE_DIR}/tests/embed/c_only_host" -B "${host}-c" -G Ninja -DCMAKE_BUILD_TYPE=Release
+    "-DCMAKE_PREFIX_PATH=${prefix}" "-DATLAS_EXAMPLES_DIR=${SOURCE_DIR}/examples/embed" ${launcher})
+run("${CMAKE_COMMAND}" --build "${host}-c")
+run("${host}-c/atlas_c_only_host" "${SOURCE_DIR}/examples/quickstart.yaml" coverage)
+if(NOT run_output MATCHES "coverage: 128x128x32, 1 channel\\(s\\), 'density' in \\[0, 1\\]")
+  message(FATAL_ERROR "install_test: unexpected output of the C-only host:\n${run_output}")
+endif()
+message(STATUS "install_test: built and ran examples/embed and a C-only host against ${prefix}")

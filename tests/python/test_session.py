@@ -331,3 +331,23 @@ def test_two_sessions_in_two_threads_before_numpy_is_imported(small_graph, tmp_p
         r = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=env)
         assert r.returncode == 0, r.stderr
         assert r.stdout.strip() == "ok"
+
+
+def test_cook_requirements_grows_the_missing_input_first(tmp_path):
+    # A graph reading another graph's output (requires:) cooks on a fresh clone from Python too.
+    (tmp_path / "maker.yaml").write_text(
+        "atlas: 1\nnodes:\n  n:\n    type: noise/value\n    params: {resolution: [8, 8, 8], bounds_max: [80, 80, 80]}\n"
+        "outputs:\n  - {node: n, file: cloud.vdb}\n")
+    (tmp_path / "reader.yaml").write_text(
+        "atlas: 1\nrequires:\n  - {graph: maker.yaml, out: made}\nnodes:\n  in:\n    type: import/vdb\n"
+        "    params: {file: made/cloud.vdb, grids: density}\noutputs:\n  - {node: in, file: in.vdb}\n")
+    s = atlas.Session()
+    s.load(tmp_path / "reader.yaml")
+    with pytest.raises(atlas.Error, match="cloud.vdb"):
+        s.cook()
+    done = s.cook_requirements(jobs=1)
+    assert [f for f, _ in done] == [str(tmp_path / "maker.yaml")]
+    assert done[0][1]["nodes"]["n"]["status"] == "cooked"
+    assert (tmp_path / "made" / "cloud.vdb").exists()
+    assert s.cook_requirements() == []
+    np.testing.assert_allclose(s.get("in")["density"].shape, (8, 8, 8))

@@ -114,10 +114,54 @@ std::vector<Session::MissingInput> Session::missing_inputs() const {
             const std::filesystem::path path = std::filesystem::path(*text).is_absolute() ? std::filesystem::path(*text) : g.base_dir / *text;
             std::error_code ec;
             if (std::filesystem::exists(n.type == "import/tga_slices" ? path.parent_path() : path, ec)) continue;
-            missing.push_back({n.name, n.type, p.name, path, it != n.params.end() ? it->second.where.line : n.where.line});
+            const GraphRequirement* by = nullptr;
+            for (const GraphRequirement& r : g.requirements) {
+                const auto rel = path.lexically_normal().lexically_relative(r.out);
+                if (!rel.empty() && *rel.begin() != "..") by = &r;
+            }
+            missing.push_back({n.name, n.type, p.name, path, it != n.params.end() ? it->second.where.line : n.where.line, by});
         }
     }
     return missing;
+}
+
+namespace {
+void cook_requirements_of(const Session& s, const CookOptions& options, const std::function<void(const GraphRequirement&)>& before,
+                          std::vector<std::filesystem::path>& chain, std::vector<std::pair<std::string, CookResult>>& done) {
+    std::vector<const GraphRequirement*> needed;
+    for (const auto& m : s.missing_inputs())
+        if (m.written_by && std::find(needed.begin(), needed.end(), m.written_by) == needed.end()) needed.push_back(m.written_by);
+    for (const GraphRequirement* r : needed) {
+        const auto key = std::filesystem::absolute(r->graph).lexically_normal();
+        if (std::find(chain.begin(), chain.end(), key) != chain.end())
+            throw ParseError(r->where, "requirement '" + r->graph.string() + "' leads back to a graph that requires it (a cycle)");
+        Session sub(s.registry());
+        sub.load(r->graph);
+        chain.push_back(key);
+        cook_requirements_of(sub, options, before, chain, done);
+        chain.pop_back();
+        if (before) before(*r);
+        CookOptions o = options;
+        o.out_dir = r->out;
+        o.outputs.clear(); // everything it writes: this graph may read any of it
+        done.emplace_back(r->graph.string(), CookResult{});
+        try {
+            done.back().second = sub.cook(o);
+        } catch (...) {
+            done.back().second = sub.last_result();
+            throw;
+        }
+    }
+}
+} // namespace
+
+std::vector<std::pair<std::string, CookResult>> Session::cook_requirements(const CookOptions& options,
+                                                                           const std::function<void(const GraphRequirement&)>& before) {
+    std::vector<std::filesystem::path> chain;
+    if (!graph().file.empty()) chain.push_back(std::filesystem::absolute(graph().file).lexically_normal());
+    std::vector<std::pair<std::string, CookResult>> done;
+    cook_requirements_of(*this, options, before, chain, done);
+    return done;
 }
 
 void Session::set(const std::string& node, const std::string& param, const ParamValue& value) {

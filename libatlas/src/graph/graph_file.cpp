@@ -266,7 +266,7 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
     const YAML::Node root = io::load_yaml(text, filename, "invalid YAML: ");
     if (!root || root.IsNull()) throw ParseError({filename, 1, 1}, "empty graph file: expected 'atlas: 1', 'nodes' and 'outputs'");
     if (!root.IsMap()) p.fail(root, "a graph file is a map with 'atlas', 'nodes' and 'outputs'");
-    p.check_keys(root, {"atlas", "description", "nodes", "outputs"}, "graph");
+    p.check_keys(root, {"atlas", "description", "requires", "nodes", "outputs"}, "graph");
 
     Graph g;
     g.base_dir = base_dir;
@@ -279,6 +279,23 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
             p.fail(vn, "unsupported graph format version " + std::to_string(v) + " (this Atlas reads version " +
                            std::to_string(kGraphFormatVersion) + ")");
         g.version = int(v);
+    }
+
+    if (const YAML::Node req = root["requires"]) {
+        if (!req.IsSequence()) p.fail(req, "'requires' must be a list of {graph, out}: graphs whose outputs this graph reads");
+        for (const auto& r : req) {
+            if (!r.IsMap()) p.fail(r, "a requirement is a map {graph: FILE.yaml, out: FOLDER} (both relative to this graph)");
+            p.check_keys(r, {"graph", "out"}, "requirement");
+            if (!r["graph"]) p.fail(r, "requirement: missing 'graph' (the graph file that writes what this graph reads)");
+            if (!r["out"]) p.fail(r, "requirement: missing 'out' (the folder that graph's cook writes, which this graph reads)");
+            GraphRequirement gr;
+            gr.where = p.at(r);
+            gr.graph = (base_dir / p.scalar(r["graph"], "requirement graph")).lexically_normal();
+            gr.out = (base_dir / p.scalar(r["out"], "requirement out")).lexically_normal();
+            if (gr.graph.empty() || gr.out.empty() || gr.out == base_dir.lexically_normal())
+                p.fail(r, "requirement: 'out' must name a folder of its own, not this graph's folder");
+            g.requirements.push_back(std::move(gr));
+        }
     }
 
     const YAML::Node nodes = root["nodes"];

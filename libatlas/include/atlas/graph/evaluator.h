@@ -14,10 +14,12 @@
 #include "atlas/graph/graph.h"
 
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace atlas {
@@ -131,8 +133,15 @@ public:
         std::string node, type, param;
         std::filesystem::path path; // resolved against the graph's folder
         int line = 0;               // of the parameter, else of the node
+        const GraphRequirement* written_by = nullptr; // the requirement whose `out` holds it
     };
     std::vector<MissingInput> missing_inputs() const;
+    // Cooks every `requires:` graph that writes a missing input (into its `out`,
+    // with `options` otherwise; one level of requirements each, recursively,
+    // a cycle refused). `before` is told each graph before it cooks. Returns
+    // (graph file, result) in cook order; a failure throws like cook().
+    std::vector<std::pair<std::string, CookResult>> cook_requirements(
+        const CookOptions& options, const std::function<void(const GraphRequirement&)>& before = {});
 
     // Parameter overrides (validated; throw atlas::Error).
     void set(const std::string& node, const std::string& param, const ParamValue& value);

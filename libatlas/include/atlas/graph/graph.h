@@ -52,12 +52,22 @@ struct GraphOutput {
     SourceLocation where;
 };
 
+// `requires:` - files this graph reads that another graph writes. `atlas cook`
+// cooks that graph into `out` first when an input file under `out` is missing
+// (Session::cook_requirements), so a fresh clone cooks (docs/graph-format.md).
+struct GraphRequirement {
+    std::filesystem::path graph; // resolved against the graph's folder
+    std::filesystem::path out;   // the folder that graph's cook writes, resolved likewise
+    SourceLocation where;
+};
+
 struct Graph {
     std::filesystem::path file;     // the graph file ("" when parsed from text)
     std::filesystem::path base_dir; // relative input paths resolve against this
     int version = kGraphFormatVersion;
     std::vector<GraphNode> nodes;   // in file order
     std::vector<GraphOutput> outputs;
+    std::vector<GraphRequirement> requirements;
 
     const GraphNode* find(const std::string& name) const;
     GraphNode* find(const std::string& name);
