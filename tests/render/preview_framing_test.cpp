@@ -55,6 +55,21 @@ TEST(PreviewFraming, DefaultViewsFillAThirdToTwoThirdsOfTheFrame) {
     }
 }
 
+TEST(PreviewFraming, TheGroundViewStandsClearOfCloudsWhoseBasesFloatHigh) {
+    // Bases at 1.2 km over a ground at 0: the camera stands below them, where the clouds' angular
+    // height first grows with the distance; the search for the distance that frames them stood
+    // the camera right under a cloud (a dark underside filled the frame: the tutorial's field).
+    std::ofstream(dir() / "high.yaml") << "atlas: 1\nnodes:\n  m:\n    type: volume/metaballs\n    params: {resolution: [96, 96, 48], "
+                                          "bounds_max: [4096, 4096, 2048], kernel: sphere, spheres: '1200 2600 1500 300; 1500 2700 1600 250; "
+                                          "2800 1400 1450 220'}\noutputs:\n  - {node: m, file: high.vdb}\n";
+    ASSERT_EQ(atlas_run("cook high.yaml --out . --no-cache --quiet").status, 0);
+    CliRun r = atlas_run("preview high.vdb -o h.exr --size 160x90 --quiet --noise none --view ground");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const double fill = rows_filled(dir() / "h.exr");
+    EXPECT_GE(fill, 1.0 / 3);
+    EXPECT_LE(fill, 2.0 / 3 + 0.05);
+}
+
 TEST(PreviewFraming, ADensityGridIsDrawnAsItIsAndItsUnitsAreRead) {
     // Cloud water as a solver writes it: mixing ratios around 0.003 kg/kg.
     write_blob("qc.vdb", 0.003);

@@ -269,7 +269,12 @@ Camera voxel_camera(const CloudScene& scene, PreviewView view, double aspect, do
         const double half = 0.5 * c.fov_deg * std::numbers::pi / 180;
         const double target = half; // the clouds' angular height: half the field of view
         auto extent = [&](double d) { return std::atan2(b.max[2] - cz, d) - std::atan2(b.min[2] - cz, d); };
-        double lo = 1e-3, hi = 1e7; // extent falls as the distance grows
+        // With the camera under the bases the extent first grows with the distance (straight
+        // below, the cloud is a sliver overhead), peaks at sqrt(above top x above base), then
+        // falls: search the falling side only (searching from 0 stood the camera under the
+        // cloud of a field whose bases float high).
+        const double peak = b.min[2] > cz ? std::sqrt((b.max[2] - cz) * (b.min[2] - cz)) : 0.0;
+        double lo = std::max(1e-3, peak), hi = std::max(1e7, 2 * lo); // extent falls as the distance grows from lo
         for (int i = 0; i < 100; ++i) {
             const double mid = std::sqrt(lo * hi);
             (extent(mid) > target ? lo : hi) = mid;
