@@ -1,10 +1,14 @@
-# Every production graph and example must stay valid: `atlas validate` on each
-# (cheap: nothing is cooked), and the quickstart is cooked for real.
+# Every production graph and example must stay valid (`atlas validate`, cheap) and cook on a
+# fresh clone (a scratch copy of graphs/ and examples/; tests/cli/cook_shipped_graph.sh).
 file(GLOB ATLAS_GRAPH_FILES CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/graphs/*.yaml" "${PROJECT_SOURCE_DIR}/examples/*.yaml")
 foreach(graph IN LISTS ATLAS_GRAPH_FILES)
   get_filename_component(name "${graph}" NAME_WE)
   add_test(NAME validate_${name} COMMAND atlas validate "${graph}")
   set_tests_properties(validate_${name} PROPERTIES LABELS graph)
+  file(RELATIVE_PATH rel "${PROJECT_SOURCE_DIR}" "${graph}")
+  add_test(NAME cook_shipped_${name} COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/cook_shipped_graph.sh $<TARGET_FILE:atlas>
+           ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/cook_shipped/${name} ${rel})
+  set_tests_properties(cook_shipped_${name} PROPERTIES LABELS graph TIMEOUT 900)
 endforeach()
 add_test(NAME cook_quickstart COMMAND atlas cook "${PROJECT_SOURCE_DIR}/examples/quickstart.yaml"
          --out "${PROJECT_BINARY_DIR}/quickstart-out" --quiet --checked)

@@ -17,7 +17,10 @@ dir="$(sed -n 's/^ATLAS_PYTHON_INSTALL_DIR:STRING=//p' "$build/CMakeCache.txt")"
 # Debian's python3 searches <default prefix>/<dir>: nothing to set after `cmake --install build`.
 "$py" -c "import sys; p='/usr/local/$dir'; assert p in sys.path, (p, sys.path)"
 
-cmake --install "$build" --prefix "$work/prefix" --component python >/dev/null
+# A prefix Python does not search: the install says which variable to set.
+cmake --install "$build" --prefix "$work/prefix" --component python > "$work/install.log"
+grep -q "does not search $work/prefix/$dir; to import atlas and atlas_dask set PYTHONPATH=$work/prefix/$dir" "$work/install.log" || {
+  echo "FAIL: the install did not say how to reach $work/prefix/$dir"; cat "$work/install.log"; exit 1; }
 test -x "$work/prefix/bin/atlas-dask" || { echo "FAIL: atlas-dask is not an executable in $work/prefix/bin"; exit 1; }
 test -f "$work/prefix/$dir/atlas_dask/__init__.py" && test -f "$work/prefix/$dir/atlas/__init__.py" || {
   echo "FAIL: atlas and atlas_dask are not both in $work/prefix/$dir"; find "$work/prefix" -name "__init__.py"; exit 1; }
