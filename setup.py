@@ -3,8 +3,8 @@
 The extension module is not compiled by setuptools: CMake builds the `atlas_python` target (the same
 build `scripts/build.sh` makes) and this packs its output, the OpenImageIO module beside it, and the
 pure-Python atlas_dask driver. ATLAS_BUILD_DIR names an existing CMake build to use (it is brought up
-to date with `cmake --build DIR --target atlas_python`); without it a Release build is configured
-in build-wheel/.
+to date with `cmake --build DIR --target atlas_python`, or used as it is with ATLAS_WHEEL_NO_BUILD=1);
+without it a Release build is configured in build-wheel/.
 """
 import os
 import pathlib
@@ -38,7 +38,8 @@ class BuildWithCMake(build_py):
         if not (build / "CMakeCache.txt").exists():
             subprocess.check_call(["cmake", "-S", str(ROOT), "-B", str(build), "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release",
                                    "-DATLAS_BUILD_TESTS=OFF", "-DATLAS_BUILD_BENCHMARKS=OFF", "-DATLAS_BUILD_PYTHON=ON"])
-        subprocess.check_call(["cmake", "--build", str(build), "--target", "atlas_python", "atlas_oiio"])
+        if not os.environ.get("ATLAS_WHEEL_NO_BUILD"):
+            subprocess.check_call(["cmake", "--build", str(build), "--target", "atlas_python", "atlas_oiio"])
         package = pathlib.Path(self.build_lib) / "atlas"
         modules = list((build / "python" / "atlas").glob("_atlas*.so"))
         oiio = list(build.glob("lib/atlas/libatlas_oiio.so")) or list(build.rglob("libatlas_oiio.so"))

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iostream>
 #include <set>
+#include <sstream>
 
 namespace atlas::cli {
 
@@ -288,6 +289,17 @@ int run_cook(const Args& a) {
         for (const auto& out : r.outputs)
             for (const auto& p : out.written) std::cout << p.string() << "\n";
     if (!quiet && current) std::cerr << current << " file" << (current == 1 ? "" : "s") << " already up to date (not rewritten)\n";
+    // GPU texture memory of the DDS outputs, per graph, against its budget (report.md "textures").
+    for (const auto& [file, r] : cooks) {
+        uint64_t tex = 0;
+        for (const auto& out : r.outputs) tex += out.texture_bytes();
+        if (quiet || (!tex && !r.texture_budget_mb)) continue;
+        std::ostringstream line;
+        line.precision(3);
+        line << file << ": textures " << double(tex) / 1e6 << " MB";
+        if (r.texture_budget_mb) line << " of the " << *r.texture_budget_mb << " MB budget";
+        std::cerr << line.str() << "\n";
+    }
     // Warnings are not a summary: --quiet keeps them (a broken cache entry must be seen).
     for (const auto& w : warnings) std::cerr << w << "\n";
     return 0;

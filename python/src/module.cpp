@@ -120,6 +120,8 @@ py::dict result_to_python(const CookResult& r) {
         for (const auto& p : o.written) written.append(p.string());
         d["written"] = written;
         d["metrics"] = o.metrics;
+        d["status"] = o.status;
+        if (!o.error.empty()) d["error"] = o.error;
         outputs.append(d);
     }
     py::dict d;

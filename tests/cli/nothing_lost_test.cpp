@@ -368,14 +368,75 @@ TEST(CliNothingLost, AFailedCooksReportListsNothingAsWritten) {
     EXPECT_FALSE(fs::exists(d / "out" / "a.exr"));
     const auto j = nlohmann::json::parse(read_file_bytes(d / "r.json"));
     EXPECT_EQ(j.at("status"), "failed");
-    bool saw_a = false;
+    bool saw_a = false, saw_b = false;
     for (const auto& o : j.at("outputs")) {
         EXPECT_NE(o.value("status", ""), "written") << o.dump();
         EXPECT_TRUE(o.at("written").empty()) << o.dump();
+        EXPECT_TRUE(o.at("files").empty()) << o.dump();
         if (o.at("file") == "a.exr") {
             saw_a = true;
             EXPECT_EQ(o.value("status", ""), "not written") << o.dump();
         }
+        if (o.at("file") == "b.dds") { // the output that failed is marked, with its reason
+            saw_b = true;
+            EXPECT_EQ(o.value("status", ""), "failed") << o.dump();
+            EXPECT_NE(o.value("error", "").find("cannot meet the bound"), std::string::npos) << o.dump();
+        }
     }
-    EXPECT_TRUE(saw_a) << j.dump();
+    EXPECT_TRUE(saw_a && saw_b) << j.dump();
+    // The error names the output, not the node that fed it, and that node is not called failed.
+    EXPECT_EQ(j.at("error").value("output", ""), "b.dds") << j.dump();
+    EXPECT_FALSE(j.at("error").contains("node")) << j.dump();
+    EXPECT_NE(j.at("nodes").at("n").value("status", ""), "failed") << j.dump();
+}
+
+// A graph's texture budget (issue 44): the report totals the DDS outputs' GPU memory, and a cook
+// over the budget fails before committing anything, naming the largest textures.
+TEST(CliNothingLost, ATextureBudgetIsTotalledAndCheckedBeforeAnythingIsWritten) {
+    const fs::path d = fresh("texture_budget");
+    // 16x16x4 BC4: 64 blocks of 8 bytes = 512 bytes of texels; RGBA16F: 8 bytes a texel, 8192.
+    const std::string outs = "  - {node: n, file: a.dds, options: {encoding: bc4, max_error: 0.05}}\n"
+                             "  - {node: n, file: b.dds, options: {encoding: rgba16f}}\n  - {node: n, file: c.exr}\n";
+    put(d / "ok.yaml", "budget: {texture_mb: 1}\n" + kNoise + outs);
+    CliRun ok = run("cook " + (d / "ok.yaml").string() + " --out " + (d / "o1").string() + " --no-cache --report " + (d / "r1.json").string());
+    ASSERT_EQ(ok.status, 0) << ok.err;
+    const auto j = nlohmann::json::parse(read_file_bytes(d / "r1.json"));
+    uint64_t sum = 0;
+    for (const auto& o : j.at("outputs")) {
+        const bool dds = o.at("format") == "dds";
+        EXPECT_EQ(o.contains("texture_bytes"), dds) << o.dump();
+        if (dds) {
+            EXPECT_EQ(o.at("texture_bytes").get<uint64_t>(), fs::file_size(d / "o1" / o.at("file").get<std::string>())) << o.dump();
+            sum += o.at("texture_bytes").get<uint64_t>();
+        }
+    }
+    EXPECT_EQ(j.at("textures").at("bytes").get<uint64_t>(), sum);
+    EXPECT_GT(sum, 2048u + 512u); // the texels and the DDS headers
+    EXPECT_EQ(j.at("textures").at("budget_mb"), 1.0);
+    EXPECT_EQ(j.at("textures").at("within_budget"), true);
+    EXPECT_NE(ok.err.find("textures 0.00"), std::string::npos) << ok.err;
+    EXPECT_NE(ok.err.find("MB of the 1 MB budget"), std::string::npos) << ok.err;
+
+    // 0.002 MB = 2000 bytes: over, by the RGBA16F texture alone. Nothing is written.
+    put(d / "over.yaml", "budget: {texture_mb: 0.002}\n" + kNoise + outs);
+    CliRun over = run("cook " + (d / "over.yaml").string() + " --out " + (d / "o2").string() + " --no-cache --report " + (d / "r2.json").string());
+    EXPECT_EQ(over.status, 1);
+    EXPECT_NE(over.err.find("over.yaml:1:22: budget: the textures take"), std::string::npos) << over.err;
+    EXPECT_NE(over.err.find("over texture_mb 0.002 by"), std::string::npos) << over.err;
+    EXPECT_NE(over.err.find("(largest first: b.dds"), std::string::npos) << over.err;
+    EXPECT_NE(over.err.find("nothing was written"), std::string::npos) << over.err;
+    EXPECT_FALSE(fs::exists(d / "o2" / "a.dds"));
+    EXPECT_FALSE(fs::exists(d / "o2" / "c.exr"));
+
+    // Bad budgets name the option.
+    for (const std::string bad : {"-1", ".nan", "0", "lots"}) {
+        put(d / "bad.yaml", "budget: {texture_mb: " + bad + "}\n" + kNoise + outs);
+        CliRun r = run("validate " + (d / "bad.yaml").string());
+        EXPECT_EQ(r.status, 1) << bad;
+        EXPECT_NE(r.err.find("budget: texture_mb must be a positive number of megabytes"), std::string::npos) << bad << ": " << r.err;
+    }
+    put(d / "bad.yaml", "budget: {texture_gb: 1}\n" + kNoise + outs);
+    CliRun r = run("validate " + (d / "bad.yaml").string());
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("texture_gb"), std::string::npos) << r.err;
 }

@@ -5,6 +5,7 @@
 #include "graph_walk.h"
 
 #include "atlas/core/files.h"
+#include "atlas/core/option_schema.h"
 #include "atlas/core/parallel.h"
 #include "atlas/io/writers.h"
 #include "../core/file_limits.h"
@@ -19,6 +20,7 @@
 #include <functional>
 #include <mutex>
 #include <set>
+#include <sstream>
 
 namespace atlas {
 
@@ -269,6 +271,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     CookResult& result = last_;
     result.checked = opt.checked;
     const Graph& g = graph();
+    result.texture_budget_mb = g.texture_budget_mb;
     const int jobs = opt.jobs > 0 ? opt.jobs : hardware_threads();
     // One budget per session: the live total of this cook's fields and values
     // and of the in-memory cache; before refusing it drops cache entries.
@@ -399,7 +402,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                     p.rel = final_path.filename();
                 }
             } catch (const std::exception& e) {
-                result.error_node = o->node;
+                result.error_output = o->file;
                 result.error_where = o->where.str();
                 throw Error(o->where.str() + ": " + e.what());
             }
@@ -702,7 +705,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         std::vector<std::pair<OutputPlan*, OutputRecord>> rekeyed;
         for (OutputPlan& p : plans) {
             const GraphOutput* o = p.out;
-            OutputReport orep{o->node, o->port, o->file, o->format, {}, {}, {}, {}};
+            OutputReport orep{o->node, o->port, o->file, o->format, {}, {}, {}, {}, {}};
             if (p.same_spec && p.same_spec->value_hash == value_hash(o)) {
                 // Upstream changed, this port did not: the files already hold it.
                 p.action = OutputPlan::current;
@@ -775,10 +778,41 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 throw;
             } catch (const std::exception& e) {
                 // Writers already name the output ("output 'x.png': ..."); add the graph position.
+                // The output failed, not the node that fed it: the report marks the output.
                 const std::string msg = e.what();
-                result.error_node = o->node;
+                result.error_output = o->file;
                 result.error_where = o->where.str();
+                orep.status = "failed";
+                orep.error = msg;
+                orep.written.clear();
+                orep.files.clear();
+                result.outputs.push_back(orep);
                 throw Error(o->where.str() + ": " + (msg.rfind("output '", 0) == 0 ? msg : "output '" + o->file + "': " + msg));
+            }
+        }
+        // The graph's texture budget, on what is staged or already up to date, before anything moves.
+        if (g.texture_budget_mb) {
+            std::vector<std::pair<uint64_t, std::string>> textures;
+            uint64_t texture_total = 0;
+            for (const OutputReport& o : result.outputs) {
+                const uint64_t b = o.texture_bytes();
+                if (b) textures.emplace_back(b, o.file), texture_total += b;
+            }
+            const double limit = *g.texture_budget_mb * 1e6;
+            if (double(texture_total) > limit) {
+                std::sort(textures.rbegin(), textures.rend());
+                auto mb = [](double bytes) {
+                    std::ostringstream os;
+                    os.precision(3);
+                    os << bytes / 1e6 << " MB";
+                    return os.str();
+                };
+                std::string list;
+                for (const auto& [b, file] : textures) list += (list.empty() ? "" : ", ") + file + " " + mb(double(b));
+                result.error_where = g.budget_where.str();
+                throw Error(g.budget_where.str() + ": budget: the textures take " + mb(double(texture_total)) + ", over texture_mb " +
+                            detail::number_text(*g.texture_budget_mb) + " by " + mb(double(texture_total) - limit) + " (largest first: " + list +
+                            "); nothing was written");
             }
         }
         // Everything written: move it into place.
@@ -823,6 +857,14 @@ std::vector<std::filesystem::path> CookResult::depends(const std::filesystem::pa
     add(graph_file);
     for (const auto& in : inputs) add(in.path);
     return v;
+}
+
+uint64_t OutputReport::texture_bytes() const {
+    if (format != "dds") return 0;
+    uint64_t b = 0;
+    for (const auto& f : files)
+        if (f.path.extension() == ".dds") b += f.bytes; // not the .dds.json manifest beside it
+    return b;
 }
 
 std::vector<std::string> CookResult::with_status(const std::string& wanted) const {

@@ -266,7 +266,7 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
     const YAML::Node root = io::load_yaml(text, filename, "invalid YAML: ");
     if (!root || root.IsNull()) throw ParseError({filename, 1, 1}, "empty graph file: expected 'atlas: 1', 'nodes' and 'outputs'");
     if (!root.IsMap()) p.fail(root, "a graph file is a map with 'atlas', 'nodes' and 'outputs'");
-    p.check_keys(root, {"atlas", "description", "requires", "nodes", "outputs"}, "graph");
+    p.check_keys(root, {"atlas", "description", "requires", "budget", "nodes", "outputs"}, "graph");
 
     Graph g;
     g.base_dir = base_dir;
@@ -295,6 +295,19 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
             if (gr.graph.empty() || gr.out.empty() || gr.out == base_dir.lexically_normal())
                 p.fail(r, "requirement: 'out' must name a folder of its own, not this graph's folder");
             g.requirements.push_back(std::move(gr));
+        }
+    }
+
+    if (const YAML::Node b = root["budget"]) {
+        if (!b.IsMap()) p.fail(b, "'budget' is a map, e.g. budget: {texture_mb: 25}");
+        p.check_keys(b, {"texture_mb"}, "budget");
+        if (const YAML::Node t = b["texture_mb"]) {
+            double mb = 0;
+            if (!t.IsScalar() || !parse_double(t.Scalar(), mb) || !std::isfinite(mb) || mb <= 0)
+                p.fail(t, "budget: texture_mb must be a positive number of megabytes (10^6 bytes of DDS texture data), got '" +
+                              (t.IsScalar() ? t.Scalar() : std::string("a list or map")) + "'");
+            g.texture_budget_mb = mb;
+            g.budget_where = p.at(t);
         }
     }
 

@@ -48,6 +48,7 @@ nlohmann::json report_doc(const CookResult& self, const std::string& graph_file)
     if (cr.status != "ok") {
         json e{{"message", cr.error}};
         if (!cr.error_node.empty()) e["node"] = cr.error_node;
+        if (!cr.error_output.empty()) e["output"] = cr.error_output;
         if (!cr.error_where.empty()) e["where"] = cr.error_where;
         doc["error"] = e;
     }
@@ -81,6 +82,8 @@ nlohmann::json report_doc(const CookResult& self, const std::string& graph_file)
         for (const auto& p : o.written) files.push_back(p.string());
         jo["written"] = files;
         if (!o.status.empty()) jo["status"] = o.status;
+        if (!o.error.empty()) jo["error"] = o.error;
+        if (const uint64_t tb = o.texture_bytes()) jo["texture_bytes"] = tb;
         json all = json::array();
         for (const auto& f : o.files) all.push_back({{"path", f.path.string()}, {"bytes", f.bytes}, {"hash", f.hash}});
         jo["files"] = all;
@@ -90,6 +93,15 @@ nlohmann::json report_doc(const CookResult& self, const std::string& graph_file)
         outs.push_back(jo);
     }
     doc["outputs"] = outs;
+    // GPU texture memory of the DDS outputs, against the graph's budget when it has one.
+    uint64_t texture_total = 0;
+    for (const auto& o : outputs) texture_total += o.texture_bytes();
+    json tex{{"bytes", texture_total}};
+    if (cr.texture_budget_mb) {
+        tex["budget_mb"] = *cr.texture_budget_mb;
+        tex["within_budget"] = double(texture_total) <= *cr.texture_budget_mb * 1e6;
+    }
+    doc["textures"] = tex;
     json ins = json::array();
     for (const auto& in : cr.inputs) ins.push_back({{"path", in.path.string()}, {"bytes", in.bytes}, {"hash", in.hash}, {"node", in.node}});
     doc["inputs"] = ins;

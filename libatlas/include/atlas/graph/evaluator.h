@@ -70,9 +70,13 @@ struct OutputReport {
     // "written" (encoded and written), "restored" (copied from the disk
     // cache's encoded files), "up to date" (the files on disk already held
     // it: not touched), "not written" (a failed or cancelled cook had
-    // encoded it, but committed nothing); empty when outputs are not written.
+    // encoded it, but committed nothing), "failed" (its writer failed: error
+    // says why); empty when outputs are not written.
     std::string status;
     std::vector<OutputFileReport> files; // every file of the output, written or not
+    std::string error;                   // why it failed (status "failed")
+    // GPU texture memory: the bytes of a DDS output's files (what an engine loads as is); 0 otherwise.
+    uint64_t texture_bytes() const;
 };
 
 // A file the cook read (an input file, a preset or forecast file a node reads).
@@ -94,10 +98,13 @@ struct CookResult {
     // The --memory-budget and the most the cook's ledger counted at once
     // (values, the in-memory cache, running nodes' scratch, writers' copies).
     uint64_t memory_budget = 0, memory_peak = 0;
+    std::optional<double> texture_budget_mb; // the graph's budget: {texture_mb} (report.md)
     // "ok", "failed" or "cancelled"; for a failure, the message and where:
-    // the node (empty when the graph itself failed) and its file:line:col.
+    // the node that failed, or the output that failed (its file; error_node is
+    // then empty: the node that fed it did not fail), or neither when the graph
+    // itself failed; and its file:line:col.
     std::string status = "ok";
-    std::string error, error_node, error_where;
+    std::string error, error_node, error_output, error_where;
 
     std::vector<std::string> with_status(const std::string& wanted) const;
     // Every file the cook depends on: the graph file (when given) and the inputs, without repeats.

@@ -17,6 +17,7 @@
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,11 @@ struct Graph {
     std::vector<GraphNode> nodes;   // in file order
     std::vector<GraphOutput> outputs;
     std::vector<GraphRequirement> requirements;
+    // `budget: {texture_mb: N}`: the most GPU texture memory (DDS outputs, MB = 10^6
+    // bytes, as the talks count) the graph's outputs may take; a cook over it fails
+    // before committing anything, naming the largest textures.
+    std::optional<double> texture_budget_mb;
+    SourceLocation budget_where;
 
     const GraphNode* find(const std::string& name) const;
     GraphNode* find(const std::string& name);
