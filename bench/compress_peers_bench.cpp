@@ -327,11 +327,19 @@ int write_inputs(const std::string& dir) {
 }
 
 // RMSE and max error (8-bit steps, channels R,G,B or R only for BC4) of a DDS
-// decoded by Atlas's Reference decoder against an 8-bit PNG.
+// decoded by Atlas's Reference decoder against an 8-bit PNG. Both files store rows top
+// down; a decoded field's y runs up (row 0 of the DDS is the field's top row, y = ny - 1),
+// so PNG row y is field row ny - 1 - y (compared as is, every image was upside down:
+// nvcompress's BC4 read as RMSE 49.9; test peers_rmse_orientation).
 int rmse_of(const std::string& dds, const std::string& png) {
     Image src;
     if (!load_png(png, src)) { std::fprintf(stderr, "cannot read %s\n", png.c_str()); return 1; }
     const atlas::Field3D f = read_dds(dds, Decoder::Reference);
+    if (f.nx() < src.w || f.ny() < src.h) {
+        std::fprintf(stderr, "%s is %dx%d, smaller than %s's %dx%d\n", dds.c_str(), f.nx(), f.ny(), png.c_str(), src.w, src.h);
+        return 1;
+    }
+    auto decoded = [&](int c, int x, int png_row) { return f.at(c, x, f.ny() - 1 - png_row, 0); };
     Errors err;
     const int ch = std::min(3, f.channels());
     int wx = 0, wy = 0, wc = 0;
@@ -339,11 +347,11 @@ int rmse_of(const std::string& dds, const std::string& png) {
         for (int x = 0; x < src.w; ++x)
             for (int c = 0; c < ch; ++c) {
                 const double before = err.max;
-                err.add(f.at(c, x, y, 0), src.rgb[(size_t(y) * size_t(src.w) + size_t(x)) * 3 + size_t(c)]);
+                err.add(decoded(c, x, y), src.rgb[(size_t(y) * size_t(src.w) + size_t(x)) * 3 + size_t(c)]);
                 if (err.max > before) { wx = x; wy = y; wc = c; }
             }
     std::printf("rmse_8bit %.4f max_err_8bit %.3f channels %d worst (%d, %d) ch %d: decoded %.1f source %d\n", err.rmse(), err.max, ch,
-                wx, wy, wc, f.at(wc, wx, wy, 0) * 255.0, int(src.rgb[(size_t(wy) * size_t(src.w) + size_t(wx)) * 3 + size_t(wc)]));
+                wx, wy, wc, decoded(wc, wx, wy) * 255.0, int(src.rgb[(size_t(wy) * size_t(src.w) + size_t(wx)) * 3 + size_t(wc)]));
     return 0;
 }
 

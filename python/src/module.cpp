@@ -121,6 +121,7 @@ py::dict result_to_python(const CookResult& r) {
         d["written"] = written;
         d["metrics"] = o.metrics;
         d["status"] = o.status;
+        d["seconds"] = o.seconds;
         if (!o.error.empty()) d["error"] = o.error;
         outputs.append(d);
     }

@@ -405,6 +405,7 @@ TEST(CliNothingLost, ATextureBudgetIsTotalledAndCheckedBeforeAnythingIsWritten) 
     for (const auto& o : j.at("outputs")) {
         const bool dds = o.at("format") == "dds";
         EXPECT_EQ(o.contains("texture_bytes"), dds) << o.dump();
+        EXPECT_GT(o.at("seconds").get<double>(), 0.0) << o.dump(); // the write is timed (issue 49)
         if (dds) {
             EXPECT_EQ(o.at("texture_bytes").get<uint64_t>(), fs::file_size(d / "o1" / o.at("file").get<std::string>())) << o.dump();
             sum += o.at("texture_bytes").get<uint64_t>();

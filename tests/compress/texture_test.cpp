@@ -118,9 +118,44 @@ TEST(Texture, BoundFailureThrowsAndWritesNothing) {
         CompressOptions ok = o;
         ok.max_error = reach;
         EXPECT_NO_THROW(compress_to_dds(sdf_field(16, 16, 1, 0), dir / "reach.dds", ok)) << what;
+        // And what each quality level reaches (a small texture: encoded again at each), each of
+        // which passes at its level.
+        for (Quality q : {Quality::Fast, Quality::Normal, Quality::Best}) {
+            const std::string qk = std::string(q == Quality::Fast ? "at quality " : ", ") + quality_name(q) + " ";
+            const size_t qa = what.find(qk);
+            ASSERT_NE(qa, std::string::npos) << qk << " in " << what;
+            CompressOptions at_q = o;
+            at_q.quality = q;
+            at_q.max_error = std::stof(what.substr(qa + qk.size()));
+            EXPECT_NO_THROW(compress_to_dds(sdf_field(16, 16, 1, 0), dir / "reach_q.dds", at_q)) << quality_name(q) << ": " << what;
+        }
     }
     EXPECT_FALSE(fs::exists(dir / "fail.dds"));
     EXPECT_FALSE(fs::exists(dir / "fail.dds.json"));
+}
+
+TEST(Texture, WrittenOverTheBoundTheManifestStatesTheBoundItHolds) {
+    const fs::path dir = temp_dir();
+    CompressOptions o;
+    o.format = Format::Bc4;
+    o.max_error = 1e-6f;
+    o.allow_over_bound = true;
+    const Field3D f = sdf_field(16, 16, 1, 0);
+    const CompressReport r = compress_to_dds(f, dir / "over.dds", o);
+    ASSERT_FALSE(r.blocks_over_bound.empty());
+    const auto m = io::read_dds_manifest(dir / "over.dds");
+    ASSERT_TRUE(m && m->max_error && m->requested_max_error);
+    EXPECT_FLOAT_EQ(*m->requested_max_error, 1e-6f);
+    EXPECT_GT(*m->max_error, 1e-6f);
+    // The stated bound holds: the file decoded again under every decoder model is within it.
+    const CompressReport v = verify_dds(dir / "over.dds", f);
+    EXPECT_LE(v.bound_max_error, *m->max_error * (1 + 1e-6)) << *m->max_error;
+    // Within the bound, the manifest says nothing more.
+    o.max_error = *m->max_error;
+    compress_to_dds(f, dir / "ok.dds", o);
+    const auto ok = io::read_dds_manifest(dir / "ok.dds");
+    ASSERT_TRUE(ok);
+    EXPECT_FALSE(ok->requested_max_error.has_value());
 }
 
 TEST(Texture, VolumeRoundTripWithMips) {
@@ -330,4 +365,51 @@ TEST(Texture, MutatedDdsHeadersNeverCrash) {
 }
 
 } // namespace
+// The cloud type convention (issue 44): Atlas's 0, 1/3, 2/3, 1 or GPU Pro 7's 0, 0.5, 1, named
+// in the manifest; the texture stores the converted values.
+TEST(Texture, TypeEncodingConvertsTheTypeChannelsAndNamesItsConvention) {
+    const fs::path dir = temp_dir();
+    Field3D f({{8, 8, 1}}, 2, Box3d{{{0, 0, 0}}, {{8, 8, 1}}}, {"coverage", "type"});
+    for (int i = 0; i < 64; ++i) {
+        f.channel(0)[size_t(i)] = float(i) / 63.0f;
+        f.channel(1)[size_t(i)] = float(i % 4) / 3.0f; // stratus, stratocumulus, cumulus, cumulonimbus
+    }
+    CompressOptions o;
+    o.format = Format::Rgba16F;
+    compress_to_dds(f, dir / "atlas.dds", o);
+    o.type_encoding = TypeEncoding::GpuPro7;
+    compress_to_dds(f, dir / "gp7.dds", o);
+    const auto ma = io::read_dds_manifest(dir / "atlas.dds");
+    const auto mg = io::read_dds_manifest(dir / "gp7.dds");
+    ASSERT_TRUE(ma && mg);
+    EXPECT_EQ(ma->type_encoding, "atlas");
+    EXPECT_EQ(mg->type_encoding, "gpu_pro_7");
+    ASSERT_GE(mg->channel_meanings.size(), 2u);
+    EXPECT_EQ(mg->channel_meanings[0], "coverage");
+    EXPECT_NE(mg->channel_meanings[1].find("0.5 stratocumulus"), std::string::npos) << mg->channel_meanings[1];
+    const Field3D a = read_dds(dir / "atlas.dds");
+    const Field3D g = read_dds(dir / "gp7.dds");
+    const float expect[4] = {0.0f, 0.5f, 1.0f, 1.0f}; // cumulonimbus becomes cumulus
+    for (int i = 0; i < 64; ++i) {
+        EXPECT_NEAR(a.channel(1)[size_t(i)], float(i % 4) / 3.0f, 1e-3f) << i;
+        EXPECT_NEAR(g.channel(1)[size_t(i)], expect[i % 4], 1e-3f) << i;
+        EXPECT_EQ(g.channel(0)[size_t(i)], a.channel(0)[size_t(i)]) << i; // other channels untouched
+    }
+    // Data without a type channel: a clear error, nothing written; the option's names are listed.
+    Field3D plain({{8, 8, 1}}, 1, Box3d{{{0, 0, 0}}, {{8, 8, 1}}}, {"density"});
+    o.format = Format::R16F;
+    try {
+        compress_to_dds(plain, dir / "plain.dds", o);
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("none is stored (stored: density)"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir / "plain.dds"));
+    EXPECT_THROW(parse_type_encoding("hzd"), Error);
+    // A field without type channels says nothing about a convention.
+    o.type_encoding = TypeEncoding::Atlas;
+    compress_to_dds(plain, dir / "plain.dds", o);
+    EXPECT_TRUE(io::read_dds_manifest(dir / "plain.dds")->type_encoding.empty());
+}
+
 } // namespace atlas::compress

@@ -23,6 +23,8 @@ std::string TextureManifest::to_json() const {
     j["value_range"] = {range_lo, range_hi};
     if (max_error) j["max_error"] = *max_error;
     else j["max_error"] = nullptr;
+    if (requested_max_error) j["requested_max_error"] = *requested_max_error;
+    if (!type_encoding.empty()) j["type_encoding"] = type_encoding;
     j["one_sided"] = one_sided_below ? "below" : "none";
     j["decoders"] = decoders;
     j["mip_filter"] = mip_filter;
@@ -50,6 +52,9 @@ TextureManifest TextureManifest::from_json(const std::string& text, const std::s
         m.range_lo = j.at("value_range").at(0).get<float>();
         m.range_hi = j.at("value_range").at(1).get<float>();
         if (j.contains("max_error") && !j["max_error"].is_null()) m.max_error = j["max_error"].get<float>();
+        if (j.contains("requested_max_error") && !j["requested_max_error"].is_null())
+            m.requested_max_error = j["requested_max_error"].get<float>();
+        m.type_encoding = j.value("type_encoding", std::string());
         m.one_sided_below = j.value("one_sided", std::string("none")) == "below";
         m.decoders = j.value("decoders", std::vector<std::string>{});
         m.mip_filter = j.value("mip_filter", std::string("box"));

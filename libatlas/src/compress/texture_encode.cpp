@@ -160,7 +160,53 @@ void encode_bc(const LevelData& L, int layer, Format fmt, const BlockOptions& bo
 
 } // namespace
 
+const char* type_encoding_name(TypeEncoding e) { return e == TypeEncoding::GpuPro7 ? "gpu_pro_7" : "atlas"; }
+
+TypeEncoding parse_type_encoding(const std::string& name) {
+    if (name == "atlas") return TypeEncoding::Atlas;
+    if (name == "gpu_pro_7") return TypeEncoding::GpuPro7;
+    throw Error("unknown type_encoding '" + name + "' (expected 'atlas' or 'gpu_pro_7')");
+}
+
+namespace {
+bool is_type_channel(const std::string& name) { return name == "type" || name == "top_type" || name == "bottom_type"; }
+
+// The stored channels: those selected, else the first ones the format holds.
+std::vector<int> stored_channels(const Field3D& field, const CompressOptions& o, int stored) {
+    std::vector<int> chans = o.channels;
+    if (chans.empty())
+        for (int c = 0; c < std::min(stored, field.channels()); ++c) chans.push_back(c);
+    return chans;
+}
+} // namespace
+
 EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, const ProgressSink* progress) {
+    if (o.type_encoding == TypeEncoding::GpuPro7) {
+        // The type channels re-encoded (t' = min(1, 1.5 t)) in a copy; the bound then holds for
+        // the converted values, which are what the texture stores.
+        const int stored = o.format == Format::Bc1Scalar ? 1 : format_channels(dxgi_format(o.format));
+        const std::vector<int> chans = stored_channels(field, o, stored);
+        Field3D converted = field;
+        int found = 0;
+        for (int c : chans)
+            if (c >= 0 && c < field.channels() && is_type_channel(field.channel_name(c))) {
+                for (float& t : converted.channel(c)) t = std::min(1.0f, 1.5f * t);
+                ++found;
+            }
+        if (!found) {
+            std::string have;
+            for (int c : chans) have += (have.empty() ? "" : ", ") + (c >= 0 && c < field.channels() ? field.channel_name(c) : "?");
+            throw Error("compress: type_encoding gpu_pro_7 re-encodes channels named type, top_type or bottom_type, and none is stored "
+                        "(stored: " + have + "); leave type_encoding at atlas for data without a cloud type");
+        }
+        CompressOptions inner = o;
+        inner.type_encoding = TypeEncoding::Atlas;
+        EncodedTexture e = encode_texture(converted, inner, progress);
+        e.manifest.type_encoding = type_encoding_name(TypeEncoding::GpuPro7);
+        for (std::string& m : e.manifest.channel_meanings)
+            if (is_type_channel(m)) m += " (gpu_pro_7: 0 stratus, 0.5 stratocumulus, 1 cumulus and cumulonimbus)";
+        return e;
+    }
     const auto t0 = std::chrono::steady_clock::now();
     const bool bc6h = o.format == Format::Bc6hUf16 || o.format == Format::Bc6hSf16;
     if (bc6h && o.one_sided_below)
@@ -169,9 +215,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     const DxgiFormat dx = dxgi_format(o.format);
     const bool scalar = o.format == Format::Bc1Scalar;
     const int stored = scalar ? 1 : format_channels(dx);
-    std::vector<int> chans = o.channels;
-    if (chans.empty())
-        for (int c = 0; c < std::min(stored, field.channels()); ++c) chans.push_back(c);
+    std::vector<int> chans = stored_channels(field, o, stored);
     if (int(chans.size()) > stored)
         throw Error(std::string("compress: format '") + format_name(o.format) + "' stores " + std::to_string(stored) +
                     " channel(s), " + std::to_string(chans.size()) + " were selected");
@@ -390,6 +434,8 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     man.mip_filter = o.one_sided_below ? "min" : "box";
     man.unpack_weights = unpack.weights;
     man.world_bounds = field.bounds();
+    for (int c : chans)
+        if (is_type_channel(field.channel_name(c))) man.type_encoding = type_encoding_name(TypeEncoding::Atlas);
 
     // The float levels are encoded: free them before the verify decodes (a
     // 512x512x64 RGBA volume's levels are ~290 MiB besides the texture).

@@ -79,6 +79,12 @@ std::vector<TextOption<CompressOptions>> make_compress_options() {
              std::string("texture format (a dds output's default: ") + format_name(kDdsOutputDefaultFormat) + "; atlas compress requires --format)",
              -INFINITY, INFINITY, format_words()},
             [](C& c, const V& v) { c.format = parse_format(v.word); }),
+        opt({"type_encoding", "--type-encoding", "NAME", K::Choice,
+             "cloud type convention of channels named type, top_type, bottom_type: atlas (0 stratus, 1/3 stratocumulus, 2/3 cumulus, "
+             "1 cumulonimbus; default) or gpu_pro_7 (HZD's 0, 0.5, 1 for stratus, stratocumulus, cumulus; cumulonimbus stored as "
+             "cumulus); recorded in the manifest",
+             -INFINITY, INFINITY, {type_encoding_name(TypeEncoding::Atlas), type_encoding_name(TypeEncoding::GpuPro7)}},
+            [](C& c, const V& v) { c.type_encoding = parse_type_encoding(v.word); }),
         opt({"quality", "--quality", "LEVEL", K::Choice, "encoder effort (default normal; bc4 best: exhaustive, provably optimal)", -INFINITY,
              INFINITY, {quality_name(Quality::Fast), quality_name(Quality::Normal), quality_name(Quality::Best)}},
             [](C& c, const V& v) { c.quality = parse_quality(v.word.c_str()); }),

@@ -705,7 +705,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         std::vector<std::pair<OutputPlan*, OutputRecord>> rekeyed;
         for (OutputPlan& p : plans) {
             const GraphOutput* o = p.out;
-            OutputReport orep{o->node, o->port, o->file, o->format, {}, {}, {}, {}, {}};
+            OutputReport orep{o->node, o->port, o->file, o->format, {}, {}, {}, {}, {}, 0.0};
             if (p.same_spec && p.same_spec->value_hash == value_hash(o)) {
                 // Upstream changed, this port did not: the files already hold it.
                 p.action = OutputPlan::current;
@@ -722,6 +722,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 result.outputs.push_back(orep);
                 continue;
             }
+            const auto t_write = std::chrono::steady_clock::now();
             try {
                 opt.progress.poll();
                 auto& st = staging[p.root];
@@ -771,6 +772,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                              "); cooking on without writing the cache");
                     }
                 }
+                orep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
                 result.outputs.push_back(orep);
                 written.push_back(std::move(w));
                 progress_step("wrote " + o->file, "", 0.0, true);

@@ -84,6 +84,7 @@ nlohmann::json report_doc(const CookResult& self, const std::string& graph_file)
         if (!o.status.empty()) jo["status"] = o.status;
         if (!o.error.empty()) jo["error"] = o.error;
         if (const uint64_t tb = o.texture_bytes()) jo["texture_bytes"] = tb;
+        jo["seconds"] = o.seconds;
         json all = json::array();
         for (const auto& f : o.files) all.push_back({{"path", f.path.string()}, {"bytes", f.bytes}, {"hash", f.hash}});
         jo["files"] = all;

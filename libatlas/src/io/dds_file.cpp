@@ -40,6 +40,26 @@ std::optional<TextureManifest> read_dds_manifest(const fs::path& dds) {
     return TextureManifest::from_json(read_file_bytes(side), side.string());
 }
 
+namespace {
+// Textures up to this many texels get the bound of every quality level in a bound error
+// (encoded again at each; a 128^3 BC4 volume takes about a second per level).
+constexpr uint64_t kGuideTexels = uint64_t(1) << 21;
+
+// The guaranteed max error of an encoding over every texel and decoder, the missed blocks included.
+double reached_bound(const CompressReport& r) {
+    double reach = r.bound_max_error;
+    for (const BlockMiss& b : r.blocks_over_bound) reach = std::max(reach, double(b.best_error));
+    return reach;
+}
+
+// Rounded up to three significant digits, so a bound printed from it passes.
+double round_up_3(double v) {
+    if (!(v > 0) || !std::isfinite(v)) return v;
+    const double unit = std::pow(10.0, std::floor(std::log10(v)) - 2);
+    return std::ceil(v / unit) * unit;
+}
+} // namespace
+
 CompressReport compress_to_dds(const Field3D& field, const fs::path& path, const CompressOptions& o, const ProgressSink* progress) {
     EncodedTexture enc = encode_texture(field, o, progress);
     enc.report.file = path.string();
@@ -56,18 +76,42 @@ CompressReport compress_to_dds(const Field3D& field, const fs::path& path, const
         }
         // What the format does reach here: its worst block over every decoder model
         // (the guaranteed figure of the file it would have written).
-        double reach = enc.report.bound_max_error;
-        for (const BlockMiss& b : enc.report.blocks_over_bound) reach = std::max(reach, double(b.best_error));
+        const double reach = reached_bound(enc.report);
         if (o.max_error && reach > 0 && std::isfinite(reach)) {
-            // Rounded up to three significant digits, so the number printed passes.
-            const double unit = std::pow(10.0, std::floor(std::log10(reach)) - 2);
             char buf[160];
-            std::snprintf(buf, sizeof buf, "; this encoding reaches max_error %.3g here (its worst block), so a bound of at least that passes",
-                          std::ceil(reach / unit) * unit);
+            std::snprintf(buf, sizeof buf, "; this encoding reaches max_error %.3g here (its worst block)", round_up_3(reach));
             msg << buf;
+            // The other quality levels, when the texture is small enough to encode again (an
+            // editor's slider move should learn where the bound is within reach, not only fail).
+            const uint64_t texels = uint64_t(field.nx()) * uint64_t(field.ny()) * uint64_t(field.nz());
+            if (texels <= kGuideTexels) {
+                msg << "; at quality";
+                const char* sep = " ";
+                for (Quality q : {Quality::Fast, Quality::Normal, Quality::Best}) {
+                    double r = reach;
+                    if (q != o.quality) {
+                        CompressOptions other = o;
+                        other.quality = q;
+                        r = reached_bound(encode_texture(field, other).report);
+                    }
+                    std::snprintf(buf, sizeof buf, "%s%s %.3g", sep, quality_name(q), round_up_3(r));
+                    msg << buf;
+                    sep = ", ";
+                }
+                msg << " it reaches";
+            } else {
+                msg << " (atlas compress --sweep gives the bound each quality level reaches)";
+            }
+            msg << ", so a bound of at least that passes";
         }
-        msg << " (allow_over_bound writes the file anyway)";
+        msg << " (allow_over_bound writes the file anyway, with the bound it reached in its manifest)";
         throw BoundError(msg.str(), enc.report);
+    }
+    if (!enc.report.blocks_over_bound.empty() && enc.manifest.max_error) {
+        // Written over the bound on request: the manifest states the bound the file holds, not the
+        // one asked for (an importer trusting max_error would be wrong by the miss).
+        enc.manifest.requested_max_error = enc.manifest.max_error;
+        enc.manifest.max_error = float(round_up_3(reached_bound(enc.report)));
     }
     const std::string manifest = enc.manifest.to_json();
     StagedOutputs staged(path.parent_path().empty() ? fs::path(".") : path.parent_path());

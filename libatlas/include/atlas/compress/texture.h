@@ -58,8 +58,18 @@ Format parse_format(const std::string& name); // throws atlas::Error listing the
 std::string format_names();                   // "bc1, bc1-scalar, ...": every name parse_format takes
 DxgiFormat dxgi_format(Format f);
 
+// How channels named type, top_type and bottom_type encode the cloud type (docs/ndf.md): the
+// sources differ, so an engine texture names its convention in the manifest.
+//   Atlas    0 stratus, 1/3 stratocumulus, 2/3 cumulus, 1 cumulonimbus (Atlas's NDF set)
+//   GpuPro7  0 stratus, 0.5 stratocumulus, 1 cumulus (HZD, GPU Pro 7 ch. 4): t' = min(1, 1.5 t),
+//            so cumulonimbus is stored as cumulus
+enum class TypeEncoding { Atlas, GpuPro7 };
+const char* type_encoding_name(TypeEncoding e);
+TypeEncoding parse_type_encoding(const std::string& name); // throws atlas::Error listing the names
+
 struct CompressOptions {
     Format format = Format::Bc4;
+    TypeEncoding type_encoding = TypeEncoding::Atlas;
     Quality quality = Quality::Normal;
     // Guarantee |decoded - source| <= max_error (source units) for every texel of
     // every mip level under every decoder in `decoders`; blocks that cannot meet it
@@ -153,6 +163,9 @@ struct TextureManifest {
     std::string mapping;
     float range_lo = 0, range_hi = 1;
     std::optional<float> max_error; // source units, as guaranteed
+    // Present when the texture was written over the bound on request (allow_over_bound):
+    // the bound asked for; max_error is then the one the file holds.
+    std::optional<float> requested_max_error;
     bool one_sided_below = false;
     std::vector<std::string> decoders;
     std::string mip_filter; // "box" or "min"
@@ -160,6 +173,9 @@ struct TextureManifest {
     // The field's world box (metres), so a decoded texture comes back where it was;
     // absent in manifests written before it existed (decoding then uses 1 m texels at 0).
     std::optional<Box3d> world_bounds;
+    // The cloud type convention of the stored type channels (type_encoding_name); empty when
+    // no stored channel is a type channel.
+    std::string type_encoding;
     std::string to_json() const;
     static TextureManifest from_json(const std::string& text, const std::string& what);
 };

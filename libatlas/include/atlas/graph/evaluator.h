@@ -75,6 +75,7 @@ struct OutputReport {
     std::string status;
     std::vector<OutputFileReport> files; // every file of the output, written or not
     std::string error;                   // why it failed (status "failed")
+    double seconds = 0;                  // encoding, writing (and a DDS's verification) and hashing its files
     // GPU texture memory: the bytes of a DDS output's files (what an engine loads as is); 0 otherwise.
     uint64_t texture_bytes() const;
 };
