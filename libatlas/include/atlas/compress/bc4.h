@@ -30,6 +30,8 @@ long bc4_shortcut_mismatches(bool snorm, const BlockOptions& options, const floa
 
 // Encodes BC4 blocks. Construction precomputes the palettes of all 65,536 endpoint
 // pairs for the decoder set (about 12 MB with the search-pruning tables); encode() is const and thread-safe.
+// The tables are shared: encoders of the same kind and options (within a process, the
+// last four kinds) reuse them instead of building them again for every texture.
 // Objective: minimise the block's max error under the decoder set (subject to
 // decoded <= source when one-sided), then the squared Reference error. The encoder's
 // palette bounds are the exact palette values rounded outward (a decoder computing in
@@ -53,9 +55,11 @@ public:
 private:
     friend long detail::bc4_shortcut_mismatches(bool snorm, const BlockOptions& options, const float* blocks, size_t count);
     struct Tables;
+    // `shared` false: tables of its own (the test hook switches their shortcuts off).
+    Bc4Encoder(bool snorm, const BlockOptions& options, bool shared);
     bool snorm_;
     BlockOptions options_;
-    std::unique_ptr<Tables> tables_;
+    std::shared_ptr<Tables> tables_;
 };
 
 } // namespace atlas::compress
