@@ -47,6 +47,7 @@ const std::vector<Command>& commands() {
           {"--report", "FILE.json", "write the cook report (nodes, inputs and outputs with hashes; also for a failed cook)"},
           {"--depfile", "FILE", "write a Make/Ninja depfile: the output files depend on the graphs and every file they read"},
           {"--rewrite", "", "write every output even when its file on disk is up to date"},
+          {"--keep-going", "", "an output whose writer fails is reported and skipped; the other outputs are written"},
           {"--memory-budget", "SIZE", "refuse allocations past this size (default 8GiB)"},
           {"--checked", "", "re-cook every node and compare with the cache (catches incomplete hashes)"},
           {"--allow-outside-out", "", "allow output paths that are absolute or leave --out"},

@@ -160,6 +160,7 @@ int run_cook(const Args& a) {
     o.checked = a.has("--checked");
     o.allow_outside_out = a.has("--allow-outside-out");
     o.reuse_outputs = !a.has("--rewrite");
+    o.keep_going = a.has("--keep-going");
     if (a.has("--jobs")) {
         try {
             o.jobs = std::stoi(a.get("--jobs"));

@@ -441,3 +441,28 @@ TEST(CliNothingLost, ATextureBudgetIsTotalledAndCheckedBeforeAnythingIsWritten) 
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find("texture_gb"), std::string::npos) << r.err;
 }
+
+// --keep-going (an editor's cook, issue 42): an output whose writer fails is reported failed with
+// a warning, nothing of it is left behind, and the other outputs are written.
+TEST(CliNothingLost, KeepGoingWritesTheOtherOutputsAndReportsTheFailedOne) {
+    const fs::path d = fresh("keep_going");
+    put(d / "g.yaml", kNoise + "  - {node: n, file: a.exr}\n  - {node: n, file: b.dds, options: {encoding: bc4, max_error: 0.00001}}\n"
+                               "  - {node: n, file: c.png}\n");
+    CliRun r = run("cook " + (d / "g.yaml").string() + " --out " + (d / "out").string() + " --no-cache --keep-going --report " +
+                   (d / "r.json").string());
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(fs::exists(d / "out" / "a.exr"));
+    EXPECT_TRUE(fs::exists(d / "out" / "c.png"));
+    EXPECT_FALSE(fs::exists(d / "out" / "b.dds"));
+    EXPECT_FALSE(fs::exists(d / "out" / "b.dds.json"));
+    EXPECT_NE(r.err.find("warning: output 'b.dds' (" + (d / "g.yaml").string() + ":"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(") was not written (keep going): compress:"), std::string::npos) << r.err;
+    const auto j = nlohmann::json::parse(read_file_bytes(d / "r.json"));
+    EXPECT_EQ(j.at("status"), "ok");
+    for (const auto& o : j.at("outputs"))
+        EXPECT_EQ(o.value("status", ""), o.at("file") == "b.dds" ? "failed" : "written") << o.dump();
+    // Without it the same cook fails and writes nothing.
+    CliRun strict = run("cook " + (d / "g.yaml").string() + " --out " + (d / "out2").string() + " --no-cache");
+    EXPECT_EQ(strict.status, 1);
+    EXPECT_FALSE(fs::exists(d / "out2" / "a.exr"));
+}

@@ -312,6 +312,16 @@ std::vector<fs::path> StagedOutputs::staged_files() const {
     return files;
 }
 
+void StagedOutputs::discard(const fs::path& relative) {
+    if (prepared_ || committed_) throw Error("internal: StagedOutputs::discard after prepare");
+    const std::string prefix = relative.lexically_normal().generic_string();
+    for (const fs::path& f : staged_files())
+        if (f.generic_string().rfind(prefix, 0) == 0) {
+            std::error_code ec;
+            fs::remove(staging_ / f, ec);
+        }
+}
+
 fs::path StagedOutputs::final_path(const fs::path& staged) const { return root_ / staged.lexically_relative(staging_); }
 
 void StagedOutputs::prepare() {

@@ -782,6 +782,17 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 // Writers already name the output ("output 'x.png': ..."); add the graph position.
                 // The output failed, not the node that fed it: the report marks the output.
                 const std::string msg = e.what();
+                if (opt.keep_going) {
+                    if (auto st = staging.find(p.root); st != staging.end() && st->second) st->second->discard(p.rel);
+                    orep.status = "failed";
+                    orep.error = msg;
+                    orep.written.clear();
+                    orep.files.clear();
+                    orep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
+                    result.outputs.push_back(orep);
+                    warn("output '" + o->file + "' (" + o->where.str() + ") was not written (keep going): " + msg);
+                    continue;
+                }
                 result.error_output = o->file;
                 result.error_where = o->where.str();
                 orep.status = "failed";

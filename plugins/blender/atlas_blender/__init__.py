@@ -73,8 +73,10 @@ class CookJob:
             self.fraction, self.task = fraction, task
 
         try:
+            # keep_going: an output a slider move made unwritable (a DDS bound out of reach) is a
+            # warning on that output; the other outputs, and the viewport, still update.
             self.report = self.session.cook(jobs=jobs, write_outputs=True, out_dir=self.out_dir, progress=progress,
-                                            cancel=self.cancel.is_set)
+                                            cancel=self.cancel.is_set, keep_going=True)
         except Exception as e:  # atlas.Error and its subclasses; shown in the panel
             self.error = e
 
@@ -316,7 +318,8 @@ def _finish(scene, job):
     cooked = sorted(n for n, r in report["nodes"].items() if r["status"] == "cooked")
     props.last_cooked = " ".join(cooked)
     props.status = f"cooked {len(cooked)} node(s) in {report['seconds']:.2f} s"
-    props.error = ""
+    failed = [o for o in report["outputs"] if o.get("status") == "failed"]
+    props.error = "; ".join(f"output '{o['file']}' not written: {o.get('error', '')}" for o in failed)
     load_outputs(scene, job.out_dir)
 
 

@@ -74,6 +74,9 @@ public:
     // Every file the writers produced in the staging area, as relative paths,
     // in commit order (sorted; the stage_last files at the end).
     std::vector<fs::path> staged_files() const;
+    // Removes what a failed writer left staged for `relative`: the files whose relative path
+    // starts with it (OUT.dds and OUT.dds.json, a slice stack's STEM.001.tga, ...).
+    void discard(const fs::path& relative);
 
 private:
     fs::path root_;

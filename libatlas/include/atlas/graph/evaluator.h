@@ -42,6 +42,11 @@ struct CookOptions {
     // With a cache_dir: after the cook, remove least recently used entries
     // until the cache holds at most this many bytes (0 = no limit).
     uint64_t cache_max_bytes = 0;
+    // An output whose writer fails (a DDS bound a slider move put out of reach) is reported
+    // failed, with its error as a warning, and the other outputs are written: what an editor
+    // wants from one edit. false (the default, and `atlas cook` without --keep-going): the
+    // cook fails and writes nothing.
+    bool keep_going = false;
     ProgressSink progress;
 };
 
