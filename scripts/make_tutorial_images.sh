@@ -13,6 +13,7 @@ cp "$t/out/top.png" docs/images/tutorial_density_top.png
 cp "$t/cumulus.png" docs/images/tutorial_cumulus.png
 cp "$t/cumulus_orbit.png" docs/images/tutorial_cumulus_orbit.png
 cp "$t/cumulus_towers.png" docs/images/tutorial_cumulus_towers.png
+cp "$t/out/density_bc4_slice.png" docs/images/tutorial_density_bc4_slice.png
 cp "$t/storm/storm_coverage.png" docs/images/tutorial_storm_coverage.png
 cp "$t/storm_aerial.png" docs/images/tutorial_storm_aerial.png
 cp "$t/storm_ground.png" docs/images/tutorial_storm_ground.png
