@@ -292,8 +292,7 @@ int run_cook(const Args& a) {
     if (!quiet && current) std::cerr << current << " file" << (current == 1 ? "" : "s") << " already up to date (not rewritten)\n";
     // GPU texture memory of the DDS outputs, per graph, against its budget (report.md "textures").
     for (const auto& [file, r] : cooks) {
-        uint64_t tex = 0;
-        for (const auto& out : r.outputs) tex += out.texture_bytes();
+        const uint64_t tex = r.texture_bytes();
         if (quiet || (!tex && !r.texture_budget_mb)) continue;
         std::ostringstream line;
         line.precision(3);

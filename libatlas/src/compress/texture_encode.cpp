@@ -171,6 +171,9 @@ TypeEncoding parse_type_encoding(const std::string& name) {
 namespace {
 bool is_type_channel(const std::string& name) { return name == "type" || name == "top_type" || name == "bottom_type"; }
 
+// How many channels the format stores (bc1-scalar: one, spread over RGB).
+int stored_channel_count(Format f) { return f == Format::Bc1Scalar ? 1 : format_channels(dxgi_format(f)); }
+
 // The stored channels: those selected, else the first ones the format holds.
 std::vector<int> stored_channels(const Field3D& field, const CompressOptions& o, int stored) {
     std::vector<int> chans = o.channels;
@@ -184,8 +187,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     if (o.type_encoding == TypeEncoding::GpuPro7) {
         // The type channels re-encoded (t' = min(1, 1.5 t)) in a copy; the bound then holds for
         // the converted values, which are what the texture stores.
-        const int stored = o.format == Format::Bc1Scalar ? 1 : format_channels(dxgi_format(o.format));
-        const std::vector<int> chans = stored_channels(field, o, stored);
+        const std::vector<int> chans = stored_channels(field, o, stored_channel_count(o.format));
         Field3D converted = field;
         int found = 0;
         for (int c : chans)
@@ -214,7 +216,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
                     "' (use bc4, bc1-scalar or an uncompressed format for one-sided data)");
     const DxgiFormat dx = dxgi_format(o.format);
     const bool scalar = o.format == Format::Bc1Scalar;
-    const int stored = scalar ? 1 : format_channels(dx);
+    const int stored = stored_channel_count(o.format);
     std::vector<int> chans = stored_channels(field, o, stored);
     if (int(chans.size()) > stored)
         throw Error(std::string("compress: format '") + format_name(o.format) + "' stores " + std::to_string(stored) +

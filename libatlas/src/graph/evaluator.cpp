@@ -782,37 +782,30 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                 // Writers already name the output ("output 'x.png': ..."); add the graph position.
                 // The output failed, not the node that fed it: the report marks the output.
                 const std::string msg = e.what();
+                orep.status = "failed";
+                orep.error = msg;
+                orep.written.clear();
+                orep.files.clear();
+                orep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
+                result.outputs.push_back(orep);
                 if (opt.keep_going) {
                     if (auto st = staging.find(p.root); st != staging.end() && st->second) st->second->discard(p.rel);
-                    orep.status = "failed";
-                    orep.error = msg;
-                    orep.written.clear();
-                    orep.files.clear();
-                    orep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
-                    result.outputs.push_back(orep);
                     warn("output '" + o->file + "' (" + o->where.str() + ") was not written (keep going): " + msg);
                     continue;
                 }
                 result.error_output = o->file;
                 result.error_where = o->where.str();
-                orep.status = "failed";
-                orep.error = msg;
-                orep.written.clear();
-                orep.files.clear();
-                result.outputs.push_back(orep);
                 throw Error(o->where.str() + ": " + (msg.rfind("output '", 0) == 0 ? msg : "output '" + o->file + "': " + msg));
             }
         }
         // The graph's texture budget, on what is staged or already up to date, before anything moves.
         if (g.texture_budget_mb) {
-            std::vector<std::pair<uint64_t, std::string>> textures;
-            uint64_t texture_total = 0;
-            for (const OutputReport& o : result.outputs) {
-                const uint64_t b = o.texture_bytes();
-                if (b) textures.emplace_back(b, o.file), texture_total += b;
-            }
+            const uint64_t texture_total = result.texture_bytes();
             const double limit = *g.texture_budget_mb * 1e6;
             if (double(texture_total) > limit) {
+                std::vector<std::pair<uint64_t, std::string>> textures;
+                for (const OutputReport& o : result.outputs)
+                    if (const uint64_t b = o.texture_bytes()) textures.emplace_back(b, o.file);
                 std::sort(textures.rbegin(), textures.rend());
                 auto mb = [](double bytes) {
                     std::ostringstream os;
@@ -877,6 +870,12 @@ uint64_t OutputReport::texture_bytes() const {
     uint64_t b = 0;
     for (const auto& f : files)
         if (f.path.extension() == ".dds") b += f.bytes; // not the .dds.json manifest beside it
+    return b;
+}
+
+uint64_t CookResult::texture_bytes() const {
+    uint64_t b = 0;
+    for (const OutputReport& o : outputs) b += o.texture_bytes();
     return b;
 }
 

@@ -95,8 +95,7 @@ nlohmann::json report_doc(const CookResult& self, const std::string& graph_file)
     }
     doc["outputs"] = outs;
     // GPU texture memory of the DDS outputs, against the graph's budget when it has one.
-    uint64_t texture_total = 0;
-    for (const auto& o : outputs) texture_total += o.texture_bytes();
+    const uint64_t texture_total = cr.texture_bytes();
     json tex{{"bytes", texture_total}};
     if (cr.texture_budget_mb) {
         tex["budget_mb"] = *cr.texture_budget_mb;

@@ -105,6 +105,7 @@ struct CookResult {
     // (values, the in-memory cache, running nodes' scratch, writers' copies).
     uint64_t memory_budget = 0, memory_peak = 0;
     std::optional<double> texture_budget_mb; // the graph's budget: {texture_mb} (report.md)
+    uint64_t texture_bytes() const;          // the outputs' OutputReport::texture_bytes, summed
     // "ok", "failed" or "cancelled"; for a failure, the message and where:
     // the node that failed, or the output that failed (its file; error_node is
     // then empty: the node that fed it did not fail), or neither when the graph
