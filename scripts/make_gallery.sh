@@ -27,5 +27,5 @@ P graphs/superstorm.yaml --camera 14000,-17000,2,14000,20000,5500 --fov 40 --lig
 P graphs/fc6_forecast.yaml -o "$OUT/look_fc6_forecast.png"
 # cumulus_cloudscape composites the solver's tower: grow it (64^3 quick cook) first.
 "$ATLAS" cook graphs/cumulus_growth.yaml --out "$WORK/cumulus_out" --set 'cloud.resolution=[64,64,64]' --set cloud.dx=62.5 --quiet >/dev/null
-P graphs/cumulus_cloudscape.yaml --set "tower.file=$WORK/cumulus_out/cumulus_final.vdb" --camera 3200,800,400,2400,3000,1500 --fov 45 -o "$OUT/look_cumulus_cloudscape.png"
+P graphs/cumulus_cloudscape.yaml --set "tower.file=$WORK/cumulus_out/cumulus_final.vdb" -o "$OUT/look_cumulus_cloudscape.png"
 ls -l "$OUT"/look_*.png

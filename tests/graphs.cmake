@@ -10,6 +10,8 @@ foreach(graph IN LISTS ATLAS_GRAPH_FILES)
            ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/cook_shipped/${name} ${rel})
   set_tests_properties(cook_shipped_${name} PROPERTIES LABELS graph TIMEOUT 900)
 endforeach()
+# tests/look/test_cumulus_anatomy.py reads the grown cloudscape this cook writes.
+set_tests_properties(cook_shipped_cumulus_cloudscape PROPERTIES FIXTURES_SETUP shipped_cumulus_cloudscape)
 add_test(NAME cook_quickstart COMMAND atlas cook "${PROJECT_SOURCE_DIR}/examples/quickstart.yaml"
          --out "${PROJECT_BINARY_DIR}/quickstart-out" --quiet --checked)
 set_tests_properties(cook_quickstart PROPERTIES LABELS graph PASS_REGULAR_EXPRESSION "cooked 9, cached 0, skipped 1 nodes")

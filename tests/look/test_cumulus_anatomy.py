@@ -3,7 +3,10 @@ OpenVDB's own Python reader (pyopenvdb), nothing of Atlas's: a flat base (the cl
 columns start within a voxel or two of one height), towers (the top well above the
 bulk), lobes at several scales (the top surface is rough at 16-80 m, not one dome),
 billowy detail type on the tops and wispy undersides, density scale rising from the
-base. Run by ctest (test `look_cumulus_anatomy`) with ATLAS_BIN set."""
+base. The same anatomy on graphs/cumulus_cloudscape.yaml's solver-grown towers, as the
+ctest fixture `cook_shipped_cumulus_cloudscape` cooked them (the 32^3 quick tower; its NVDF set
+is ATLAS_SHIPPED_CUMULUS_CLOUDSCAPE). Run by ctest (test `look_cumulus_anatomy`) with ATLAS_BIN
+set."""
 import os
 import pathlib
 import subprocess
@@ -89,3 +92,41 @@ def test_billowy_tops_wispy_undersides_density_from_the_base(grids):
     base_scale = ds[xs, ys, basez[xs, ys]]
     high = ds[:, :, int((BASE + 200) / VOXEL)][occ[:, :, int((BASE + 200) / VOXEL)]]
     assert high.size > 0 and np.mean(high) > np.mean(base_scale) + 0.2
+
+
+# graphs/cumulus_cloudscape.yaml: 256 x 256 x 224 voxels over 4 x 4 x 3.5 km, base 650 m.
+CS_RES = (256, 256, 224)
+CS_VOXEL = 4000.0 / 256
+CS_BASE = 650.0
+
+
+@pytest.fixture(scope="module")
+def cloudscape():
+    g = {g.name: g for g in vdb.readAll(os.environ["ATLAS_SHIPPED_CUMULUS_CLOUDSCAPE"])[0]}["dimensional_profile"]
+    a = np.zeros(CS_RES, dtype=np.float32)
+    g.copyToArray(a, ijk=(0, 0, 0))
+    return a > 0.05
+
+
+def test_grown_towers_stand_on_a_flat_base(cloudscape):
+    occ = cloudscape
+    cols = occ.any(axis=2)
+    assert cols.sum() > 2000, "clouds, not specks"
+    base = np.argmax(occ, axis=2)[cols] * CS_VOXEL
+    # Nothing below the condensation height; the bulk of the columns start on it (the
+    # rest are lobes bulging out over the base and the decaying tower's bubbles).
+    assert CS_BASE - CS_VOXEL <= base.min() <= CS_BASE + 2 * CS_VOXEL, base.min()
+    assert np.mean(base <= base.min() + 2 * CS_VOXEL) > 0.3, np.percentile(base, [10, 50, 90])
+
+
+def test_the_grown_cloud_is_a_tower(cloudscape):
+    # The tower as grown (south-west quarter): taller than it is wide. Measured on the
+    # 32^3 quick tower: 2.44 km tall on a 1.39 km footprint (1.75); the soft blob this
+    # graph made before was about as tall as wide.
+    occ = cloudscape[:128, :128, :]
+    cols = occ.any(axis=2)
+    xs, ys = np.nonzero(cols)
+    width = max(xs.max() - xs.min(), ys.max() - ys.min()) * CS_VOXEL
+    top = (occ.shape[2] - 1 - np.argmax(occ[:, :, ::-1], axis=2))[cols].max() * CS_VOXEL
+    height = top - np.argmax(occ, axis=2)[cols].min() * CS_VOXEL
+    assert height > 1.2 * width, (height, width)
