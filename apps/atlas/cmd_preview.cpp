@@ -12,6 +12,7 @@
 #include "atlas/io/image.h"
 #include "atlas/io/readers.h"
 #include "atlas/ndf/cone_map.h"
+#include "atlas/preview/graph_preview.h"
 #include "atlas/render/image_out.h"
 #include "atlas/render/layer.h"
 #include "atlas/render/preview.h"
@@ -25,6 +26,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <thread>
 #include <optional>
 #include <sstream>
@@ -56,27 +58,6 @@ bool is_graph(const std::string& f) {
     return ext == ".yaml" || ext == ".yml" || ext == ".atlas";
 }
 
-// What a graph writes that the preview can draw, found by cooking (values
-// only, through the cache like `atlas cook`) the graph's outputs:
-//   volume/nvdf vdb_set                    -> voxel mode
-//   a 2D field with coverage, min_height, max_height (an NDF set) -> 2.5D mode
-//   a 2D field with coverage only (a weather map)      -> 2.5D, heights 1500..4000 m
-//   a 2D field with bottom, top (ndf/profile_lut)      -> the layer's profile LUT
-//   a 2D field with anvil_bias (ndf/superstorm anvil)  -> the storm's anvil spread
-//   ndf/vortex_rings' table (inner, outer, speed, ...)  -> the storm turns with --time
-//   a 2D field with apex_height, cone_ratio (ndf/cone_map) / ndf/distance_map -> envelope
-//   a 2D field with a 'cirrus' channel (ndf/cirrus)    -> a cirrus layer at 8 km
-//   otherwise the last 1-channel 2D field               -> a sky layer at 6 km (Quilez)
-struct GraphContent {
-    Field3DPtr nvdf;
-    Field2DPtr ndf, lut, cone, cirrus, sky2d, anvil, vortex;
-    Field3DPtr distance;
-    Field3DPtr forecast; // ndf/forecast maps: z = time slice, channels coverage, precipitation, type, ...
-    std::string ndf_node;
-    std::vector<std::string> written; // "node 'n' (type) port 'p' -> file"
-    std::vector<std::filesystem::path> depends; // the graph file and every file the cook read (--watch)
-};
-
 void apply_sets(Session& s, const Args& a) {
     for (const auto& kv : a.all("--set")) {
         auto eq = kv.find('=');
@@ -85,157 +66,6 @@ void apply_sets(Session& s, const Args& a) {
             throw UsageError{"--set expects NODE.PARAM=VALUE, got '" + kv + "'", "preview"};
         s.set_text(kv.substr(0, dot), kv.substr(dot + 1, eq - dot - 1), kv.substr(eq + 1));
     }
-}
-
-bool has_channels(const Field2D& f, std::initializer_list<const char*> names) {
-    for (const char* n : names)
-        if (f.find_channel(n) < 0) return false;
-    return true;
-}
-
-GraphContent cook_graph(Session& session, const std::string& file, int jobs, ProgressSink progress,
-                        const std::optional<std::filesystem::path>& cache_dir, bool quiet) {
-    GraphContent g;
-    struct Want {
-        std::string node, port, type, file;
-        bool generic; // a PortType::Field port: 2D or 3D, known only once cooked
-    };
-    std::vector<Want> wants;
-    for (const auto& out : session.graph().outputs) {
-        const GraphNode* n = session.graph().find(out.node);
-        if (!n) continue;
-        const NodeType* t = session.registry().find(n->type);
-        if (!t || t->decl.outputs().empty()) continue;
-        const PortDecl* port = out.port.empty() ? &t->decl.outputs().front() : t->decl.find_output(out.port);
-        if (!port) continue;
-        g.written.push_back("node '" + out.node + "' (" + n->type + ") port '" + port->name + "' -> " + out.file);
-        const bool nvdf = n->type == "volume/nvdf" && port->name == "vdb_set";
-        const bool dist = n->type == "ndf/distance_map";
-        const bool forecast = port->type == PortType::Field3D && n->type.rfind("ndf/", 0) == 0;
-        if (nvdf || dist || forecast || port->type == PortType::Field2D || port->type == PortType::Field)
-            wants.push_back({out.node, port->name, n->type, out.file, port->type == PortType::Field && !nvdf && !dist});
-    }
-    // Two passes: typed outputs first; generic field outputs (which may be
-    // large volumes) only when nothing drawable was found.
-    for (int pass = 0; pass < 2; ++pass) {
-        std::vector<const Want*> now;
-        for (const auto& w : wants)
-            if (w.generic == (pass == 1)) now.push_back(&w);
-        if (now.empty()) continue;
-        if (pass == 1 && (g.nvdf || g.ndf || g.cirrus || g.sky2d)) break;
-        CookOptions o;
-        o.write_outputs = false;
-        o.jobs = jobs;
-        o.cache_dir = cache_dir;
-        o.progress = progress;
-        for (const Want* w : now) o.outputs.push_back(w->file);
-        const CookResult r = session.cook(o);
-        for (const auto& d : r.depends(file))
-            if (std::find(g.depends.begin(), g.depends.end(), d) == g.depends.end()) g.depends.push_back(d);
-        if (!quiet)
-            std::fprintf(stderr, "graph: cooked %zu, cached %zu nodes in %.2f s%s\n", r.with_status("cooked").size(), r.with_status("cached").size(),
-                         r.seconds, cache_dir ? (" (cache " + cache_dir->string() + ")").c_str() : "");
-        for (const Want* wp : now) {
-            const Want& w = *wp;
-            Value v = session.get(w.node, w.port, o); // from the session's memory cache now
-            const std::string what = file + ": node '" + w.node + "' output '" + w.port + "'";
-            if (auto* f3 = std::get_if<Field3DPtr>(&v); f3 && *f3) {
-                if (w.type == "volume/nvdf" && !g.nvdf) render::check_finite(**f3, what), g.nvdf = *f3;
-                else if (w.type == "ndf/distance_map" && !g.distance) render::check_finite(**f3, what), g.distance = *f3;
-                else if ((*f3)->find_channel("coverage") >= 0 && !g.forecast) render::check_finite(**f3, what), g.forecast = *f3;
-                continue;
-            }
-            auto* f2 = std::get_if<Field2DPtr>(&v);
-            if (!f2 || !*f2) continue;
-            const Field2D& f = **f2;
-            if (render::is_ndf_set(f) || render::is_weather_map(f)) {
-                render::check_finite(f, what);
-                if (!g.ndf) g.ndf = *f2, g.ndf_node = w.node; // a weather map becomes a set in render::layer_preview_scene
-            } else if (has_channels(f, {"inner", "outer", "speed", "overlap_end"})) {
-                render::check_finite(f, what);
-                if (!g.vortex) g.vortex = *f2;
-            } else if (has_channels(f, {"anvil_bias"})) {
-                render::check_finite(f, what);
-                g.anvil = *f2; // the last one written: the end of a stencil chain
-            } else if (has_channels(f, {"bottom", "top"})) {
-                if (!g.lut) g.lut = *f2;
-            } else if (has_channels(f, {"apex_height", "cone_ratio"})) {
-                if (!g.cone) g.cone = *f2;
-            } else if (has_channels(f, {"cirrus"})) {
-                render::check_finite(f, what);
-                if (!g.cirrus) g.cirrus = *f2;
-            } else if (f.channels() == 1 && w.type.rfind("volume/", 0) != 0) {
-                // (A volume node's 2D output is a picture of the volume, e.g.
-                // volume/projection's top view, not a sky texture.)
-                render::check_finite(f, what);
-                g.sky2d = *f2; // the last one written
-            }
-        }
-    }
-    return g;
-}
-
-// Slice z of a stack of weather maps (ndf/forecast's maps) as a 2D map.
-Field2D forecast_slice(const Field3D& f, int z) {
-    const Box3d& b = f.bounds();
-    Field2D m({{f.nx(), f.ny()}}, f.channels(), Box2d{{{b.min[0], b.min[1]}}, {{b.max[0], b.max[1]}}}, f.channel_names());
-    for (int c = 0; c < f.channels(); ++c)
-        for (int y = 0; y < f.ny(); ++y)
-            for (int x = 0; x < f.nx(); ++x) m.at(c, x, y) = f.at(c, x, y, z);
-    return m;
-}
-
-// The HZD noise set and the default profile LUT, cooked through the same
-// cache as the graph (a second preview cooks nothing).
-struct LayerInputs {
-    Field3DPtr low, high;
-    Field2DPtr curl, lut;
-};
-// Cooks a small built-in graph (no files written) through the same cache as the
-// previewed graph, so a second preview cooks nothing; prints what it did.
-CookOptions cook_builtin(Session& s, const std::string& text, const std::string& what, int jobs,
-                         const std::optional<std::filesystem::path>& cache_dir, ProgressSink progress, bool quiet) {
-    s.load_text(text, "<preview " + what + ">", ".");
-    CookOptions o;
-    o.write_outputs = false;
-    o.jobs = jobs;
-    o.cache_dir = cache_dir;
-    o.progress = std::move(progress);
-    const CookResult r = s.cook(o);
-    if (!quiet)
-        std::fprintf(stderr, "%s: cooked %zu, cached %zu in %.2f s\n", what.c_str(), r.with_status("cooked").size(), r.with_status("cached").size(),
-                     r.seconds);
-    return o;
-}
-
-LayerInputs cook_layer_inputs(int jobs, const std::optional<std::filesystem::path>& cache_dir, ProgressSink progress, bool quiet) {
-    Session s(builtin_nodes());
-    const CookOptions o = cook_builtin(s,
-                                       "atlas: 1\n"
-                                       "nodes:\n"
-                                       "  hzd_noise: {type: noise/hzd_set, params: {low_size: 128, high_size: 32, curl_size: 128, seed: 0}}\n"
-                                       "  profile_lut: {type: ndf/profile_lut, params: {resolution: [97, 128]}}\n"
-                                       "outputs:\n"
-                                       "  - {node: hzd_noise, port: low, file: low.exr}\n"
-                                       "  - {node: hzd_noise, port: high, file: high.exr}\n"
-                                       "  - {node: hzd_noise, port: curl, file: curl.exr}\n"
-                                       "  - {node: profile_lut, file: lut.exr}\n",
-                                       "noise/hzd_set + ndf/profile_lut", jobs, cache_dir, std::move(progress), quiet);
-    LayerInputs in;
-    in.low = std::get<Field3DPtr>(s.get("hzd_noise", "low", o));
-    in.high = std::get<Field3DPtr>(s.get("hzd_noise", "high", o));
-    in.curl = std::get<Field2DPtr>(s.get("hzd_noise", "curl", o));
-    in.lut = std::get<Field2DPtr>(s.get("profile_lut", "out", o));
-    return in;
-}
-
-Field3DPtr cook_voxel_noise(int jobs, const std::optional<std::filesystem::path>& cache_dir, ProgressSink progress, bool quiet) {
-    Session s(builtin_nodes());
-    const CookOptions o = cook_builtin(s,
-                                       "atlas: 1\nnodes:\n  nubis_noise: {type: noise/nubis_set, params: {size: 128, seed: 0}}\n"
-                                       "outputs:\n  - {node: nubis_noise, file: nubis_noise.exr}\n",
-                                       "noise/nubis_set", jobs, cache_dir, std::move(progress), quiet);
-    return std::get<Field3DPtr>(s.get("nubis_noise", "out", o));
 }
 
 // Writes into `staged` (a temporary path); the caller moves it into place.
@@ -290,8 +120,10 @@ render::PreviewOptions read_preview_flags(const Args& a) {
 } // namespace
 
 // One preview: cook, render, write. `depends` receives the files a --watch
-// loop polls (the graph file and every file the cook read).
-int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
+// loop polls (the graph file and every file the cook read). `session` is kept
+// by --watch between rounds: what it cooked stays in memory, so an edit cooks
+// only the nodes it changed (also with --no-cache).
+int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std::unique_ptr<Session>& session) {
     if (a.positional.empty()) throw UsageError{"expected a graph file or NVDF files", "preview"};
     if (!a.has("--out") && !a.has("--sweep")) throw UsageError{"expected -o OUT.png (or OUT.exr)", "preview"};
     int jobs = 0;
@@ -308,97 +140,51 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
     ProgressSink sink = bar.sink();
     const auto t_start = std::chrono::steady_clock::now();
 
-    Field3DPtr noise;
-    const std::string noise_opt = a.has("--noise") ? a.get("--noise") : "auto";
-    if (noise_opt != "auto" && noise_opt != "none" && noise_opt != "nubis") noise = io::as_field3d(io::read_field_file(noise_opt));
     if (a.has("--cache") && a.has("--no-cache")) throw UsageError{"--cache and --no-cache contradict each other", "preview"};
-    std::optional<std::filesystem::path> cache_dir;
-    if (a.has("--cache")) cache_dir = a.get("--cache");
-    else if (const char* env = std::getenv("ATLAS_CACHE_DIR"); env && *env && !a.has("--no-cache")) cache_dir = env;
-
-    bool have_voxel = false, have_layer = false;
-    Field3DPtr forecast; // time slices, when the preview steps a forecast
-    int slice0 = 0;
-    render::CloudScene scene;
-    render::LayerScene layer;
+    preview::GraphPreviewOptions how;
+    how.jobs = jobs;
+    how.progress = sink;
+    how.mode = mode;
+    how.noise = a.has("--noise") ? a.get("--noise") : "auto";
+    if (a.has("--cache")) how.cache_dir = a.get("--cache");
+    else if (const char* env = std::getenv("ATLAS_CACHE_DIR"); env && *env && !a.has("--no-cache")) how.cache_dir = env;
+    if (a.has("--proxy")) {
+        how.proxy = static_cast<int>(numbers(a.get("--proxy"), 1, "--proxy")[0]);
+        if (how.proxy < 1 || how.proxy > 64) throw UsageError{"--proxy expects a factor 1..64 (4: a quarter of the cells per axis)", "preview"};
+    }
     if (a.positional.size() > 1)
         for (const std::string& f : a.positional)
             if (is_graph(f))
                 throw UsageError{"a graph is previewed alone: '" + f + "' was given with " + std::to_string(a.positional.size() - 1) +
                                      " more file(s); preview the graph, or the files it writes",
                                  "preview"};
-    if (a.positional.size() == 1 && is_graph(a.positional[0])) {
-        const std::string file = a.positional[0];
-        Session session(builtin_nodes());
-        session.load(file);
-        apply_sets(session, a);
-        depends = {file};
-        GraphContent g = cook_graph(session, file, jobs, sink, cache_dir, quiet);
-        for (const auto& d : g.depends)
-            if (std::find(depends.begin(), depends.end(), d) == depends.end()) depends.push_back(d);
-        // A forecast (ndf/forecast) is drawn when asked for (--slice, --frames) or when nothing else is there.
-        if (g.forecast && (a.has("--slice") || a.has("--frames") || !g.ndf)) {
-            forecast = g.forecast;
-            slice0 = a.has("--slice") ? static_cast<int>(numbers(a.get("--slice"), 1, "--slice")[0]) : 0;
-            if (slice0 < 0 || slice0 >= forecast->nz())
-                throw UsageError{"--slice expects 0.." + std::to_string(forecast->nz() - 1) + " (the forecast's time slices)", "preview"};
-            g.ndf = std::make_shared<const Field2D>(forecast_slice(*forecast, slice0));
-        }
-        const bool layerish = g.ndf || g.cirrus || g.sky2d;
-        if (!g.nvdf && !layerish) {
-            std::string list;
-            for (const auto& x : g.written) list += "\n  " + x;
-            throw Error(file + ": the graph writes nothing to preview: no volume/nvdf vdb_set (voxel mode), no NDF set or weather map (2.5D mode) and no "
-                               "2D sky layer; it writes:" + (list.empty() ? std::string(" no outputs") : list));
-        }
-        if (mode == "voxel" && !g.nvdf) throw Error(file + ": --mode voxel, but the graph writes no volume/nvdf output");
-        if (mode == "layer" && !layerish) throw Error(file + ": --mode layer, but the graph writes no NDF set, weather map or 2D sky layer");
-        have_voxel = g.nvdf && mode != "layer";
-        have_layer = layerish && mode != "voxel";
-        if (have_voxel) scene = render::scene_from_nvdf_set(g.nvdf);
-        if (have_layer) {
-            LayerInputs in = cook_layer_inputs(jobs, cache_dir, sink, quiet);
-            // The library assembles the scene (the render/preview node calls the same).
-            render::LayerPreviewInputs li;
-            li.ndf = g.ndf;
-            li.profile_lut = g.lut ? g.lut : in.lut;
-            li.base_noise = in.low;
-            li.detail_noise = in.high;
-            li.curl = in.curl;
-            li.cone_map = g.cone;
-            li.anvil = g.anvil;
-            li.vortex_table = g.vortex;
-            li.distance_map = g.distance;
-            li.cirrus = g.cirrus;
-            li.sky_texture = g.sky2d;
-            layer = render::layer_preview_scene(li);
-        }
-    } else {
-        if (mode == "layer") throw UsageError{"--mode layer needs a graph that writes an NDF set", "preview"};
-        std::vector<render::SceneField> files;
-        for (const std::string& p : a.positional) files.push_back({io::as_field3d(io::read_field_file(p)), p});
-        scene = render::scene_from_fields(std::move(files), a.has("--voxel") ? numbers(a.get("--voxel"), 1, "--voxel")[0] : 0.0);
-        have_voxel = true;
-    }
-    if (have_voxel) {
-        // Voxel up-rez by default for modelled clouds (an NVDF set): the Nubis
-        // noise set (noise/nubis_set 128^3), cooked through the same cache as
-        // the graph. A plain density grid (a sim, a production cloud) has its
-        // own detail: eroding it made foam, so it is drawn as it is.
-        if (noise_opt == "nubis" || (noise_opt == "auto" && !scene.density_grid_max)) noise = cook_voxel_noise(jobs, cache_dir, sink, quiet);
-        if (noise_opt == "auto" && scene.density_grid_max && !quiet)
-            std::fprintf(stderr, "noise: none for a plain density grid (its own detail is kept); --noise nubis or FILE up-rezzes it anyway\n");
-        scene.noise = noise;
-    }
-    if (po.lightning && !have_layer) throw UsageError{"--lightning places flashes over a 2.5D layer; this preview has no NDF set", "preview"};
-    // The library entry the render/preview node calls: the options applied to the
-    // scenes, the settings of the render calls (render/preview.h).
     const bool from_graph = a.positional.size() == 1 && is_graph(a.positional[0]);
-    render::PreviewJob job = render::prepare_preview(have_voxel ? std::optional<render::CloudScene>(scene) : std::nullopt,
-                                                     have_layer ? std::optional<render::LayerScene>(layer) : std::nullopt, po,
-                                                     from_graph ? render::PreviewLook::Graph : render::PreviewLook::Fields, nullptr, jobs);
+    if (!from_graph && mode == "layer") throw UsageError{"--mode layer needs a graph that writes an NDF set", "preview"};
+    if (!from_graph && how.proxy > 1) throw UsageError{"--proxy scales a graph's grids; files are drawn as they are", "preview"};
+    if (a.has("--slice")) how.slice = static_cast<int>(numbers(a.get("--slice"), 1, "--slice")[0]);
+    if (a.has("--slice") && how.slice < 0) throw UsageError{"--slice expects a time slice >= 0", "preview"};
+    how.forecast = a.has("--frames");
+    if (a.has("--voxel")) how.voxel = numbers(a.get("--voxel"), 1, "--voxel")[0];
+
+    // The library entry every front end calls (atlas/preview/graph_preview.h): what the
+    // graph writes, cooked as values, the scenes and the render job.
+    preview::GraphPreview prepared;
+    if (from_graph) {
+        if (!session) session = std::make_unique<Session>(builtin_nodes());
+        session->load(a.positional[0]);
+        apply_sets(*session, a);
+        prepared = preview::prepare_graph_preview(*session, po, how, a.positional[0]);
+    } else {
+        std::vector<std::filesystem::path> files(a.positional.begin(), a.positional.end());
+        prepared = preview::prepare_file_preview(files, po, how);
+    }
+    depends = prepared.depends;
     if (!quiet)
-        for (const std::string& note : job.notes) std::fprintf(stderr, "%s\n", note.c_str());
+        for (const std::string& line : prepared.log) std::fprintf(stderr, "%s\n", line.c_str());
+    render::PreviewJob& job = prepared.job;
+    const bool have_voxel = prepared.voxel, have_layer = prepared.layer;
+    const Field3DPtr forecast = prepared.forecast;
+    const int slice0 = prepared.slice;
     render::RenderSettings& s = job.settings;
     const Box3d bounds = have_voxel ? job.voxel->modeling->bounds() : Box3d{{{0, 0, 0}}, {{1, 1, 1}}};
     const double exposure = job.exposure;
@@ -468,7 +254,7 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends) {
                     render::LayerScene& layer_now = *job.layer;
                     layer_now.time = time0 + i * time_step;
                     if (forecast) {
-                        layer_now.ndf = render::weather_map_as_set(forecast_slice(*forecast, (slice0 + i) % forecast->nz()));
+                        layer_now.ndf = render::weather_map_as_set(preview::forecast_slice(*forecast, (slice0 + i) % forecast->nz()));
                         if (layer_now.envelope.cone_map) layer_now.envelope.cone_map = render::cloud_top_cone_map(*layer_now.ndf);
                     }
                 }
@@ -523,13 +309,14 @@ FileStamps stamps_of(const std::vector<std::filesystem::path>& files) {
 // after N re-renders (scripts, tests).
 int run_preview(const Args& a) {
     std::vector<std::filesystem::path> depends;
-    if (!a.has("--watch")) return preview_once(a, depends);
+    std::unique_ptr<Session> session;
+    if (!a.has("--watch")) return preview_once(a, depends, session);
     if (a.positional.size() != 1 || !is_graph(a.positional[0])) throw UsageError{"--watch needs one graph file", "preview"};
     const int max_rounds = a.has("--watch-max") ? static_cast<int>(numbers(a.get("--watch-max"), 1, "--watch-max")[0]) : -1;
     depends = {a.positional[0]};
     auto round = [&] {
         try {
-            preview_once(a, depends);
+            preview_once(a, depends, session);
         } catch (const UsageError&) {
             throw;
         } catch (const std::exception& e) {

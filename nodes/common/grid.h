@@ -42,11 +42,11 @@ inline void declare_map_bounds(NodeDeclaration& d, Vec2d lo, Vec2d hi) {
 
 // resolution (1..65536 voxels per axis), then the bounds.
 inline void declare_grid(NodeDeclaration& d, const GridDefaults& g, const char* resolution_doc = "voxels along x, y, z") {
-    d.param_int3("resolution", g.resolution).range(1, kMaxGridResolution).with_unit("voxels").describe(resolution_doc);
+    d.param_int3("resolution", g.resolution).range(1, kMaxGridResolution).with_unit("voxels").describe(resolution_doc).follows_proxy(ProxyScale::Cells);
     declare_bounds(d, g.bounds_min, g.bounds_max);
 }
 inline void declare_map(NodeDeclaration& d, const MapDefaults& g) {
-    d.param_int2("resolution", g.resolution).range(1, kMaxGridResolution).with_unit("texels").describe("texels along x, y");
+    d.param_int2("resolution", g.resolution).range(1, kMaxGridResolution).with_unit("texels").describe("texels along x, y").follows_proxy(ProxyScale::Cells);
     declare_map_bounds(d, g.bounds_min, g.bounds_max);
 }
 

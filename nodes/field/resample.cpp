@@ -23,7 +23,7 @@ void declare(NodeDeclaration& d) {
                                  })
                  .with_window());
     d.output("out", PortType::Field, "resampled field, same dimensionality");
-    d.param_int3("resolution", {{64, 64, 16}}).range(1, 65536).with_unit("voxels").describe("new resolution (z ignored for 2D)");
+    d.param_int3("resolution", {{64, 64, 16}}).range(1, 65536).with_unit("voxels").describe("new resolution (z ignored for 2D)").follows_proxy(ProxyScale::Cells);
     d.param_bool("keep_bounds", true).describe("keep the input's world bounds (else use bounds_min/bounds_max)");
     d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("new minimum corner when keep_bounds is false");
     d.param_float3("bounds_max", {{1, 1, 1}}).with_unit("m").describe("new maximum corner when keep_bounds is false");

@@ -13,7 +13,7 @@ void declare(NodeDeclaration& d) {
     d.input("in", PortType::Field2D, "NDF set");
     d.output("out", PortType::Field3D, "dimensional profile (1 channel)");
     d.param_enum("formula", {"vertical_profile", "envelope"}, "vertical_profile").describe("profile formula");
-    d.param_int3("resolution", {{256, 256, 64}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z");
+    d.param_int3("resolution", {{256, 256, 64}}).range(1, 65536).with_unit("voxels").describe("voxels along x, y, z").follows_proxy(ProxyScale::Cells);
     d.param_float("z_min", 0).with_unit("m").describe("volume bottom (x, y take the set's bounds)");
     d.param_float("z_max", 10000).with_unit("m").describe("volume top");
 }

@@ -13,7 +13,7 @@ void declare(NodeDeclaration& d) {
     d.input("in", PortType::Field2D, "map");
     d.tiling(TileRule::with_halo([](const NodeParams& p) { return int(std::ceil(3 * p.get_float("sigma"))); }, [](const NodeParams& p) { return p.get_bool("tileable") ? std::string("tileable: true wraps around the map edges (set tileable: false to tile)") : std::string(); }));
     d.output("out", PortType::Field2D, "blurred map");
-    d.param_float("sigma", 2.0).range(0, 4096).with_unit("texels").describe("standard deviation (0 copies)");
+    d.param_float("sigma", 2.0).range(0, 4096).with_unit("texels").describe("standard deviation (0 copies)").follows_proxy(ProxyScale::CellLength);
     d.param_bool("tileable", true).describe("wrap around the edges (keeps tileable maps tileable); else clamp");
 }
 

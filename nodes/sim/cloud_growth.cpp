@@ -45,8 +45,8 @@ void declare(NodeDeclaration& d) {
     d.output("velocity", PortType::Field3D, "velocity at cell centres after the last step, channels 'vel.x', 'vel.y', 'vel.z', m/s");
     d.output("rain", PortType::Field3D, "rain-water mixing ratio after the last step, channel 'rain', kg/kg (zeros unless 'rain' is on)");
     d.output("sequence", PortType::Field3D, "frames for the 'vdb-sequence' format: channels 'NNNN:GRID', NNNN = 1, 2, ...");
-    d.param_int3("resolution", {{64, 64, 64}}).range(1, 4096).with_unit("cells").describe("cells along x, y, z (at least 2 along two axes)");
-    d.param_float("dx", 40).range(1e-3, 1e5).with_unit("m").describe("cubic cell edge; the top cell centre, (nz - 1/2) dx, must lie inside the modelled atmosphere (Exner > 0.05, about 29 km for 300 K), else an error names that height");
+    d.param_int3("resolution", {{64, 64, 64}}).range(1, 4096).with_unit("cells").describe("cells along x, y, z (at least 2 along two axes)").follows_proxy(ProxyScale::Cells);
+    d.param_float("dx", 40).range(1e-3, 1e5).with_unit("m").describe("cubic cell edge; the top cell centre, (nz - 1/2) dx, must lie inside the modelled atmosphere (Exner > 0.05, about 29 km for 300 K), else an error names that height").follows_proxy(ProxyScale::CellSize);
     d.param_float3("origin", {{0, 0, 0}}).with_unit("m").describe("world position of the grid's minimum corner");
     d.param_enum("boundary", {"closed", "open_top", "open_sides_top", "open_sides"}, "closed")
         .describe("closed: free-slip walls everywhere; open_top: the top is open; open_sides_top: only the floor is a wall; "

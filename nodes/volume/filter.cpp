@@ -11,8 +11,8 @@ void declare(NodeDeclaration& d) {
     d.input("in", PortType::Field3D, "field");
     d.output("out", PortType::Field3D, "filtered field");
     d.param_enum("op", {"smooth", "dilate", "erode"}, "smooth").describe("filter");
-    d.param_float("sigma", 1).range(0, 1000).with_unit("voxels").describe("Gaussian sigma (smooth)");
-    d.param_int("radius", 1).range(0, 1000).with_unit("voxels").describe("cube half size (dilate, erode)");
+    d.param_float("sigma", 1).range(0, 1000).with_unit("voxels").describe("Gaussian sigma (smooth)").follows_proxy(ProxyScale::CellLength);
+    d.param_int("radius", 1).range(0, 1000).with_unit("voxels").describe("cube half size (dilate, erode)").follows_proxy(ProxyScale::CellLength);
 }
 
 void cook(CookContext& ctx) {

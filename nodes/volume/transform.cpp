@@ -16,7 +16,7 @@ void declare(NodeDeclaration& d) {
     d.param_float("squash", 1).range(1e-3, 1e3).describe("vertical squash (< 1 flattens), volume-preserving");
     d.param_float3("pivot", {{2048, 2048, 256}}).with_unit("m").describe("centre of rotation and scaling");
     d.param_bool("keep_grid", true).describe("output on the input's grid (else resolution/bounds below)");
-    d.param_int3("resolution", {{512, 512, 64}}).range(1, 65536).with_unit("voxels").describe("output voxels when keep_grid is false");
+    d.param_int3("resolution", {{512, 512, 64}}).range(1, 65536).with_unit("voxels").describe("output voxels when keep_grid is false").follows_proxy(ProxyScale::Cells);
     d.param_float3("bounds_min", {{0, 0, 0}}).with_unit("m").describe("output minimum corner when keep_grid is false");
     d.param_float3("bounds_max", {{4096, 4096, 512}}).with_unit("m").describe("output maximum corner when keep_grid is false");
 }

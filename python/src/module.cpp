@@ -3,6 +3,8 @@
 #include "bindings.h"
 
 #include "atlas/graph/node_docs.h"
+#include "atlas/preview/graph_preview.h"
+#include "atlas/render/image_out.h"
 
 #include <pybind11/numpy.h>
 
@@ -312,6 +314,29 @@ py::dict declaration_to_python(const NodeType& t) {
     return d;
 }
 
+// A Python value as the text of a preview option ("640,360" for (640, 360)).
+std::string option_text(const py::handle& v) {
+    if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+    if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+    if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
+        std::string out;
+        for (const py::handle& x : v) out += (out.empty() ? "" : ",") + option_text(x);
+        return out;
+    }
+    return py::str(v).cast<std::string>();
+}
+
+// A picture as a NumPy array, rows from the top: float32 (h, w, channels).
+py::array_t<float> image_to_numpy(const Field2D& img) {
+    const int w = img.width(), h = img.height(), nc = img.channels();
+    py::array_t<float> a({py::ssize_t(h), py::ssize_t(w), py::ssize_t(nc)});
+    auto m = a.mutable_unchecked<3>();
+    for (int row = 0; row < h; ++row)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < nc; ++c) m(row, x, c) = img.at(c, x, h - 1 - row);
+    return a;
+}
+
 } // namespace atlas::python
 
 using namespace atlas;
@@ -384,11 +409,12 @@ per Session (cook releases the GIL, so other Python threads run meanwhile).)doc"
              "Overrides NODE.PARAM from text as the CLI's --set spells it ('0.5', '[1, 2, 3]', 'name').")
         .def("cook", [](PySession& ps, const py::object& outputs, int jobs, bool write_outputs, const py::object& out_dir,
                         const py::object& cache_dir, bool checked, const py::object& memory_budget, const py::object& progress,
-                        const py::object& cancel, bool keep_going) {
+                        const py::object& cancel, bool keep_going, int proxy) {
                  BusyGuard guard(ps);
                  Session& s = ps.session;
                  CookOptions o = make_options(outputs, jobs, write_outputs, out_dir, cache_dir, checked, memory_budget, progress, cancel);
                  o.keep_going = keep_going;
+                 o.proxy = proxy;
                  CookResult r;
                  {
                      py::gil_scoped_release nogil;
@@ -398,14 +424,47 @@ per Session (cook releases the GIL, so other Python threads run meanwhile).)doc"
              },
              py::arg("outputs") = py::none(), py::arg("jobs") = 0, py::arg("write_outputs") = false, py::arg("out_dir") = py::none(),
              py::arg("cache_dir") = py::none(), py::arg("checked") = false, py::arg("memory_budget") = py::none(),
-             py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("keep_going") = false,
+             py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("keep_going") = false, py::arg("proxy") = 1,
              R"doc(Cooks the graph's outputs (or those named) and returns the report as a dict:
 {"nodes": {name: {"status": "cooked"|"cached"|"skipped", "type", "reason", "hash", "seconds", "bytes", "metrics", "warnings"}}, "outputs": [...], ...}.
 write_outputs=True also writes the output files into out_dir (atomically). The GIL is released while
 cooking; progress(fraction, task, done, total) and cancel() -> bool are called from worker threads
 with the GIL taken. Raises atlas.CancelledError when cancel() returns true. keep_going=True: an output
 whose writer fails is reported with "status": "failed" and its "error" (and a warning), and the other
-outputs are written (an editor's edit); otherwise the cook raises and writes nothing.)doc")
+outputs are written (an editor's edit); otherwise the cook raises and writes nothing. proxy=P: every world
+grid at 1/P of its cells per axis (values only: a proxy cook never writes outputs).)doc")
+        .def("preview", [](PySession& ps, const py::object& options, int proxy, int jobs, const py::object& cache_dir, const std::string& mode,
+                           const std::string& noise, bool tone_mapped, const py::object& progress, const py::object& cancel) {
+                 BusyGuard guard(ps);
+                 render::PreviewOptions po;
+                 std::vector<std::pair<std::string, std::string>> settings;
+                 if (!options.is_none())
+                     for (const auto& item : options.cast<py::dict>()) settings.emplace_back(py::str(item.first).cast<std::string>(), option_text(item.second));
+                 preview::set_preview_options(po, settings);
+                 preview::GraphPreviewOptions how;
+                 how.jobs = jobs;
+                 how.proxy = proxy;
+                 how.mode = mode;
+                 how.noise = noise;
+                 if (!cache_dir.is_none()) how.cache_dir = std::filesystem::path(py::str(cache_dir).cast<std::string>());
+                 how.progress = make_sink(progress, cancel);
+                 std::optional<render::PreviewFrame> f;
+                 {
+                     py::gil_scoped_release nogil;
+                     f.emplace(preview::preview_session(ps.session, po, how));
+                 }
+                 if (!tone_mapped) return image_to_numpy(f->image);
+                 return image_to_numpy(render::tone_map(f->image, po.exposure));
+             },
+             py::arg("options") = py::none(), py::arg("proxy") = 1, py::arg("jobs") = 0, py::arg("cache_dir") = py::none(),
+             py::arg("mode") = "auto", py::arg("noise") = "auto", py::arg("tone_mapped") = false, py::arg("progress") = py::none(),
+             py::arg("cancel") = py::none(),
+             R"doc(Renders what the graph writes, as `atlas preview GRAPH` does, through this session: values stay
+in memory, so after an edit only the changed nodes cook. Nothing is written. `options` is a dict of
+preview options by their docs/options.md names, as values or text: {"size": (640, 360), "view": "orbit",
+"sun_azimuth": 200}. proxy=4 cooks every world grid at a quarter of its cells per axis (for
+interaction). Returns a float32 NumPy array (height, width, 4) of linear radiance r, g, b and view
+transmittance, rows from the top; tone_mapped=True: the PNG's sRGB values in 0..1 (height, width, 3).)doc")
         .def("cook_requirements", [](PySession& ps, int jobs, const py::object& cache_dir, const py::object& memory_budget,
                                      const py::object& progress, const py::object& cancel) {
                  BusyGuard guard(ps);
@@ -425,7 +484,7 @@ outputs are written (an editor's edit); otherwise the cook raises and writes not
 and is missing (into that requirement's `out` folder), as `atlas cook` does first. Returns a list of
 (graph file, report dict) in cook order; [] when every input is there.)doc")
         .def("get", [](PySession& ps, const std::string& node, const py::object& port, int jobs, const py::object& cache_dir,
-                       const py::object& memory_budget, const py::object& progress, const py::object& cancel) {
+                       const py::object& memory_budget, const py::object& progress, const py::object& cancel, int proxy) {
                  BusyGuard guard(ps);
                  Session& s = ps.session;
                  std::string port_name = port.is_none() ? "" : port.cast<std::string>();
@@ -435,6 +494,7 @@ and is missing (into that requirement's `out` folder), as `atlas cook` does firs
                      if (t && !t->decl.outputs().empty()) port_name = t->decl.outputs().front().name;
                  }
                  CookOptions o = make_options(py::none(), jobs, false, py::none(), cache_dir, false, memory_budget, progress, cancel);
+                 o.proxy = proxy;
                  Value v;
                  {
                      py::gil_scoped_release nogil;
@@ -443,8 +503,8 @@ and is missing (into that requirement's `out` folder), as `atlas cook` does firs
                  return value_to_python(v);
              },
              py::arg("node"), py::arg("port") = py::none(), py::arg("jobs") = 0, py::arg("cache_dir") = py::none(),
-             py::arg("memory_budget") = py::none(), py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
-             "Cooks what one node output needs (port default: the node's first output) and returns it: an atlas.Field2D or "
+             py::arg("memory_budget") = py::none(), py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("proxy") = 1,
+             "Cooks what one node output needs (port default: the node's first output; proxy as in cook) and returns it: an atlas.Field2D or "
              "Field3D (channels as read-only NumPy views), or for a mesh / points a dict of read-only arrays.")
         .def("nodes", [](PySession& ps) { BusyGuard guard(ps); return graph_nodes(ps.session); }, "The graph's nodes in file order: [{name, type, where, params (resolved), explicit, inputs}].")
         .def("outputs", [](PySession& ps) { BusyGuard guard(ps); return graph_outputs(ps.session); }, "The graph's outputs: [{node, port, file, format, options, where}].")

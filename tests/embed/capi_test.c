@@ -541,6 +541,53 @@ static void test_same_messages_as_the_cli(const char* cli, const char* dir) {
     atlas_session_destroy(s);
 }
 
+/* atlas_session_preview: the picture `atlas preview` draws, through the session, at a
+ * proxy; an edit re-renders; bad options are refused with the option's name. */
+static const char* kCloud =
+    "atlas: 1\n"
+    "nodes:\n"
+    "  density: {type: volume/metaballs, params: {resolution: [32, 32, 16], bounds_max: [1000, 1000, 500], kernel: sphere, blend: max,\n"
+    "            spheres: 500 500 220 160}}\n"
+    "  sdf: {type: volume/sdf, inputs: {in: density}, params: {iso: 0.5}}\n"
+    "  nvdf: {type: volume/nvdf, inputs: {sdf: sdf}, params: {depth: 30}}\n"
+    "outputs:\n"
+    "  - {node: nvdf, port: vdb_set, file: cloud.vdb}\n";
+
+static void test_preview(void) {
+    AtlasSession* s = NULL;
+    CHECK_OK(s, atlas_session_create(&s));
+    CHECK_OK(s, atlas_session_load_text(s, kCloud, "cloud.yaml", "."));
+    AtlasCookOptions o;
+    atlas_cook_options_init(&o);
+    o.proxy = 2;
+    AtlasField* img = NULL;
+    CHECK_OK(s, atlas_session_preview(s, "{\"size\": [40, 24], \"noise\": \"none\", \"view\": \"orbit\"}", &o, &img));
+    CHECK(img != NULL);
+    if (img) {
+        int res[3];
+        atlas_field_resolution(img, res);
+        CHECK(res[0] == 40 && res[1] == 24 && atlas_field_channels(img) == 4);
+        const float* t = atlas_field_channel_data(img, 3);
+        float tmin = 1, tmax = 0;
+        for (int i = 0; i < 40 * 24; ++i) {
+            if (t[i] < tmin) tmin = t[i];
+            if (t[i] > tmax) tmax = t[i];
+        }
+        CHECK(tmin < 0.5f && tmax > 0.99f && tmax <= 1.0f); /* the cloud covers some pixels, sky others */
+        atlas_field_release(img);
+    }
+    img = NULL;
+    CHECK(atlas_session_preview(s, "{\"sizes\": 3}", &o, &img) != ATLAS_OK && img == NULL);
+    CHECK(strstr(atlas_session_error(s), "preview option 'sizes' does not exist") != NULL);
+    CHECK(atlas_session_preview(s, "{not json", &o, &img) == ATLAS_INVALID_ARGUMENT);
+    CHECK(img == NULL);
+    /* A proxy cook never writes. */
+    o.write_outputs = 1;
+    CHECK(atlas_session_cook(s, &o) != ATLAS_OK);
+    CHECK(strstr(atlas_session_error(s), "never written as final outputs") != NULL);
+    atlas_session_destroy(s);
+}
+
 int main(int argc, char** argv) {
     if (argc != 2 && argc != 4) {
         fprintf(stderr, "usage: capi_test QUICKSTART.yaml [ATLAS_CLI SCRATCH_DIR]\n");
@@ -554,6 +601,7 @@ int main(int argc, char** argv) {
     test_destroy_during_a_cook();
     test_mesh_and_points();
     test_c_node_types();
+    test_preview();
     if (argc == 4) test_same_messages_as_the_cli(argv[2], argv[3]);
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;

@@ -351,3 +351,41 @@ def test_cook_requirements_grows_the_missing_input_first(tmp_path):
     assert (tmp_path / "made" / "cloud.vdb").exists()
     assert s.cook_requirements() == []
     np.testing.assert_allclose(s.get("in")["density"].shape, (8, 8, 8))
+
+
+CLOUD_GRAPH = """atlas: 1
+nodes:
+  density: {type: volume/metaballs, params: {resolution: [32, 32, 16], bounds_max: [1000, 1000, 500], kernel: sphere, blend: max,
+            spheres: 500 500 220 160; 640 520 240 110}}
+  sdf: {type: volume/sdf, inputs: {in: density}, params: {iso: 0.5}}
+  nvdf: {type: volume/nvdf, inputs: {sdf: sdf}, params: {depth: 30}}
+outputs:
+  - {node: nvdf, port: vdb_set, file: cloud.vdb}
+"""
+
+
+def test_preview_is_the_cli_picture_and_proxies_never_write(tmp_path):
+    # Session.preview and `atlas preview` call one library entry: the same linear
+    # picture, the CLI's read back with OpenImageIO (rows from the top in both).
+    import OpenImageIO as oiio
+    (tmp_path / "cloud.yaml").write_text(CLOUD_GRAPH)
+    s = atlas.Session()
+    s.load(tmp_path / "cloud.yaml")
+    img = s.preview({"size": (40, 24), "view": "orbit", "sun_azimuth": 200}, noise="none")
+    assert img.shape == (24, 40, 4) and img.dtype == np.float32
+    subprocess.run([os.environ["ATLAS_BIN"], "preview", str(tmp_path / "cloud.yaml"), "--size", "40x24", "--view", "orbit", "--sun", "200,25",
+                    "--noise", "none", "--no-cache", "--quiet", "-o", str(tmp_path / "cli.exr")], check=True)
+    cli = oiio.ImageBuf(str(tmp_path / "cli.exr")).get_pixels(oiio.FLOAT)
+    np.testing.assert_array_equal(img, cli)
+    t = img[..., 3]
+    assert t.min() < 0.5 and t.max() > 0.99  # a cloud in front of the sky
+    # The PNG's values; at a proxy (half the cells) a similar picture.
+    png = s.preview({"size": "40x24", "view": "orbit"}, noise="none", tone_mapped=True)
+    assert png.shape == (24, 40, 3) and 0 <= png.min() and png.max() <= 1
+    half = s.preview({"size": (40, 24), "view": "orbit", "sun_azimuth": 200}, noise="none", proxy=2)
+    assert np.abs(half[..., 3] - t).mean() < 0.1
+    with pytest.raises(atlas.Error, match="never written as final outputs"):
+        s.cook(proxy=2, write_outputs=True, out_dir=tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+    with pytest.raises(atlas.Error, match="preview option 'sizes' does not exist"):
+        s.preview({"sizes": 3})

@@ -163,13 +163,14 @@ TEST(LayerCli, NonFiniteChannelNamesNodeAndChannel) {
     EXPECT_FALSE(fs::exists(work_dir() / "x.png"));
 }
 
-TEST(LayerCli, WatchReRendersWhenTheGraphChanges) {
+TEST(LayerCli, WatchReRendersWhenTheGraphChangesAndKeepsWhatItCooked) {
     const fs::path dir = work_dir();
     write("watch.yaml", kLayerGraph);
     fs::remove(dir / "w.png");
     // In the background (timeout: never outlives the test): one preview, then one re-render.
+    // No disk cache: what the second round does not cook comes from the watch's memory.
     const std::string cmd = "cd " + dir.string() + " && ATLAS_CACHE_DIR= timeout 120 " + std::string(ATLAS_BINARY_DIR) +
-                            "/bin/atlas preview watch.yaml --size 24x14 --watch --watch-max 1 --cache cache -o w.png 2>watch_err.txt &";
+                            "/bin/atlas preview watch.yaml --size 24x14 --watch --watch-max 1 --no-cache -o w.png 2>watch_err.txt &";
     ASSERT_EQ(std::system(cmd.c_str()), 0);
     auto log_text = [&] {
         std::ifstream in(dir / "watch_err.txt");
@@ -183,12 +184,17 @@ TEST(LayerCli, WatchReRendersWhenTheGraphChanges) {
         << log_text();
     const std::string first = atlas::read_file_bytes(dir / "w.png");
     std::string g = kLayerGraph;
-    g.replace(g.find("seed: 5"), 7, "seed: 6");
+    g.replace(g.find("type: 0.6"), 9, "type: 0.9");
     write("watch.yaml", g);
     ASSERT_TRUE(wait_for([&] { return log_text().find("re-cooked and re-rendered") != std::string::npos; }))
         << log_text();
     const std::string log = log_text();
-    EXPECT_NE(log.find("watch.yaml changed"), std::string::npos) << log;
+    const size_t changed = log.find("watch.yaml changed");
+    ASSERT_NE(changed, std::string::npos) << log;
+    // Only the edited node cooks; the noise it reads and the preview's built-in noise sets are kept.
+    const std::string second = log.substr(changed);
+    EXPECT_NE(second.find("graph: cooked 1, cached 1 nodes"), std::string::npos) << log;
+    EXPECT_EQ(second.find("noise/hzd_set"), std::string::npos) << log;
     EXPECT_NE(atlas::read_file_bytes(dir / "w.png"), first);
 }
 
@@ -205,5 +211,5 @@ TEST(LayerCli, ForecastSequenceStepsTheSlices) {
     EXPECT_NE(atlas::read_file_bytes(work_dir() / "fc_000.png"), atlas::read_file_bytes(work_dir() / "fc_001.png"));
     const CliRun bad = run_atlas("preview forecast.yaml --size 24x14 --slice 3 -o x.png");
     EXPECT_NE(bad.status, 0);
-    EXPECT_NE(bad.err.find("--slice expects 0..2"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("time slices (0..2)"), std::string::npos) << bad.err;
 }

@@ -118,6 +118,8 @@ typedef struct AtlasCookOptions {
     AtlasProgressFn progress; /* may be NULL */
     AtlasCancelFn cancel;     /* may be NULL */
     void* user;               /* passed to progress and cancel */
+    int proxy;                /* 0 or 1: full resolution; P > 1: every world grid at 1/P of its cells
+                                 per axis over the same bounds, for interaction (never written) */
 } AtlasCookOptions;
 
 /* Defaults: all threads, values only (no files written), no disk cache. */
@@ -145,6 +147,18 @@ ATLAS_API const char* atlas_session_report_json(AtlasSession* session);
  * "type", "default", "min", "max", "unit", "doc", "choices"}]}] - what a host
  * needs to draw parameter widgets. NULL on failure. */
 ATLAS_API const char* atlas_session_node_types_json(AtlasSession* session);
+
+/* Renders what the graph writes, as `atlas preview GRAPH` does, through the
+ * session (values stay in memory: after an edit only the changed nodes cook;
+ * nothing is written). `options_json`: NULL or a JSON object of preview options
+ * by their docs/options.md names, as text or numbers ({"size": "640,360",
+ * "view": "orbit", "sun_azimuth": 200}), plus "mode" (auto, voxel, layer) and
+ * "noise" (auto, nubis, none, FILE). `options` (may be NULL) gives jobs, the
+ * cache directory, proxy, progress and cancellation. The picture is a new 2D
+ * field: channels r, g, b (linear radiance) and transmittance, one value per
+ * pixel, row y = 0 at the bottom. */
+ATLAS_API AtlasStatus atlas_session_preview(AtlasSession* session, const char* options_json, const AtlasCookOptions* options,
+                                            AtlasField** out);
 
 /* ------------------------------------------------------------------ fields
  * A field is a dense grid of float channels over a world box (metres),

@@ -1,6 +1,7 @@
 // The C API (atlas/atlas.h) over atlas::Session. Every entry point catches
 // everything: no exception crosses into C.
 #include "atlas/atlas.h"
+#include "atlas/preview/graph_preview.h"
 
 // This file is compiled with hidden visibility (only ATLAS_API is exported);
 // the C++ API it uses keeps its default visibility, so that type information
@@ -130,6 +131,7 @@ atlas::CookOptions cook_options(const AtlasCookOptions* o) {
         opt.cache_dir = std::filesystem::path(o->cache_dir);
     if (has(offsetof(AtlasCookOptions, memory_budget) + sizeof(uint64_t)) && o->memory_budget)
         opt.memory_budget = o->memory_budget;
+    if (has(offsetof(AtlasCookOptions, proxy) + sizeof(int)) && o->proxy > 1) opt.proxy = o->proxy;
     if (has(offsetof(AtlasCookOptions, user) + sizeof(void*))) {
         void* user = o->user;
         if (AtlasProgressFn fn = o->progress)
@@ -314,6 +316,45 @@ AtlasStatus atlas_session_get(AtlasSession* s, const char* node, const char* por
         if (auto* p3 = std::get_if<atlas::Field3DPtr>(&v)) f->f3 = *p3;
         else f->f2 = std::get<atlas::Field2DPtr>(v);
         *out = f.release();
+    });
+}
+
+AtlasStatus atlas_session_preview(AtlasSession* s, const char* options_json, const AtlasCookOptions* options, AtlasField** out) {
+    if (out) *out = nullptr;
+    return guarded(s, [&] {
+        if (!out) throw InvalidArgument("atlas_session_preview: NULL argument");
+        atlas::preview::GraphPreviewOptions how;
+        const atlas::CookOptions co = cook_options(options);
+        how.jobs = co.jobs;
+        how.cache_dir = co.cache_dir;
+        how.progress = co.progress;
+        how.proxy = co.proxy;
+        std::vector<std::pair<std::string, std::string>> settings;
+        if (options_json && *options_json) {
+            nlohmann::json j;
+            try {
+                j = nlohmann::json::parse(options_json);
+            } catch (const nlohmann::json::exception& e) {
+                throw InvalidArgument(std::string("atlas_session_preview: options_json is not JSON: ") + e.what());
+            }
+            if (!j.is_object()) throw InvalidArgument("atlas_session_preview: options_json must be a JSON object of preview options");
+            for (const auto& [name, v] : j.items()) {
+                std::string text;
+                if (v.is_string()) text = v.get<std::string>();
+                else if (v.is_array()) {
+                    for (const auto& x : v) text += (text.empty() ? "" : ",") + (x.is_string() ? x.get<std::string>() : x.dump());
+                } else text = v.dump();
+                if (name == "mode") how.mode = text;
+                else if (name == "noise") how.noise = text;
+                else settings.emplace_back(name, text);
+            }
+        }
+        atlas::render::PreviewOptions po;
+        atlas::preview::set_preview_options(po, settings);
+        atlas::render::PreviewFrame f = atlas::preview::preview_session(s->session, po, how);
+        auto field = std::make_unique<AtlasField>();
+        field->f2 = std::make_shared<const atlas::Field2D>(std::move(f.image));
+        *out = field.release();
     });
 }
 

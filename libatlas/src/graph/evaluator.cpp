@@ -182,10 +182,12 @@ using detail::source_port;
 using detail::topological_order;
 
 Hash128 node_hash(const Graph& g, const NodeRegistry& reg, const GraphNode& n, const NodeType& type,
-                  const std::map<std::string, Hash128>& input_hashes) {
+                  const std::map<std::string, Hash128>& input_hashes, int proxy) {
     Hasher h;
     h.add("atlas-node").add(type.name).add(int64_t(type.version));
-    auto params = resolved_params(n, type);
+    // A proxy cook's scaled parameters are what is hashed: a node with none keeps
+    // its full-resolution hash (and cache entry) unless an input changed.
+    auto params = resolved_params(n, type, proxy);
     for (const auto& d : type.decl.params()) {
         h.add(d.name);
         hash_param_value(h, params.at(d.name));
@@ -215,7 +217,7 @@ Hash128 node_hash(const Graph& g, const NodeRegistry& reg, const GraphNode& n, c
 std::map<std::string, Hash128> Session::node_hashes() const {
     const Graph& g = graph();
     std::map<std::string, Hash128> hashes;
-    for (const GraphNode* n : topological_order(g)) hashes[n->name] = node_hash(g, registry_, *n, *registry_.find(n->type), hashes);
+    for (const GraphNode* n : topological_order(g)) hashes[n->name] = node_hash(g, registry_, *n, *registry_.find(n->type), hashes, 1);
     return hashes;
 }
 
@@ -272,6 +274,11 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     result.checked = opt.checked;
     const Graph& g = graph();
     result.texture_budget_mb = g.texture_budget_mb;
+    if (opt.proxy < 1 || opt.proxy > 64) throw Error("proxy: expected a factor 1..64, got " + std::to_string(opt.proxy));
+    if (opt.proxy > 1 && opt.write_outputs && !want_value)
+        throw Error("a proxy cook (proxy " + std::to_string(opt.proxy) +
+                    ") is for interaction: its results are never written as final outputs; cook without proxy to write them");
+    result.proxy = opt.proxy;
     const int jobs = opt.jobs > 0 ? opt.jobs : hardware_threads();
     // One budget per session: the live total of this cook's fields and values
     // and of the in-memory cache; before refusing it drops cache entries.
@@ -350,7 +357,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             FileReadRecorder recorder(&reads);
             const detail::FileReadLimits limits(opt.memory_budget, opt.progress.is_cancelled);
             try {
-                s.hash = node_hash(g, registry_, *n, *s.type, hashes);
+                s.hash = node_hash(g, registry_, *n, *s.type, hashes, opt.proxy);
             } catch (...) {
                 result.error_node = n->name;
                 result.error_where = n->where.str();
@@ -568,7 +575,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                     std::map<std::string, Value> inputs;
                     // `values` is only written between levels, so reading it here needs no lock.
                     for (const auto& [port, b] : n.inputs) inputs[port] = values.at(b.node)->at(source_port(g, registry_, b));
-                    NodeParams params(&s.type->decl, resolved_params(n, *s.type), g.base_dir);
+                    NodeParams params(&s.type->decl, resolved_params(n, *s.type, opt.proxy), g.base_dir);
                     ProgressSink node_progress;
                     node_progress.is_cancelled = opt.progress.is_cancelled;
                     node_progress.on_progress = [&, name = n.name](const ProgressEvent& e) { report_progress(name, e.fraction); };
@@ -676,11 +683,12 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         }
     }
     // Keep results of nodes that are part of the graph now (needed this time
-    // or not); drop stale ones (old parameter values, removed nodes).
-    for (const auto& [name, h] : last_hashes_)
-        if (g.find(name) && !state.at(name).needed) keep.insert(h);
+    // or not), at full resolution and at each proxy factor used (an artist
+    // switches between them); drop stale ones (old parameter values, removed nodes).
+    for (const auto& [key, h] : last_hashes_)
+        if (g.find(key.first) && !(key.second == opt.proxy && state.at(key.first).needed)) keep.insert(h);
     for (const auto& n : g.nodes)
-        if (state.at(n.name).needed) last_hashes_[n.name] = state.at(n.name).hash;
+        if (state.at(n.name).needed) last_hashes_[{n.name, opt.proxy}] = state.at(n.name).hash;
     cache_->retain_only(keep);
 
     // 8. Values for the host, or files (all staged, committed together).

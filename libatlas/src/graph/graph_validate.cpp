@@ -97,10 +97,12 @@ void validate_graph(const Graph& graph, const NodeRegistry& registry) {
         if (colour[n.name] == 0) visit(n);
 }
 
-std::map<std::string, ParamValue> resolved_params(const GraphNode& node, const NodeType& type) {
+std::map<std::string, ParamValue> resolved_params(const GraphNode& node, const NodeType& type, int proxy) {
     std::map<std::string, ParamValue> values;
     for (const auto& d : type.decl.params()) values[d.name] = d.default_value;
     for (const auto& [name, setting] : node.params) values[name] = setting.value;
+    if (proxy > 1)
+        for (const auto& d : type.decl.params()) values[d.name] = d.at_proxy(values[d.name], proxy);
     return values;
 }
 

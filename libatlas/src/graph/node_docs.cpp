@@ -76,6 +76,24 @@ std::string node_reference_text(const NodeType& t) {
     return out.str();
 }
 
+namespace {
+// What a proxy cook (CookOptions::proxy) does to the node: the parameters that follow it.
+std::string proxy_text(const NodeType& t) {
+    std::string scaled;
+    for (const auto& p : t.decl.params()) {
+        const char* how = p.proxy == ProxyScale::Cells        ? " / P (cells)"
+                          : p.proxy == ProxyScale::CellLength ? " / P (a length in cells)"
+                          : p.proxy == ProxyScale::CellSize   ? " x P (metres per cell)"
+                                                               : nullptr;
+        if (how) scaled += (scaled.empty() ? "" : ", ") + ("`" + p.name + "`" + how);
+    }
+    if (!scaled.empty()) return "at proxy P, " + scaled;
+    bool grid_input = false;
+    for (const auto& in : t.decl.inputs()) grid_input |= in.type == PortType::Field3D || in.type == PortType::Field2D || in.type == PortType::Field;
+    return grid_input ? "follows its inputs' grids" : "not scaled (its size is not a world grid)";
+}
+} // namespace
+
 std::string node_reference_markdown(const NodeRegistry& registry) {
     std::ostringstream out;
     out << "# Node reference\n\n"
@@ -89,7 +107,7 @@ std::string node_reference_markdown(const NodeRegistry& registry) {
         }() << ")\n";
     for (const NodeType* t : registry.all()) {
         out << "\n## " << t->name << "\n\n" << t->decl.doc() << " (version " << t->version << ")\n\n"
-            << "Tiling: " << tiling_text(*t) << ".\n\n";
+            << "Tiling: " << tiling_text(*t) << ".\n\n" << "Proxy: " << proxy_text(*t) << ".\n\n";
         if (!t->decl.inputs().empty()) {
             out << "| input | type | description |\n|---|---|---|\n";
             for (const auto& p : t->decl.inputs()) out << "| `" << p.name << "` | " << port_line(p) << " | " << p.doc << " |\n";

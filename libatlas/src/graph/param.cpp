@@ -133,4 +133,29 @@ std::string ParamDecl::check(const ParamValue& v) const {
     return "unknown parameter type";
 }
 
+ParamValue ParamDecl::at_proxy(const ParamValue& v, int factor) const {
+    if (factor <= 1 || proxy == ProxyScale::None) return v;
+    const double p = factor;
+    auto one = [&](double x) {
+        switch (proxy) {
+        case ProxyScale::Cells: x = std::ceil(x / p); break;
+        case ProxyScale::CellLength: x = x / p; break;
+        case ProxyScale::CellSize: x = x * p; break;
+        case ProxyScale::None: break;
+        }
+        if (min) x = std::max(x, *min);
+        if (max) x = std::min(x, *max);
+        return x;
+    };
+    if (const auto* d = std::get_if<double>(&v)) return one(*d);
+    if (const auto* i = std::get_if<int64_t>(&v)) return int64_t(std::llround(one(double(*i))));
+    if (const auto* xs = std::get_if<std::vector<double>>(&v)) {
+        const bool integral = type == ParamType::Int2 || type == ParamType::Int3;
+        std::vector<double> out;
+        for (double x : *xs) out.push_back(integral ? std::round(one(x)) : one(x));
+        return out;
+    }
+    return v;
+}
+
 } // namespace atlas

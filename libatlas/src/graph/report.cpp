@@ -58,6 +58,7 @@ nlohmann::json report_doc(const CookResult& self, const std::string& graph_file)
     doc["seconds"] = seconds;
     doc["jobs"] = jobs;
     doc["checked"] = checked;
+    if (cr.proxy > 1) doc["proxy"] = cr.proxy;
     if (cr.memory_budget) doc["memory"] = json{{"budget", cr.memory_budget}, {"peak_counted", cr.memory_peak}};
     json jn = json::object();
     for (const auto& [name, r] : nodes) {

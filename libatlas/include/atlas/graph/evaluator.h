@@ -47,6 +47,12 @@ struct CookOptions {
     // wants from one edit. false (the default, and `atlas cook` without --keep-going): the
     // cook fails and writes nothing.
     bool keep_going = false;
+    // A proxy cook for interaction: every world-space grid 1/proxy of its cells per
+    // axis over the same bounds (the parameters declared to follow it,
+    // ParamDecl::proxy; docs/nodes.md lists them per node). Its results hash, and
+    // so cache, apart from full ones; it never writes outputs (write_outputs must be
+    // false). 1: full resolution.
+    int proxy = 1;
     ProgressSink progress;
 };
 
@@ -101,6 +107,7 @@ struct CookResult {
     double seconds = 0;
     int jobs = 1;
     bool checked = false;
+    int proxy = 1; // CookOptions::proxy
     // The --memory-budget and the most the cook's ledger counted at once
     // (values, the in-memory cache, running nodes' scratch, writers' copies).
     uint64_t memory_budget = 0, memory_peak = 0;
@@ -179,7 +186,7 @@ private:
     NodeRegistry registry_;
     std::unique_ptr<Graph> graph_;
     std::unique_ptr<ValueCache> cache_;
-    std::map<std::string, Hash128> last_hashes_; // node -> hash when last needed
+    std::map<std::pair<std::string, int>, Hash128> last_hashes_; // (node, proxy) -> hash when last needed
     CookResult last_;
 };
 

@@ -96,8 +96,9 @@ void set_param_text(Graph& graph, const NodeRegistry& registry, const std::strin
 void set_param(Graph& graph, const NodeRegistry& registry, const std::string& node, const std::string& param,
                const ParamValue& value);
 
-// The resolved parameter values of a node (explicit over defaults).
-std::map<std::string, ParamValue> resolved_params(const GraphNode& node, const NodeType& type);
+// The resolved parameter values of a node (explicit over defaults), as a proxy
+// cook of factor `proxy` uses them (ParamDecl::at_proxy; 1: as written).
+std::map<std::string, ParamValue> resolved_params(const GraphNode& node, const NodeType& type, int proxy = 1);
 
 // "did you mean 'amount'?" helper: the closest candidate within a small edit
 // distance, or "".
