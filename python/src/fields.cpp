@@ -2,7 +2,9 @@
 // the field's own memory whose base object keeps the (immutable) field alive.
 #include "bindings.h"
 
+#include "atlas/core/files.h"
 #include "atlas/core/memory.h"
+#include "atlas/io/writers.h"
 
 #include <algorithm>
 #include <cstring>
@@ -29,6 +31,15 @@ py::array readonly_view(const Ptr& owner, const float* data, std::vector<py::ssi
     py::array a(py::dtype::of<float>(), shape, strides, data, keep_alive(owner));
     a.attr("setflags")(py::arg("write") = false);
     return a;
+}
+
+// A field written to one file in a graph output's format (by the extension unless
+// given), atomically: a failed write leaves no file.
+void write_field(const Value& v, const py::object& path, const py::object& format) {
+    const std::filesystem::path p = py::str(path).cast<std::string>();
+    const std::string fmt = format.is_none() ? io::output_format_for_path(p) : format.cast<std::string>();
+    py::gil_scoped_release nogil;
+    write_file_atomic(p, [&](const std::filesystem::path& tmp) { io::write_value(v, tmp, fmt, {}); });
 }
 
 struct PyField2D {
@@ -182,6 +193,9 @@ field["name"] or field[i] is one channel as a read-only NumPy array of shape
                     std::memcpy(a.mutable_data(c), s.f->channel(c).data(), s.f->voxel_count() * sizeof(float));
                 return a;
             }, "A writable copy of all channels, shape (channels, nz, ny, nx).")
+        .def("write", [](const PyField3D& s, const py::object& path, const py::object& format) { write_field(Value(s.f), path, format); },
+             py::arg("path"), py::arg("format") = py::none(),
+             "Writes the field to one file as a graph output would (format from the extension: vdb, exr, ...; or given), atomically.")
         .def("__eq__", [](const PyField3D& a, const PyField3D& b) { return a.f == b.f || *a.f == *b.f; })
         .def("__repr__", [](const PyField3D& s) {
             return "<atlas.Field3D " + std::to_string(s.f->nx()) + "x" + std::to_string(s.f->ny()) + "x" +
@@ -219,6 +233,9 @@ NumPy array of shape (ny, nx) sharing the field's memory.)doc")
                     std::memcpy(a.mutable_data(c), s.f->channel(c).data(), s.f->voxel_count() * sizeof(float));
                 return a;
             }, "A writable copy of all channels, shape (channels, ny, nx).")
+        .def("write", [](const PyField2D& s, const py::object& path, const py::object& format) { write_field(Value(s.f), path, format); },
+             py::arg("path"), py::arg("format") = py::none(),
+             "Writes the field to one file as a graph output would (format from the extension: exr, png, dds, ...; or given), atomically.")
         .def("__eq__", [](const PyField2D& a, const PyField2D& b) { return a.f == b.f || *a.f == *b.f; })
         .def("__repr__", [](const PyField2D& s) {
             return "<atlas.Field2D " + std::to_string(s.f->width()) + "x" + std::to_string(s.f->height()) + ", " +

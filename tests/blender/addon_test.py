@@ -118,14 +118,57 @@ def same_voxels_as_the_cli():
         check(not diff, f"{name}: voxels differ from the CLI's at {diff[:3]}")
 
 
+def _voxels(path, name, coords):
+    import pyopenvdb as vdb
+
+    acc = vdb.read(path, name).getConstAccessor()
+    return [acc.getValue(c) for c in coords]
+
+
 def incremental_recook():
+    """An edit with Re-cook on change updates the view only: the Volume reads a new file (Blender keeps
+    a Volume's grids while its path is unchanged, so rewriting in place showed the old cloud), nothing
+    is written into the output folder, the preview image follows; the Cook button then writes the
+    outputs from the values the view already cooked."""
     props = scene.atlas
     props.auto_cook = True  # headless: the re-cook runs synchronously in the update
+    props.preview_size = (96, 54)
+    written = os.path.join(out_dir, "nvdf.vdb")
+    before = os.stat(written).st_mtime_ns
+    vol = bpy.data.volumes["atlas_nvdf"]
+    path0 = vol.filepath
+    coords = [(x, y, z) for x in (0, 40, 64, 100) for y in (3, 50, 101) for z in (0, 9, 20, 31)]
+    shown0 = _voxels(path0, "dimensional_profile", coords)
     in_min = next(p for p in props.params if (p.node, p.name) == ("coverage", "in_min"))
     in_min.f = 0.45  # (0.5 leaves 4 BC4 blocks above the quickstart's 0.05 bound: an honest cook error)
     check(props.error == "", f"no error after the edit: {props.error}")
-    recooked = set(props.last_cooked.split())
-    check({"coverage", "distance", "nvdf"} <= recooked and "base" not in recooked, f"re-cooked: {props.last_cooked}")
+    check("view updated" in props.status, f"status {props.status!r}")
+    check(vol.filepath != path0 and os.path.exists(vol.filepath), f"the viewport reads a new file: {path0} -> {vol.filepath}")
+    check(os.stat(written).st_mtime_ns == before, "an edit writes nothing into the output folder")
+    cli_out = os.path.join(args.work, "cli045")
+    r = subprocess.run([args.atlas_bin, "cook", args.graph, "--out", cli_out, "--output", "nvdf.vdb", "--quiet",
+                        "--set", "coverage.in_min=0.45"], capture_output=True, text=True)
+    check(r.returncode == 0, f"CLI cook: {r.stderr}")
+    for grid in ("dimensional_profile", "sdf"):
+        check(_voxels(vol.filepath, grid, coords) == _voxels(os.path.join(cli_out, "nvdf.vdb"), grid, coords),
+              f"the viewport's {grid} is the CLI's after the edit")
+    check(not os.path.exists(path0), "the replaced view file is removed")
+    check(any(a != b for a, b in zip(shown0, _voxels(vol.filepath, "dimensional_profile", coords))),
+          "the edit changed the viewport's voxels")
+    img = bpy.data.images.get("atlas_preview")
+    check(img is not None and tuple(img.size) == (96, 54), f"the Atlas preview image: {img and tuple(img.size)}")
+    # Cook writes the outputs, from the values the view cooked (nothing cooks again).
+    check(bpy.ops.atlas.cook(background=False) == {"FINISHED"}, f"cook: {props.error}")
+    check(props.last_cooked == "", f"the cook reused the view's values: {props.last_cooked!r}")
+    check(os.stat(written).st_mtime_ns != before, "Cook wrote nvdf.vdb")
+    # At proxy 2 the view's grids have half the cells per axis over the same box.
+    props.proxy = 2
+    in_min.f = 0.44
+    grids = {g.name: g for g in vol.grids}
+    m = grids["sdf"].matrix_object if "sdf" in grids else None
+    check(m is not None and [round(m[i][i], 4) for i in range(3)] == [64.0, 64.0, 32.0], f"proxy 2 voxel size {m}")
+    props.proxy = 1
+    in_min.f = 0.45
 
 
 def bad_input():
@@ -135,6 +178,7 @@ def bad_input():
     octaves.i = 99
     check("base" in props.error and "octaves" in props.error and "16" in props.error,
           f"out-of-range message: {props.error!r}")
+    check(octaves.i == 4, f"the field returned to the last good value: {octaves.i}")
     broken = os.path.join(args.work, "broken.yaml")
     with open(broken, "w") as f:
         f.write("atlas: 1\nnodes:\n  base:\n    type: noise/value\n    params: {octavs: 2}\noutputs: []\n")
@@ -196,6 +240,7 @@ def ndf_as_image():
 
 
 def render_small_picture():
+    """Also: the render follows an edit (the viewport is not left with the old grids)."""
     obj = bpy.data.objects["atlas_nvdf"]
     cam_data = bpy.data.cameras.new("cam")
     cam = bpy.data.objects.new("cam", cam_data)
@@ -220,6 +265,15 @@ def render_small_picture():
     lum = [sum(px[i:i + 3]) / 3 for i in range(0, len(px), 4)]
     check(max(lum) - min(lum) > 0.02, f"the render shows something (luminance {min(lum):.3f}..{max(lum):.3f})")
     check(obj.visible_get(), "volume visible")
+    scene.atlas.auto_cook = True
+    scene.atlas.show_preview = False
+    next(p for p in scene.atlas.params if (p.node, p.name) == ("coverage", "in_min")).f = 0.7  # much less cloud
+    check(scene.atlas.error == "", f"edit before the second render: {scene.atlas.error}")
+    scene.render.filepath = os.path.join(args.work, "render_after.png")
+    bpy.ops.render.render(write_still=True)
+    after = list(bpy.data.images.load(scene.render.filepath).pixels)
+    moved = sum(abs(a - b) for a, b in zip(px, after)) / len(px)
+    check(moved > 0.005, f"the render changed with the edit (mean |difference| {moved:.4f})")
 
 
 for s in (install_and_enable, open_and_cook, volume_object, same_voxels_as_the_cli, incremental_recook, bad_input,

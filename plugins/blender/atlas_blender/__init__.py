@@ -22,9 +22,11 @@ bl_info = {
 }
 
 import os
+import shutil
 import sys
 import tempfile
 import threading
+import time
 
 import bpy
 from bpy.props import (BoolProperty, CollectionProperty, FloatProperty, FloatVectorProperty, IntProperty,
@@ -58,27 +60,71 @@ def _atlas_module():
 
 
 class CookJob:
-    def __init__(self, session, out_dir):
+    """A cook on a worker thread. "export": every output written at full resolution into out_dir (the
+    Cook button). "view" (an edit with Re-cook on change): only what the viewport shows, as values at
+    the scene's proxy, nothing written to out_dir: each VDB output into a new file of its own in the
+    add-on's scratch folder (a new path, so Blender loads the new grids), 2D outputs as values, and
+    the Atlas preview picture."""
+
+    def __init__(self, session, out_dir, view=None):
         self.session = session
         self.out_dir = out_dir
+        self.view = view  # None, or {"dir", "serial", "proxy", "outputs": [(out, port, is_vdb)], "preview": (w, h) | None}
         self.cancel = threading.Event()
         self.fraction = 0.0
         self.task = ""
         self.report = None
         self.error = None
         self.thread = None
+        self.volumes = {}   # stem -> the VDB file to show
+        self.images = {}    # stem -> a cooked 2D field
+        self.picture = None  # the preview's sRGB pixels (h, w, 3)
+        self.seconds = 0.0
+        self.failed = []  # "output: error" of outputs that failed in a view
 
     def run(self, jobs):
         def progress(fraction, task, done, total):
             self.fraction, self.task = fraction, task
 
+        t0 = time.perf_counter()
         try:
-            # keep_going: an output a slider move made unwritable (a DDS bound out of reach) is a
-            # warning on that output; the other outputs, and the viewport, still update.
-            self.report = self.session.cook(jobs=jobs, write_outputs=True, out_dir=self.out_dir, progress=progress,
-                                            cancel=self.cancel.is_set, keep_going=True)
+            if self.view is None:
+                # keep_going: an output a slider move made unwritable (a DDS bound out of reach) is a
+                # warning on that output; the other outputs, and the viewport, still update.
+                self.report = self.session.cook(jobs=jobs, write_outputs=True, out_dir=self.out_dir, progress=progress,
+                                                cancel=self.cancel.is_set, keep_going=True)
+            else:
+                self._run_view(jobs, progress)
         except Exception as e:  # atlas.Error and its subclasses; shown in the panel
             self.error = e
+        self.seconds = time.perf_counter() - t0
+
+    def _run_view(self, jobs, progress):
+        v = self.view
+        for out, port, is_vdb in v["outputs"]:
+            stem = "atlas_" + os.path.splitext(os.path.basename(out["file"]))[0]
+            try:
+                value = self.session.get(out["node"], port, jobs=jobs, proxy=v["proxy"], progress=progress, cancel=self.cancel.is_set)
+            except Exception as e:
+                if type(e).__name__ == "CancelledError":
+                    raise
+                # One output that fails is a warning on it; the rest of the view updates.
+                self.failed.append(f"{out['file']}: {e}")
+                continue
+            if is_vdb:
+                path = os.path.join(v["dir"], f"{stem}.{v['serial']}.vdb")
+                value.write(path, "vdb")
+                self.volumes[stem] = path
+            else:
+                self.images[stem] = value
+        if v["preview"]:
+            try:
+                self.picture = self.session.preview({"size": v["preview"]}, proxy=v["proxy"], jobs=jobs, tone_mapped=True,
+                                                    progress=progress, cancel=self.cancel.is_set)
+            except Exception as e:
+                if type(e).__name__ == "CancelledError":
+                    raise
+                self.failed.append(f"preview: {e}")
 
     def done(self):
         return self.thread is None or not self.thread.is_alive()
@@ -124,9 +170,18 @@ def _on_param_changed(self, context):
         st["again"] = st["again"] or props.auto_cook
         return
     if not _apply_edit(scene, self.node, self.name, self.value()):
+        # Refused (the library's message is in the panel): the field returns to the value the
+        # session holds, the last good one.
+        node = next((n for n in st["session"].nodes() if n["name"] == self.node), None)
+        if node is not None:
+            _on_param_changed.loading = True
+            try:
+                self.assign(node["params"][self.name])
+            finally:
+                _on_param_changed.loading = False
         return
     if props.auto_cook:
-        start_cook(scene, background=not bpy.app.background)
+        start_cook(scene, background=not bpy.app.background, view=True)
 
 
 class AtlasParam(bpy.types.PropertyGroup):
@@ -181,6 +236,12 @@ class AtlasSceneProps(bpy.types.PropertyGroup):
     jobs: IntProperty(name="Threads", default=0, min=0, description="Cook threads (0: all); results do not depend on it")
     auto_cook: BoolProperty(name="Re-cook on change", default=True,
                             description="Re-cook (incrementally) whenever a parameter changes")
+    proxy: IntProperty(name="Proxy", default=1, min=1, max=16,
+                       description="Edits cook every world grid at 1/P of its cells per axis (4: a quarter) for a quick look; "
+                                   "Cook writes the outputs at full resolution")
+    show_preview: BoolProperty(name="Atlas preview", default=True,
+                               description="Render Atlas's own preview of each edit into the image 'atlas_preview' (Image Editor)")
+    preview_size: IntVectorProperty(name="Preview size", size=2, default=(480, 270), min=16, max=4096)
     show_all: BoolProperty(name="All parameters", default=False,
                            description="Show every declared parameter, not only those the graph sets")
     params: CollectionProperty(type=AtlasParam)
@@ -252,9 +313,41 @@ def _out_dir(scene):
     return st["tmp"]
 
 
-def start_cook(scene, background=True):
+def _scratch_dir(scene):
+    """The add-on's own folder for the files the viewport reads (never the output folder)."""
+    st = _scene_state(scene)
+    if "scratch" not in st:
+        st["scratch"] = tempfile.mkdtemp(prefix="atlas_blender_view_")
+    return st["scratch"]
+
+
+def _view_outputs(session):
+    """What the viewport shows of a graph's outputs: (output, port, is_vdb) for each VDB output and
+    each 2D field output."""
+    decls = {d["name"]: d for d in session.node_types()}
+    node_types = {n["name"]: n["type"] for n in session.nodes()}
+    found = []
+    for out in session.outputs():
+        ports = decls[node_types[out["node"]]]["outputs"]
+        port = next((p for p in ports if p["name"] == (out["port"] or ports[0]["name"])), ports[0])
+        if out["format"] == "vdb":
+            found.append((out, port["name"], True))
+        elif port["type"] == "field2d":
+            found.append((out, port["name"], False))
+    return found
+
+
+def _next_serial(scene):
+    st = _scene_state(scene)
+    st["serial"] = st.get("serial", 0) + 1
+    return st["serial"]
+
+
+def start_cook(scene, background=True, view=False):
     """Cooks the scene's graph. In the background: a thread, polled by a timer that loads the
-    results on the main thread; a cook already running is cancelled and cooked again."""
+    results on the main thread; a cook already running is cancelled and cooked again.
+    view=True (an edit): what the viewport shows, at the scene's proxy, nothing written to the
+    output folder; view=False (the Cook button): every output written at full resolution."""
     st = _scene_state(scene)
     if st["session"] is None:
         raise RuntimeError("open a graph first")
@@ -262,8 +355,15 @@ def start_cook(scene, background=True):
     if job is not None and not job.done():
         job.cancel.set()
         st["again"] = True
+        st["again_view"] = st.get("again_view", True) and view
         return
-    job = CookJob(st["session"], _out_dir(scene))
+    props = scene.atlas
+    spec = None
+    if view:
+        spec = {"dir": _scratch_dir(scene), "serial": _next_serial(scene), "proxy": props.proxy,
+                "outputs": _view_outputs(st["session"]),
+                "preview": tuple(props.preview_size) if props.show_preview else None}
+    job = CookJob(st["session"], _out_dir(scene), spec)
     st["job"] = job
     props = scene.atlas
     props.status = "cooking"
@@ -293,8 +393,9 @@ def start_cook(scene, background=True):
         ok = all([_apply_edit(sc, *e) for e in edits])
         if state["again"]:
             state["again"] = False
+            view, state["again_view"] = state.get("again_view", True), True
             if ok:
-                start_cook(sc, background=True)
+                start_cook(sc, background=True, view=view)
         return None
 
     bpy.app.timers.register(poll, first_interval=0.1)
@@ -310,9 +411,21 @@ def _redraw():
 def _finish(scene, job):
     props = scene.atlas
     if job.error is not None:
+        # The last good cloud stays in the viewport; the error stays in the panel.
         cancelled = type(job.error).__name__ == "CancelledError"
         props.status = "cancelled" if cancelled else "failed"
         props.error = "" if cancelled else str(job.error)
+        return
+    if job.view is not None:
+        proxy = job.view["proxy"]
+        props.status = f"view updated in {job.seconds:.2f} s" + (f" at proxy {proxy}" if proxy > 1 else "") + " (Cook writes the outputs)"
+        props.error = "; ".join(job.failed)
+        for stem, path in job.volumes.items():
+            _load_volume(scene, stem, path)
+        for stem, field in job.images.items():
+            _field_image(stem, field)
+        if job.picture is not None:
+            _picture_image("atlas_preview", job.picture)
         return
     report = job.report
     cooked = sorted(n for n, r in report["nodes"].items() if r["status"] == "cooked")
@@ -372,12 +485,51 @@ def _field_image(name, field):
     return img
 
 
+def _picture_image(name, pixels):
+    """The Atlas preview (sRGB values, rows from the top) as an image for an Image Editor."""
+    import numpy as np
+
+    h, w = pixels.shape[:2]
+    img = bpy.data.images.get(name)
+    if img is None or tuple(img.size) != (w, h):
+        if img is not None:
+            bpy.data.images.remove(img)
+        img = bpy.data.images.new(name, w, h, alpha=True, float_buffer=True)
+        img.colorspace_settings.name = "Non-Color"  # the values are already the PNG's
+    rgba = np.ones((h, w, 4), np.float32)
+    rgba[..., :3] = pixels[::-1]  # Blender's rows start at the bottom
+    img.pixels.foreach_set(rgba.ravel())
+    img.update()
+    return img
+
+
 def _load_volume(scene, name, path):
+    """Shows a VDB as the Volume datablock `name`. Blender keeps a Volume's grids as long as its
+    file path does not change (rewriting the file in place showed the old cloud), so every load
+    is a new path: the add-on's own files are new already; an output file is linked (or copied)
+    under a new name in the scratch folder. The previous file is removed once replaced."""
+    st = _scene_state(scene)
+    scratch = _scratch_dir(scene)
+    if os.path.dirname(os.path.abspath(path)) != os.path.abspath(scratch):
+        view = os.path.join(scratch, f"{name}.{_next_serial(scene)}.vdb")
+        try:
+            os.link(path, view)
+        except OSError:
+            shutil.copy2(path, view)
+        path = view
     vol = bpy.data.volumes.get(name) or bpy.data.volumes.new(name)
+    old = vol.filepath
     vol.grids.unload()
     vol.filepath = path
     if not vol.grids.load():
         raise RuntimeError(f"{path}: {vol.grids.error_message}")
+    shown = st.setdefault("shown", {})
+    if old and old != path and shown.get(name) == old and os.path.dirname(old) == scratch:
+        try:
+            os.remove(old)
+        except OSError:
+            pass
+    shown[name] = path
     # The viewport draws the active grid: the cloud's shape, not the SDF's whole box.
     names = [g.name for g in vol.grids]
     if "dimensional_profile" in names:
@@ -521,6 +673,9 @@ class ATLAS_PT_panel(bpy.types.Panel):
         row = layout.row()
         row.prop(props, "auto_cook")
         row.prop(props, "jobs")
+        row = layout.row()
+        row.prop(props, "proxy")
+        row.prop(props, "show_preview")
         if props.status:
             layout.label(text=props.status, icon="INFO")
         if props.error:
