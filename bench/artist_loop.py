@@ -4,7 +4,7 @@ picture, through one atlas.Session as an editor holds it (Session.preview: value
 stay in memory, nothing is written). Not a test: it prints a table for
 docs/PERFORMANCE.md with the time and the process's memory beside each step.
 
-    PYTHONPATH=BUILD/python bench/artist_loop.py [--size 960x540] [--proxy 4] [--atlas BUILD/bin/atlas]
+    PYTHONPATH=BUILD/python bench/artist_loop.py [--size 960x540] [--proxy 4] [--pixel-size 1] [--atlas BUILD/bin/atlas]
 
 Per graph (graphs/cloudscape.yaml, graphs/superstorm.yaml):
   first picture   a fresh session's first preview at the proxy (includes the
@@ -62,13 +62,15 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--size", default="960x540")
     ap.add_argument("--proxy", type=int, default=4)
+    ap.add_argument("--pixel-size", type=int, default=1, help="the preview's pixel_size for the proxy steps (full steps: 1)")
     ap.add_argument("--atlas", default=None, help="the atlas CLI for the cold cook (default: next to the module's build)")
     ap.add_argument("--graphs", nargs="*", default=None)
     a = ap.parse_args()
     w, h = (int(x) for x in a.size.split("x"))
     opts = {"size": (w, h)}
+    proxy_opts = {"size": (w, h), "pixel_size": a.pixel_size}
     cli = a.atlas or str(pathlib.Path(atlas.__file__).resolve().parents[2] / "bin" / "atlas")
-    print(f"# load {open('/proc/loadavg').read().split()[:3]}, {os.cpu_count()} cores, {a.size}, proxy {a.proxy}")
+    print(f"# load {open('/proc/loadavg').read().split()[:3]}, {os.cpu_count()} cores, {a.size}, proxy {a.proxy}, pixel size {a.pixel_size} at the proxy")
     print("graph | step | seconds | RSS MB | peak MB")
     print("---|---|---|---|---")
     for graph, edits in CASES:
@@ -79,10 +81,10 @@ def main():
         s.load(path)
         name = pathlib.Path(graph).name
         row = lambda step, sec: print(f"{name} | {step} | {sec:.2f} | {rss_mb():.0f} | {peak_mb():.0f}", flush=True)
-        row(f"first picture @proxy {a.proxy}", timed(lambda: s.preview(opts, proxy=a.proxy)))
+        row(f"first picture @proxy {a.proxy}", timed(lambda: s.preview(proxy_opts, proxy=a.proxy)))
         for node, param, value, what in edits:
             s.set(node, param, value)
-            row(f"edit @proxy {a.proxy}: {node}.{param} ({what})", timed(lambda: s.preview(opts, proxy=a.proxy)))
+            row(f"edit @proxy {a.proxy}: {node}.{param} ({what})", timed(lambda: s.preview(proxy_opts, proxy=a.proxy)))
         with tempfile.TemporaryDirectory() as out:
             t = time.perf_counter()
             subprocess.run([cli, "cook", str(path), "--out", out, "--no-cache", "--quiet"], check=True, stdout=subprocess.DEVNULL,

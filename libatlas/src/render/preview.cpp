@@ -513,24 +513,59 @@ PreviewJob prepare_preview(std::optional<CloudScene> voxel, std::optional<LayerS
     job.layer = std::move(layer);
     job.settings = std::move(s);
     job.exposure = o.exposure;
+    job.pixel_size = o.pixel_size;
     return job;
 }
 
+namespace {
+// `small` scaled up bilinearly to w x h (pixel centres mapped onto pixel centres,
+// clamped at the edges): the picture of a preview marched at pixel_size > 1.
+Field2D scale_up(const Field2D& small, int w, int h) {
+    Field2D out({{w, h}}, small.channels(), small.bounds(), small.channel_names());
+    const int sw = small.width(), sh = small.height();
+    for (int y = 0; y < h; ++y) {
+        const double fy = std::clamp((y + 0.5) * sh / h - 0.5, 0.0, double(sh - 1));
+        const int y0 = std::min(int(fy), sh - 1), y1 = std::min(y0 + 1, sh - 1);
+        const float ty = float(fy - y0);
+        for (int x = 0; x < w; ++x) {
+            const double fx = std::clamp((x + 0.5) * sw / w - 0.5, 0.0, double(sw - 1));
+            const int x0 = std::min(int(fx), sw - 1), x1 = std::min(x0 + 1, sw - 1);
+            const float tx = float(fx - x0);
+            for (int c = 0; c < small.channels(); ++c) {
+                const float a = small.at(c, x0, y0) + (small.at(c, x1, y0) - small.at(c, x0, y0)) * tx;
+                const float b = small.at(c, x0, y1) + (small.at(c, x1, y1) - small.at(c, x0, y1)) * tx;
+                out.at(c, x, y) = a + (b - a) * ty;
+            }
+        }
+    }
+    return out;
+}
+} // namespace
+
 PreviewFrame render_preview(const PreviewJob& job, const ProgressSink* progress) {
     if (!job.voxel && !job.layer) throw Error("preview: nothing to draw (no voxel scene and no 2.5D layer)");
+    if (job.pixel_size < 1 || job.pixel_size > 8) throw Error("preview: pixel_size must be 1..8, got " + std::to_string(job.pixel_size));
+    // One ray per pixel_size x pixel_size block: the same camera (its vertical field of
+    // view) over a smaller picture of about the same aspect.
+    RenderSettings settings = job.settings;
+    if (job.pixel_size > 1) {
+        settings.width = std::max(1, (settings.width + job.pixel_size - 1) / job.pixel_size);
+        settings.height = std::max(1, (settings.height + job.pixel_size - 1) / job.pixel_size);
+    }
     std::optional<Field2D> image;
     std::optional<LayerReport> layer_report;
     std::optional<RenderReport> voxel_report;
     if (job.layer) {
-        LayerResult r = render_layer(*job.layer, job.settings, progress);
+        LayerResult r = render_layer(*job.layer, settings, progress);
         layer_report = r.report;
         image = std::move(r.image);
     }
     if (job.voxel) {
-        RenderResult r = render_clouds(*job.voxel, job.settings, progress);
+        RenderResult r = render_clouds(*job.voxel, settings, progress);
         voxel_report = r.report;
-        image = image ? composite_over(r.image, *image, job.settings) : std::move(r.image);
+        image = image ? composite_over(r.image, *image, settings) : std::move(r.image);
     }
+    if (job.pixel_size > 1) image = scale_up(*image, job.settings.width, job.settings.height);
     return PreviewFrame{std::move(*image), std::move(layer_report), std::move(voxel_report)};
 }
 

@@ -27,7 +27,7 @@ bool PreviewOptions::operator==(const PreviewOptions& o) const {
            ms_octaves == o.ms_octaves && ms_diffusion == o.ms_diffusion && ms_diffusion_sweeps == o.ms_diffusion_sweeps && light_grid == o.light_grid &&
            time == o.time && wind == o.wind && earth_radius == o.earth_radius &&
            edge == o.edge && envelope == o.envelope && density_units == o.density_units && sdf_skipping == o.sdf_skipping &&
-           light_lookup_grid == o.light_lookup_grid;
+           light_lookup_grid == o.light_lookup_grid && pixel_size == o.pixel_size;
 }
 
 namespace {
@@ -187,6 +187,9 @@ std::vector<TextOption<P>> make_preview_options() {
             "fast", "", [](P& p, const V& v) { p.mode = v.word == "reference" ? RenderMode::Reference : RenderMode::Fast; }),
         opt({"quality", "--quality", "Q", K::Number, "fast mode: step count scale (2 = half-length steps)", 0.01, 64}, "1", "",
             [](P& p, const V& v) { p.quality = v.number; }),
+        opt({"pixel_size", "--pixel-size", "N", K::Integer,
+             "interactive previews: march one ray per N x N pixels and scale the picture up bilinearly (as a viewport's pixel size)", 1, 8},
+            "1", "", [](P& p, const V& v) { p.pixel_size = int(v.number); }),
         opt({"extinction", "--extinction", "PER_M", K::Number, "extinction per metre at density 1", 0, 1e6}, "0.04", "1/m",
             [](P& p, const V& v) { p.extinction = v.number; }),
         opt({"exposure", "--exposure", "E", K::Number, "PNG tone map: radiance multiplier before Reinhard and sRGB", 1e-6, 1e6}, "1.5", "",

@@ -103,6 +103,7 @@ struct PreviewJob {
     std::optional<LayerScene> layer; // the 2.5D layer
     RenderSettings settings;
     double exposure = 1.5;           // PNG tone map (tone_map)
+    int pixel_size = 1;              // PreviewOptions::pixel_size: settings hold the picture's size
     std::vector<std::string> notes;  // work done on the way, for a log ("envelope: cone map ...")
 };
 

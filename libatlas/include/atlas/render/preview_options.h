@@ -69,6 +69,9 @@ struct PreviewOptions {
     // Voxel accelerations (RenderSettings::skip_empty_space, use_light_grid).
     bool sdf_skipping = true;
     bool light_lookup_grid = true;
+    // Rays per pixel block: 2 marches one ray per 2 x 2 pixels (a quarter of the
+    // work) and scales the picture up bilinearly, for interaction.
+    int pixel_size = 1;
 
     bool operator==(const PreviewOptions&) const;
 };
