@@ -276,8 +276,52 @@ def render_small_picture():
     check(moved > 0.005, f"the render changed with the edit (mean |difference| {moved:.4f})")
 
 
+def spheres_as_objects():
+    """A metaball graph's spheres as Empties: moving one, or adding one, rewrites the parameter and
+    re-cooks the view (the depsgraph handler)."""
+    import atlas_blender
+
+    graph = os.path.join(args.work, "balls.yaml")
+    with open(graph, "w") as f:
+        f.write("atlas: 1\nnodes:\n"
+                "  density: {type: volume/metaballs, params: {resolution: [32, 32, 16], bounds_max: [1000, 1000, 500],\n"
+                "            kernel: sphere, blend: max, spheres: 300 500 200 120; 650 520 230 110}}\n"
+                "  sdf: {type: volume/sdf, inputs: {in: density}, params: {iso: 0.5}}\n"
+                "  nvdf: {type: volume/nvdf, inputs: {sdf: sdf}, params: {depth: 30}}\n"
+                "outputs:\n  - {node: nvdf, port: vdb_set, file: balls.vdb}\n")
+    props = scene.atlas
+    props.auto_cook = False
+    check(bpy.ops.atlas.open_graph(filepath=graph) == {"FINISHED"}, f"open balls: {props.error}")
+    check(bpy.ops.atlas.cook(background=False) == {"FINISHED"}, f"cook balls: {props.error}")
+    props.auto_cook = True
+    props.show_preview = False
+    props.proxy = 1
+    check(bpy.ops.atlas.edit_spheres(node="density", param="spheres") == {"FINISHED"}, "edit_spheres")
+    coll = bpy.data.collections.get("atlas density.spheres")
+    objs = sorted(coll.objects, key=lambda o: o.name) if coll else []
+    check(len(objs) == 2 and objs[0].empty_display_size == 120 and tuple(objs[1].location) == (650, 520, 230),
+          f"two sphere Empties: {[(o.name, tuple(o.location), o.empty_display_size) for o in objs]}")
+    vol = bpy.data.volumes["atlas_balls"]
+    path0 = vol.filepath
+    objs[0].location.x += 100
+    bpy.context.view_layer.update()  # the depsgraph handler writes the parameter back
+    item = next(p for p in props.params if (p.node, p.name) == ("density", "spheres"))
+    check(item.s == "400 500 200 120; 650 520 230 110", f"the parameter follows the move: {item.s!r}")
+    session = atlas_blender._scene_state(scene)["session"]
+    node = next(n for n in session.nodes() if n["name"] == "density")
+    check(node["params"]["spheres"] == item.s, f"the session has it: {node['params']['spheres']!r}")
+    check(vol.filepath != path0, "the view re-cooked after the move")
+    extra = bpy.data.objects.new("density.spheres.002", None)
+    extra.empty_display_type = "SPHERE"
+    extra.empty_display_size = 50
+    extra.location = (500, 300, 250)
+    coll.objects.link(extra)
+    bpy.context.view_layer.update()
+    check(item.s.count(";") == 2 and item.s.endswith("500 300 250 50"), f"a third sphere: {item.s!r}")
+
+
 for s in (install_and_enable, open_and_cook, volume_object, same_voxels_as_the_cli, incremental_recook, bad_input,
-          background_thread_and_cancel, ndf_as_image, render_small_picture):
+          background_thread_and_cancel, ndf_as_image, render_small_picture, spheres_as_objects):
     step(s)
 
 print(f"{passed} passed, {failed} failed")

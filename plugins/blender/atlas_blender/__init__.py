@@ -697,6 +697,9 @@ class ATLAS_PT_panel(bpy.types.Panel):
             vector = "iv" if p.ptype.startswith("int") else "v"
             field = {"float": "f", "int": "i", "bool": "b"}.get(p.ptype, vector if p.ptype in _VECTOR_TYPES else "s")
             row.prop(p, field, text=label)
+            if p.name == "spheres" and p.ptype == "string":
+                edit = row.operator("atlas.edit_spheres", text="", icon="SPHERE")
+                edit.node, edit.param = p.node, p.name
             info = row.operator("atlas.param_info", text="", icon="QUESTION")
             info.node, info.param = p.node, p.name
 
@@ -712,19 +715,117 @@ class ATLAS_PT_scene_panel(bpy.types.Panel):
     draw = ATLAS_PT_panel.draw
 
 
+# ---------------------------------------------------------------- spheres as Blender objects
+# A 'spheres' parameter ("x y z radius; ...", metres: volume/metaballs, volume/billows) can be edited in
+# the viewport: each sphere becomes an Empty (display: sphere, size: the radius) in a collection named
+# after the parameter; moving, scaling, duplicating or deleting them rewrites the parameter, which
+# re-cooks the view like any edit.
+
+_SPHERES_KEY = "atlas_spheres"  # collection property: "node.param"
+
+
+def _parse_spheres(text):
+    spheres = []
+    for item in text.replace("\n", " ").split(";"):
+        parts = item.split()
+        if len(parts) == 4:
+            spheres.append(tuple(float(x) for x in parts))
+    return spheres
+
+
+def _spheres_text(objects):
+    def num(x):
+        return f"{x:.6g}"
+    return "; ".join(" ".join(num(v) for v in (o.location.x, o.location.y, o.location.z,
+                                                o.empty_display_size * max(abs(c) for c in o.scale))) for o in objects)
+
+
+def make_sphere_objects(scene, node, param):
+    """Empties for the spheres of NODE.PARAM, in a collection of their own (replaced if it exists)."""
+    item = next(p for p in scene.atlas.params if (p.node, p.name) == (node, param))
+    name = f"atlas {node}.{param}"
+    coll = bpy.data.collections.get(name)
+    if coll is None:
+        coll = bpy.data.collections.new(name)
+        scene.collection.children.link(coll)
+    for o in list(coll.objects):
+        bpy.data.objects.remove(o)
+    coll[_SPHERES_KEY] = f"{node}.{param}"
+    for i, (x, y, z, r) in enumerate(_parse_spheres(item.s)):
+        o = bpy.data.objects.new(f"{node}.{param}.{i:03d}", None)
+        o.empty_display_type = "SPHERE"
+        o.empty_display_size = r
+        o.location = (x, y, z)
+        coll.objects.link(o)
+    return coll
+
+
+def sync_sphere_objects(scene):
+    """Writes each sphere collection back into its parameter when the objects changed (a move,
+    scale, duplicate or delete). Called after every depsgraph update; returns the parameters set."""
+    changed = []
+    props = getattr(scene, "atlas", None)
+    if props is None or _scene_state(scene)["session"] is None:
+        return changed
+    for coll in bpy.data.collections:
+        key = coll.get(_SPHERES_KEY)
+        if not key:
+            continue
+        node, param = key.split(".", 1)
+        item = next((p for p in props.params if (p.node, p.name) == (node, param)), None)
+        if item is None:
+            continue
+        objects = sorted((o for o in coll.objects if o.type == "EMPTY"), key=lambda o: o.name)
+        text = _spheres_text(objects)
+        if _parse_spheres(text) != [tuple(float(f"{v:.6g}") for v in sp) for sp in _parse_spheres(item.s)]:
+            item.s = text  # the update re-cooks the view, or shows the library's message
+            changed.append(key)
+    return changed
+
+
+@bpy.app.handlers.persistent
+def _on_depsgraph(scene, depsgraph=None):
+    if getattr(_on_depsgraph, "busy", False):
+        return
+    _on_depsgraph.busy = True
+    try:
+        sync_sphere_objects(scene)
+    finally:
+        _on_depsgraph.busy = False
+
+
+class ATLAS_OT_edit_spheres(bpy.types.Operator):
+    bl_idname = "atlas.edit_spheres"
+    bl_label = "Edit in Viewport"
+    bl_description = "Make the spheres Empties you can move, scale, duplicate or delete; the parameter follows"
+    node: StringProperty()
+    param: StringProperty()
+
+    def execute(self, context):
+        try:
+            make_sphere_objects(context.scene, self.node, self.param)
+        except Exception as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
 _classes = (AtlasParam, AtlasSceneProps, AtlasPreferences, ATLAS_OT_open_graph, ATLAS_OT_cook, ATLAS_OT_cancel,
-            ATLAS_OT_param_info, ATLAS_PT_panel, ATLAS_PT_scene_panel)
+            ATLAS_OT_param_info, ATLAS_OT_edit_spheres, ATLAS_PT_panel, ATLAS_PT_scene_panel)
 
 
 def register():
     for c in _classes:
         bpy.utils.register_class(c)
     bpy.types.Scene.atlas = PointerProperty(type=AtlasSceneProps)
+    bpy.app.handlers.depsgraph_update_post.append(_on_depsgraph)
 
 
 def unregister():
     for job in [s["job"] for s in _state.values() if s["job"] is not None]:
         job.cancel.set()
+    if _on_depsgraph in bpy.app.handlers.depsgraph_update_post:
+        bpy.app.handlers.depsgraph_update_post.remove(_on_depsgraph)
     del bpy.types.Scene.atlas
     for c in reversed(_classes):
         bpy.utils.unregister_class(c)
