@@ -32,21 +32,36 @@ scene.atlas.out_dir = tempfile.mkdtemp(prefix="atlas_shot_")
 scene.atlas.auto_cook = False
 atlas_blender.open_graph(scene, os.path.abspath(args.graph))
 atlas_blender.start_cook(scene, background=False)
-for p in scene.atlas.params:  # an edit, as an artist would make it
+# An edit as an artist makes it: the view at proxy 2 with Atlas's preview (Re-cook on change shown on).
+scene.atlas.proxy = 2
+for p in scene.atlas.params:
     if (p.node, p.name) == ("coverage", "in_min"):
         p.f = 0.45  # 0.5 makes the BC4 output's 0.05 bound unreachable (the cook fails)
-atlas_blender.start_cook(scene, background=False)
+atlas_blender.start_cook(scene, background=False, view=True)
+scene.atlas.auto_cook = True
+
+
+def _split(win, area, direction, factor):
+    """Splits `area`; returns the new area."""
+    before = set(win.screen.areas[:])
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    with bpy.context.temp_override(window=win, screen=win.screen, area=area, region=region):
+        bpy.ops.screen.area_split(direction=direction, factor=factor)
+    return next(a for a in win.screen.areas if a not in before)
 
 
 def shoot():
     win = bpy.context.window_manager.windows[0]
     view = next(a for a in win.screen.areas if a.type == "VIEW_3D")
-    before = set(win.screen.areas[:])
-    with bpy.context.temp_override(window=win, screen=win.screen, area=view):
-        bpy.ops.screen.area_split(direction="VERTICAL", factor=0.58)
-    new = [a for a in win.screen.areas if a not in before]
-    right = max([view] + new, key=lambda a: a.x)
+    other = _split(win, view, "VERTICAL", 0.58)
+    left, right = sorted((view, other), key=lambda a: a.x)
     right.type = "PROPERTIES"
+    # Below the viewport, Atlas's preview of the last edit (the image 'atlas_preview').
+    other = _split(win, left, "HORIZONTAL", 0.45)
+    low, high = sorted((left, other), key=lambda a: a.y)
+    high.type = "VIEW_3D"
+    low.type = "IMAGE_EDITOR"
+    low.spaces.active.image = bpy.data.images.get("atlas_preview")
     for area in win.screen.areas:
         area.tag_redraw()
     return None
@@ -62,6 +77,10 @@ def arrange():
                     area.spaces.active.context = "SCENE"
             except TypeError:
                 pass  # an editor that has not been drawn yet offers no tabs; a new one opens on Scene
+        if area.type == "IMAGE_EDITOR":
+            region = next(r for r in area.regions if r.type == "WINDOW")
+            with bpy.context.temp_override(window=win, screen=win.screen, area=area, region=region):
+                bpy.ops.image.view_all(fit_view=True)
         if area.type == "VIEW_3D":
             space = area.spaces.active
             space.shading.type = "SOLID"
@@ -99,4 +118,4 @@ def save_and_quit():
 bpy.app.timers.register(shoot, first_interval=0.5)
 bpy.app.timers.register(arrange, first_interval=1.5)
 bpy.app.timers.register(show_scene_tab, first_interval=3.0)
-bpy.app.timers.register(save_and_quit, first_interval=5.0)
+bpy.app.timers.register(save_and_quit, first_interval=6.0)
