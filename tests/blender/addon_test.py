@@ -320,8 +320,88 @@ def spheres_as_objects():
     check(item.s.count(";") == 2 and item.s.endswith("500 300 250 50"), f"a third sphere: {item.s!r}")
 
 
+def mesh_from_a_blender_object():
+    """volume/read_mesh's file follows a Blender mesh object: binding it, then moving it, re-cooks the
+    view with the cloud where the object is."""
+    import atlas_blender
+
+    cube_obj = os.path.join(args.work, "start.obj")
+    with open(cube_obj, "w") as f:  # a 200 m cube at (700, 700, 250): where the cloud starts
+        for x in (600, 800):
+            for y in (600, 800):
+                for z in (150, 350):
+                    f.write(f"v {x} {y} {z}\n")
+        for a, b, c in ((1, 3, 2), (2, 3, 4), (5, 6, 7), (6, 8, 7), (1, 2, 5), (2, 6, 5), (3, 7, 4), (4, 7, 8),
+                        (1, 5, 3), (3, 5, 7), (2, 4, 6), (4, 8, 6)):
+            f.write(f"f {a} {b} {c}\n")
+    graph = os.path.join(args.work, "meshcloud.yaml")
+    with open(graph, "w") as f:
+        f.write("atlas: 1\nnodes:\n"
+                "  shape: {type: volume/read_mesh, params: {file: start.obj}}\n"
+                "  sdf: {type: volume/mesh_to_sdf, inputs: {mesh: shape}, params: {resolution: [32, 32, 16], bounds_max: [1000, 1000, 500]}}\n"
+                "  nvdf: {type: volume/nvdf, inputs: {sdf: sdf.sdf}, params: {depth: 30}}\n"
+                "outputs:\n  - {node: nvdf, port: vdb_set, file: meshcloud.vdb}\n")
+    props = scene.atlas
+    props.auto_cook = False
+    check(bpy.ops.atlas.open_graph(filepath=graph) == {"FINISHED"}, f"open mesh graph: {props.error}")
+    check(bpy.ops.atlas.cook(background=False) == {"FINISHED"}, f"cook mesh graph: {props.error}")
+    props.auto_cook = True
+    props.show_preview = False
+    props.proxy = 1
+    me = bpy.data.meshes.new("blob")
+    me.from_pydata([(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], [],
+                   [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)])
+    blob = bpy.data.objects.new("blob", me)
+    scene.collection.objects.link(blob)
+    blob.location = (300, 300, 250)
+    blob.scale = (120, 120, 120)
+    bpy.context.view_layer.update()
+    atlas_blender.bind_object(scene, blob, "shape", "file")
+    item = next(p for p in props.params if (p.node, p.name) == ("shape", "file"))
+    check(item.s.endswith(".obj") and os.path.dirname(item.s) == atlas_blender._scratch_dir(scene), f"the file follows the object: {item.s!r}")
+    vol = bpy.data.volumes["atlas_meshcloud"]
+
+    def profile_at(x, y, z):
+        return _voxels(vol.filepath, "dimensional_profile", [(int(x // 31.25), int(y // 31.25), int(z // 31.25))])[0]
+
+    check(profile_at(300, 300, 250) > 0 and profile_at(700, 700, 250) == 0,
+          f"the cloud is where the object is: {profile_at(300, 300, 250)}, {profile_at(700, 700, 250)}")
+    blob.location = (650, 350, 250)
+    bpy.context.view_layer.update()  # the depsgraph handler writes the moved object
+    check(profile_at(650, 350, 250) > 0 and profile_at(300, 300, 250) == 0,
+          f"the cloud followed the move: {profile_at(650, 350, 250)}, {profile_at(300, 300, 250)}")
+    # volume/read_points the same way: the object's vertices become spheres of its 'atlas_radius'.
+    pts = os.path.join(args.work, "start.xyz")
+    with open(pts, "w") as f:
+        f.write("800 800 250 100\n")
+    graph = os.path.join(args.work, "pointcloud.yaml")
+    with open(graph, "w") as f:
+        f.write("atlas: 1\nnodes:\n"
+                "  centres: {type: volume/read_points, params: {file: start.xyz}}\n"
+                "  density: {type: volume/metaballs, inputs: {points: centres}, params: {resolution: [32, 32, 16], bounds_max: [1000, 1000, 500],\n"
+                "            kernel: sphere, blend: max}}\n"
+                "  sdf: {type: volume/sdf, inputs: {in: density}, params: {iso: 0.5}}\n"
+                "  nvdf: {type: volume/nvdf, inputs: {sdf: sdf}, params: {depth: 30}}\n"
+                "outputs:\n  - {node: nvdf, port: vdb_set, file: meshcloud.vdb}\n")
+    props.auto_cook = False
+    check(bpy.ops.atlas.open_graph(filepath=graph) == {"FINISHED"}, f"open points graph: {props.error}")
+    check(bpy.ops.atlas.cook(background=False) == {"FINISHED"}, f"cook points graph: {props.error}")
+    props.auto_cook = True
+    del blob[atlas_blender._BIND_KEY]
+    blob["atlas_radius"] = 90.0
+    blob.location = (300, 300, 250)
+    bpy.context.view_layer.update()
+    atlas_blender.bind_object(scene, blob, "centres", "file")
+    item = next(p for p in props.params if (p.node, p.name) == ("centres", "file"))
+    check(item.s.endswith(".xyz"), f"the points file follows the object: {item.s!r}")
+    # The cube's corners, 120 m from its centre, each a 90 m sphere: cloud at a corner, none at 800, 800.
+    check(profile_at(420, 420, 370) > 0 and profile_at(800, 800, 250) == 0,
+          f"spheres at the object's vertices: {profile_at(420, 420, 370)}, {profile_at(800, 800, 250)}")
+
+
 for s in (install_and_enable, open_and_cook, volume_object, same_voxels_as_the_cli, incremental_recook, bad_input,
-          background_thread_and_cancel, ndf_as_image, render_small_picture, spheres_as_objects):
+          background_thread_and_cancel, ndf_as_image, render_small_picture, spheres_as_objects,
+          mesh_from_a_blender_object):
     step(s)
 
 print(f"{passed} passed, {failed} failed")

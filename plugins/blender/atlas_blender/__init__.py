@@ -186,6 +186,7 @@ def _on_param_changed(self, context):
 
 class AtlasParam(bpy.types.PropertyGroup):
     node: StringProperty()
+    node_type: StringProperty()
     name: StringProperty()
     ptype: StringProperty()
     unit: StringProperty()
@@ -290,6 +291,7 @@ def fill_params(scene):
             for p in decl["params"]:
                 item = props.params.add()
                 item.node, item.name, item.ptype = node["name"], p["name"], p["type"]
+                item.node_type = node["type"]
                 item.unit, item.doc = p["unit"], p["doc"]
                 lo, hi = p["min"], p["max"]
                 item.range_text = "" if lo is None and hi is None else f"[{'' if lo is None else f'{lo:g}'}, {'' if hi is None else f'{hi:g}'}]"
@@ -700,6 +702,9 @@ class ATLAS_PT_panel(bpy.types.Panel):
             if p.name == "spheres" and p.ptype == "string":
                 edit = row.operator("atlas.edit_spheres", text="", icon="SPHERE")
                 edit.node, edit.param = p.node, p.name
+            if p.node_type in _OBJECT_FILE_NODES and p.ptype == "path":
+                bind = row.operator("atlas.bind_object", text="", icon="OBJECT_DATA")
+                bind.node, bind.param = p.node, p.name
             info = row.operator("atlas.param_info", text="", icon="QUESTION")
             info.node, info.param = p.node, p.name
 
@@ -790,6 +795,7 @@ def _on_depsgraph(scene, depsgraph=None):
     _on_depsgraph.busy = True
     try:
         sync_sphere_objects(scene)
+        sync_object_files(scene)
     finally:
         _on_depsgraph.busy = False
 
@@ -810,8 +816,110 @@ class ATLAS_OT_edit_spheres(bpy.types.Operator):
         return {"FINISHED"}
 
 
+
+# ---------------------------------------------------------------- meshes and points from Blender objects
+# The file parameter of volume/read_mesh or volume/read_points can follow a Blender object: the
+# object (its evaluated mesh in world space, metres) is written to a new file in the add-on's
+# scratch folder whenever it changes (a move, a scale, an edit of its vertices), and the parameter
+# is set to it, which re-cooks the view. read_points takes the vertices, with a 'radius' float
+# attribute when the mesh has one (else the object's 'atlas_radius', 50 m).
+
+_OBJECT_FILE_NODES = {"volume/read_mesh": "obj", "volume/read_points": "xyz"}
+_BIND_KEY = "atlas_file_for"  # object property: "node.param"
+
+
+def _object_geometry(obj):
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    ev = obj.evaluated_get(depsgraph)
+    mesh = ev.to_mesh()
+    try:
+        m = obj.matrix_world
+        verts = [tuple(m @ v.co) for v in mesh.vertices]
+        mesh.calc_loop_triangles()
+        tris = [tuple(t.vertices) for t in mesh.loop_triangles]
+        radius = None
+        attr = mesh.attributes.get("radius")
+        if attr is not None and attr.domain == "POINT" and attr.data_type == "FLOAT":
+            radius = [d.value for d in attr.data]
+    finally:
+        ev.to_mesh_clear()
+    return verts, tris, radius
+
+
+def _write_object_file(obj, path, kind):
+    verts, tris, radius = _object_geometry(obj)
+    with open(path + ".tmp", "w") as f:
+        if kind == "obj":
+            f.writelines(f"v {x:.6g} {y:.6g} {z:.6g}\n" for x, y, z in verts)
+            f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in tris)
+        else:
+            r0 = float(obj.get("atlas_radius", 50.0))
+            for i, (x, y, z) in enumerate(verts):
+                f.write(f"{x:.6g} {y:.6g} {z:.6g} {radius[i] if radius else r0:.6g}\n")
+    os.replace(path + ".tmp", path)
+
+
+def bind_object(scene, obj, node, param):
+    """Makes NODE.PARAM (a read_mesh / read_points file) follow `obj`; writes it once now."""
+    obj[_BIND_KEY] = f"{node}.{param}"
+    obj["atlas_signature"] = ""
+    return sync_object_files(scene)
+
+
+def _signature(obj):
+    verts, tris, radius = _object_geometry(obj)
+    return repr((len(verts), len(tris), [round(c, 4) for v in verts[:64] for c in v], round(sum(sum(v) for v in verts), 3),
+                 None if radius is None else round(sum(radius), 3)))
+
+
+def sync_object_files(scene):
+    """Writes each bound object whose geometry or placement changed and points its parameter at the
+    new file. Returns the parameters set."""
+    changed = []
+    props = getattr(scene, "atlas", None)
+    if props is None or _scene_state(scene)["session"] is None:
+        return changed
+    for obj in scene.objects:
+        key = obj.get(_BIND_KEY)
+        if not key or obj.type != "MESH":
+            continue
+        node, param = key.split(".", 1)
+        item = next((p for p in props.params if (p.node, p.name) == (node, param)), None)
+        kind = _OBJECT_FILE_NODES.get(item.node_type) if item is not None else None
+        if kind is None:
+            continue
+        sig = _signature(obj)
+        if obj.get("atlas_signature") == sig:
+            continue
+        obj["atlas_signature"] = sig
+        path = os.path.join(_scratch_dir(scene), f"{node}.{param}.{_next_serial(scene)}.{kind}")
+        _write_object_file(obj, path, kind)
+        old = item.s
+        item.s = path  # the update re-cooks the view, or shows the library's message
+        if old.startswith(_scratch_dir(scene)) and old != path and os.path.exists(old):
+            os.remove(old)
+        changed.append(key)
+    return changed
+
+
+class ATLAS_OT_bind_object(bpy.types.Operator):
+    bl_idname = "atlas.bind_object"
+    bl_label = "Use Active Object"
+    bl_description = "Make this file follow the active mesh object: moving or editing it re-cooks"
+    node: StringProperty()
+    param: StringProperty()
+
+    def execute(self, context):
+        obj = context.view_layer.objects.active
+        if obj is None or obj.type != "MESH":
+            self.report({"ERROR"}, "select a mesh object first")
+            return {"CANCELLED"}
+        bind_object(context.scene, obj, self.node, self.param)
+        return {"FINISHED"}
+
+
 _classes = (AtlasParam, AtlasSceneProps, AtlasPreferences, ATLAS_OT_open_graph, ATLAS_OT_cook, ATLAS_OT_cancel,
-            ATLAS_OT_param_info, ATLAS_OT_edit_spheres, ATLAS_PT_panel, ATLAS_PT_scene_panel)
+            ATLAS_OT_param_info, ATLAS_OT_edit_spheres, ATLAS_OT_bind_object, ATLAS_PT_panel, ATLAS_PT_scene_panel)
 
 
 def register():
