@@ -465,6 +465,53 @@ preview options by their docs/options.md names, as values or text: {"size": (640
 "sun_azimuth": 200}. proxy=4 cooks every world grid at a quarter of its cells per axis (for
 interaction). Returns a float32 NumPy array (height, width, 4) of linear radiance r, g, b and view
 transmittance, rows from the top; tone_mapped=True: the PNG's sRGB values in 0..1 (height, width, 3).)doc")
+        .def("preview_settings", [](PySession& ps, const py::object& options, int proxy, const std::string& mode, const std::string& noise) {
+                 BusyGuard guard(ps);
+                 render::PreviewOptions po;
+                 std::vector<std::pair<std::string, std::string>> settings;
+                 if (!options.is_none())
+                     for (const auto& item : options.cast<py::dict>()) settings.emplace_back(py::str(item.first).cast<std::string>(), option_text(item.second));
+                 preview::set_preview_options(po, settings);
+                 preview::GraphPreviewOptions how;
+                 how.proxy = proxy;
+                 how.mode = mode;
+                 how.noise = noise;
+                 std::optional<preview::GraphPreview> p;
+                 {
+                     py::gil_scoped_release nogil;
+                     p.emplace(preview::prepare_graph_preview(ps.session, po, how));
+                 }
+                 const render::RenderSettings& rs = p->job.settings;
+                 auto v3 = [](const auto& v) { return py::make_tuple(double(v[0]), double(v[1]), double(v[2])); };
+                 const double four_pi = 4 * 3.14159265358979323846;
+                 const Vec3d sun = rs.sun_direction / length(rs.sun_direction);
+                 py::dict d, cam, sund, sky, phase;
+                 cam["position"] = v3(rs.camera.position);
+                 cam["look_at"] = v3(rs.camera.look_at);
+                 cam["up"] = v3(rs.camera.up);
+                 cam["fov_y_deg"] = rs.camera.fov_deg;
+                 sund["direction_to_sun"] = v3(sun);
+                 sund["irradiance_rgb"] = py::make_tuple(four_pi * rs.sun_colour[0], four_pi * rs.sun_colour[1], four_pi * rs.sun_colour[2]);
+                 sky["zenith_rgb"] = v3(rs.sky_colour);
+                 sky["horizon_rgb"] = v3(rs.sky_horizon.value_or(rs.sky_colour));
+                 phase["g_forward"] = rs.hg_forward;
+                 phase["g_back"] = rs.hg_back;
+                 phase["forward_weight"] = rs.hg_forward_weight;
+                 d["camera"] = cam;
+                 d["sun"] = sund;
+                 d["sky"] = sky;
+                 d["phase"] = phase;
+                 d["width"] = rs.width;
+                 d["height"] = rs.height;
+                 d["extinction_per_metre"] = rs.extinction;
+                 d["artistic"] = rs.artistic;
+                 return d;
+             },
+             py::arg("options") = py::none(), py::arg("proxy") = 1, py::arg("mode") = "auto", py::arg("noise") = "auto",
+             R"doc(What Session.preview would render with, as plain data (the keys of `atlas preview --export-scene`'s
+scene.json): camera (position, look_at, up, fov_y_deg), sun (direction_to_sun, irradiance_rgb = 4 pi x
+Atlas's sun colour), sky (zenith_rgb, horizon_rgb), phase (g_forward, g_back, forward_weight),
+extinction_per_metre, width, height, artistic. A host sets its own renderer's camera and lights from it.)doc")
         .def("cook_requirements", [](PySession& ps, int jobs, const py::object& cache_dir, const py::object& memory_budget,
                                      const py::object& progress, const py::object& cancel) {
                  BusyGuard guard(ps);

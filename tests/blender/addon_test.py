@@ -399,9 +399,51 @@ def mesh_from_a_blender_object():
           f"spheres at the object's vertices: {profile_at(420, 420, 370)}, {profile_at(800, 800, 250)}")
 
 
+def cycles_draws_what_atlas_previews():
+    """"Atlas Camera & Light" and the add-on's material: Cycles draws the quickstart's cloud as
+    `atlas preview --reference --artistic off --noise none` does from the same view (the mean
+    radiance of the cloud's pixels), and white, not as dark smudges."""
+    import numpy as np
+    import OpenImageIO as oiio
+
+    props = scene.atlas
+    props.auto_cook = False
+    check(bpy.ops.atlas.open_graph(filepath=args.graph) == {"FINISHED"}, "open the quickstart again")
+    check(bpy.ops.atlas.cook(background=False) == {"FINISHED"}, f"cook: {props.error}")
+    check(bpy.ops.atlas.camera_and_light() == {"FINISHED"}, "camera_and_light")
+    for o in list(bpy.data.objects):  # only the cloud and the operator's sun, as atlas preview has them
+        o.hide_render = o.name not in ("atlas_nvdf", "Atlas Sun", "Atlas Camera")
+    w, h = 96, 54
+    ref = os.path.join(args.work, "atlas_ref.exr")
+    r = subprocess.run([args.atlas_bin, "preview", args.graph, "--reference", "--artistic", "off", "--noise", "none", "--size", f"{w}x{h}",
+                        "--no-cache", "--quiet", "-o", ref], capture_output=True, text=True)
+    check(r.returncode == 0, f"atlas preview --reference: {r.stderr}")
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = 64
+    scene.cycles.use_denoising = False
+    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = w, h, 100
+    scene.render.filter_size = 0.01
+    scene.view_settings.view_transform = "Standard"
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = os.path.join(args.work, "cycles.exr")
+    bpy.ops.render.render(write_still=True)
+    ours = oiio.ImageBuf(ref).get_pixels(oiio.FLOAT)
+    theirs = oiio.ImageBuf(scene.render.filepath).get_pixels(oiio.FLOAT)[..., :3]
+    cloud = ours[..., 3] < 0.5
+    check(cloud.sum() > 50, f"the view shows the cloud ({cloud.sum()} pixels)")
+    a, b = ours[..., :3][cloud].mean(), theirs[cloud].mean()
+    print(f"cloud pixels {cloud.sum()}: atlas {a:.4f}, cycles {b:.4f}, ratio {b / a:.3f}; "
+          f"cycles rgb {theirs[cloud].mean(axis=0)}, sky {theirs[~cloud].mean(axis=0)}")
+    check(0.85 < b / a < 1.15, f"Cycles' cloud within 15% of atlas preview --reference: {b / a:.3f}")
+    rgb = theirs[cloud].mean(axis=0)
+    check(rgb.min() > 0.8 * rgb.max(), f"white, not tinted: {rgb}")
+
+
 for s in (install_and_enable, open_and_cook, volume_object, same_voxels_as_the_cli, incremental_recook, bad_input,
           background_thread_and_cancel, ndf_as_image, render_small_picture, spheres_as_objects,
-          mesh_from_a_blender_object):
+          mesh_from_a_blender_object, cycles_draws_what_atlas_previews):
     step(s)
 
 print(f"{passed} passed, {failed} failed")
