@@ -8,6 +8,7 @@
 // against select_indices: Bc1Eval.Avx2EqualsSelectIndices.
 #pragma once
 
+#include "simd_choice.h"
 #include "bc1_palette.h"
 #include "palette_search.h"
 
@@ -31,7 +32,7 @@ struct Bc1Planes {
 };
 
 #if defined(ATLAS_BC1_AVX2)
-inline bool bc1_cpu_has_avx2() { return __builtin_cpu_supports("avx2") != 0; }
+inline bool bc1_cpu_has_avx2() { return !simd_env_forbids_avx2() && __builtin_cpu_supports("avx2") != 0; }
 
 template <bool OneSided>
 __attribute__((target("avx2"))) inline Selection bc1_select_avx2(const Bc1PaletteCm& p, const Bc1Planes& s, float stop_above, float budget = -1.0f,

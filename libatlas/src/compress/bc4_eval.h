@@ -14,6 +14,7 @@
 // keys and sums (test Bc4Eval.Sse2EqualsPortable).
 #pragma once
 
+#include "simd_choice.h"
 #include "atlas/compress/decoder_model.h"
 #include "palette_search.h"
 
@@ -415,7 +416,7 @@ __attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, 
     bits = uint64_t(half[0]) | (uint64_t(half[1]) << 24);
 }
 
-inline bool bc4_cpu_has_avx2() { return __builtin_cpu_supports("avx2") != 0; }
+inline bool bc4_cpu_has_avx2() { return !simd_env_forbids_avx2() && __builtin_cpu_supports("avx2") != 0; }
 #else
 inline bool bc4_cpu_has_avx2() { return false; }
 #endif
