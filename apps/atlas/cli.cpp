@@ -2,6 +2,7 @@
 
 #include "atlas/compress/compress_options.h"
 #include "atlas/compress/texture.h"
+#include "atlas/graph/evaluator.h"
 #include "atlas/graph/graph.h"
 #include "atlas/render/preview_options.h"
 #include "atlas/render/renderer.h"
@@ -167,6 +168,18 @@ std::string general_help() {
     out << "\nrun 'atlas COMMAND --help' for a command's options. Messages and progress go to\n"
         << "stderr; stdout carries only data. Exit status: 0 ok, 1 error, 2 usage, 130 cancelled.\n";
     return out.str();
+}
+
+void apply_sets(Session& s, const Args& a, const std::string& cmd, std::set<std::string>* matched) {
+    for (const auto& kv : a.all("--set")) {
+        auto eq = kv.find('=');
+        auto dot = kv.find('.');
+        if (eq == std::string::npos || dot == std::string::npos || dot > eq)
+            throw UsageError{"--set expects NODE.PARAM=VALUE, got '" + kv + "'", cmd};
+        if (matched && !s.graph().find(kv.substr(0, dot))) continue;
+        s.set_text(kv.substr(0, dot), kv.substr(dot + 1, eq - dot - 1), kv.substr(eq + 1));
+        if (matched) matched->insert(kv);
+    }
 }
 
 } // namespace atlas::cli

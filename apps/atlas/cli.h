@@ -6,9 +6,14 @@
 
 #include <functional>
 #include <map>
+#include <set>
 #include <span>
 #include <string>
 #include <vector>
+
+namespace atlas {
+class Session;
+}
 
 namespace atlas::cli {
 
@@ -50,6 +55,11 @@ struct UsageError {
 };
 
 const std::vector<Command>& commands();
+
+// Applies every --set NODE.PARAM=VALUE of `a` to the session (`cmd` names the command in a usage
+// error). With several graphs (`matched` given), a --set applies to the graphs that have its node,
+// and the caller checks that each one matched some graph.
+void apply_sets(Session& s, const Args& a, const std::string& cmd, std::set<std::string>* matched = nullptr);
 Args parse_args(const Command& cmd, const std::vector<std::string>& argv);
 std::string command_help(const Command& cmd);
 std::string general_help();

@@ -17,20 +17,6 @@
 namespace atlas::cli {
 
 namespace {
-// With several graphs (`matched` given), a --set applies to the graphs that
-// have its node; the caller checks that each one matched some graph.
-void apply_sets(Session& s, const Args& a, const std::string& cmd, std::set<std::string>* matched = nullptr) {
-    for (const auto& kv : a.all("--set")) {
-        auto eq = kv.find('=');
-        auto dot = kv.find('.');
-        if (eq == std::string::npos || dot == std::string::npos || dot > eq)
-            throw UsageError{"--set expects NODE.PARAM=VALUE, got '" + kv + "'", cmd};
-        if (matched && !s.graph().find(kv.substr(0, dot))) continue;
-        s.set_text(kv.substr(0, dot), kv.substr(dot + 1, eq - dot - 1), kv.substr(eq + 1));
-        if (matched) matched->insert(kv);
-    }
-}
-
 std::string one_graph(const Args& a, const std::string& cmd) {
     if (a.positional.size() != 1) throw UsageError{"expected one graph file, got " + std::to_string(a.positional.size()), cmd};
     return a.positional[0];

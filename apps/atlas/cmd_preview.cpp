@@ -10,8 +10,6 @@
 #include "atlas/graph/evaluator.h"
 #include "atlas/io/exr.h"
 #include "atlas/io/image.h"
-#include "atlas/io/readers.h"
-#include "atlas/ndf/cone_map.h"
 #include "atlas/preview/graph_preview.h"
 #include "atlas/render/image_out.h"
 #include "atlas/render/layer.h"
@@ -25,12 +23,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
-#include <limits>
 #include <memory>
 #include <thread>
-#include <optional>
 #include <sstream>
-#include <variant>
 
 namespace atlas::cli {
 
@@ -56,16 +51,6 @@ std::vector<double> numbers(const std::string& text, size_t count, const std::st
 bool is_graph(const std::string& f) {
     auto ext = std::filesystem::path(f).extension().string();
     return ext == ".yaml" || ext == ".yml" || ext == ".atlas";
-}
-
-void apply_sets(Session& s, const Args& a) {
-    for (const auto& kv : a.all("--set")) {
-        auto eq = kv.find('=');
-        auto dot = kv.find('.');
-        if (eq == std::string::npos || dot == std::string::npos || dot > eq)
-            throw UsageError{"--set expects NODE.PARAM=VALUE, got '" + kv + "'", "preview"};
-        s.set_text(kv.substr(0, dot), kv.substr(dot + 1, eq - dot - 1), kv.substr(eq + 1));
-    }
 }
 
 // Writes into `staged` (a temporary path); the caller moves it into place.
@@ -172,7 +157,7 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
     if (from_graph) {
         if (!session) session = std::make_unique<Session>(builtin_nodes());
         session->load(a.positional[0]);
-        apply_sets(*session, a);
+        apply_sets(*session, a, "preview");
         prepared = preview::prepare_graph_preview(*session, po, how, a.positional[0]);
     } else {
         std::vector<std::filesystem::path> files(a.positional.begin(), a.positional.end());

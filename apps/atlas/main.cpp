@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
             std::cout << general_help();
             return args.empty() ? 2 : 0;
         }
-        if (args[0] == "--version") { std::cout << "atlas 0.1.0\n"; return 0; }
+        if (args[0] == "--version") { std::cout << "atlas " ATLAS_VERSION_STRING "\n"; return 0; }
         for (const auto& c : commands()) {
             if (c.name != args[0]) continue;
             Args parsed = parse_args(c, {args.begin() + 1, args.end()});

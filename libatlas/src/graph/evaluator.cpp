@@ -26,10 +26,6 @@ namespace atlas {
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // Prefixes an error with the node it came from (unless it already names it)
 // and the node's place in the graph file (file:line:col), keeping its type.
 [[noreturn]] void rethrow_for_node(const std::string& name, const std::string& type, const std::string& where, std::exception_ptr ep) {

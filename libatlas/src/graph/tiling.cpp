@@ -1,5 +1,6 @@
 // Tiled cooking (atlas/graph/tiling.h, docs/scale.md): regions per node,
 // crops, tile files, fragments, the tile index and assembly.
+#include "atlas/core/progress.h"
 #include "atlas/graph/tiling.h"
 #include "graph_walk.h"
 
@@ -280,10 +281,6 @@ Grid grid_from_json(const json& j) {
     g.hi = {{j.at("bounds_max")[0].get<double>(), j.at("bounds_max")[1].get<double>()}};
     g.from = "the tile fragments";
     return g;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 double cpu_seconds() {

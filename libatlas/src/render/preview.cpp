@@ -350,10 +350,6 @@ void density_grid_units(CloudScene& scene, const PreviewOptions& o, std::vector<
     }
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 // Lightning over the layer: flashes placed by the set's storm (or rain, or coverage) channel,
 // 20-60 % up the columns that can flash (in-cloud flashes).
 Field3DPtr layer_lightning_probability(const Field2D& set) {

@@ -1,4 +1,5 @@
 // The cloud-growth Simulation: sounding, sources, forces, stepping (see simulation.h).
+#include "atlas/core/progress.h"
 #include "atlas/sim/simulation.h"
 #include "atlas/sim/sounding_options.h"
 
@@ -19,7 +20,6 @@ namespace atlas::sim {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 
 void check_range(double v, double lo, double hi, const char* what) {

@@ -7,10 +7,16 @@
 // thread-safe; Atlas serialises nothing for them.
 #pragma once
 
+#include <chrono>
 #include <functional>
 #include <string>
 
 namespace atlas {
+
+// Wall seconds since t0 (the figures reports and progress print).
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 struct ProgressEvent {
     std::string task;     // what is running, e.g. "node 'clouds'"
