@@ -326,6 +326,24 @@ std::string option_text(const py::handle& v) {
     return py::str(v).cast<std::string>();
 }
 
+// A host's dict of preview options ({"size": (640, 360), ...}) as PreviewOptions.
+render::PreviewOptions preview_options_from(const py::object& options) {
+    render::PreviewOptions po;
+    std::vector<std::pair<std::string, std::string>> settings;
+    if (!options.is_none())
+        for (const auto& item : options.cast<py::dict>()) settings.emplace_back(py::str(item.first).cast<std::string>(), option_text(item.second));
+    preview::set_preview_options(po, settings);
+    return po;
+}
+
+preview::GraphPreviewOptions preview_how(int proxy, const std::string& mode, const std::string& noise) {
+    preview::GraphPreviewOptions how;
+    how.proxy = proxy;
+    how.mode = mode;
+    how.noise = noise;
+    return how;
+}
+
 // A picture as a NumPy array, rows from the top: float32 (h, w, channels).
 py::array_t<float> image_to_numpy(const Field2D& img) {
     const int w = img.width(), h = img.height(), nc = img.channels();
@@ -436,16 +454,9 @@ grid at 1/P of its cells per axis (values only: a proxy cook never writes output
         .def("preview", [](PySession& ps, const py::object& options, int proxy, int jobs, const py::object& cache_dir, const std::string& mode,
                            const std::string& noise, bool tone_mapped, const py::object& progress, const py::object& cancel) {
                  BusyGuard guard(ps);
-                 render::PreviewOptions po;
-                 std::vector<std::pair<std::string, std::string>> settings;
-                 if (!options.is_none())
-                     for (const auto& item : options.cast<py::dict>()) settings.emplace_back(py::str(item.first).cast<std::string>(), option_text(item.second));
-                 preview::set_preview_options(po, settings);
-                 preview::GraphPreviewOptions how;
+                 const render::PreviewOptions po = preview_options_from(options);
+                 preview::GraphPreviewOptions how = preview_how(proxy, mode, noise);
                  how.jobs = jobs;
-                 how.proxy = proxy;
-                 how.mode = mode;
-                 how.noise = noise;
                  if (!cache_dir.is_none()) how.cache_dir = std::filesystem::path(py::str(cache_dir).cast<std::string>());
                  how.progress = make_sink(progress, cancel);
                  std::optional<render::PreviewFrame> f;
@@ -467,15 +478,8 @@ interaction). Returns a float32 NumPy array (height, width, 4) of linear radianc
 transmittance, rows from the top; tone_mapped=True: the PNG's sRGB values in 0..1 (height, width, 3).)doc")
         .def("preview_settings", [](PySession& ps, const py::object& options, int proxy, const std::string& mode, const std::string& noise) {
                  BusyGuard guard(ps);
-                 render::PreviewOptions po;
-                 std::vector<std::pair<std::string, std::string>> settings;
-                 if (!options.is_none())
-                     for (const auto& item : options.cast<py::dict>()) settings.emplace_back(py::str(item.first).cast<std::string>(), option_text(item.second));
-                 preview::set_preview_options(po, settings);
-                 preview::GraphPreviewOptions how;
-                 how.proxy = proxy;
-                 how.mode = mode;
-                 how.noise = noise;
+                 const render::PreviewOptions po = preview_options_from(options);
+                 const preview::GraphPreviewOptions how = preview_how(proxy, mode, noise);
                  std::optional<preview::GraphPreview> p;
                  {
                      py::gil_scoped_release nogil;
