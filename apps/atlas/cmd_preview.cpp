@@ -247,7 +247,7 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
             } else if (have_layer) {
                 s.camera = render::layer_camera(*job.layer, render::LayerView::Orbit, double(w) / h, 30 + 360.0 * i / frames, po.elevation);
             } else {
-                s.camera = render::framing_camera(have_voxel && is_graph(a.positional[0]) ? render::cloud_bounds(*job.voxel) : bounds, double(w) / h,
+                s.camera = render::framing_camera(have_voxel && from_graph ? render::cloud_bounds(*job.voxel) : bounds, double(w) / h,
                                                   30 + 360.0 * i / frames);
             }
             Field2D image = render_frame();

@@ -21,6 +21,7 @@ bl_info = {
     "category": "Import-Export",
 }
 
+import math
 import os
 import shutil
 import sys
@@ -563,14 +564,11 @@ def nubis_material(vol, extinction=0.04, g=0.33):
         a_.attribute_name = name
         return a_.outputs["Fac"]
 
-    def math(op, x, y=None, value=None):
+    def node_math(op, x, y):
         m = nt.nodes.new("ShaderNodeMath")
         m.operation = op
         for i, v in enumerate((x, y)):
-            if v is None:
-                if i == 1 and value is not None:
-                    m.inputs[1].default_value = value
-            elif isinstance(v, (int, float)):
+            if isinstance(v, (int, float)):
                 m.inputs[i].default_value = v
             else:
                 nt.links.new(v, m.inputs[i])
@@ -581,15 +579,15 @@ def nubis_material(vol, extinction=0.04, g=0.33):
     scatter.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     scatter.inputs["Anisotropy"].default_value = g
     profile = "dimensional_profile" if "dimensional_profile" in names else sorted(names)[0] if names else "density"
-    density = math("MAXIMUM", math("MINIMUM", attr(profile), 1.0), 0.0)
+    density = node_math("MAXIMUM", node_math("MINIMUM", attr(profile), 1.0), 0.0)
     if "density_scale" in names:
-        scale = math("MAXIMUM", attr("density_scale"), 0.0)
-        d = math("MULTIPLY", density, scale)
-        s4 = math("POWER", math("MINIMUM", scale, 1.0), 4.0)
-        density = math("POWER", d, math("ADD", math("MULTIPLY", s4, 0.3), 0.3))
+        scale = node_math("MAXIMUM", attr("density_scale"), 0.0)
+        d = node_math("MULTIPLY", density, scale)
+        s4 = node_math("POWER", node_math("MINIMUM", scale, 1.0), 4.0)
+        density = node_math("POWER", d, node_math("ADD", node_math("MULTIPLY", s4, 0.3), 0.3))
     if "sdf" in names:
-        density = math("MULTIPLY", density, math("LESS_THAN", attr("sdf"), 0.0))
-    nt.links.new(math("MULTIPLY", density, extinction), scatter.inputs["Density"])
+        density = node_math("MULTIPLY", density, node_math("LESS_THAN", attr("sdf"), 0.0))
+    nt.links.new(node_math("MULTIPLY", density, extinction), scatter.inputs["Density"])
     nt.links.new(scatter.outputs["Volume"], out.inputs["Volume"])
     return mat
 
@@ -610,7 +608,7 @@ def setup_camera_and_light(scene):
         scene.collection.objects.link(cam)
     cam.data.sensor_fit = "VERTICAL"
     cam.data.sensor_height = 24.0
-    cam.data.lens = 0.5 * 24.0 / math_tan_deg(0.5 * c["fov_y_deg"])
+    cam.data.lens = 0.5 * 24.0 / math.tan(math.radians(0.5 * c["fov_y_deg"]))
     cam.data.clip_start, cam.data.clip_end = 0.05, 1e7
     pos, look = Vector(c["position"]), Vector(c["look_at"])
     cam.location = pos
@@ -656,12 +654,6 @@ def setup_camera_and_light(scene):
         if vol.name.startswith("atlas_") and vol.materials:
             nubis_material(vol, st["extinction_per_metre"], g)
     return cam, sun
-
-
-def math_tan_deg(deg):
-    import math
-
-    return math.tan(math.radians(deg))
 
 
 # ---------------------------------------------------------------- operators and panel
@@ -931,8 +923,8 @@ def _object_geometry(obj):
     return verts, tris, radius
 
 
-def _write_object_file(obj, path, kind):
-    verts, tris, radius = _object_geometry(obj)
+def _write_object_file(obj, geometry, path, kind):
+    verts, tris, radius = geometry
     with open(path + ".tmp", "w") as f:
         if kind == "obj":
             f.writelines(f"v {x:.6g} {y:.6g} {z:.6g}\n" for x, y, z in verts)
@@ -951,8 +943,8 @@ def bind_object(scene, obj, node, param):
     return sync_object_files(scene)
 
 
-def _signature(obj):
-    verts, tris, radius = _object_geometry(obj)
+def _signature(geometry):
+    verts, tris, radius = geometry
     return repr((len(verts), len(tris), [round(c, 4) for v in verts[:64] for c in v], round(sum(sum(v) for v in verts), 3),
                  None if radius is None else round(sum(radius), 3)))
 
@@ -973,12 +965,13 @@ def sync_object_files(scene):
         kind = _OBJECT_FILE_NODES.get(item.node_type) if item is not None else None
         if kind is None:
             continue
-        sig = _signature(obj)
+        geometry = _object_geometry(obj)  # evaluated once: compared, then written when it changed
+        sig = _signature(geometry)
         if obj.get("atlas_signature") == sig:
             continue
         obj["atlas_signature"] = sig
         path = os.path.join(_scratch_dir(scene), f"{node}.{param}.{_next_serial(scene)}.{kind}")
-        _write_object_file(obj, path, kind)
+        _write_object_file(obj, geometry, path, kind)
         old = item.s
         item.s = path  # the update re-cooks the view, or shows the library's message
         if old.startswith(_scratch_dir(scene)) and old != path and os.path.exists(old):
