@@ -36,7 +36,10 @@ PACKAGES=(
   python3-matplotlib
   # docs/images/architecture.svg (scripts/module_graph.py | dot): the module dependency picture.
   graphviz
+  chromium
 )
+# atlas view's page (plugins/web) is bundled from npm packages; Node.js >= 18 builds it.
+command -v npm >/dev/null || PACKAGES+=(nodejs npm)
 # `scripts/setup.sh --bench`: also the peers the benchmarks compare against (not needed by CI):
 # OpenVDB's vdb_tool and vdb_render (mesh SDF, voxel preview) and nvcompress (BC encoders).
 case "${1:-}" in

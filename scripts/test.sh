@@ -13,6 +13,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
+bash scripts/web.sh
 
 if [ "${ATLAS_TEST_BUILD:-sanitized}" = "release" ]; then
   echo "== Release build (GCC) and the whole test suite" >&2

@@ -107,6 +107,15 @@ const std::vector<Command>& commands() {
           {"--export-scene", "DIR", "also write DIR/density.vdb and DIR/scene.json for scripts/cycles_reference.py (Blender Cycles)"},
           {"--quiet", "", "no progress bar or summary"}}),
          run_preview},
+        {"view", "GRAPH [-o DIR] [options]",
+         "write the graph's 2.5D cloudscape (its NDF set) as a page @takram/three-clouds draws in real time, and open it (docs/web.md)",
+         with_preview_flags({{"--out", "DIR", "the page's folder (also -o; default GRAPH_view beside the working directory)"}}, {
+          {"--no-open", "", "write the page, do not open a browser"},
+          {"--cache", "DIR", "on-disk cache of node results (as atlas cook)"},
+          {"--no-cache", "", "do not use ATLAS_CACHE_DIR"},
+          {"--set", "NODE.PARAM=VALUE", "override a parameter before cooking (as atlas cook); repeatable", true},
+          {"--quiet", "", "no progress bar or summary"}}),
+         run_view},
     };
     return table;
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "atlas/core/option_schema.h"
+#include "atlas/render/preview_options.h"
 
 #include <functional>
 #include <map>
@@ -95,6 +96,11 @@ int run_nodes(const Args&);
 int run_options(const Args&);
 int run_info(const Args&);
 int run_preview(const Args&);
+int run_view(const Args&);
+
+// The preview's render flags (--size, --camera, --sun, ...), checked; errors name
+// `command` (cmd_preview.cpp).
+render::PreviewOptions read_preview_flags(const Args& a, const char* command);
 int run_compress(const Args&);
 int run_decompress(const Args&);
 

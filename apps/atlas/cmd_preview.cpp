@@ -72,37 +72,33 @@ void write_picture_atomic(const Field2D& image, const std::filesystem::path& pat
 
 } // namespace
 
-namespace {
-
 // The preview's render flags: the schema's (render::preview_options) and the
 // spellings that set several of its options (--sun AZ,EL, --camera, --view, ...),
 // parsed by the schema as the render/preview node's parameters are.
-render::PreviewOptions read_preview_flags(const Args& a) {
+render::PreviewOptions read_preview_flags(const Args& a, const char* command) {
     render::PreviewOptions o;
     const auto schema = render::preview_options();
-    read_schema_flags(a, schema, o, "preview");
+    read_schema_flags(a, schema, o, command);
     for (const render::OptionSpelling& sp : render::preview_cli_spellings()) {
         if (!a.has(sp.cli_flag)) continue;
         const std::string text = a.get(sp.cli_flag);
         std::vector<std::pair<std::string, std::string>> parts;
-        if (!sp.expand(text, parts)) throw UsageError{std::string(sp.cli_flag) + " expects " + sp.metavar + ", got '" + text + "'", "preview"};
+        if (!sp.expand(text, parts)) throw UsageError{std::string(sp.cli_flag) + " expects " + sp.metavar + ", got '" + text + "'", command};
         for (const auto& [name, value] : parts) {
             const TextOption<render::PreviewOptions>* opt = find_option(schema, name);
             if (!opt || !set_text_option(*opt, value, o))
                 throw UsageError{std::string(sp.cli_flag) + " expects " + sp.metavar + " with " + name + " " + (opt ? opt->expected() : "?") + ", got '" +
                                      text + "'",
-                                 "preview"};
+                                 command};
         }
     }
     try {
         render::check_preview_options(o);
     } catch (const Error& e) {
-        throw UsageError{e.what(), "preview"};
+        throw UsageError{e.what(), command};
     }
     return o;
 }
-
-} // namespace
 
 // One preview: cook, render, write. `depends` receives the files a --watch
 // loop polls (the graph file and every file the cook read). `session` is kept
@@ -116,7 +112,7 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
         jobs = static_cast<int>(numbers(a.get("--jobs"), 1, "--jobs")[0]);
         if (jobs < 1 || jobs > 1024) throw UsageError{"--jobs expects a number of threads >= 1", "preview"};
     }
-    const render::PreviewOptions po = read_preview_flags(a);
+    const render::PreviewOptions po = read_preview_flags(a, "preview");
     const int w = po.size[0], h = po.size[1];
     std::string mode = a.has("--mode") ? a.get("--mode") : "auto";
     if (mode != "auto" && mode != "layer" && mode != "voxel") throw UsageError{"--mode expects layer or voxel, got '" + mode + "'", "preview"};
