@@ -162,11 +162,14 @@ WebViewResult write_web_view(const GraphPreview& preview, const render::PreviewO
 
 fs::path find_web_bundle(const fs::path& exe_dir) {
     std::vector<fs::path> tried;
-    if (const char* env = std::getenv("ATLAS_WEB_DIR"); env && *env) tried.emplace_back(env);
-    if (!exe_dir.empty()) tried.push_back(exe_dir / ".." / "share" / "atlas" / "web");
+    if (const char* env = std::getenv("ATLAS_WEB_DIR"); env && *env) {
+        tried.emplace_back(env); // asked for: that one only
+    } else {
+        if (!exe_dir.empty()) tried.push_back(exe_dir / ".." / "share" / "atlas" / "web");
 #ifdef ATLAS_WEB_DIST
-    tried.emplace_back(ATLAS_WEB_DIST);
+        tried.emplace_back(ATLAS_WEB_DIST);
 #endif
+    }
     std::string where;
     for (const fs::path& d : tried) {
         if (fs::is_regular_file(d / "atlas_view.js") && fs::is_regular_file(d / "atmosphere.js")) return d;

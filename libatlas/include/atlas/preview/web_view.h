@@ -43,8 +43,9 @@ struct WebViewResult {
 WebViewResult write_web_view(const GraphPreview& preview, const render::PreviewOptions& options,
                              const std::filesystem::path& out_dir, const WebViewOptions& how);
 
-// Where the built page is: $ATLAS_WEB_DIR, else `exe_dir`/../share/atlas/web, else the
-// source tree's plugins/web/dist. Throws atlas::Error saying how to build it.
+// Where the built page is: $ATLAS_WEB_DIR when set (only there), else
+// `exe_dir`/../share/atlas/web, else the source tree's plugins/web/dist. Throws
+// atlas::Error naming where it looked and how to build it.
 std::filesystem::path find_web_bundle(const std::filesystem::path& exe_dir);
 
 } // namespace atlas::preview
