@@ -96,6 +96,14 @@ def main():
     with tempfile.TemporaryDirectory(prefix="atlas-web-") as tmp:
         work = pathlib.Path(tmp)
 
+        # Bad input: clear messages, nothing written.
+        for env, graph, expect in (({"ATLAS_WEB_DIR": str(work / "nowhere")}, "graphs/hzd_weather.yaml", "scripts/web.sh"),
+                                   ({}, "graphs/nubis_noise.yaml", "no NDF set")):
+            r = subprocess.run([ATLAS, "view", str(SRC / graph), "-o", str(work / "refused"), "--no-open", "--quiet"],
+                               env={**os.environ, **env}, capture_output=True, text=True)
+            if r.returncode != 1 or expect not in r.stderr or (work / "refused").exists():
+                failures.append(f"atlas view {graph} {env}: expected status 1 saying '{expect}', nothing written; got {r.returncode}: {r.stderr.strip()}")
+
         # Coverage pattern, from above.
         t, a = both(work, "top", SRC / "graphs/hzd_weather.yaml", "30000,29990,30000,30000,30000,0", 60)
         raw, smooth = corr(t, a), corr(box(t, 5), box(a, 5))
