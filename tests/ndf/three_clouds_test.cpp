@@ -151,6 +151,18 @@ TEST(ThreeClouds, ShapeIsTheEqualisedDilatedBase) {
     EXPECT_NEAR(d.channel(0)[3], n.channel(0)[3] * 0.625 + n.channel(1)[3] * 0.25 + n.channel(2)[3] * 0.125, 1e-6);
 }
 
+TEST(ThreeClouds, AWeatherMapWithoutTypesIsStratus) {
+    // A 2.5D preview's weather map as a set: coverage and heights only.
+    Field2D m({{2, 1}}, 3, {{{0, 0}}, {{200, 100}}}, {"coverage", "min_height", "max_height"}, nullptr);
+    m.at(0, 0, 0) = 0.6f, m.at(1, 0, 0) = 1500, m.at(2, 0, 0) = 4000;
+    m.at(0, 1, 0) = 0.0f, m.at(1, 1, 0) = 1500, m.at(2, 1, 0) = 4000;
+    const ThreeCloudsWeather w = three_clouds_weather(m, default_lut(), nullptr);
+    EXPECT_FLOAT_EQ(w.weather.at(0, 0, 0), 0.6f);
+    EXPECT_EQ(w.weather.at(1, 0, 0), 0.0f);
+    EXPECT_TRUE(w.layers[0].used);
+    EXPECT_FALSE(w.layers[2].used);
+}
+
 TEST(ThreeClouds, BadInputIsRefusedByName) {
     const Field2D lut = default_lut();
     Field2D empty = set_with({{0.0f, 0.5f}});
@@ -160,7 +172,7 @@ TEST(ThreeClouds, BadInputIsRefusedByName) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("no cloud"), std::string::npos) << e.what();
     }
-    EXPECT_THROW(three_clouds_weather(lut, lut, nullptr), Error);                         // not an NDF set
+    EXPECT_THROW(three_clouds_weather(lut, lut, nullptr), Error);                         // no coverage channel
     EXPECT_THROW(three_clouds_weather(set_with({{1.0f, 0.5f}}), set_with({{1.0f, 0.5f}}), nullptr), Error); // not a LUT
     Field3D two({{4, 4, 4}}, 2, {{{0, 0, 0}}, {{1, 1, 1}}}, {}, nullptr);
     EXPECT_THROW(three_clouds_shape(two, nullptr), Error);

@@ -3,7 +3,6 @@
 
 #include "atlas/core/error.h"
 #include "atlas/core/parallel.h"
-#include "atlas/ndf/ndf_set.h"
 #include "atlas/ndf/vertical_profile.h"
 
 #include <algorithm>
@@ -58,12 +57,20 @@ double three_clouds_bias_for_peak(double peak) {
 }
 
 ThreeCloudsWeather three_clouds_weather(const Field2D& set, const Field2D& profile_lut, const MemoryBudget* budget) {
-    check_ndf_set(set);
+    // Channels by name, as the 2.5D preview reads them: a weather map made a set
+    // (render::weather_map_as_set) has no top/bottom types.
+    const int ccov = set.find_channel("coverage"), clo = set.find_channel("min_height"), chi = set.find_channel("max_height"),
+              ctype = set.find_channel("type");
+    if (ccov < 0 || clo < 0 || chi < 0)
+        throw Error("three-clouds weather: expected an NDF set or weather map with channels coverage, min_height and max_height "
+                    "(type optional; ndf/set makes one)");
     const int cb = profile_lut.find_channel("bottom"), ct = profile_lut.find_channel("top");
     if (cb < 0 || ct < 0) throw Error("three-clouds weather: the profile LUT has no 'bottom' and 'top' channels (ndf/profile_lut)");
     std::array<ThreeCloudsLayer, 4> layers;
     double min_height = 0, max_height = 0, spread = 0;
-    auto cov = set.channel(Coverage), type = set.channel(Type), lo = set.channel(MinHeight), hi = set.channel(MaxHeight);
+    const auto cov = set.channel(ccov), lo = set.channel(clo), hi = set.channel(chi);
+    const std::vector<float> no_type(ctype < 0 ? cov.size() : 0, 0.0f);
+    const std::span<const float> type = ctype < 0 ? std::span<const float>(no_type) : set.channel(ctype);
     double w = 0, sum_lo = 0, sum_hi = 0;
     for (size_t i = 0; i < cov.size(); ++i) {
         if (!(cov[i] > 0) || !(hi[i] > lo[i])) continue;

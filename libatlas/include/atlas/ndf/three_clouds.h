@@ -58,8 +58,10 @@ struct ThreeCloudsWeather {
     double envelope_spread = 0;
 };
 
-// Throws on a non-NDF-set input, a profile LUT without bottom/top channels,
-// or a set with no covered texel whose max_height > min_height.
+// The set's channels are found by name: coverage, min_height, max_height
+// (type optional, 0 without). Throws when one of those is missing, on a
+// profile LUT without bottom/top channels, or a set with no covered texel
+// whose max_height > min_height.
 ThreeCloudsWeather three_clouds_weather(const Field2D& set, const Field2D& profile_lut, const MemoryBudget* budget);
 
 // The equalised dilated base shape of a 4-channel base noise (noise/hzd_set
