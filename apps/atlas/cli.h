@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -49,10 +50,13 @@ struct Command {
     std::function<int(const Args&)> run;
 };
 
-// Thrown for a bad command line; main prints it with the usage and exits 2.
-struct UsageError {
+// Thrown for a bad command line; main prints it with the usage and exits 2. A
+// std::exception, so code that catches those does not lose it; main and the
+// --watch loops catch it first.
+struct UsageError : std::runtime_error {
+    UsageError(std::string text, std::string cmd) : std::runtime_error(text), message(std::move(text)), command(std::move(cmd)) {}
     std::string message;
-    std::string command;
+    std::string command; // the subcommand whose --help to suggest ("" = the command list)
 };
 
 const std::vector<Command>& commands();

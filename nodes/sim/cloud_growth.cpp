@@ -2,7 +2,9 @@
 // returns cloud water as density, optional extra fields, and a frame sequence
 // for the 'vdb-sequence' output format. The node is a thin adapter: the
 // physics is in libatlas/sim (docs/solver.md).
+#include "atlas/sim/resample.h"
 #include "atlas/sim/simulation.h"
+#include "atlas/sim/sounding_options.h"
 #include "sim_params.h"
 
 #include <algorithm>
@@ -170,91 +172,14 @@ sim::SimOptions options_from(const CookContext& ctx, int nz, double dx) {
     return o;
 }
 
-// Channel `c` of `e` sampled at the grid's cell centres (world positions):
-// copied cell by cell when the cells line up, else trilinear; 0 outside it.
-// NaN/Inf is an error naming the input and channel.
-std::vector<float> on_grid_periodic(const Field3D& e, int c, const sim::GridSpec& s, const Vec3d& origin);
-
+// A field on the solver's grid (sim::resample_to_grid), its errors naming the input.
 std::vector<float> on_grid(const CookContext& ctx, const Field3D& e, int c, const sim::GridSpec& s, const Vec3d& origin,
                            const std::string& port) {
-    for (float v : e.channel(c))
-        if (!std::isfinite(v)) ctx.fail("input '" + port + "' channel '" + e.channel_name(c) + "' holds NaN/Inf; values must be finite");
-    if (s.periodic(0) || s.periodic(1)) return on_grid_periodic(e, c, s, origin);
-    std::vector<float> out(s.cells(), 0.f);
-    const Box3d& b = e.bounds();
-    bool aligned = true;
-    std::array<long, 3> off{};
-    for (int a = 0; a < 3; ++a) {
-        const double vs = e.voxel_size()[a], o = (b.min[a] - origin[a]) / s.dx;
-        off[size_t(a)] = std::lround(o);
-        aligned = aligned && std::fabs(vs - s.dx) <= 1e-9 * s.dx && std::fabs(o - double(off[size_t(a)])) <= 1e-6;
+    try {
+        return sim::resample_to_grid(e, c, s, origin);
+    } catch (const Error& err) {
+        ctx.fail("input '" + port + "' " + err.what());
     }
-    const Vec3i er = e.resolution();
-    size_t n = 0;
-    for (int k = 0; k < s.nz; ++k)
-        for (int j = 0; j < s.ny; ++j)
-            for (int i = 0; i < s.nx; ++i, ++n) {
-                if (aligned) {
-                    const long x = i - off[0], y = j - off[1], z = k - off[2];
-                    if (x < 0 || y < 0 || z < 0 || x >= er[0] || y >= er[1] || z >= er[2]) continue;
-                    out[n] = e.at(c, int(x), int(y), int(z));
-                    continue;
-                }
-                const Vec3d p{{origin[0] + (i + 0.5) * s.dx, origin[1] + (j + 0.5) * s.dx, origin[2] + (k + 0.5) * s.dx}};
-                bool inside = true;
-                for (int a = 0; a < 3; ++a) inside = inside && p[a] >= b.min[a] && p[a] <= b.max[a];
-                if (inside) out[n] = e.sample_world(c, p, WrapMode::Clamp);
-            }
-    return out;
-}
-
-// on_grid for a grid with periodic x and/or y: a cell also sees the field
-// through its periodic images (cell centre + m L along a periodic axis of
-// length L), the values of every image inside the field added (copied when
-// the cells line up, else trilinear), so a field reaching over a periodic face
-// wraps around.
-std::vector<float> on_grid_periodic(const Field3D& e, int c, const sim::GridSpec& s, const Vec3d& origin) {
-    std::vector<float> out(s.cells(), 0.f);
-    const Box3d& b = e.bounds();
-    const double L[3] = {s.nx * s.dx, s.ny * s.dx, s.nz * s.dx};
-    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    for (int a = 0; a < 2; ++a)
-        if (s.periodic(a)) {
-            // Images whose domain copy [origin + m L, origin + (m + 1) L] meets the field's box.
-            lo[a] = int(std::floor((b.min[a] - origin[a]) / L[a])) - 1;
-            hi[a] = int(std::ceil((b.max[a] - origin[a]) / L[a])) + 1;
-        }
-    bool aligned = true;
-    std::array<long, 3> off{};
-    for (int a = 0; a < 3; ++a) {
-        const double vs = e.voxel_size()[a], o = (b.min[a] - origin[a]) / s.dx;
-        off[size_t(a)] = std::lround(o);
-        aligned = aligned && std::fabs(vs - s.dx) <= 1e-9 * s.dx && std::fabs(o - double(off[size_t(a)])) <= 1e-6;
-    }
-    const Vec3i er = e.resolution();
-    const int n3[3] = {s.nx, s.ny, s.nz};
-    size_t n = 0;
-    for (int k = 0; k < s.nz; ++k)
-        for (int j = 0; j < s.ny; ++j)
-            for (int i = 0; i < s.nx; ++i, ++n) {
-                double sum = 0;
-                for (int my = lo[1]; my <= hi[1]; ++my)
-                    for (int mx = lo[0]; mx <= hi[0]; ++mx) {
-                        const int idx[3] = {i + mx * n3[0], j + my * n3[1], k};
-                        if (aligned) {
-                            const long x = idx[0] - off[0], y = idx[1] - off[1], z = idx[2] - off[2];
-                            if (x < 0 || y < 0 || z < 0 || x >= er[0] || y >= er[1] || z >= er[2]) continue;
-                            sum += e.at(c, int(x), int(y), int(z));
-                            continue;
-                        }
-                        const Vec3d p{{origin[0] + (idx[0] + 0.5) * s.dx, origin[1] + (idx[1] + 0.5) * s.dx, origin[2] + (k + 0.5) * s.dx}};
-                        bool inside = true;
-                        for (int a = 0; a < 3; ++a) inside = inside && p[a] >= b.min[a] && p[a] < b.max[a];
-                        if (inside) sum += e.sample_world(c, p, WrapMode::Clamp);
-                    }
-                out[n] = float(sum);
-            }
-    return out;
 }
 
 void apply_emitter(CookContext& ctx, sim::Simulation& sim, const Vec3d& origin) {
@@ -448,18 +373,9 @@ void cook(CookContext& ctx) {
                                           " B per cell with these options) and its outputs");
     ctx.metric("simulation_bytes", double(state));
 
-    sim::Sounding snd;
-    if (ctx.has_input("sounding")) snd = sim_nodes::sounding_from_record(ctx, *ctx.input_field2d("sounding"), "sounding");
-    else {
-        // The sim/sounding node's defaults, so an unconnected input means the same atmosphere.
-        snd.theta_lapse = 0.003;
-        snd.inversion_height = 2500;
-        snd.inversion_jump = 4;
-        snd.theta_lapse_above = 0.004;
-        snd.surface_rh = 0.85;
-        snd.rh_lapse = -1e-4;
-        snd.rh_above = 0.3;
-    }
+    // Unconnected: the sim/sounding node's defaults, so it means the same atmosphere.
+    const sim::Sounding snd = ctx.has_input("sounding") ? sim_nodes::sounding_from_record(ctx, *ctx.input_field2d("sounding"), "sounding")
+                                                        : sim::capped_boundary_layer_sounding();
     opt.validate(spec.nz);
     sim::Simulation sim(spec, snd, opt, &ctx.budget());
     if (ctx.has_input("emitter")) apply_emitter(ctx, sim, origin);

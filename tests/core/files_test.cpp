@@ -1,7 +1,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
 #include "atlas/core/hash.h"
-#include "../../libatlas/src/core/file_limits.h"
+#include "atlas/core/file_limits.h"
 
 #include <gtest/gtest.h>
 

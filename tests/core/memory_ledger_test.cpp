@@ -3,7 +3,7 @@
 // its own token counts once, the cache is asked to give room before a refusal,
 // and the high-water mark sees all of it. The expected totals are sums of the
 // sizes the test asks for.
-#include "../../libatlas/src/core/memory_ledger.h"
+#include "atlas/core/memory_ledger.h"
 
 #include "atlas/core/error.h"
 

@@ -1,6 +1,6 @@
 #include "atlas/core/files.h"
 #include "atlas/core/memory.h"
-#include "file_limits.h"
+#include "atlas/core/file_limits.h"
 
 #include "atlas/core/error.h"
 #include "atlas/core/hash.h"

@@ -1,5 +1,5 @@
 #include "atlas/core/memory.h"
-#include "memory_ledger.h"
+#include "atlas/core/memory_ledger.h"
 
 #include "atlas/core/error.h"
 

@@ -8,7 +8,7 @@
 #include "atlas/core/option_schema.h"
 #include "atlas/core/parallel.h"
 #include "atlas/io/writers.h"
-#include "../core/file_limits.h"
+#include "atlas/core/file_limits.h"
 #include "output_records.h"
 #include "value_cache.h"
 

@@ -1,5 +1,5 @@
 #include "atlas/graph/node.h"
-#include "../core/memory_ledger.h"
+#include "atlas/core/memory_ledger.h"
 
 #include "atlas/core/hash.h"
 

@@ -2,7 +2,7 @@
 #pragma once
 
 #include "atlas/core/hash.h"
-#include "../core/memory_ledger.h"
+#include "atlas/core/memory_ledger.h"
 #include "atlas/core/value.h"
 #include "atlas/graph/disk_cache.h"
 

@@ -6,6 +6,7 @@
 #include "atlas/core/field_math.h"
 #include "atlas/core/parallel.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -43,21 +44,32 @@ inline Taps taps(double u, int n, WrapMode wrap) {
 } // namespace
 
 Field2D domain_warp(const Field2D& in, const Field2D& warp, double amount, WrapMode wrap, const MemoryBudget* budget) {
+    return domain_warp(in, warp, amount, wrap, WarpWindow{in.bounds(), in.resolution(), 0, 0}, budget);
+}
+
+Field2D domain_warp(const Field2D& in, const Field2D& warp, double amount, WrapMode wrap, const WarpWindow& window, const MemoryBudget* budget) {
     if (warp.resolution() != in.resolution()) throw Error("warp: the 'warp' input must have the resolution of 'in'");
     if (!std::isfinite(amount)) throw Error("warp: 'amount' must be finite");
     Field2D out = like(in, budget);
     const int cy = warp.channels() > 1 ? 1 : 0;
     const int w = in.width(), h = in.height();
-    const Vec2d s = in.voxel_size();
-    const Vec2d lo = in.bounds().min;
+    // Positions and taps are the whole grid's; a tap is read from the window,
+    // clamped into it (for the whole grid a no-op).
+    const Vec2d lo = window.bounds.min;
+    const Vec2d s{{window.bounds.size()[0] / window.grid[0], window.bounds.size()[1] / window.grid[1]}};
+    const int x0 = window.x0, y0 = window.y0;
+    auto local = [](Taps t, int origin, int n) {
+        return Taps{std::clamp(t.i0 - origin, 0, n - 1), std::clamp(t.i1 - origin, 0, n - 1), t.t};
+    };
     const auto wx = warp.channel(0), wy = warp.channel(cy);
-    parallel_for_index(h, [&](int y) {
-        const double py = lo[1] + (y + 0.5) * s[1];
+    parallel_for_index(h, [&](int y) { // rows are independent: the same bytes for any thread count
+        const double py = lo[1] + (y0 + y + 0.5) * s[1];
         for (int x = 0; x < w; ++x) {
             const size_t i = in.index(x, y);
-            const double px = lo[0] + (x + 0.5) * s[0];
+            const double px = lo[0] + (x0 + x + 0.5) * s[0];
             const double qx = px + amount * (2.0 * wx[i] - 1.0), qy = py + amount * (2.0 * wy[i] - 1.0);
-            const Taps tx = taps((qx - lo[0]) / s[0], w, wrap), ty = taps((qy - lo[1]) / s[1], h, wrap);
+            const Taps tx = local(taps((qx - lo[0]) / s[0], window.grid[0], wrap), x0, w);
+            const Taps ty = local(taps((qy - lo[1]) / s[1], window.grid[1], wrap), y0, h);
             const size_t r0 = size_t(ty.i0) * size_t(w), r1 = size_t(ty.i1) * size_t(w);
             for (int c = 0; c < in.channels(); ++c) {
                 const float* ch = in.channel(c).data();

@@ -255,7 +255,7 @@ async function start() {
   const dither = ditherVolume()
   clouds.stbnTexture = dither
   aerialPerspective.stbnTexture = dither
-  status.textContent = scene.title ?? ''
+  status.textContent = (scene.title ?? '') + (still ? '' : ' | drag: orbit, right-drag: pan, wheel: zoom')
 
   let frame = 0
   renderer.setAnimationLoop(() => {

@@ -18,6 +18,18 @@ namespace atlas::ndf {
 // channel 0 again - offsets y); amount in metres. Wrap mode Wrap keeps a
 // tileable map tileable.
 Field2D domain_warp(const Field2D& in, const Field2D& warp, double amount, WrapMode wrap, const MemoryBudget* budget);
+// The same on a window of a larger grid (a tiled cook): `in` and `warp` hold
+// texels [x0, x0 + width) x [y0, y0 + height) of a `grid` of texels over
+// `bounds`. Positions and taps are the whole grid's (so the bytes equal the
+// whole map's there); a tap is then read from the window, clamped into it,
+// so only texels in a halo band wider than the offsets differ.
+struct WarpWindow {
+    Box2d bounds;
+    Vec2i grid;
+    int x0 = 0, y0 = 0;
+};
+Field2D domain_warp(const Field2D& in, const Field2D& warp, double amount, WrapMode wrap, const WarpWindow& window,
+                    const MemoryBudget* budget);
 
 // A monotone cubic (Fritsch-Carlson) spline through (x, y) control points
 // with strictly increasing x; constant beyond the ends. No overshoot between

@@ -1,4 +1,5 @@
-// Internal: limits on hash_file() (core/files.h) for the evaluator's thread.
+// atlas/core/file_limits.h - limits on hash_file() (core/files.h) for the evaluator's thread (graph);
+// hosts do not need it. Implemented in files.cpp, beside hash_file.
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,7 @@
-// Internal: the live total behind a MemoryBudget (issue 17 item 6).
+// atlas/core/memory_ledger.h - the live total behind a MemoryBudget (issue 17 item 6), for the
+// evaluator (graph) and its tests; hosts use Session and MemoryBudget, not this.
+//
+// Implemented in memory.cpp, beside MemoryBudget::check, which reads the attached ledger.
 //
 // A MemoryBudget alone checks each allocation against its limit. A session
 // keeps one MemoryLedger across cooks and attaches it to the cook's budget:
