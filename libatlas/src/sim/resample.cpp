@@ -10,6 +10,22 @@ namespace atlas::sim {
 
 namespace {
 
+// Whether the field's cells are the grid's, offset by whole cells (`off`):
+// then values are copied, not interpolated.
+struct Alignment {
+    bool aligned = true;
+    std::array<long, 3> off{};
+};
+Alignment alignment(const Field3D& e, const GridSpec& s, const Vec3d& origin) {
+    Alignment r;
+    for (int a = 0; a < 3; ++a) {
+        const double vs = e.voxel_size()[a], o = (e.bounds().min[a] - origin[a]) / s.dx;
+        r.off[size_t(a)] = std::lround(o);
+        r.aligned = r.aligned && std::fabs(vs - s.dx) <= 1e-9 * s.dx && std::fabs(o - double(r.off[size_t(a)])) <= 1e-6;
+    }
+    return r;
+}
+
 std::vector<float> on_grid_periodic(const Field3D& e, int c, const GridSpec& s, const Vec3d& origin);
 
 } // namespace
@@ -20,13 +36,7 @@ std::vector<float> resample_to_grid(const Field3D& e, int c, const GridSpec& s, 
     if (s.periodic(0) || s.periodic(1)) return on_grid_periodic(e, c, s, origin);
     std::vector<float> out(s.cells(), 0.f);
     const Box3d& b = e.bounds();
-    bool aligned = true;
-    std::array<long, 3> off{};
-    for (int a = 0; a < 3; ++a) {
-        const double vs = e.voxel_size()[a], o = (b.min[a] - origin[a]) / s.dx;
-        off[size_t(a)] = std::lround(o);
-        aligned = aligned && std::fabs(vs - s.dx) <= 1e-9 * s.dx && std::fabs(o - double(off[size_t(a)])) <= 1e-6;
-    }
+    const auto [aligned, off] = alignment(e, s, origin);
     const Vec3i er = e.resolution();
     size_t n = 0;
     for (int k = 0; k < s.nz; ++k)
@@ -60,13 +70,7 @@ std::vector<float> on_grid_periodic(const Field3D& e, int c, const GridSpec& s, 
             lo[a] = int(std::floor((b.min[a] - origin[a]) / L[a])) - 1;
             hi[a] = int(std::ceil((b.max[a] - origin[a]) / L[a])) + 1;
         }
-    bool aligned = true;
-    std::array<long, 3> off{};
-    for (int a = 0; a < 3; ++a) {
-        const double vs = e.voxel_size()[a], o = (b.min[a] - origin[a]) / s.dx;
-        off[size_t(a)] = std::lround(o);
-        aligned = aligned && std::fabs(vs - s.dx) <= 1e-9 * s.dx && std::fabs(o - double(off[size_t(a)])) <= 1e-6;
-    }
+    const auto [aligned, off] = alignment(e, s, origin);
     const Vec3i er = e.resolution();
     const int n3[3] = {s.nx, s.ny, s.nz};
     size_t n = 0;
