@@ -7,6 +7,7 @@
 #include "atlas/render/preview_options.h"
 #include "atlas/render/renderer.h"
 
+#include <cstdlib>
 #include <sstream>
 
 namespace atlas::cli {
@@ -189,6 +190,13 @@ void apply_sets(Session& s, const Args& a, const std::string& cmd, std::set<std:
         s.set_text(kv.substr(0, dot), kv.substr(dot + 1, eq - dot - 1), kv.substr(eq + 1));
         if (matched) matched->insert(kv);
     }
+}
+
+std::optional<std::filesystem::path> cache_dir_flag(const Args& a, const std::string& cmd) {
+    if (a.has("--cache") && a.has("--no-cache")) throw UsageError{"--cache and --no-cache contradict each other", cmd};
+    if (a.has("--cache")) return std::filesystem::path(a.get("--cache"));
+    if (const char* env = std::getenv("ATLAS_CACHE_DIR"); env && *env && !a.has("--no-cache")) return std::filesystem::path(env);
+    return std::nullopt;
 }
 
 } // namespace atlas::cli

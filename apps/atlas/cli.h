@@ -5,8 +5,10 @@
 #include "atlas/core/option_schema.h"
 #include "atlas/render/preview_options.h"
 
+#include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <span>
 #include <stdexcept>
@@ -65,6 +67,9 @@ const std::vector<Command>& commands();
 // error). With several graphs (`matched` given), a --set applies to the graphs that have its node,
 // and the caller checks that each one matched some graph.
 void apply_sets(Session& s, const Args& a, const std::string& cmd, std::set<std::string>* matched = nullptr);
+// The on-disk cache a command uses: --cache DIR, else $ATLAS_CACHE_DIR unless --no-cache;
+// none when neither. --cache with --no-cache is a usage error naming `cmd`.
+std::optional<std::filesystem::path> cache_dir_flag(const Args& a, const std::string& cmd);
 Args parse_args(const Command& cmd, const std::vector<std::string>& argv);
 std::string command_help(const Command& cmd);
 std::string general_help();

@@ -8,7 +8,6 @@
 #include "atlas/graph/tiling.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <set>
@@ -156,9 +155,7 @@ int run_cook(const Args& a) {
         if (o.jobs < 1 || o.jobs > 1024) throw UsageError{"--jobs expects a number of threads >= 1, got '" + a.get("--jobs") + "'", "cook"};
     }
     if (a.has("--memory-budget")) o.memory_budget = parse_byte_size(a.get("--memory-budget"));
-    if (a.has("--cache") && a.has("--no-cache")) throw UsageError{"--cache and --no-cache contradict each other", "cook"};
-    if (a.has("--cache")) o.cache_dir = a.get("--cache");
-    else if (const char* env = std::getenv("ATLAS_CACHE_DIR"); env && *env && !a.has("--no-cache")) o.cache_dir = env;
+    o.cache_dir = cache_dir_flag(a, "cook");
     if (a.has("--cache-max-size")) {
         if (!o.cache_dir) throw UsageError{"--cache-max-size needs a cache (--cache DIR or ATLAS_CACHE_DIR)", "cook"};
         o.cache_max_bytes = parse_byte_size(a.get("--cache-max-size"));

@@ -21,7 +21,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <thread>
@@ -121,14 +120,12 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
     ProgressSink sink = bar.sink();
     const auto t_start = std::chrono::steady_clock::now();
 
-    if (a.has("--cache") && a.has("--no-cache")) throw UsageError{"--cache and --no-cache contradict each other", "preview"};
     preview::GraphPreviewOptions how;
+    how.cache_dir = cache_dir_flag(a, "preview");
     how.jobs = jobs;
     how.progress = sink;
     how.mode = mode;
     how.noise = a.has("--noise") ? a.get("--noise") : "auto";
-    if (a.has("--cache")) how.cache_dir = a.get("--cache");
-    else if (const char* env = std::getenv("ATLAS_CACHE_DIR"); env && *env && !a.has("--no-cache")) how.cache_dir = env;
     if (a.has("--proxy")) {
         how.proxy = static_cast<int>(numbers(a.get("--proxy"), 1, "--proxy")[0]);
         if (how.proxy < 1 || how.proxy > 64) throw UsageError{"--proxy expects a factor 1..64 (4: a quarter of the cells per axis)", "preview"};

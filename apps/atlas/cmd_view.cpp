@@ -11,7 +11,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
-#include <memory>
 #include <spawn.h>
 
 extern char** environ;
@@ -28,8 +27,7 @@ int run_view(const Args& a) {
     preview::GraphPreviewOptions how;
     how.progress = bar.sink();
     how.mode = "layer";
-    if (a.has("--cache")) how.cache_dir = a.get("--cache");
-    else if (const char* env = std::getenv("ATLAS_CACHE_DIR"); env && *env && !a.has("--no-cache")) how.cache_dir = env;
+    how.cache_dir = cache_dir_flag(a, "view");
     std::error_code ec;
     const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
     preview::WebViewOptions web;

@@ -8,7 +8,6 @@
 #include "sim_params.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <sstream>

@@ -3,6 +3,7 @@
 
 #include "atlas/core/error.h"
 #include "atlas/core/parallel.h"
+#include "atlas/ndf/hzd_shape.h"
 #include "atlas/ndf/vertical_profile.h"
 
 #include <algorithm>
@@ -115,10 +116,7 @@ Field3D three_clouds_shape(const Field3D& base_noise, const MemoryBudget* budget
     auto r = base_noise.channel(0), g = base_noise.channel(1), b = base_noise.channel(2), a = base_noise.channel(3);
     std::vector<float> base(r.size());
     parallel_for_each(r.size(), 4096, [&](size_t i) {
-        // The preview's dilated base (render/layer_model.h): Perlin-Worley
-        // remapped from [-(1 - low_fbm), 1] to [0, 1].
-        const double low_fbm = g[i] * 0.625 + b[i] * 0.25 + a[i] * 0.125;
-        base[i] = float((r[i] + (1.0 - low_fbm)) / (2.0 - low_fbm));
+        base[i] = float(dilated_base(r[i], g[i], b[i], a[i])); // the 2.5D preview's base shape
     });
     std::vector<float> sorted = base;
     std::sort(sorted.begin(), sorted.end());
@@ -139,7 +137,7 @@ Field3D three_clouds_shape_detail(const Field3D& detail_noise, const MemoryBudge
     Field3D out(detail_noise.resolution(), 1, detail_noise.bounds(), {"detail"}, budget);
     const auto r = detail_noise.channel(0), g = detail_noise.channel(1), b = detail_noise.channel(2);
     auto d = out.channel(0);
-    parallel_for_each(d.size(), 4096, [&](size_t i) { d[i] = saturate(r[i] * 0.625 + g[i] * 0.25 + b[i] * 0.125); });
+    parallel_for_each(d.size(), 4096, [&](size_t i) { d[i] = saturate(worley_fbm(r[i], g[i], b[i])); });
     return out;
 }
 

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
@@ -24,6 +25,15 @@ namespace {
 // WGS84 equatorial radius: the scene sits at latitude 0, longitude 0.
 constexpr double kEquatorRadius = 6378137.0;
 constexpr int kShapeSize = 128, kDetailSize = 32; // three-clouds' CLOUD_SHAPE(_DETAIL)_TEXTURE_SIZE
+// The built page (plugins/web/dist), copied into every folder.
+constexpr std::array<const char*, 3> kBundleFiles{"index.html", "atlas_view.js", "atmosphere.js"};
+
+// The first page file `dir` lacks, or null when it holds them all.
+const char* missing_bundle_file(const fs::path& dir) {
+    for (const char* f : kBundleFiles)
+        if (!fs::is_regular_file(dir / f)) return f;
+    return nullptr;
+}
 
 std::string base64(const std::string& bytes) {
     static constexpr char k[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -68,9 +78,8 @@ WebViewResult write_web_view(const GraphPreview& preview, const render::PreviewO
     if (!preview.job.layer || !preview.job.layer->ndf)
         throw Error("atlas view: the graph writes no NDF set or weather map; three-clouds draws 2.5D cloud layers only "
                     "(voxel clouds: atlas preview)");
-    for (const char* f : {"index.html", "atlas_view.js", "atmosphere.js"})
-        if (!fs::is_regular_file(how.bundle_dir / f))
-            throw Error("atlas view: the page bundle " + (how.bundle_dir / f).string() + " is missing; build it with scripts/web.sh");
+    if (const char* f = missing_bundle_file(how.bundle_dir))
+        throw Error("atlas view: the page bundle " + (how.bundle_dir / f).string() + " is missing; build it with scripts/web.sh");
     const render::LayerScene& L = *preview.job.layer;
     if (!L.base_noise || !L.detail_noise || !L.curl) throw Error("atlas view: the preview has no base, detail or curl noise to export");
 
@@ -114,6 +123,12 @@ WebViewResult write_web_view(const GraphPreview& preview, const render::PreviewO
     // shape is sampled where Atlas samples its base noise.
     const double evolution = 2e4 * std::hypot(off_x, off_y);
     const double shape_rep = 1.0 / L.base_tile, detail_rep = 1.3 / L.detail_tile; // the preview's detail runs 1.3x the base's coordinates
+    // A volume stacked along the Earth-centred axes at the place (up, east, north;
+    // web_view.h) lines up with Atlas's noise when offset so: up by the Earth's
+    // radius less `up_shift`, east and north by the map centre.
+    auto stack_offset = [&](double rep, double up_shift) {
+        return vec({frac((up_shift - kEquatorRadius) * rep), frac(cx * rep), frac(cy * rep)});
+    };
     const render::Camera& cam = preview.job.settings.camera;
     json scene = {
         {"title", how.title},
@@ -126,11 +141,8 @@ WebViewResult write_web_view(const GraphPreview& preview, const render::PreviewO
         {"coverage", 0.5},
         {"layers", layers},
         {"weather", {{"repeat", vec({rep_x, rep_y})}, {"offset", vec({off_x, off_y})}}},
-        // Earth-centred axes at the place: up, east, north (web_view.h).
-        {"shape", {{"repeat", vec({shape_rep, shape_rep, shape_rep})},
-                   {"offset", vec({frac((evolution - kEquatorRadius) * shape_rep), frac(cx * shape_rep), frac(cy * shape_rep)})}}},
-        {"shape_detail", {{"repeat", vec({detail_rep, detail_rep, detail_rep})},
-                          {"offset", vec({frac(-kEquatorRadius * detail_rep), frac(cx * detail_rep), frac(cy * detail_rep)})}}},
+        {"shape", {{"repeat", vec({shape_rep, shape_rep, shape_rep})}, {"offset", stack_offset(shape_rep, evolution)}}},
+        {"shape_detail", {{"repeat", vec({detail_rep, detail_rep, detail_rep})}, {"offset", stack_offset(detail_rep, 0.0)}}},
         {"turbulence", {{"repeat", vec({size_x / L.curl_tile, size_y / L.curl_tile})}, {"displacement", L.curl_amount}}},
         {"envelope", {{"min_height", w.min_height}, {"max_height", w.max_height}, {"spread", w.envelope_spread}}},
     };
@@ -154,7 +166,7 @@ WebViewResult write_web_view(const GraphPreview& preview, const render::PreviewO
                          {"turbulence", "data:image/png;base64," + base64(read_file_bytes(turbulence_png))}};
     const std::string scene_js = "window.ATLAS_SCENE = " + scene.dump() + ";\n";
     write_file_checked(out.stage("scene.js"), scene_js.data(), scene_js.size());
-    for (const char* f : {"index.html", "atlas_view.js", "atmosphere.js"}) fs::copy_file(how.bundle_dir / f, out.stage(f));
+    for (const char* f : kBundleFiles) fs::copy_file(how.bundle_dir / f, out.stage(f));
     out.commit();
     result.index = out_dir / "index.html";
     return result;
@@ -172,7 +184,7 @@ fs::path find_web_bundle(const fs::path& exe_dir) {
     }
     std::string where;
     for (const fs::path& d : tried) {
-        if (fs::is_regular_file(d / "atlas_view.js") && fs::is_regular_file(d / "atmosphere.js")) return d;
+        if (!missing_bundle_file(d)) return d;
         where += (where.empty() ? "" : ", ") + d.string();
     }
     throw Error("atlas view: the web page is not built (looked in " + where +

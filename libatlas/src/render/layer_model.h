@@ -6,6 +6,7 @@
 #pragma once
 
 #include "atlas/core/error.h"
+#include "atlas/ndf/hzd_shape.h"
 #include "atlas/render/layer.h"
 #include "render_common.h"
 
@@ -334,16 +335,11 @@ public:
         auto r = n.channel(0), g = n.channel(std::min(1, c - 1)), b = n.channel(std::min(2, c - 1)), a = n.channel(std::min(3, c - 1));
         std::vector<float> v;
         const size_t stride = std::max<size_t>(1, r.size() / 65536);
-        for (size_t i = 0; i < r.size(); i += stride) v.push_back(float(dilated_base(r[i], g[i], b[i], a[i])));
+        for (size_t i = 0; i < r.size(); i += stride) v.push_back(float(ndf::dilated_base(r[i], g[i], b[i], a[i])));
         std::sort(v.begin(), v.end());
         for (int k = 0; k <= kQuantiles; ++k) quantile_[size_t(k)] = v[std::min(v.size() - 1, size_t(double(k) / kQuantiles * double(v.size() - 1) + 0.5))];
         equalised_ = true;
         base_max_ = quantile_[kQuantiles];
-    }
-    static double dilated_base(double r, double g, double b, double a) {
-        const double low_fbm = g * 0.625 + b * 0.25 + a * 0.125;
-        // Dilate the Perlin-Worley shape by the Worley FBM (GPU Pro 7).
-        return detail::remap_unclamped(r, -(1.0 - low_fbm), 1.0, 0.0, 1.0);
     }
     // The base value above which a fraction `coverage` of the texture lies.
     double coverage_threshold(double coverage) const {
@@ -392,7 +388,7 @@ public:
         if (base_.ok()) {
             float n[4];
             base_.sample(qx, qy, qz, n);
-            base = dilated_base(n[0], n[1], n[2], n[3]);
+            base = ndf::dilated_base(n[0], n[1], n[2], n[3]);
         }
         base *= profile;
         // Coverage grows the shape and scales its density: HZD's
@@ -415,7 +411,7 @@ public:
         }
         float n[4];
         detail_.sample(dx, dy, dz, n);
-        const double high_fbm = n[0] * 0.625 + n[1] * 0.25 + n[2] * 0.125;
+        const double high_fbm = ndf::worley_fbm(n[0], n[1], n[2]);
         // Wispy (FBM) at the base to billowy (inverted) above 10 % height.
         const double mod = high_fbm + ((1.0 - high_fbm) - high_fbm) * detail::saturate(f * 10.0);
         const double final_density = detail::saturate(detail::remap_unclamped(shaped, mod * s_.erosion, 1.0, 0.0, 1.0));

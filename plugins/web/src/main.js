@@ -69,10 +69,10 @@ function fail(message) {
   throw new Error(message)
 }
 
-function numbers(text, count, name) {
-  const v = text.split(',').map(Number)
+function numbers(text, count, name, separator = ',') {
+  const v = text.split(separator).map(Number)
   if (v.length !== count || v.some(x => !Number.isFinite(x))) {
-    fail(`URL parameter ${name}: expected ${count} numbers separated by ',', got '${text}'`)
+    fail(`URL parameter ${name}: expected ${count} numbers separated by '${separator}', got '${text}'`)
   }
   return v
 }
@@ -90,9 +90,9 @@ function toEcef([x, y, z]) {
 const cam = params.has('camera')
   ? numbers(params.get('camera'), 6, 'camera')
   : [...scene.camera.position, ...scene.camera.look_at]
-const fov = params.has('fov') ? Number(params.get('fov')) : scene.camera.fov
+const fov = params.has('fov') ? numbers(params.get('fov'), 1, 'fov')[0] : scene.camera.fov
 const [width, height] = params.has('size')
-  ? params.get('size').split('x').map(Number)
+  ? numbers(params.get('size'), 2, 'size', 'x')
   : [window.innerWidth, window.innerHeight]
 const output = params.get('output') ?? 'color'
 const still = params.get('still') === '1'
@@ -109,7 +109,7 @@ const renderer = new WebGLRenderer({ depth: false, preserveDrawingBuffer: true }
 renderer.setPixelRatio(still ? 1 : window.devicePixelRatio)
 renderer.setSize(width, height)
 renderer.toneMapping = NoToneMapping
-renderer.toneMappingExposure = scene.exposure ?? 10
+renderer.toneMappingExposure = 10 // three-clouds' examples' exposure for its physical radiance
 document.body.appendChild(renderer.domElement)
 
 let controls = null
@@ -125,7 +125,7 @@ aerialPerspective.sunLight = true
 aerialPerspective.skyLight = true
 
 const clouds = new CloudsEffect(camera)
-clouds.qualityPreset = scene.quality ?? 'high'
+clouds.qualityPreset = 'high'
 clouds.temporalUpscale = !still
 clouds.coverage = scene.coverage
 clouds.cloudLayers.set(scene.layers)
