@@ -91,13 +91,13 @@ def volume_object():
     grids = {g.name: g for g in obj.data.grids}
     check(set(grids) == {"dimensional_profile", "detail_type", "density_scale", "sdf"}, f"grids: {sorted(grids)}")
     m = grids["sdf"].matrix_object
-    # The field is 128x128x32 over [0, 4096] x [0, 4096] x [0, 512] m, cell-centred.
-    check([round(m[i][i], 4) for i in range(3)] == [32.0, 32.0, 16.0], f"voxel size {m}")
-    check([round(m[i][3], 4) for i in range(3)] == [16.0, 16.0, 8.0], f"first voxel centre {m}")
+    # The cumulus grid is 288x288x80 over [-256, 4352] x [-256, 4352] x [0, 1280] m, cell-centred.
+    check([round(m[i][i], 4) for i in range(3)] == [16.0, 16.0, 16.0], f"voxel size {m}")
+    check([round(m[i][3], 4) for i in range(3)] == [-248.0, -248.0, 8.0], f"first voxel centre {m}")
     ev = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
     lo = [min(v[i] for v in ev.bound_box) for i in range(3)]
     hi = [max(v[i] for v in ev.bound_box) for i in range(3)]
-    check(all(0 <= lo[i] < hi[i] <= (4096, 4096, 512)[i] for i in range(3)), f"bounds in metres {lo} {hi}")
+    check(all((-256, -256, 0)[i] <= lo[i] < hi[i] <= (4352, 4352, 1280)[i] for i in range(3)), f"bounds in metres {lo} {hi}")
     check(obj.data.materials and obj.data.materials[0].name == "Atlas Nubis", "volume material")
 
 
@@ -166,7 +166,7 @@ def incremental_recook():
     in_min.f = 0.44
     grids = {g.name: g for g in vol.grids}
     m = grids["sdf"].matrix_object if "sdf" in grids else None
-    check(m is not None and [round(m[i][i], 4) for i in range(3)] == [64.0, 64.0, 32.0], f"proxy 2 voxel size {m}")
+    check(m is not None and [round(m[i][i], 4) for i in range(3)] == [32.0, 32.0, 32.0], f"proxy 2 voxel size {m}")
     props.proxy = 1
     in_min.f = 0.45
 
@@ -220,7 +220,7 @@ def background_thread_and_cancel():
     job.thread.join(60)
     check(job.error is None and job.fraction > 0, f"thread cook: {job.error!r}")
     atlas_blender._finish(scene, job)
-    check(scene.atlas.last_cooked == "coverage distance nvdf", f"thread re-cook: {scene.atlas.last_cooked!r}")
+    check(scene.atlas.last_cooked == "anatomy cloud coverage cumulus distance lobes nvdf outline spheres", f"thread re-cook: {scene.atlas.last_cooked!r}")
 
 
 def ndf_as_image():

