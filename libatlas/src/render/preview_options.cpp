@@ -224,7 +224,7 @@ std::vector<TextOption<P>> make_preview_options() {
             };
             return o;
         }(),
-        opt(vec({"light_grid", "--light-grid", "NX,NY,NZ", K::Integer, "light grid resolution (voxel: capped at the volume's; 2.5D with artistic off: the diffusion patch's columns and least levels)", 1, 1024}, 3),
+        opt(vec({"light_grid", "--light-grid", "NX,NY,NZ", K::Integer, "light grid resolution (voxel: the diffusion term's grid, capped at the volume's; 2.5D with artistic off: the diffusion patch's columns and least levels)", 1, 1024}, 3),
             "128,128,32", "voxels", [](P& p, const V& v) { p.light_grid = {{int(v.numbers[0]), int(v.numbers[1]), int(v.numbers[2])}}; }),
         opt({"time", "--time", "S", K::Number, "2.5D: seconds of wind scroll (map and noise) and vortex-ring turn", -1e9, 1e9}, "0", "s",
             [](P& p, const V& v) { p.time = v.number; }),
