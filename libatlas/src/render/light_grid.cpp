@@ -7,6 +7,30 @@
 
 namespace atlas::render::detail {
 
+namespace {
+
+// Trilinear blend at lattice coordinates q (samples at the integers, clamped
+// to [0, n - 1]) of at(i, j, k): the grid's and the sun map's lookups.
+template <class At>
+float trilinear(const double q[3], const int n[3], const At& at) {
+    int i0[3], i1[3];
+    float w[3];
+    for (int e = 0; e < 3; ++e) {
+        const double r = std::clamp(q[e], 0.0, double(n[e] - 1));
+        i0[e] = std::min(static_cast<int>(r), n[e] - 1);
+        i1[e] = std::min(i0[e] + 1, n[e] - 1);
+        w[e] = static_cast<float>(r - i0[e]);
+    }
+    const float c00 = at(i0[0], i0[1], i0[2]) + (at(i1[0], i0[1], i0[2]) - at(i0[0], i0[1], i0[2])) * w[0];
+    const float c10 = at(i0[0], i1[1], i0[2]) + (at(i1[0], i1[1], i0[2]) - at(i0[0], i1[1], i0[2])) * w[0];
+    const float c01 = at(i0[0], i0[1], i1[2]) + (at(i1[0], i0[1], i1[2]) - at(i0[0], i0[1], i1[2])) * w[0];
+    const float c11 = at(i0[0], i1[1], i1[2]) + (at(i1[0], i1[1], i1[2]) - at(i0[0], i1[1], i1[2])) * w[0];
+    const float c0 = c00 + (c10 - c00) * w[1], c1 = c01 + (c11 - c01) * w[1];
+    return c0 + (c1 - c0) * w[2];
+}
+
+} // namespace
+
 double exit_distance(const Box3d& b, const Vec3d& p, const Vec3d& d) {
     double t1 = std::numeric_limits<double>::infinity();
     for (int a = 0; a < 3; ++a) {
@@ -224,40 +248,13 @@ float SunDepthMap::sun(double x, double y, double z) const {
     const double p[3] = {x, y, z};
     const double t = p[a_] - a0_;
     const double q[3] = {t / voxel_[a_] - 0.5, (p[b_] - sb_ * t - u0_) / voxel_[b_] - 0.5, (p[c_] - sc_ * t - v0_) / voxel_[c_] - 0.5};
-    int i0[3], i1[3];
-    float w[3];
-    for (int e = 0; e < 3; ++e) {
-        const double r = std::clamp(q[e], 0.0, double(n_[e] - 1));
-        i0[e] = std::min(static_cast<int>(r), n_[e] - 1);
-        i1[e] = std::min(i0[e] + 1, n_[e] - 1);
-        w[e] = static_cast<float>(r - i0[e]);
-    }
-    const float c00 = at(i0[0], i0[1], i0[2]) + (at(i1[0], i0[1], i0[2]) - at(i0[0], i0[1], i0[2])) * w[0];
-    const float c10 = at(i0[0], i1[1], i0[2]) + (at(i1[0], i1[1], i0[2]) - at(i0[0], i1[1], i0[2])) * w[0];
-    const float c01 = at(i0[0], i0[1], i1[2]) + (at(i1[0], i0[1], i1[2]) - at(i0[0], i0[1], i1[2])) * w[0];
-    const float c11 = at(i0[0], i1[1], i1[2]) + (at(i1[0], i1[1], i1[2]) - at(i0[0], i1[1], i1[2])) * w[0];
-    const float c0 = c00 + (c10 - c00) * w[1], c1 = c01 + (c11 - c01) * w[1];
-    return c0 + (c1 - c0) * w[2];
+    return trilinear(q, n_, [this](int i, int j, int k) { return at(i, j, k); });
 }
 
 float LightGrid::sample(const std::vector<float>& g, double x, double y, double z) const {
-    double u[3] = {(x - bounds_.min[0]) / voxel_[0] - 0.5, (y - bounds_.min[1]) / voxel_[1] - 0.5, (z - bounds_.min[2]) / voxel_[2] - 0.5};
-    int i0[3], i1[3];
-    float t[3];
-    for (int a = 0; a < 3; ++a) {
-        double v = std::clamp(u[a], 0.0, double(res_[a] - 1));
-        i0[a] = std::min(static_cast<int>(v), res_[a] - 1);
-        i1[a] = std::min(i0[a] + 1, res_[a] - 1);
-        t[a] = static_cast<float>(v - i0[a]);
-    }
+    const double u[3] = {(x - bounds_.min[0]) / voxel_[0] - 0.5, (y - bounds_.min[1]) / voxel_[1] - 0.5, (z - bounds_.min[2]) / voxel_[2] - 0.5};
     const size_t row = size_t(res_[0]), slab = row * size_t(res_[1]);
-    auto at = [&](int xx, int yy, int zz) { return g[size_t(zz) * slab + size_t(yy) * row + size_t(xx)]; };
-    float c00 = at(i0[0], i0[1], i0[2]) + (at(i1[0], i0[1], i0[2]) - at(i0[0], i0[1], i0[2])) * t[0];
-    float c10 = at(i0[0], i1[1], i0[2]) + (at(i1[0], i1[1], i0[2]) - at(i0[0], i1[1], i0[2])) * t[0];
-    float c01 = at(i0[0], i0[1], i1[2]) + (at(i1[0], i0[1], i1[2]) - at(i0[0], i0[1], i1[2])) * t[0];
-    float c11 = at(i0[0], i1[1], i1[2]) + (at(i1[0], i1[1], i1[2]) - at(i0[0], i1[1], i1[2])) * t[0];
-    float c0 = c00 + (c10 - c00) * t[1], c1 = c01 + (c11 - c01) * t[1];
-    return c0 + (c1 - c0) * t[2];
+    return trilinear(u, res_.v.data(), [&](int xx, int yy, int zz) { return g[size_t(zz) * slab + size_t(yy) * row + size_t(xx)]; });
 }
 
 } // namespace atlas::render::detail
