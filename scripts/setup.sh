@@ -14,6 +14,7 @@ DEMO_PACKAGES=(
   libopenvdb-dev libopenexr-dev libimath-dev libopenimageio-dev libpng-dev
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev libboost-iostreams-dev
   libtet1.5-dev libtbb-dev libyaml-cpp-dev zlib1g-dev libblosc-dev nlohmann-json3-dev
+  libwebp-dev
 )
 PACKAGES=(
   "${DEMO_PACKAGES[@]}"
@@ -32,6 +33,8 @@ PACKAGES=(
   python3-dask python3-distributed
   # The Blender add-on's headless test (plugins/blender/): Debian's Blender 3.4 runs the same Python.
   blender
+  # Independent WebP readers (Pillow, webpmux) for the animation test (tests/render/animation_test.py).
+  webp python3-pil
   # The Cycles reference (scripts/cycles_reference.py, bench/render_vs_cycles.sh): its error plots.
   python3-matplotlib
   # docs/images/architecture.svg (scripts/module_graph.py | dot): the module dependency picture.

@@ -8,6 +8,7 @@
 #include "atlas/core/error.h"
 #include "atlas/core/files.h"
 #include "atlas/graph/evaluator.h"
+#include "atlas/io/animation.h"
 #include "atlas/io/exr.h"
 #include "atlas/io/image.h"
 #include "atlas/preview/graph_preview.h"
@@ -20,6 +21,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -192,6 +194,25 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
     const int frames = a.has(frames_opt) ? static_cast<int>(numbers(a.get(frames_opt), 1, frames_opt)[0]) : 0;
     if (a.has(frames_opt) && (frames < 1 || frames > 3600)) throw UsageError{std::string(frames_opt) + " expects 1..3600 frames", "preview"};
     const double time_step = a.has("--time-step") ? numbers(a.get("--time-step"), 1, "--time-step")[0] : 60.0;
+    // A sequence can also be one animation and one contact sheet, staged and
+    // committed with its frames.
+    for (const char* opt : {"--animation", "--contact-sheet", "--fps", "--animation-quality"})
+        if (a.has(opt) && frames == 0) throw UsageError{std::string(opt) + " needs --frames N or --turntable N", "preview"};
+    if ((a.has("--fps") || a.has("--animation-quality")) && !a.has("--animation"))
+        throw UsageError{std::string(a.has("--fps") ? "--fps" : "--animation-quality") + " needs --animation FILE.webp", "preview"};
+    const std::filesystem::path animation_path = a.has("--animation") ? std::filesystem::path(a.get("--animation")) : std::filesystem::path();
+    const std::filesystem::path sheet_path = a.has("--contact-sheet") ? std::filesystem::path(a.get("--contact-sheet")) : std::filesystem::path();
+    if (!animation_path.empty() && animation_path.extension() != ".webp")
+        throw UsageError{"--animation writes an animated WebP: name it .webp, not '" + animation_path.string() + "'", "preview"};
+    if (!sheet_path.empty() && sheet_path.extension() == ".exr")
+        throw UsageError{"--contact-sheet writes a tone-mapped picture (.png), not EXR", "preview"};
+    io::AnimationOptions anim_options;
+    if (a.has("--fps")) anim_options.fps = numbers(a.get("--fps"), 1, "--fps")[0];
+    if (a.has("--animation-quality")) anim_options.quality = static_cast<int>(numbers(a.get("--animation-quality"), 1, "--animation-quality")[0]);
+    std::unique_ptr<io::AnimationWriter> animation;
+    if (!animation_path.empty()) animation = std::make_unique<io::AnimationWriter>(w, h, anim_options);
+    std::unique_ptr<render::ContactSheet> sheet;
+    if (!sheet_path.empty()) sheet = std::make_unique<render::ContactSheet>(frames, w, h);
     const double time0 = have_layer ? job.layer->time : 0.0;
     auto t0 = std::chrono::steady_clock::now();
     std::string features;
@@ -249,7 +270,27 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
             const std::filesystem::path name = out.stem().string() + suffix + out.extension().string();
             write_picture(image, staged.stage(name), exposure);
             paths.push_back(out.parent_path() / name);
+            if (animation || sheet) {
+                const Field2D shown = render::tone_map(image, exposure);
+                if (animation) animation->add(shown);
+                if (sheet) sheet->add(i, shown);
+            }
         }
+        // The animation and the sheet sit where they were asked for: staged
+        // beside OUT when they share its folder, else each atomically.
+        auto extra = [&](const std::filesystem::path& p, const std::function<void(const std::filesystem::path&)>& write) {
+            const std::filesystem::path folder = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
+            const std::filesystem::path out_folder = out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path();
+            std::error_code ec;
+            if (std::filesystem::equivalent(folder, out_folder, ec)) {
+                write(staged.stage(p.filename()));
+            } else {
+                write_file_atomic(p, write);
+            }
+            paths.push_back(p);
+        };
+        if (animation) extra(animation_path, [&](const std::filesystem::path& t) { animation->write(t); });
+        if (sheet) extra(sheet_path, [&](const std::filesystem::path& t) { io::write_image(sheet->sheet(), t); });
         staged.commit();
         bar.finish();
         for (const auto& p : paths) std::cout << p.string() << "\n";

@@ -2,6 +2,7 @@
 // centre-pixel radiance has a closed form (the renderer's own output is
 // never stored). Also the sweep and image writers.
 #include "atlas/core/error.h"
+#include "atlas/io/animation.h"
 #include "atlas/io/exr.h"
 #include "atlas/io/image.h"
 #include "atlas/render/image_out.h"
@@ -11,6 +12,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
+#include <string>
 
 #include <unistd.h>
 
@@ -146,5 +149,85 @@ TEST(RenderOutput, PngAndExrRoundTrip) {
         for (size_t i = 0; i < back.voxel_count(); ++i) EXPECT_EQ(back.channel(bc)[i], r.image.channel(c)[i]);
     }
     EXPECT_THROW(tone_map(r.image, 0), Error);
+    std::filesystem::remove_all(dir);
+}
+
+namespace {
+// A frame whose every pixel says which frame and where: r = frame / 10, g = x / w, b = y / h.
+Field2D labelled_frame(int frame, int w, int h) {
+    Field2D f({{w, h}}, 3, Box2d{{{0, 0}}, {{double(w), double(h)}}}, {"r", "g", "b"});
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            f.at(0, x, y) = float(frame) / 10.0f;
+            f.at(1, x, y) = float(x) / float(w);
+            f.at(2, x, y) = float(y) / float(h);
+        }
+    return f;
+}
+} // namespace
+
+TEST(RenderOutput, ContactSheetPutsFrameZeroTopLeftAndScalesDownToFit) {
+    // Five 8x4 frames: three columns, two rows, 2 pixels of black between.
+    ContactSheet s(5, 8, 4, 0, 1920, 2);
+    EXPECT_EQ(s.columns(), 3);
+    EXPECT_EQ(s.scale(), 1);
+    for (int i = 0; i < 5; ++i) s.add(i, labelled_frame(i, 8, 4));
+    const Field2D& sh = s.sheet();
+    ASSERT_EQ(sh.width(), 3 * 8 + 2 * 2);
+    ASSERT_EQ(sh.height(), 2 * 4 + 2);
+    // The field's y = 0 is the bottom: frame 0's tile is the top rows.
+    for (int i = 0; i < 5; ++i) {
+        const int x0 = (i % 3) * 10, y0 = sh.height() - (i / 3 + 1) * 4 - (i / 3) * 2;
+        for (int y = 0; y < 4; ++y)
+            for (int x = 0; x < 8; ++x) {
+                EXPECT_FLOAT_EQ(sh.at(0, x0 + x, y0 + y), float(i) / 10.0f) << "frame " << i;
+                EXPECT_FLOAT_EQ(sh.at(1, x0 + x, y0 + y), float(x) / 8.0f);
+                EXPECT_FLOAT_EQ(sh.at(2, x0 + x, y0 + y), float(y) / 4.0f);
+            }
+    }
+    EXPECT_EQ(sh.at(0, 8, sh.height() - 1), 0.0f); // the gap
+    EXPECT_EQ(sh.at(0, 25, 0), 0.0f);              // the sixth, empty tile
+    // Twenty-four 960x540 frames fit 1920 pixels in five columns at a third of their size (box filter).
+    ContactSheet big(24, 960, 540);
+    EXPECT_EQ(big.columns(), 5);
+    EXPECT_EQ(big.scale(), 3);
+    EXPECT_LE(big.sheet().width(), 1920);
+    ContactSheet tiny(1, 4, 4, 0, 1, 0); // a sheet narrower than a pixel per tile keeps one pixel
+    EXPECT_EQ(tiny.sheet().width(), 1);
+    tiny.add(0, labelled_frame(3, 4, 4));
+    EXPECT_NEAR(tiny.sheet().at(0, 0, 0), 0.3f, 1e-6f); // the mean of a constant
+    EXPECT_THROW(ContactSheet(0, 8, 4), Error);
+    EXPECT_THROW(s.add(5, labelled_frame(0, 8, 4)), Error);
+    EXPECT_THROW(s.add(0, labelled_frame(0, 8, 5)), Error);
+}
+
+TEST(RenderOutput, AnimationWriterRefusesBadOptionsAndFrames) {
+    io::AnimationOptions o;
+    o.fps = 0;
+    EXPECT_THROW(io::AnimationWriter(8, 4, o), Error);
+    o.fps = 12;
+    o.quality = 102;
+    EXPECT_THROW(io::AnimationWriter(8, 4, o), Error);
+    EXPECT_THROW(io::AnimationWriter(0, 4), Error);
+    io::AnimationWriter w(8, 4);
+    EXPECT_THROW(w.add(labelled_frame(0, 9, 4)), Error);
+    Field2D nan = labelled_frame(0, 8, 4);
+    nan.at(1, 2, 3) = std::numeric_limits<float>::quiet_NaN();
+    try {
+        w.add(nan);
+        ADD_FAILURE() << "a NaN frame was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("NaN at pixel (2, 3)"), std::string::npos) << e.what();
+    }
+    const auto dir = std::filesystem::temp_directory_path() / ("atlas_anim_test_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    EXPECT_THROW(w.write(dir / "none.webp"), Error); // no frames
+    w.add(labelled_frame(0, 8, 4));
+    EXPECT_EQ(w.frames(), 1);
+    EXPECT_THROW(w.write(dir / "a.gif"), Error);
+    EXPECT_FALSE(std::filesystem::exists(dir / "a.gif"));
+    w.write(dir / "a.webp");
+    EXPECT_GT(std::filesystem::file_size(dir / "a.webp"), 0u);
+    EXPECT_THROW(w.add(labelled_frame(1, 8, 4)), Error); // spent
     std::filesystem::remove_all(dir);
 }

@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""ctest preview_animation: `atlas preview --turntable/--frames` also as one animated WebP and one
+contact sheet (docs/render.md, "Sequences"), read back by programs that are not Atlas's: Pillow
+decodes the animation (composited frames, durations, loop), webpmux lists its frames, OpenImageIO
+reads the PNG frames and the sheet.
+
+    ATLAS=build/bin/atlas ATLAS_SOURCE_DIR=. python3 tests/render/animation_test.py
+"""
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import OpenImageIO as oiio
+from PIL import Image
+
+ATLAS = os.environ["ATLAS"]
+SRC = os.environ["ATLAS_SOURCE_DIR"]
+GRAPH = os.path.join(SRC, "graphs", "towering_cumulus.yaml")
+failures = []
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what)
+    if not ok:
+        failures.append(what)
+
+
+def atlas(*args, expect=0):
+    r = subprocess.run([ATLAS, "preview", GRAPH, "--size", "96x54", "--quiet", *args], capture_output=True, text=True)
+    check(r.returncode == expect, f"exit {r.returncode} (expected {expect}) for {' '.join(args)}: {r.stderr.strip()[:300]}")
+    return r
+
+
+def png(path):
+    return oiio.ImageInput.open(path).read_image("uint8")[..., :3].astype(int)
+
+
+def frames_of(webp):
+    im = Image.open(webp)
+    out, durations = [], []
+    for i in range(im.n_frames):
+        im.seek(i)
+        out.append(np.asarray(im.convert("RGB")).astype(int))
+        durations.append(im.info.get("duration"))
+    return out, durations, im.info.get("loop")
+
+
+with tempfile.TemporaryDirectory() as d:
+    cache = ["--cache", os.path.join(d, "cache")]
+    # Lossless: the animation holds exactly the PNG frames' pixels.
+    out = os.path.join(d, "t.png")
+    atlas("--turntable", "4", "-o", out, "--animation", os.path.join(d, "t.webp"), "--animation-quality", "101", "--fps", "8",
+          "--contact-sheet", os.path.join(d, "sheet.png"), *cache)
+    frames = [png(os.path.join(d, f"t_{i:03d}.png")) for i in range(4)]
+    anim, durations, loop = frames_of(os.path.join(d, "t.webp"))
+    check(len(anim) == 4, f"4 frames in the animation (Pillow): {len(anim)}")
+    check(all(a.shape == (54, 96, 3) for a in anim), "every frame 96x54")
+    check(all(np.array_equal(a, f) for a, f in zip(anim, frames)), "lossless frames equal the PNG frames")
+    check(not np.array_equal(frames[0], frames[1]), "the turntable turns (frames differ)")
+    check(all(abs(t - 125) <= 1 for t in durations), f"8 fps: 125 ms a frame, got {durations}")
+    check(loop == 0, f"loops forever (loop 0), got {loop}")
+    info = subprocess.run(["webpmux", "-info", os.path.join(d, "t.webp")], capture_output=True, text=True).stdout
+    check("Number of frames: 4" in info and "Canvas size: 96 x 54" in info, "webpmux: 4 frames on a 96 x 54 canvas")
+    # The sheet: 2 x 2 tiles, 4 pixels apart, frame 0 top left, each the PNG frame.
+    sheet = png(os.path.join(d, "sheet.png"))
+    check(sheet.shape == (2 * 54 + 4, 2 * 96 + 4, 3), f"sheet size {sheet.shape}")
+    for i in range(4):
+        r, c = divmod(i, 2)
+        tile = sheet[r * 58:r * 58 + 54, c * 100:c * 100 + 96]
+        check(np.array_equal(tile, frames[i]), f"sheet tile {i} is frame {i}")
+    check(sheet[:, 96:100].max() == 0, "black between the tiles")
+
+    # Lossy (the default): close to the frames, smaller than lossless.
+    atlas("--turntable", "4", "-o", os.path.join(d, "l.png"), "--animation", os.path.join(d, "l.webp"), *cache)
+    lossy, _, _ = frames_of(os.path.join(d, "l.webp"))
+    mse = np.mean([np.mean((a - f) ** 2) for a, f in zip(lossy, frames)])
+    psnr = 10 * np.log10(255 ** 2 / max(mse, 1e-9))
+    check(psnr > 30, f"lossy quality 90: PSNR {psnr:.1f} dB > 30 against the PNG frames")
+    check(os.path.getsize(os.path.join(d, "l.webp")) < os.path.getsize(os.path.join(d, "t.webp")), "lossy is smaller than lossless")
+
+    # A sheet in another folder is written there (atomically); frames of a time sequence too.
+    other = os.path.join(d, "sheets")
+    os.makedirs(other)
+    atlas("--frames", "2", "-o", os.path.join(d, "s.png"), "--contact-sheet", os.path.join(other, "s_sheet.png"), *cache)
+    check(os.path.exists(os.path.join(other, "s_sheet.png")) and os.path.exists(os.path.join(d, "s_001.png")), "sheet in another folder")
+
+    # Bad input: a clear message, exit 2, nothing written.
+    before = sorted(os.listdir(d))
+    r = atlas("-o", os.path.join(d, "x.png"), "--animation", os.path.join(d, "x.webp"), expect=2)
+    check("--animation needs --frames N or --turntable N" in r.stderr, f"--animation without frames: {r.stderr.strip()}")
+    r = atlas("--turntable", "2", "-o", os.path.join(d, "x.png"), "--animation", os.path.join(d, "x.gif"), expect=2)
+    check("name it .webp" in r.stderr, f"--animation x.gif: {r.stderr.strip()}")
+    r = atlas("--turntable", "2", "-o", os.path.join(d, "x.png"), "--fps", "5", expect=2)
+    check("--fps needs --animation" in r.stderr, f"--fps alone: {r.stderr.strip()}")
+    r = atlas("--turntable", "2", "-o", os.path.join(d, "x.png"), "--animation", os.path.join(d, "x.webp"), "--fps", "0", expect=1)
+    check("fps must be in (0, 120]" in r.stderr, f"--fps 0: {r.stderr.strip()}")
+    check(sorted(os.listdir(d)) == before, "the refused previews wrote nothing")
+
+print(f"{len(failures)} failed" if failures else "all passed")
+sys.exit(1 if failures else 0)
