@@ -53,6 +53,7 @@ const std::vector<Command>& commands() {
           {"--memory-budget", "SIZE", "refuse allocations past this size (default 8GiB)"},
           {"--checked", "", "re-cook every node and compare with the cache (catches incomplete hashes)"},
           {"--allow-outside-out", "", "allow output paths that are absolute or leave --out"},
+          {"--frames", "A:B|N|all", "the graph's time sequence (its time: block): frame f into OUT/frame_NNNN/ with keyed parameters at start + f / fps, then OUT/frames.json (docs/graph-format.md, \"Time\")"},
           {"--tiles", "NX,NY", "cook in NX x NY tiles of the XY grid: tile files and OUT/tiles/index.json (docs/scale.md)"},
           {"--tile", "I,J", "with --tiles: cook only tile I,J (0-based; for a cluster worker)"},
           {"--assemble", "", "with --tiles: also write the untiled outputs from the tiles (the bytes one cook writes)"},

@@ -7,7 +7,10 @@
 #include "atlas/graph/evaluator.h"
 #include "atlas/graph/tiling.h"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <set>
@@ -136,6 +139,90 @@ int run_cook_tiled(const Args& a, CookOptions o) {
 }
 } // namespace
 
+// `atlas cook GRAPH --frames A:B`: the graph's time sequence (its `time:` block),
+// frame f into OUT/frame_NNNN/ with the keyed parameters at time start + f / fps.
+// One session cooks them all, so a frame re-cooks only the nodes that read a
+// keyed parameter and what depends on them. OUT/frames.json lists the frames,
+// their times, folders and the nodes each cooked; it is written last, so a
+// sequence that failed half way has none.
+int run_cook_frames(const Args& a, CookOptions o) {
+    if (a.positional.size() != 1) throw UsageError{"--frames cooks one graph's time sequence; give one graph", "cook"};
+    const bool quiet = a.has("--quiet");
+    Session session(builtin_nodes());
+    session.load(a.positional[0]);
+    apply_sets(session, a, "cook");
+    const Graph& g = session.graph();
+    if (!g.time)
+        throw UsageError{"--frames: " + a.positional[0] + " declares no time range (add time: {start: 0, end: 300, fps: 1}; docs/graph-format.md, \"Time\")",
+                         "cook"};
+    const int total = g.time->frames();
+    int first = 0, last = total - 1;
+    const std::string spec = a.get("--frames");
+    if (spec != "all") {
+        const auto colon = spec.find(':');
+        try {
+            size_t used = 0;
+            first = std::stoi(spec.substr(0, colon), &used);
+            if (used != (colon == std::string::npos ? spec.size() : colon)) throw std::invalid_argument("x");
+            last = first;
+            if (colon != std::string::npos) {
+                last = std::stoi(spec.substr(colon + 1), &used);
+                if (used != spec.size() - colon - 1) throw std::invalid_argument("x");
+            }
+        } catch (const std::exception&) {
+            throw UsageError{"--frames expects A:B (frame numbers, inclusive), N or all, got '" + spec + "'", "cook"};
+        }
+        if (first < 0 || last < first || last >= total)
+            throw UsageError{"--frames " + spec + ": the graph's frames are 0:" + std::to_string(total - 1) + " (" + std::to_string(total) + " frames at " +
+                                 format_param_value(g.time->fps) + " fps from " + format_param_value(g.time->start) + " s)",
+                             "cook"};
+    }
+    if (!a.all("--output").empty()) o.outputs = a.all("--output");
+    const std::filesystem::path out = o.out_dir;
+    const int digits = std::max(4, int(std::to_string(total - 1).size()));
+    ProgressBar bar(!quiet);
+    nlohmann::json manifest = {{"graph", a.positional[0]},
+                               {"time", {{"start", g.time->start}, {"end", g.time->end}, {"fps", g.time->fps}, {"frames", total}}},
+                               {"frames", nlohmann::json::array()}};
+    std::vector<std::pair<std::string, CookResult>> cooks;
+    for (int f = first; f <= last; ++f) {
+        bar.begin_part(f - first, last - first + 1);
+        const double t = g.time->at_frame(f);
+        session.set_time(t);
+        std::string number = std::to_string(f);
+        const std::string folder = "frame_" + std::string(size_t(std::max(0, digits - int(number.size()))), '0') + number;
+        CookOptions fo = o;
+        fo.out_dir = out / folder;
+        fo.progress = bar.sink();
+        CookResult r;
+        try {
+            r = session.cook(fo);
+        } catch (const std::exception&) {
+            bar.finish();
+            if (a.has("--report")) {
+                cooks.emplace_back(a.positional[0] + "@" + folder, session.last_result());
+                write_text_atomic(a.get("--report"), combined_report_json(cooks), "the report", {});
+            }
+            std::cerr << "atlas: frame " << f << " (t = " << format_param_value(t) << " s) failed; frames " << first << ".." << f - 1
+                      << " were written, " << (out / "frames.json").string() << " was not\n";
+            throw;
+        }
+        nlohmann::json files = nlohmann::json::array();
+        for (const auto& o2 : r.outputs)
+            for (const auto& file : o2.files) files.push_back(std::filesystem::path(file.path).lexically_relative(out).generic_string());
+        manifest["frames"].push_back({{"frame", f}, {"time", t}, {"folder", folder}, {"cooked", r.with_status("cooked")}, {"files", files}});
+        if (!quiet)
+            std::fprintf(stderr, "frame %d (t = %s s): cooked %zu, cached %zu nodes\n", f, format_param_value(t).c_str(), r.with_status("cooked").size(),
+                         r.with_status("cached").size());
+        cooks.emplace_back(a.positional[0] + "@" + folder, std::move(r));
+    }
+    bar.finish();
+    write_text_atomic((out / "frames.json").string(), manifest.dump(2) + "\n", "the frame manifest", {});
+    if (a.has("--report")) write_text_atomic(a.get("--report"), combined_report_json(cooks), "the report", {});
+    if (!quiet) std::cout << (out / "frames.json").string() << "\n";
+    return 0;
+}
+
 int run_cook(const Args& a) {
     if (a.positional.empty()) throw UsageError{"expected a graph file (or several)", "cook"};
     const bool quiet = a.has("--quiet");
@@ -161,7 +248,11 @@ int run_cook(const Args& a) {
         o.cache_max_bytes = parse_byte_size(a.get("--cache-max-size"));
     }
 
-    if (a.has("--tiles") || a.has("--tile") || a.has("--assemble")) return run_cook_tiled(a, o);
+    if (a.has("--tiles") || a.has("--tile") || a.has("--assemble")) {
+        if (a.has("--frames")) throw UsageError{"--frames and --tiles: cook a sequence's frames one at a time", "cook"};
+        return run_cook_tiled(a, o);
+    }
+    if (a.has("--frames")) return run_cook_frames(a, o);
     if (a.has("--report") && a.has("--depfile") && std::filesystem::path(a.get("--report")).lexically_normal() == std::filesystem::path(a.get("--depfile")).lexically_normal())
         throw UsageError{"--report and --depfile name one file", "cook"};
     const std::vector<ProtectedFile> graphs = cook_files(a, {});

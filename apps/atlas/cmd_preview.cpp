@@ -153,6 +153,8 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
         if (!session) session = std::make_unique<Session>(builtin_nodes());
         session->load(a.positional[0]);
         apply_sets(*session, a, "preview");
+        // A graph with a time range (docs/graph-format.md, "Time") is drawn at --time.
+        if (session->graph().time && a.has("--time")) session->set_time(po.time);
         prepared = preview::prepare_graph_preview(*session, po, how, a.positional[0]);
     } else {
         std::vector<std::filesystem::path> files(a.positional.begin(), a.positional.end());
@@ -193,7 +195,12 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
     const char* frames_opt = sequence ? "--frames" : "--turntable";
     const int frames = a.has(frames_opt) ? static_cast<int>(numbers(a.get(frames_opt), 1, frames_opt)[0]) : 0;
     if (a.has(frames_opt) && (frames < 1 || frames > 3600)) throw UsageError{std::string(frames_opt) + " expects 1..3600 frames", "preview"};
-    const double time_step = a.has("--time-step") ? numbers(a.get("--time-step"), 1, "--time-step")[0] : 60.0;
+    // A graph with a time range steps its own time, a frame (1 / fps) at a time by
+    // default: keyed parameters change, and each frame re-cooks what reads them.
+    const bool timed = sequence && from_graph && session && session->graph().time;
+    const double time_step = a.has("--time-step") ? numbers(a.get("--time-step"), 1, "--time-step")[0]
+                                                  : (timed ? 1.0 / session->graph().time->fps : 60.0);
+    const double graph_time0 = timed ? session->graph().current_time : 0.0;
     // A sequence can also be one animation and one contact sheet, staged and
     // committed with its frames.
     for (const char* opt : {"--animation", "--contact-sheet", "--fps", "--animation-quality"})
@@ -247,6 +254,10 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
         std::vector<std::filesystem::path> paths;
         for (int i = 0; i < frames; ++i) {
             if (sequence) {
+                if (timed && i > 0) {
+                    session->set_time(graph_time0 + i * time_step);
+                    prepared = preview::prepare_graph_preview(*session, po, how, a.positional[0]);
+                }
                 // A time sequence: the wind scroll advances, each frame a new flash,
                 // and a forecast its next time slice (the envelope follows the slice).
                 if (have_layer) {

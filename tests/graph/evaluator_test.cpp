@@ -12,6 +12,7 @@
 #include <cctype>
 #include <chrono>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -863,4 +864,34 @@ TEST_F(Fixture, NonRegularInputFilesAreRefused) {
             EXPECT_NE(std::string(e.what()).find(f + ": not a regular file"), std::string::npos) << e.what();
         }
     }
+}
+
+TEST_F(Fixture, SetTimeRecooksOnlyWhatReadsAKeyedParameter) {
+    Session s = session(R"(atlas: 1
+time: {start: 0, end: 20, fps: 0.1}
+nodes:
+  a:
+    type: test/source
+    params: {value: {keys: [[0, 1], [20, 3]]}}
+  b:
+    type: test/source
+    params: {value: 3}
+  sum:
+    type: test/add
+    inputs: {a: a, b: b}
+outputs:
+  - {node: sum, file: sum.exr}
+)");
+    CookOptions o = writing_options();
+    o.cache_dir = dir / "cache";
+    s.cook(o);
+    s.set_time(10);
+    CookResult r = s.cook(o);
+    EXPECT_EQ(r.with_status("cooked"), (std::vector<std::string>{"a", "sum"}));
+    EXPECT_EQ(r.nodes.at("b").status, "cached");
+    EXPECT_EQ(std::get<double>(s.graph().find("a")->params.at("value").value), 2.0);
+    // Back at a time already cooked: from the disk cache, nothing cooks.
+    s.set_time(0);
+    EXPECT_TRUE(s.cook(o).with_status("cooked").empty());
+    EXPECT_THROW(s.set_time(std::numeric_limits<double>::infinity()), Error);
 }

@@ -231,3 +231,70 @@ TEST(GraphParse, HugeUnknownTypeIsCutInTheMessage) {
     EXPECT_NE(f.message.find("(2000000 bytes)"), std::string::npos) << f.message.substr(0, 200);
     EXPECT_LT(f.message.size(), 1000u);
 }
+
+// Time (docs/graph-format.md, "Time"): keyed parameters and the graph's time range.
+namespace {
+std::string timed(const std::string& time, const std::string& value) {
+    return "atlas: 1\n" + time + "nodes:\n  a:\n    type: test/source\n    params:\n      value: " + value +
+           "\n  b:\n    type: test/source\n  sum:\n    type: test/add\n    inputs: {a: a, b: b}\noutputs:\n  - {node: sum, file: sum.exr}\n";
+}
+} // namespace
+
+TEST(GraphTime, KeyedParametersHoldTheirValueAtTheStartTime) {
+    auto reg = test::test_registry(std::make_shared<test::CookLog>());
+    Graph g = parse_graph(timed("time: {start: 10, end: 70, fps: 0.5}\n", "{keys: [[0, 1], [20, 3], [40, 5]], interp: linear}"), "g.yaml", ".", reg);
+    ASSERT_TRUE(g.time.has_value());
+    EXPECT_EQ(g.time->frames(), 31);
+    EXPECT_DOUBLE_EQ(g.time->at_frame(3), 16.0);
+    EXPECT_EQ(g.nodes[0].keyed.count("value"), 1u);
+    EXPECT_EQ(std::get<double>(g.nodes[0].params.at("value").value), 2.0); // t = 10: half way from 1 to 3
+    set_graph_time(g, reg, 30);
+    EXPECT_EQ(std::get<double>(g.nodes[0].params.at("value").value), 4.0);
+    set_graph_time(g, reg, -5);
+    EXPECT_EQ(std::get<double>(g.nodes[0].params.at("value").value), 1.0); // before the first key: the first value
+    set_graph_time(g, reg, 99);
+    EXPECT_EQ(std::get<double>(g.nodes[0].params.at("value").value), 5.0); // after the last: the last
+    // An override is a constant: the keys are gone.
+    set_param(g, reg, "a", "value", ParamValue(7.0));
+    set_graph_time(g, reg, 30);
+    EXPECT_EQ(std::get<double>(g.nodes[0].params.at("value").value), 7.0);
+    // Without a time block keys are read at t = 0.
+    Graph g0 = parse_graph(timed("", "{keys: [[0, 1], [20, 3]]}"), "g.yaml", ".", reg);
+    EXPECT_FALSE(g0.time.has_value());
+    EXPECT_EQ(std::get<double>(g0.nodes[0].params.at("value").value), 1.0);
+}
+
+TEST(GraphTime, KeyedValuesInterpolateLinearSmoothIntegerAndVector) {
+    ParamDecl f{.name = "f", .type = ParamType::Float, .default_value = 0.0};
+    ParamKeys lin{false, {{0.0, 0.0}, {10.0, 1.0}}, {}};
+    EXPECT_DOUBLE_EQ(std::get<double>(keyed_value(lin, f, 2.5)), 0.25);
+    ParamKeys smooth{true, {{0.0, 0.0}, {10.0, 1.0}}, {}};
+    EXPECT_DOUBLE_EQ(std::get<double>(keyed_value(smooth, f, 2.5)), 0.15625); // 3u^2 - 2u^3 at u = 1/4
+    EXPECT_DOUBLE_EQ(std::get<double>(keyed_value(smooth, f, 5)), 0.5);
+    ParamDecl i{.name = "i", .type = ParamType::Int, .default_value = int64_t(0)};
+    ParamKeys ik{false, {{0.0, int64_t(0)}, {10.0, int64_t(3)}}, {}};
+    EXPECT_EQ(std::get<int64_t>(keyed_value(ik, i, 4)), 1); // 1.2 rounds to 1
+    EXPECT_EQ(std::get<int64_t>(keyed_value(ik, i, 6)), 2); // 1.8 rounds to 2
+    ParamDecl v{.name = "v", .type = ParamType::Float3, .default_value = std::vector<double>{0, 0, 0}};
+    ParamKeys vk{false, {{0.0, std::vector<double>{0, 10, -2}}, {4.0, std::vector<double>{4, 10, 2}}}, {}};
+    EXPECT_EQ(std::get<std::vector<double>>(keyed_value(vk, v, 1)), (std::vector<double>{1, 10, -1}));
+}
+
+TEST(GraphTime, BadTimeAndKeysAreLocatedErrors) {
+    auto has = [](const Failure& f, const std::string& what) {
+        EXPECT_NE(f.message.find(what), std::string::npos) << f.message;
+        EXPECT_GT(f.line, 0);
+    };
+    has(parse_failure(timed("", "{keys: [[0, 1], [0, 2]]}")), "key times must increase");
+    has(parse_failure(timed("", "{keys: [[0, 1], [10, 500]]}")), "the key at 10 s");
+    has(parse_failure(timed("", "{keys: [[0, 1], [10, 2]], interp: cubic}")), "interp must be 'linear' or 'smooth'");
+    has(parse_failure(timed("", "{keys: []}")), "keys must be a list of [time, value] pairs");
+    has(parse_failure(timed("", "{keys: [[0, 1, 2]]}")), "a key is [time, value]");
+    has(parse_failure(timed("", "{keys: [[soon, 1]]}")), "a key's time must be a number of seconds");
+    has(parse_failure(timed("", "{keys: [[0, 1]], ease: 2}")), "unknown key 'ease'");
+    has(parse_failure(timed("time: {start: 0}\n", "1")), "'end' is required");
+    has(parse_failure(timed("time: {start: 5, end: 1}\n", "1")), "end must not be before start");
+    has(parse_failure(timed("time: {start: 0, end: 10, fps: 0}\n", "1")), "fps must be in (0, 1000]");
+    has(parse_failure(timed("time: {start: 0, end: 10, rate: 2}\n", "1")), "unknown key 'rate'");
+    has(parse_failure(timed("time: [0, 10]\n", "1")), "'time' is a map");
+}

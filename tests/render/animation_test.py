@@ -2,7 +2,8 @@
 """ctest preview_animation: `atlas preview --turntable/--frames` also as one animated WebP and one
 contact sheet (docs/render.md, "Sequences"), read back by programs that are not Atlas's: Pillow
 decodes the animation (composited frames, durations, loop), webpmux lists its frames, OpenImageIO
-reads the PNG frames and the sheet.
+reads the PNG frames and the sheet. Then a graph with a time range (docs/graph-format.md, "Time"):
+`atlas cook --frames` and the preview's frames of graphs/superstorm_lifecycle.yaml.
 
     ATLAS=build/bin/atlas ATLAS_SOURCE_DIR=. python3 tests/render/animation_test.py
 """
@@ -97,6 +98,38 @@ with tempfile.TemporaryDirectory() as d:
     r = atlas("--turntable", "2", "-o", os.path.join(d, "x.png"), "--animation", os.path.join(d, "x.webp"), "--fps", "0", expect=1)
     check("fps must be in (0, 120]" in r.stderr, f"--fps 0: {r.stderr.strip()}")
     check(sorted(os.listdir(d)) == before, "the refused previews wrote nothing")
+
+# Time (docs/graph-format.md, "Time"): a graph's keyed parameters through its frames.
+LIFE = os.path.join(SRC, "graphs", "superstorm_lifecycle.yaml")
+with tempfile.TemporaryDirectory() as d:
+    out = os.path.join(d, "frames")
+    r = subprocess.run([ATLAS, "cook", LIFE, "--frames", "2:4", "--out", out, "--cache", os.path.join(d, "cache")], capture_output=True, text=True)
+    check(r.returncode == 0, f"cook --frames 2:4: {r.stderr.strip()[-300:]}")
+    import json
+    m = json.load(open(os.path.join(out, "frames.json")))
+    check([f["frame"] for f in m["frames"]] == [2, 3, 4] and [f["time"] for f in m["frames"]] == [40, 60, 80], f"frames and times {m['frames']!r:.200}")
+    check(m["time"] == {"start": 0, "end": 480, "fps": 0.05, "frames": 25}, f"the time range {m['time']}")
+    first, later = set(m["frames"][0]["cooked"]), [set(f["cooked"]) for f in m["frames"][1:]]
+    check({"rings", "coverage_noise"} <= first, f"frame 2 cooks everything: {sorted(first)}")
+    check(all(c == {"mesocyclone", "volume"} for c in later), f"later frames re-cook only the keyed tower and its bake: {[sorted(c) for c in later]}")
+    # The tower grows: its coverage sum rises from frame to frame (read with OpenImageIO).
+    cov = []
+    for f in m["frames"]:
+        img = oiio.ImageInput.open(os.path.join(out, f["folder"], "superstorm_ndf_set.exr"))
+        spec = img.spec()
+        px = img.read_image("float")
+        cov.append(float(px[..., spec.channelnames.index("superstorm_coverage")].sum()))
+    check(cov[0] < cov[1] < cov[2], f"the storm forms: superstorm coverage {cov}")
+    r = subprocess.run([ATLAS, "cook", LIFE, "--frames", "7:99", "--out", out], capture_output=True, text=True)
+    check(r.returncode == 2 and "the graph's frames are 0:24" in r.stderr, f"a range past the end: {r.stderr.strip()}")
+    r = subprocess.run([ATLAS, "cook", GRAPH, "--frames", "all", "--out", out], capture_output=True, text=True)
+    check(r.returncode == 2 and "declares no time range" in r.stderr, f"a graph without time: {r.stderr.strip()}")
+    # The preview steps the graph's time a frame (20 s) at a time: the storm grows on screen.
+    atlas_life = subprocess.run([ATLAS, "preview", LIFE, "--frames", "3", "--time", "40", "--size", "96x54", "--quiet", "-o",
+                                 os.path.join(d, "p.png"), "--cache", os.path.join(d, "cache")], capture_output=True, text=True)
+    check(atlas_life.returncode == 0, f"preview --frames of a timed graph: {atlas_life.stderr.strip()[-300:]}")
+    p = [png(os.path.join(d, f"p_{i:03d}.png")) for i in range(3)]
+    check(not np.array_equal(p[0], p[1]) and not np.array_equal(p[1], p[2]), "the frames differ as the storm forms")
 
 print(f"{len(failures)} failed" if failures else "all passed")
 sys.exit(1 if failures else 0)

@@ -162,6 +162,11 @@ std::vector<std::pair<std::string, CookResult>> Session::cook_requirements(const
     return done;
 }
 
+void Session::set_time(double t) {
+    if (!graph_) throw Error("no graph loaded");
+    set_graph_time(*graph_, registry_, t);
+}
+
 void Session::set(const std::string& node, const std::string& param, const ParamValue& value) {
     if (!graph_) throw Error("no graph loaded");
     set_param(*graph_, registry_, node, param, value);

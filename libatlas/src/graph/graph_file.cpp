@@ -206,6 +206,43 @@ void check_output_request(PortType produced, const std::string& format, const st
     }
 }
 
+// `{keys: [[t, v], ...], interp: linear|smooth}` for a numeric parameter.
+ParamKeys parse_keys(const Parser& p, const YAML::Node& n, const ParamDecl& decl, const std::string& what) {
+    p.check_keys(n, {"keys", "interp"}, "keyed parameter");
+    switch (decl.type) {
+    case ParamType::Float: case ParamType::Int: case ParamType::Float2: case ParamType::Float3: case ParamType::Int2: case ParamType::Int3: break;
+    default: p.fail(n, what + "only numbers can be keyed over time; give a plain value");
+    }
+    ParamKeys k;
+    k.where = p.at(n);
+    if (const YAML::Node in = n["interp"]) {
+        const std::string s = p.scalar(in, "interp");
+        if (s != "linear" && s != "smooth") p.fail(in, what + "interp must be 'linear' or 'smooth', got '" + excerpt(s) + "'");
+        k.smooth = s == "smooth";
+    }
+    const YAML::Node keys = n["keys"];
+    if (!keys || !keys.IsSequence() || keys.size() == 0)
+        p.fail(keys ? keys : n, what + "keys must be a list of [time, value] pairs, e.g. keys: [[0, 0.2], [120, 0.8]]");
+    for (const YAML::Node& key : keys) {
+        if (!key.IsSequence() || key.size() != 2) p.fail(key, what + "a key is [time, value], e.g. [120, 0.8]");
+        double t = 0;
+        try {
+            t = key[0].as<double>();
+        } catch (const YAML::Exception&) {
+            p.fail(key[0], what + "a key's time must be a number of seconds");
+        }
+        if (!std::isfinite(t)) p.fail(key[0], what + "a key's time must be finite");
+        if (!k.keys.empty() && !(t > k.keys.back().first))
+            p.fail(key[0], what + "key times must increase: " + format_param_value(t) + " follows " + format_param_value(k.keys.back().first));
+        ParamValue v;
+        std::string err = yaml_to_param(key[1], decl, v);
+        if (err.empty()) err = decl.check(v);
+        if (!err.empty()) p.fail(key[1], what + "the key at " + format_param_value(t) + " s: " + err);
+        k.keys.emplace_back(t, v);
+    }
+    return k;
+}
+
 } // namespace
 
 std::string detail::param_from_yaml(const YAML::Node& n, const ParamDecl& decl, ParamValue& out) { return yaml_to_param(n, decl, out); }
@@ -266,7 +303,7 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
     const YAML::Node root = io::load_yaml(text, filename, "invalid YAML: ");
     if (!root || root.IsNull()) throw ParseError({filename, 1, 1}, "empty graph file: expected 'atlas: 1', 'nodes' and 'outputs'");
     if (!root.IsMap()) p.fail(root, "a graph file is a map with 'atlas', 'nodes' and 'outputs'");
-    p.check_keys(root, {"atlas", "description", "requires", "budget", "nodes", "outputs"}, "graph");
+    p.check_keys(root, {"atlas", "description", "requires", "budget", "time", "nodes", "outputs"}, "graph");
 
     Graph g;
     g.base_dir = base_dir;
@@ -310,6 +347,33 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
             g.budget_where = p.at(t);
         }
     }
+    if (const YAML::Node tn = root["time"]) {
+        if (!tn.IsMap()) p.fail(tn, "'time' is a map, e.g. time: {start: 0, end: 300, fps: 1} (seconds, frames per second)");
+        p.check_keys(tn, {"start", "end", "fps"}, "time");
+        GraphTime gt;
+        gt.where = p.at(tn);
+        auto number = [&](const char* key, double fallback) {
+            const YAML::Node v = tn[key];
+            if (!v) return fallback;
+            double x = 0;
+            try {
+                x = v.as<double>();
+            } catch (const YAML::Exception&) {
+                p.fail(v, std::string("time: ") + key + " must be a number of seconds" + (std::string(key) == "fps" ? " (frames per second)" : ""));
+            }
+            if (!std::isfinite(x)) p.fail(v, std::string("time: ") + key + " must be finite");
+            return x;
+        };
+        gt.start = number("start", 0);
+        if (!tn["end"]) p.fail(tn, "time: 'end' is required (the last frame's time in seconds)");
+        gt.end = number("end", 0);
+        gt.fps = number("fps", 1);
+        if (!(gt.end >= gt.start)) p.fail(tn["end"], "time: end must not be before start");
+        if (!(gt.fps > 0 && gt.fps <= 1000)) p.fail(tn["fps"] ? tn["fps"] : tn, "time: fps must be in (0, 1000]");
+        if ((gt.end - gt.start) * gt.fps > 1e6) p.fail(tn, "time: more than a million frames");
+        g.time = gt;
+        g.current_time = gt.start;
+    }
 
     const YAML::Node nodes = root["nodes"];
     if (!nodes) p.fail(root, "missing 'nodes' map");
@@ -346,11 +410,17 @@ Graph parse_graph(const std::string& text, const std::string& filename, const st
                 }
                 if (n.params.count(pname)) p.fail(pit->first, "node '" + n.name + "': parameter '" + pname + "' given twice");
                 ParamValue v;
+                const std::string what = "node '" + n.name + "': parameter '" + pname + "' (" + std::string(param_type_name(decl->type)) + "): ";
+                if (pit->second.IsMap()) {
+                    // Keyed over time: {keys: [[t, v], ...], interp: linear|smooth}.
+                    n.keyed[pname] = parse_keys(p, pit->second, *decl, what);
+                    v = keyed_value(n.keyed[pname], *decl, g.current_time);
+                    n.params[pname] = {v, p.at(pit->second)};
+                    continue;
+                }
                 std::string err = yaml_to_param(pit->second, *decl, v);
                 if (err.empty()) err = decl->check(v);
-                if (!err.empty())
-                    p.fail(pit->second, "node '" + n.name + "': parameter '" + pname + "' (" +
-                                            std::string(param_type_name(decl->type)) + "): " + err);
+                if (!err.empty()) p.fail(pit->second, what + err);
                 n.params[pname] = {v, p.at(pit->second)};
             }
         }

@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 
 namespace atlas {
@@ -134,6 +135,7 @@ void set_param(Graph& graph, const NodeRegistry& registry, const std::string& no
     if (d.type == ParamType::Float && std::holds_alternative<int64_t>(v)) v = double(std::get<int64_t>(v));
     if (auto err = d.check(v); !err.empty()) throw Error("node '" + node + "': parameter '" + param + "': " + err);
     gn->params[param] = {v, SourceLocation{"<host>", 0, 0}};
+    gn->keyed.erase(param); // an override is a constant
 }
 
 void set_param_text(Graph& graph, const NodeRegistry& registry, const std::string& node, const std::string& param,
@@ -166,6 +168,49 @@ void set_param_text(Graph& graph, const NodeRegistry& registry, const std::strin
     if (!err.empty())
         throw Error(origin + ": node '" + node + "': parameter '" + param + "' (" + std::string(param_type_name(d->type)) + "): " + err);
     gn->params[param] = {v, SourceLocation{origin, 0, 0}};
+    gn->keyed.erase(param); // an override is a constant
+}
+
+ParamValue keyed_value(const ParamKeys& k, const ParamDecl& decl, double t) {
+    if (k.keys.empty()) return decl.default_value;
+    if (t <= k.keys.front().first) return k.keys.front().second;
+    if (t >= k.keys.back().first) return k.keys.back().second;
+    size_t i = 1;
+    while (k.keys[i].first < t) ++i;
+    const auto& [t0, v0] = k.keys[i - 1];
+    const auto& [t1, v1] = k.keys[i];
+    double u = (t - t0) / (t1 - t0);
+    if (k.smooth) u = u * u * (3 - 2 * u);
+    const bool integral = decl.type == ParamType::Int || decl.type == ParamType::Int2 || decl.type == ParamType::Int3;
+    auto mix = [&](double a, double b) {
+        const double x = a + (b - a) * u;
+        return integral ? double(std::llround(x)) : x;
+    };
+    auto num = [](const ParamValue& v) { return std::holds_alternative<int64_t>(v) ? double(std::get<int64_t>(v)) : std::get<double>(v); };
+    if (std::holds_alternative<std::vector<double>>(v0)) {
+        const auto& a = std::get<std::vector<double>>(v0);
+        const auto& b = std::get<std::vector<double>>(v1);
+        std::vector<double> out(a.size());
+        for (size_t c = 0; c < a.size(); ++c) out[c] = mix(a[c], b[c]);
+        return out;
+    }
+    const double x = mix(num(v0), num(v1));
+    if (decl.type == ParamType::Int) return int64_t(x);
+    return x;
+}
+
+void set_graph_time(Graph& graph, const NodeRegistry& registry, double t) {
+    if (!std::isfinite(t)) throw Error("graph time must be finite");
+    for (GraphNode& n : graph.nodes) {
+        if (n.keyed.empty()) continue;
+        const NodeType* type = registry.find(n.type);
+        for (const auto& [name, keys] : n.keyed) {
+            const ParamDecl* d = type ? type->decl.find_param(name) : nullptr;
+            if (!d) continue;
+            n.params[name] = {keyed_value(keys, *d, t), keys.where};
+        }
+    }
+    graph.current_time = t;
 }
 
 } // namespace atlas

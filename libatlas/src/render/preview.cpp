@@ -86,11 +86,10 @@ LayerScene layer_preview_scene(const LayerPreviewInputs& in) {
     }
     if (in.sky_texture) layer.sky_layers.push_back(sky_layer_from(in.sky_texture, 0, 6000, tile_of(*in.sky_texture), 0.9));
     // A storm is one feature: no copies of it beyond the map. Weather maps tile.
-    const int cs = layer.ndf->find_channel("superstorm_coverage");
-    bool storm = false;
-    if (cs >= 0)
-        for (float v : layer.ndf->channel(cs)) storm = storm || v > 0;
-    layer.edge = storm ? MapEdge::Empty : MapEdge::Wrap;
+    // A map that carries a storm channel is a storm's, also at a time its storm
+    // has not formed yet (a lifecycle's first frame): the edge stays the same
+    // through a sequence.
+    layer.edge = layer.ndf->find_channel("superstorm_coverage") >= 0 ? MapEdge::Empty : MapEdge::Wrap;
     validate_layer_scene(layer);
     return layer;
 }

@@ -232,7 +232,7 @@ std::vector<TextOption<P>> make_preview_options() {
             [](P& p, const V& v) { p.wind = {{v.numbers[0], v.numbers[1]}}; }),
         opt({"earth_radius", "--earth-radius", "M", K::Number, "2.5D: Earth radius", 1, 1e12}, "6360000", "m",
             [](P& p, const V& v) { p.earth_radius = v.number; }),
-        opt({"edge", "--edge", "auto|wrap|clamp|empty", K::Choice, "2.5D: the map beyond its bounds; auto = empty for a superstorm set, else wrap",
+        opt({"edge", "--edge", "auto|wrap|clamp|empty", K::Choice, "2.5D: the map beyond its bounds; auto = empty for a map with a superstorm channel, else wrap",
              -inf, inf, {"auto", "wrap", "clamp", "empty"}},
             "auto", "",
             [](P& p, const V& v) {

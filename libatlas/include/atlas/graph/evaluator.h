@@ -166,6 +166,9 @@ public:
 
     // Parameter overrides (validated; throw atlas::Error).
     void set(const std::string& node, const std::string& param, const ParamValue& value);
+    // The graph's time in seconds (docs/graph-format.md, "Time"): keyed parameters
+    // take their values at t; the next cook re-cooks only what reads them.
+    void set_time(double t);
     void set_text(const std::string& node, const std::string& param, const std::string& text);
 
     // Cooks the requested outputs and writes them (atomically: a failed cook

@@ -15,6 +15,7 @@
 #include "atlas/core/error.h"
 #include "atlas/graph/node.h"
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -36,12 +37,33 @@ struct ParamSetting {
     SourceLocation where;
 };
 
+// A numeric parameter keyed over the graph's time (docs/graph-format.md, "Time"):
+// `param: {keys: [[t0, v0], [t1, v1], ...], interp: linear|smooth}`, times in
+// seconds, strictly increasing; before the first key the first value, after the
+// last the last. Smooth eases each span with smoothstep; integers round to nearest.
+struct ParamKeys {
+    bool smooth = false;
+    std::vector<std::pair<double, ParamValue>> keys;
+    SourceLocation where;
+};
+
 struct GraphNode {
     std::string name;
     std::string type;
     SourceLocation where;
     std::map<std::string, ParamSetting> params; // explicitly set; defaults are not listed
+    // Keyed parameters; params[name] holds the value at the graph's current time.
+    std::map<std::string, ParamKeys> keyed;
     std::map<std::string, InputBinding> inputs;
+};
+
+// `time: {start: S, end: E, fps: F}`: the graph's time range in seconds and its
+// frame rate. Frame f is at start + f / fps, f = 0 .. frames() - 1.
+struct GraphTime {
+    double start = 0, end = 0, fps = 1;
+    SourceLocation where;
+    int frames() const { return static_cast<int>(std::floor((end - start) * fps + 1e-9)) + 1; }
+    double at_frame(int f) const { return start + double(f) / fps; }
 };
 
 struct GraphOutput {
@@ -74,6 +96,8 @@ struct Graph {
     // before committing anything, naming the largest textures.
     std::optional<double> texture_budget_mb;
     SourceLocation budget_where;
+    std::optional<GraphTime> time;  // `time:`, when the graph declares one
+    double current_time = 0;        // what keyed parameters hold now (set_graph_time)
 
     const GraphNode* find(const std::string& name) const;
     GraphNode* find(const std::string& name);
@@ -95,6 +119,13 @@ void set_param_text(Graph& graph, const NodeRegistry& registry, const std::strin
 // The same with a typed value (for host programs).
 void set_param(Graph& graph, const NodeRegistry& registry, const std::string& node, const std::string& param,
                const ParamValue& value);
+
+// The value of keyed parameter `keys` (declared `decl`) at time t.
+ParamValue keyed_value(const ParamKeys& keys, const ParamDecl& decl, double t);
+// Sets every keyed parameter to its value at time t (seconds). Nothing else
+// changes, so a cook at another time re-cooks only the nodes that read a keyed
+// parameter and what depends on them (their content hashes are unchanged).
+void set_graph_time(Graph& graph, const NodeRegistry& registry, double t);
 
 // The resolved parameter values of a node (explicit over defaults), as a proxy
 // cook of factor `proxy` uses them (ParamDecl::at_proxy; 1: as written).
