@@ -420,6 +420,18 @@ per Session (cook releases the GIL, so other Python threads run meanwhile).)doc"
                  s.set(node, param, param_from_python(value, d->type, node + "." + param));
              }, py::arg("node"), py::arg("param"), py::arg("value"),
              "Overrides NODE.PARAM with a Python value, validated against the declaration (type, range, choices).")
+        .def("set_time", [](PySession& ps, double t) {
+                 BusyGuard guard(ps);
+                 ps.session.set_time(t);
+             }, py::arg("t"),
+             "Sets the graph's time in seconds (docs/graph-format.md, \"Time\"): keyed parameters take their values at t; "
+             "the next cook re-cooks only the nodes that read them.")
+        .def("time_range", [](PySession& ps) -> py::object {
+                 const auto& t = ps.session.graph().time;
+                 if (!t) return py::none();
+                 return py::make_tuple(t->start, t->end, t->fps);
+             },
+             "The graph's time block as (start, end, fps) in seconds and frames per second, or None.")
         .def("set_text", [](PySession& ps, const std::string& node, const std::string& param, const std::string& text) {
                  BusyGuard guard(ps);
                  ps.session.set_text(node, param, text);

@@ -239,6 +239,34 @@ static void test_quickstart(const char* path) {
     atlas_session_destroy(s);
 }
 
+/* Time: a parameter keyed over the graph's time follows atlas_session_set_time. */
+static void test_time(void) {
+    static const char* graph =
+        "atlas: 1\n"
+        "time: {start: 0, end: 10, fps: 1}\n"
+        "nodes:\n"
+        "  c:\n"
+        "    type: field/constant\n"
+        "    params: {resolution: [2, 2, 1], value: {keys: [[0, 1], [10, 3]], interp: linear}}\n"
+        "outputs: []\n";
+    AtlasSession* s = NULL;
+    CHECK(atlas_session_create(&s) == ATLAS_OK);
+    CHECK_OK(s, atlas_session_load_text(s, graph, "time.yaml", NULL));
+    const double times[3] = {0, 5, 20};
+    const float expected[3] = {1.0f, 2.0f, 3.0f}; /* after the last key: the last value */
+    for (int i = 0; i < 3; ++i) {
+        CHECK_OK(s, atlas_session_set_time(s, times[i]));
+        AtlasField* f = NULL;
+        CHECK_OK(s, atlas_session_get(s, "c", "out", NULL, &f));
+        if (f) {
+            CHECK(atlas_field_channel_data(f, 0)[0] == expected[i]);
+            atlas_field_release(f);
+        }
+    }
+    CHECK(atlas_session_set_time(s, 1.0 / 0.0) == ATLAS_INVALID_ARGUMENT);
+    atlas_session_destroy(s);
+}
+
 /* Meshes and points: a box mesh and samples filling it. */
 static void test_mesh_and_points(void) {
     static const char* graph =
@@ -597,6 +625,7 @@ int main(int argc, char** argv) {
     test_inline_graph();
     test_errors();
     test_quickstart(argv[1]);
+    test_time();
     test_one_call_at_a_time();
     test_destroy_during_a_cook();
     test_mesh_and_points();

@@ -389,3 +389,27 @@ def test_preview_is_the_cli_picture_and_proxies_never_write(tmp_path):
     assert not (tmp_path / "out").exists()
     with pytest.raises(atlas.Error, match="preview option 'sizes' does not exist"):
         s.preview({"sizes": 3})
+
+
+def test_set_time_moves_keyed_parameters(tmp_path):
+    s = atlas.Session()
+    s.load_text("""atlas: 1
+time: {start: 0, end: 10, fps: 1}
+nodes:
+  keyed:
+    type: field/constant
+    params: {resolution: [2, 2, 1], value: {keys: [[0, 1], [10, 3]], interp: smooth}}
+  still:
+    type: field/constant
+    params: {resolution: [2, 2, 1], value: 4}
+outputs: []
+""", name="time.yaml", base_dir=str(tmp_path))
+    assert s.time_range() == (0.0, 10.0, 1.0)
+    assert float(s.get("keyed").channel(0).flat[0]) == 1.0
+    s.set_time(5)
+    assert float(s.get("keyed").channel(0).flat[0]) == 2.0  # smoothstep at half way: half
+    s.set_time(2.5)
+    assert float(s.get("keyed").channel(0).flat[0]) == pytest.approx(1.3125)  # 1 + 2 (3u^2 - 2u^3), u = 1/4
+    assert float(s.get("still").channel(0).flat[0]) == 4.0
+    with pytest.raises(atlas.Error):
+        s.set_time(float("nan"))

@@ -91,6 +91,10 @@ ATLAS_API AtlasStatus atlas_session_load_text(AtlasSession* session, const char*
  * "0.5", "4", "true", "[1, 2, 3]", "name". */
 ATLAS_API AtlasStatus atlas_session_set(AtlasSession* session, const char* node, const char* param,
                                         const char* value_text);
+/* Sets the graph's time in seconds (docs/graph-format.md, "Time"): parameters
+ * keyed over time take their values at t, and the next cook re-cooks only the
+ * nodes that read them. ATLAS_INVALID_ARGUMENT for a time that is not finite. */
+ATLAS_API AtlasStatus atlas_session_set_time(AtlasSession* session, double t);
 /* Typed overrides: an integral value is accepted by a float parameter and a
  * float with an integral value by an int parameter. */
 ATLAS_API AtlasStatus atlas_session_set_float(AtlasSession* session, const char* node, const char* param,

@@ -268,6 +268,13 @@ AtlasStatus atlas_session_set(AtlasSession* s, const char* node, const char* par
     });
 }
 
+AtlasStatus atlas_session_set_time(AtlasSession* s, double t) {
+    return guarded(s, [&] {
+        if (!std::isfinite(t)) throw InvalidArgument("atlas_session_set_time: the time must be finite");
+        s->session.set_time(t);
+    });
+}
+
 AtlasStatus atlas_session_set_float(AtlasSession* s, const char* node, const char* param, double value) {
     return guarded(s, [&] {
         if (!node || !param) throw InvalidArgument("atlas_session_set_float: NULL argument");
