@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -185,6 +186,7 @@ int run_cook_frames(const Args& a, CookOptions o) {
                                {"time", {{"start", g.time->start}, {"end", g.time->end}, {"fps", g.time->fps}, {"frames", total}}},
                                {"frames", nlohmann::json::array()}};
     std::vector<std::pair<std::string, CookResult>> cooks;
+    std::map<std::string, std::string> last_hashes; // output file -> its files' content hashes in the frame before
     for (int f = first; f <= last; ++f) {
         bar.begin_part(f - first, last - first + 1);
         const double t = g.time->at_frame(f);
@@ -207,16 +209,45 @@ int run_cook_frames(const Args& a, CookOptions o) {
                       << " were written, " << (out / "frames.json").string() << " was not\n";
             throw;
         }
-        nlohmann::json files = nlohmann::json::array();
-        for (const auto& o2 : r.outputs)
-            for (const auto& file : o2.files) files.push_back(std::filesystem::path(file.path).lexically_relative(out).generic_string());
-        manifest["frames"].push_back({{"frame", f}, {"time", t}, {"folder", folder}, {"cooked", r.with_status("cooked")}, {"files", files}});
+        // Per output: its files and whether their bytes differ from the frame before
+        // (a streaming engine reloads only what changed; frame_NNNN holds every file,
+        // so a frame loads without reading another).
+        nlohmann::json files = nlohmann::json::array(), outputs = nlohmann::json::array();
+        for (const auto& o2 : r.outputs) {
+            nlohmann::json of = nlohmann::json::array();
+            std::string hashes;
+            for (const auto& file : o2.files) {
+                const std::string rel = std::filesystem::path(file.path).lexically_relative(out).generic_string();
+                files.push_back(rel);
+                of.push_back({{"path", rel}, {"bytes", file.bytes}, {"hash", file.hash}});
+                hashes += file.hash + ";";
+            }
+            const auto prev = last_hashes.find(o2.file);
+            outputs.push_back({{"file", o2.file}, {"node", o2.node}, {"format", o2.format},
+                               {"changed", f == first || prev == last_hashes.end() || prev->second != hashes}, {"files", of}});
+            last_hashes[o2.file] = hashes;
+        }
+        manifest["frames"].push_back(
+            {{"frame", f}, {"time", t}, {"folder", folder}, {"cooked", r.with_status("cooked")}, {"files", files}, {"outputs", outputs}});
         if (!quiet)
             std::fprintf(stderr, "frame %d (t = %s s): cooked %zu, cached %zu nodes\n", f, format_param_value(t).c_str(), r.with_status("cooked").size(),
                          r.with_status("cached").size());
         cooks.emplace_back(a.positional[0] + "@" + folder, std::move(r));
     }
     bar.finish();
+    // Each output once: its format and options (a DDS's encoding) and whether any frame changed it.
+    nlohmann::json outs = nlohmann::json::array();
+    for (const GraphOutput& go : g.outputs) {
+        if (!o.outputs.empty() && std::find(o.outputs.begin(), o.outputs.end(), go.file) == o.outputs.end() &&
+            std::find(o.outputs.begin(), o.outputs.end(), go.node) == o.outputs.end())
+            continue;
+        bool changes = false;
+        for (const auto& fr : manifest["frames"])
+            for (const auto& fo : fr["outputs"])
+                if (fo["file"] == go.file && fo["changed"] && fr["frame"] != first) changes = true;
+        outs.push_back({{"file", go.file}, {"node", go.node}, {"port", go.port}, {"format", go.format}, {"options", go.options}, {"changes", changes}});
+    }
+    manifest["outputs"] = outs;
     write_text_atomic((out / "frames.json").string(), manifest.dump(2) + "\n", "the frame manifest", {});
     if (a.has("--report")) write_text_atomic(a.get("--report"), combined_report_json(cooks), "the report", {});
     if (!quiet) std::cout << (out / "frames.json").string() << "\n";

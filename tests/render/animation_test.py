@@ -112,6 +112,12 @@ with tempfile.TemporaryDirectory() as d:
     first, later = set(m["frames"][0]["cooked"]), [set(f["cooked"]) for f in m["frames"][1:]]
     check({"rings", "coverage_noise"} <= first, f"frame 2 cooks everything: {sorted(first)}")
     check(all(c == {"mesocyclone", "volume"} for c in later), f"later frames re-cook only the keyed tower and its bake: {[sorted(c) for c in later]}")
+    changes = {o["file"]: o["changes"] for o in m["outputs"]}
+    check(changes.get("superstorm_ndf_set.exr") is True and changes.get("vortex_ring_map.exr") is False, f"which outputs change: {changes}")
+    f3 = {o["file"]: o for o in m["frames"][1]["outputs"]}
+    check(not f3["vortex_rings.json"]["changed"] and f3["superstorm_ndf_set.exr"]["changed"], "per frame: the rings unchanged, the set changed")
+    check(all(os.path.exists(os.path.join(out, x["path"])) and os.path.getsize(os.path.join(out, x["path"])) == x["bytes"]
+              for fr in m["frames"] for o in fr["outputs"] for x in o["files"]), "every listed file exists with its size")
     # The tower grows: its coverage sum rises from frame to frame (read with OpenImageIO).
     cov = []
     for f in m["frames"]:
