@@ -255,8 +255,12 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
         for (int i = 0; i < frames; ++i) {
             if (sequence) {
                 if (timed && i > 0) {
+                    // The camera stays where frame 0 put it (a default camera frames
+                    // each frame's clouds, and the view would jump).
+                    const render::Camera camera = s.camera;
                     session->set_time(graph_time0 + i * time_step);
                     prepared = preview::prepare_graph_preview(*session, po, how, a.positional[0]);
+                    s.camera = camera;
                 }
                 // A time sequence: the wind scroll advances, each frame a new flash,
                 // and a forecast its next time slice (the envelope follows the slice).

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <string>
 #include <vector>
 
 using namespace atlas;
@@ -175,4 +176,57 @@ TEST(Nvdf, AssembleTakesEachInputsChannel) {
         EXPECT_NE(w.find("density_scale"), std::string::npos) << w;
         EXPECT_NE(w.find("channel 4"), std::string::npos) << w;
     }
+}
+
+namespace {
+// An NVDF-like set of a sphere: profile 1 inside, sdf its exact distance (brute force), scale s.
+Field3D sphere_set(double cx, double r, float scale) {
+    Field3D f({{16, 8, 8}}, 2, Box3d{{{0, 0, 0}}, {{16, 8, 8}}}, {"dimensional_profile", "sdf"});
+    for (int z = 0; z < 8; ++z)
+        for (int y = 0; y < 8; ++y)
+            for (int x = 0; x < 16; ++x) {
+                const double d = std::sqrt((x + 0.5 - cx) * (x + 0.5 - cx) + (y + 0.5 - 4) * (y + 0.5 - 4) + (z + 0.5 - 4) * (z + 0.5 - 4)) - r;
+                f.at(0, x, y, z) = d < 0 ? scale : 0.0f;
+                f.at(1, x, y, z) = float(d);
+            }
+    return f;
+}
+} // namespace
+
+TEST(NvdfBlend, ChannelsLerpAndTheSdfIsTheUnionsExactDistance) {
+    const Field3D a = sphere_set(4, 3, 1.0f), b = sphere_set(12, 2.5, 0.5f);
+    const Field3D m = volume::blend_nvdf(a, b, 0.25);
+    ASSERT_EQ(m.channels(), 2);
+    EXPECT_EQ(m.channel_name(1), "sdf");
+    for (size_t i = 0; i < m.voxel_count(); ++i) {
+        EXPECT_FLOAT_EQ(m.channel(0)[i], a.channel(0)[i] * 0.75f + b.channel(0)[i] * 0.25f);
+        // The distance to the union of the two spheres, brute force: the smaller one. Never more:
+        // the blended cloud lies where either cloud does, and skipping must not step over it.
+        EXPECT_EQ(m.channel(1)[i], std::min(a.channel(1)[i], b.channel(1)[i]));
+        if (m.channel(0)[i] > 0) {
+            EXPECT_LT(m.channel(1)[i], 0.0f) << "density outside the blended SDF at voxel " << i;
+        }
+    }
+    // At the ends, the sets themselves (sdf included), and t is clamped.
+    const Field3D at0 = volume::blend_nvdf(a, b, 0), at1 = volume::blend_nvdf(a, b, 1), past = volume::blend_nvdf(a, b, 7);
+    for (size_t i = 0; i < a.voxel_count(); ++i) {
+        EXPECT_EQ(at0.channel(1)[i], a.channel(1)[i]);
+        EXPECT_EQ(at1.channel(1)[i], b.channel(1)[i]);
+        EXPECT_EQ(past.channel(0)[i], b.channel(0)[i]);
+    }
+}
+
+TEST(NvdfBlend, DifferentGridsOrChannelsAreClearErrors) {
+    const Field3D a = sphere_set(4, 3, 1.0f);
+    Field3D moved({{16, 8, 8}}, 2, Box3d{{{1, 0, 0}}, {{17, 8, 8}}}, {"dimensional_profile", "sdf"});
+    try {
+        volume::blend_nvdf(a, moved, 0.5);
+        ADD_FAILURE() << "different bounds were blended";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("must share one grid"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("[1, 0, 0]"), std::string::npos) << e.what();
+    }
+    Field3D renamed({{16, 8, 8}}, 2, Box3d{{{0, 0, 0}}, {{16, 8, 8}}}, {"dimensional_profile", "distance"});
+    EXPECT_THROW(volume::blend_nvdf(a, renamed, 0.5), Error);
+    EXPECT_THROW(volume::blend_nvdf(a, a, std::nan("")), Error);
 }

@@ -18,7 +18,7 @@ namespace {
 
 // What a graph writes that the preview can draw, found by cooking (values only)
 // the graph's outputs:
-//   volume/nvdf vdb_set                    -> voxel mode
+//   volume/nvdf vdb_set, volume/blend      -> voxel mode
 //   a 2D field with coverage, min_height, max_height (an NDF set) -> 2.5D mode
 //   a 2D field with coverage only (a weather map)      -> 2.5D, heights 1500..4000 m
 //   a 2D field with bottom, top (ndf/profile_lut)      -> the layer's profile LUT
@@ -75,7 +75,8 @@ GraphContent cook_graph(Session& session, const std::string& file, const GraphPr
         const PortDecl* port = o.port.empty() ? &t->decl.outputs().front() : t->decl.find_output(o.port);
         if (!port) continue;
         g.written.push_back("node '" + o.node + "' (" + n->type + ") port '" + port->name + "' -> " + o.file);
-        const bool nvdf = n->type == "volume/nvdf" && port->name == "vdb_set";
+        // An NVDF set: volume/nvdf's, or two of them blended (volume/blend).
+        const bool nvdf = (n->type == "volume/nvdf" && port->name == "vdb_set") || n->type == "volume/blend";
         const bool dist = n->type == "ndf/distance_map";
         const bool forecast = port->type == PortType::Field3D && n->type.rfind("ndf/", 0) == 0;
         if (nvdf || dist || forecast || port->type == PortType::Field2D || port->type == PortType::Field)
@@ -101,7 +102,8 @@ GraphContent cook_graph(Session& session, const std::string& file, const GraphPr
             Value v = session.get(w.node, w.port, o); // from the session's memory cache now
             const std::string what = file + ": node '" + w.node + "' output '" + w.port + "'";
             if (auto* f3 = std::get_if<Field3DPtr>(&v); f3 && *f3) {
-                if (w.type == "volume/nvdf" && !g.nvdf) render::check_finite(**f3, what), g.nvdf = *f3;
+                if ((w.type == "volume/nvdf" || (w.type == "volume/blend" && (*f3)->find_channel("dimensional_profile") >= 0)) && !g.nvdf)
+                    render::check_finite(**f3, what), g.nvdf = *f3;
                 else if (w.type == "ndf/distance_map" && !g.distance) render::check_finite(**f3, what), g.distance = *f3;
                 else if ((*f3)->find_channel("coverage") >= 0 && !g.forecast) render::check_finite(**f3, what), g.forecast = *f3;
                 continue;

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 namespace atlas::volume {
 namespace {
@@ -63,6 +65,40 @@ Field3D assemble_modeling_nvdf(const Field3D& dp, const Field3D& dt, const Field
     for (int c = 0; c < 3; ++c) check_channel(*src[c], sel[c], names[c]);
     Field3D out(dp.resolution(), 3, dp.bounds(), {"dimensional_profile", "detail_type", "density_scale"}, budget);
     for (int c = 0; c < 3; ++c) std::copy(src[c]->channel(sel[c]).begin(), src[c]->channel(sel[c]).end(), out.channel(c).begin());
+    return out;
+}
+
+Field3D blend_nvdf(const Field3D& a, const Field3D& b, double t, const MemoryBudget* budget) {
+    auto grid_text = [](const Field3D& f) {
+        const auto r = f.resolution();
+        const Box3d& bb = f.bounds();
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "%dx%dx%d over [%g, %g, %g] - [%g, %g, %g] m", r[0], r[1], r[2], bb.min[0], bb.min[1], bb.min[2], bb.max[0],
+                      bb.max[1], bb.max[2]);
+        return std::string(buf);
+    };
+    if (a.resolution() != b.resolution() || !(a.bounds() == b.bounds()))
+        throw Error("blend: the two sets must share one grid; a is " + grid_text(a) + ", b is " + grid_text(b) +
+                    " (resample one onto the other's grid with volume/transform)");
+    if (a.channels() != b.channels()) throw Error("blend: a has " + std::to_string(a.channels()) + " channels, b " + std::to_string(b.channels()));
+    for (int c = 0; c < a.channels(); ++c)
+        if (a.channel_name(c) != b.channel_name(c))
+            throw Error("blend: channel " + std::to_string(c) + " is '" + a.channel_name(c) + "' in a but '" + b.channel_name(c) + "' in b");
+    if (!std::isfinite(t)) throw Error("blend: the blend amount must be finite");
+    const float u = static_cast<float>(std::clamp(t, 0.0, 1.0));
+    std::vector<std::string> names;
+    for (int c = 0; c < a.channels(); ++c) names.push_back(a.channel_name(c));
+    Field3D out(a.resolution(), a.channels(), a.bounds(), names, budget);
+    for (int c = 0; c < a.channels(); ++c) {
+        const auto pa = a.channel(c), pb = b.channel(c);
+        auto po = out.channel(c);
+        if (a.channel_name(c) == "sdf" && u > 0.0f && u < 1.0f) {
+            for (size_t i = 0; i < po.size(); ++i) po[i] = std::min(pa[i], pb[i]);
+        } else {
+            // a (1 - t) + b t: exactly a at 0 and exactly b at 1.
+            for (size_t i = 0; i < po.size(); ++i) po[i] = pa[i] * (1.0f - u) + pb[i] * u;
+        }
+    }
     return out;
 }
 

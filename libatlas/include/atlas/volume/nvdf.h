@@ -54,4 +54,13 @@ struct ModelingChannels {
 Field3D assemble_modeling_nvdf(const Field3D& dimensional_profile, const Field3D& detail_type, const Field3D& density_scale,
                                const MemoryBudget* budget = nullptr, const ModelingChannels& channels = {});
 
+// One NVDF set turning into another (issue 43: a cloudscape blending into
+// another over a time range): every channel is a (1 - t) + b t, but a channel
+// named "sdf" is the distance to the union of both clouds, min(a, b), for
+// 0 < t < 1 (a's at t <= 0, b's at t >= 1): the blended cloud lies where
+// either does, and the renderer's empty-space skipping must never step over
+// it (a blended distance could). t is clamped to [0, 1]. Throws atlas::Error
+// when the grids (resolution, bounds) or the channel names differ.
+Field3D blend_nvdf(const Field3D& a, const Field3D& b, double t, const MemoryBudget* budget = nullptr);
+
 } // namespace atlas::volume
