@@ -154,7 +154,13 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
         session->load(a.positional[0]);
         apply_sets(*session, a, "preview");
         // A graph with a time range (docs/graph-format.md, "Time") is drawn at --time.
-        if (session->graph().time && a.has("--time")) session->set_time(po.time);
+        if (const auto& gt = session->graph().time; gt && a.has("--time")) {
+            if (po.time < gt->start || po.time > gt->end)
+                throw UsageError{"--time " + format_param_value(po.time) + ": " + a.positional[0] + "'s time runs from " + format_param_value(gt->start) +
+                                     " to " + format_param_value(gt->end) + " s",
+                                 "preview"};
+            session->set_time(po.time);
+        }
         prepared = preview::prepare_graph_preview(*session, po, how, a.positional[0]);
     } else {
         std::vector<std::filesystem::path> files(a.positional.begin(), a.positional.end());
@@ -201,6 +207,10 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
     const double time_step = a.has("--time-step") ? numbers(a.get("--time-step"), 1, "--time-step")[0]
                                                   : (timed ? 1.0 / session->graph().time->fps : 60.0);
     const double graph_time0 = timed ? session->graph().current_time : 0.0;
+    if (timed && graph_time0 + (frames - 1) * time_step > session->graph().time->end + 1e-9)
+        throw UsageError{"--frames " + std::to_string(frames) + " from " + format_param_value(graph_time0) + " s, " + format_param_value(time_step) +
+                             " s apart, runs past the graph's end at " + format_param_value(session->graph().time->end) + " s",
+                         "preview"};
     // A sequence can also be one animation and one contact sheet, staged and
     // committed with its frames.
     for (const char* opt : {"--animation", "--contact-sheet", "--fps", "--animation-quality"})

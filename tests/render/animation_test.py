@@ -134,6 +134,9 @@ with tempfile.TemporaryDirectory() as d:
     atlas_life = subprocess.run([ATLAS, "preview", LIFE, "--frames", "3", "--time", "40", "--size", "96x54", "--quiet", "-o",
                                  os.path.join(d, "p.png"), "--cache", os.path.join(d, "cache")], capture_output=True, text=True)
     check(atlas_life.returncode == 0, f"preview --frames of a timed graph: {atlas_life.stderr.strip()[-300:]}")
+    for args, what in ((["--time", "900"], "time runs from 0 to 480 s"), (["--frames", "30"], "runs past the graph's end at 480 s")):
+        r = subprocess.run([ATLAS, "preview", LIFE, *args, "--size", "32x18", "--quiet", "-o", os.path.join(d, "bad.png")], capture_output=True, text=True)
+        check(r.returncode == 2 and what in r.stderr, f"preview {' '.join(args)}: {r.stderr.strip()}")
     p = [png(os.path.join(d, f"p_{i:03d}.png")) for i in range(3)]
     check(not np.array_equal(p[0], p[1]) and not np.array_equal(p[1], p[2]), "the frames differ as the storm forms")
 
