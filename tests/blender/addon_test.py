@@ -420,7 +420,7 @@ def cycles_draws_what_atlas_previews():
     check(r.returncode == 0, f"atlas preview --reference: {r.stderr}")
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
-    scene.cycles.samples = 64
+    scene.cycles.samples = 16  # the mean over the cloud's ~1700 pixels: 64 gave the same ratio at four times the cost
     scene.cycles.use_denoising = False
     scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = w, h, 100
     scene.render.filter_size = 0.01
