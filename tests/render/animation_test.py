@@ -111,14 +111,17 @@ with tempfile.TemporaryDirectory() as d:
     check(m["time"] == {"start": 0, "end": 480, "fps": 0.05, "frames": 25}, f"the time range {m['time']}")
     first, later = set(m["frames"][0]["cooked"]), [set(f["cooked"]) for f in m["frames"][1:]]
     check({"rings", "coverage_noise"} <= first, f"frame 2 cooks everything: {sorted(first)}")
-    check(all(c == {"mesocyclone", "volume"} for c in later), f"later frames re-cook only the keyed tower and its bake: {[sorted(c) for c in later]}")
+    check(all(c == {"mesocyclone", "volume", "rings"} for c in later),
+          f"later frames re-cook only the keyed tower, its bake and the rings: {[sorted(c) for c in later]}")
     changes = {o["file"]: o["changes"] for o in m["outputs"]}
-    check(changes.get("superstorm_ndf_set.exr") is True and changes.get("vortex_ring_map.exr") is False, f"which outputs change: {changes}")
+    check(changes.get("superstorm_ndf_set.exr") is True and changes.get("superstorm_anvil.exr") is False, f"which outputs change: {changes}")
     f3 = {o["file"]: o for o in m["frames"][1]["outputs"]}
-    check(not f3["vortex_rings.json"]["changed"] and f3["superstorm_ndf_set.exr"]["changed"], "per frame: the rings unchanged, the set changed")
+    check(not f3["superstorm_anvil.exr"]["changed"] and f3["vortex_rings.json"]["changed"], "per frame: the anvil bias unchanged, the rings changed")
     check(all(os.path.exists(os.path.join(out, x["path"])) and os.path.getsize(os.path.join(out, x["path"])) == x["bytes"]
               for fr in m["frames"] for o in fr["outputs"] for x in o["files"]), "every listed file exists with its size")
     # The tower grows: its coverage sum rises from frame to frame (read with OpenImageIO).
+    rings = [json.load(open(os.path.join(out, f["folder"], "vortex_rings.json"))) for f in m["frames"]]
+    check(len({json.dumps(r, sort_keys=True) for r in rings}) == 3, "the rings' table follows the tower's radius")
     cov = []
     for f in m["frames"]:
         img = oiio.ImageInput.open(os.path.join(out, f["folder"], "superstorm_ndf_set.exr"))
