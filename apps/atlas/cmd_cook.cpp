@@ -179,6 +179,10 @@ int run_cook_frames(const Args& a, CookOptions o) {
                              "cook"};
     }
     if (!a.all("--output").empty()) o.outputs = a.all("--output");
+    // Inputs another graph writes (requires:) are cooked once, before the frames.
+    session.cook_requirements(o, [&](const GraphRequirement& r) {
+        if (!quiet) std::cerr << "atlas: " << a.positional[0] << " reads files " << r.graph.string() << " writes: cooking it into " << r.out.string() << " first\n";
+    });
     const std::filesystem::path out = o.out_dir;
     const int digits = std::max(4, int(std::to_string(total - 1).size()));
     ProgressBar bar(!quiet);
