@@ -191,6 +191,7 @@ int run_cook_frames(const Args& a, CookOptions o) {
                                {"frames", nlohmann::json::array()}};
     std::vector<std::pair<std::string, CookResult>> cooks;
     std::map<std::string, std::string> last_hashes; // output file -> its files' content hashes in the frame before
+    std::set<std::string> changing;                 // outputs whose bytes changed after the first frame
     for (int f = first; f <= last; ++f) {
         bar.begin_part(f - first, last - first + 1);
         const double t = g.time->at_frame(f);
@@ -227,8 +228,9 @@ int run_cook_frames(const Args& a, CookOptions o) {
                 hashes += file.hash + ";";
             }
             const auto prev = last_hashes.find(o2.file);
-            outputs.push_back({{"file", o2.file}, {"node", o2.node}, {"format", o2.format},
-                               {"changed", f == first || prev == last_hashes.end() || prev->second != hashes}, {"files", of}});
+            const bool changed = f == first || prev == last_hashes.end() || prev->second != hashes;
+            if (changed && f != first) changing.insert(o2.file);
+            outputs.push_back({{"file", o2.file}, {"node", o2.node}, {"format", o2.format}, {"changed", changed}, {"files", of}});
             last_hashes[o2.file] = hashes;
         }
         manifest["frames"].push_back(
@@ -239,18 +241,13 @@ int run_cook_frames(const Args& a, CookOptions o) {
         cooks.emplace_back(a.positional[0] + "@" + folder, std::move(r));
     }
     bar.finish();
-    // Each output once: its format and options (a DDS's encoding) and whether any frame changed it.
+    // Each output the frames wrote, once: its format and options (a DDS's
+    // encoding) and whether any frame after the first changed it.
     nlohmann::json outs = nlohmann::json::array();
-    for (const GraphOutput& go : g.outputs) {
-        if (!o.outputs.empty() && std::find(o.outputs.begin(), o.outputs.end(), go.file) == o.outputs.end() &&
-            std::find(o.outputs.begin(), o.outputs.end(), go.node) == o.outputs.end())
-            continue;
-        bool changes = false;
-        for (const auto& fr : manifest["frames"])
-            for (const auto& fo : fr["outputs"])
-                if (fo["file"] == go.file && fo["changed"] && fr["frame"] != first) changes = true;
-        outs.push_back({{"file", go.file}, {"node", go.node}, {"port", go.port}, {"format", go.format}, {"options", go.options}, {"changes", changes}});
-    }
+    for (const GraphOutput& go : g.outputs)
+        if (last_hashes.count(go.file))
+            outs.push_back({{"file", go.file}, {"node", go.node}, {"port", go.port}, {"format", go.format}, {"options", go.options},
+                            {"changes", changing.count(go.file) > 0}});
     manifest["outputs"] = outs;
     write_text_atomic((out / "frames.json").string(), manifest.dump(2) + "\n", "the frame manifest", {});
     if (a.has("--report")) write_text_atomic(a.get("--report"), combined_report_json(cooks), "the report", {});

@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <thread>
 #include <sstream>
 
@@ -55,14 +56,15 @@ bool is_graph(const std::string& f) {
 }
 
 // Writes into `staged` (a temporary path); the caller moves it into place.
-void write_picture(const Field2D& image, const std::filesystem::path& staged, double exposure) {
+// `shown`: the image already tone-mapped with `exposure`, when the caller has it.
+void write_picture(const Field2D& image, const std::filesystem::path& staged, double exposure, const Field2D* shown = nullptr) {
     auto ext = staged.extension().string();
     if (ext == ".exr") {
         io::ExrOptions o;
         o.channel_meaning = render::kLinearImageMeaning;
         io::write_exr(image, staged, o);
     } else {
-        io::write_image(render::tone_map(image, exposure), staged);
+        io::write_image(shown ? *shown : render::tone_map(image, exposure), staged);
     }
 }
 
@@ -293,13 +295,13 @@ int preview_once(const Args& a, std::vector<std::filesystem::path>& depends, std
             char suffix[32];
             std::snprintf(suffix, sizeof suffix, "_%03d", i);
             const std::filesystem::path name = out.stem().string() + suffix + out.extension().string();
-            write_picture(image, staged.stage(name), exposure);
+            // Tone-mapped once for the frame, the animation and the sheet.
+            std::optional<Field2D> shown;
+            if (animation || sheet) shown = render::tone_map(image, exposure);
+            write_picture(image, staged.stage(name), exposure, shown ? &*shown : nullptr);
             paths.push_back(out.parent_path() / name);
-            if (animation || sheet) {
-                const Field2D shown = render::tone_map(image, exposure);
-                if (animation) animation->add(shown);
-                if (sheet) sheet->add(i, shown);
-            }
+            if (animation) animation->add(*shown);
+            if (sheet) sheet->add(i, *shown);
         }
         // The animation and the sheet sit where they were asked for: staged
         // beside OUT when they share its folder, else each atomically.

@@ -59,19 +59,7 @@ LightGrid::LightGrid(const Box3d& bounds, Vec3i res, Vec3d sun_dir, const Densit
                 dens[size_t(z) * slab + size_t(y) * row + size_t(x)] = density(px, py, pz);
             }
     });
-    // 2. Toward the sky: a running sum down each column (midpoint rule).
-    sky_.assign(n, 0.0f);
-    parallel_for_index(res_[1], [&](int y) {
-        for (int x = 0; x < res_[0]; ++x) {
-            double acc = 0;
-            for (int z = res_[2] - 1; z >= 0; --z) {
-                const size_t i = size_t(z) * slab + size_t(y) * row + size_t(x);
-                sky_[i] = static_cast<float>(acc + 0.5 * dens[i] * voxel_[2]);
-                acc += dens[i] * voxel_[2];
-            }
-        }
-    });
-    // 3. Toward the sun: march the coarse density from each voxel centre.
+    // 2. Toward the sun: march the coarse density from each voxel centre.
     //    A sample whose trilinear cell has eight zero corners adds exactly 0,
     //    so it is skipped after a one-byte test (most of a sparse cloud's
     //    grid is empty; same bytes as sampling it).
