@@ -157,6 +157,25 @@ TEST(RenderPreviewNode, RendersAnNdfSetIn25DAsTheLibraryEntryDoes) {
     EXPECT_THROW(cook({}, {{"ndf", Field2DPtr(std::make_shared<Field2D>(wrong))}}), Error);
 }
 
+TEST(RenderPreviewEdge, WeatherSetsWrapAndStormsStayOneFeature) {
+    // Every NDF set carries a storm channel; an all-zero one is a weather
+    // map, which tiles (hzd_weather's horizon). Storm content, an anvil map or
+    // vortex rings (a lifecycle's frames before its storm forms) keep empty
+    // edges: no copies of the storm beyond the map.
+    auto set = std::make_shared<Field2D>(ndf::make_ndf_set({{8, 8}}, Box2d{{{0, 0}}, {{20000, 20000}}}, 1500, 4000, nullptr));
+    const int cov = set->find_channel("coverage"), storm = set->find_channel("superstorm_coverage");
+    ASSERT_GE(storm, 0);
+    for (float& v : set->channel(cov)) v = 0.6f;
+    render::LayerPreviewInputs in;
+    in.ndf = set;
+    EXPECT_EQ(render::layer_preview_scene(in).edge, render::MapEdge::Wrap);
+    render::LayerPreviewInputs with_anvil = in;
+    with_anvil.anvil = std::make_shared<const Field2D>(Field2D({{4, 4}}, 1, set->bounds(), {"anvil"}));
+    EXPECT_EQ(render::layer_preview_scene(with_anvil).edge, render::MapEdge::Empty);
+    set->at(storm, 4, 4) = 0.5f;
+    EXPECT_EQ(render::layer_preview_scene(in).edge, render::MapEdge::Empty);
+}
+
 TEST(PointLightSyntax, CommasOrSpacesSemicolonsBetweenLights) {
     const auto a = render::parse_point_lights("1,2,3,0.5,0.25,1,100; 4 5 6 1 1 1 2e3 50;;");
     ASSERT_EQ(a.size(), 2u);

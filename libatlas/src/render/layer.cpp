@@ -328,6 +328,11 @@ struct LayerIntegrator {
     const std::vector<PointLight>& lights; // point lights and flashes (lights.h)
     double light_core2;
     const LayerDiffusion* diffusion; // null unless physical with ms_diffusion
+    // In cloud a step is at most 2 detail texels / quality (58 m at the
+    // default 1200 m tile of 32 texels): the step that grows with distance
+    // (700 m at 35 km) sampled the detail noise's billows at random, a grain
+    // of 3-12/255 RMS against 16x the steps (docs/look.md).
+    double detail_step = std::numeric_limits<double>::infinity();
 
     // The ray from p toward the sun meets the ground sphere ahead of p.
     bool earth_hides_sun(const Vec3d& p) const {
@@ -423,6 +428,11 @@ struct LayerIntegrator {
         return std::min(std::max(max_step, 0.02 * td / step_quality), base_step * (1 + td / grow));
     }
 
+    // The cheap search's stride: half the step. At twice the step (1.4 km
+    // at 35 km) it stepped over the thin edges of lobes and small far clouds
+    // at random, a speckle along every silhouette.
+    static double search_stride(double step) { return 0.5 * step; }
+
     void trace(const Vec3d& o, const Vec3d& dir, float jitter, double rgb[3], double& trans, double& bg_weight_t, uint64_t& cheap,
                uint64_t& full, uint64_t& skipped) const {
         rgb[0] = rgb[1] = rgb[2] = 0;
@@ -433,7 +443,9 @@ struct LayerIntegrator {
         const detail::SunTerms st = detail::sun_terms(s, dot(dir, sun));
         const double ext = s.extinction;
         int steps = 0;
-        constexpr int kMaxSteps = 1024;
+        // A bound on a ray's work that a grazing ray through the layer (over
+        // 200 km of shell) at any quality stays under.
+        const int kMaxSteps = static_cast<int>(4096 * std::max(1.0, step_quality));
         for (int si = 0; si < nseg && steps < kMaxSteps; ++si) {
             double t = seg[2 * si];
             const double t_end = seg[2 * si + 1];
@@ -450,12 +462,12 @@ struct LayerIntegrator {
                 if (first) dt *= 0.5 + 0.5 * jitter; // jittered start
                 first = false;
                 if (searching) {
-                    // Cheap search at twice the step; step back on a hit.
+                    // Cheap search (search_stride); step back on a hit.
                     const Vec3d p = o + dir * t;
                     const double h = m.altitude(p);
                     if (use_envelope) {
                         const double skip = m.skip_distance(p, dir, h);
-                        if (skip > 2 * dt) {
+                        if (skip > search_stride(dt)) {
                             // Walk the search's own strides over the empty stretch
                             // without sampling: every stride whose sample point lies
                             // in it would have found nothing, so the march goes on
@@ -466,7 +478,7 @@ struct LayerIntegrator {
                             ++skipped;
                             bool ended = false;
                             for (;;) {
-                                const double len = std::min(2 * dt, t_end - t);
+                                const double len = std::min(search_stride(dt), t_end - t);
                                 if (!(t + 0.5 * len < end)) break; // this stride's sample may see cloud
                                 t += len;
                                 if (!(t < t_end && steps < kMaxSteps)) {
@@ -481,7 +493,7 @@ struct LayerIntegrator {
                             continue;
                         }
                     }
-                    const double len = std::min(2 * dt, t_end - t);
+                    const double len = std::min(search_stride(dt), t_end - t);
                     const Vec3d q = o + dir * (t + 0.5 * len);
                     ++cheap;
                     if (m.density(q, m.altitude(q), false) > 0) {
@@ -507,7 +519,7 @@ struct LayerIntegrator {
                 }
                 // Optically deep (under 10 % of the view left): what lies further
                 // adds at most that much, so it is marched at twice the step.
-                dt = std::min(dt, tau_cap);
+                dt = std::min({dt, tau_cap, detail_step});
                 if (trans < 0.1) dt *= 2;
                 dt = std::min(dt, t_end - t);
                 const double tm = t + 0.5 * dt;
@@ -555,7 +567,7 @@ struct LayerIntegrator {
                     const double w = trans * absorbed;
                     double glow[3] = {0, 0, 0};
                     if (!lights.empty())
-                        detail::point_light_radiance(s, lights, light_core2, p, dir,
+                        detail::point_light_radiance(s, lights, light_core2, p, dir, 0.5 * dt,
                                                      [&](const Vec3d& q, const Vec3d& d2, double len) { return light_depth(q, d2, len); }, glow);
                     for (int c = 0; c < 3; ++c) {
                         const double ls = sun_w * s.sun_colour[c] + sky_w * sky.light(c, sky_field) + glow[c];
@@ -690,7 +702,7 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
                        detail::normalized(settings.camera.position - model.centre()),
                        std::clamp(thickness / 96.0, 5.0, 60.0) / step_quality,
                        2500.0, // the step doubles every 2.5 km of distance
-                       400.0 / step_quality, // at most 400 m (the search strides twice that)
+                       400.0 / step_quality, // at most 400 m (the search strides half that)
                        step_quality,
                        std::clamp(thickness / 40.0, 20.0, 120.0),
                        scene.earth_radius,
@@ -705,6 +717,7 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
                        25.0, // a 5 m core keeps the inverse square finite at the light
                        diffusion.get()};
     // Six fixed directions in [-1, 1]^3 spread the light cone (the talk's noise kernel).
+    in.detail_step = 2.0 * model.detail_texel() / step_quality;
     for (int i = 0; i < 6; ++i)
         for (int a = 0; a < 3; ++a) in.cone_kernel[i][a] = 2.0 * hash_to_unit(hash_coords(0x636f6e65u, i, a)) - 1.0;
 

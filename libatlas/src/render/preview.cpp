@@ -86,10 +86,14 @@ LayerScene layer_preview_scene(const LayerPreviewInputs& in) {
     }
     if (in.sky_texture) layer.sky_layers.push_back(sky_layer_from(in.sky_texture, 0, 6000, tile_of(*in.sky_texture), 0.9));
     // A storm is one feature: no copies of it beyond the map. Weather maps tile.
-    // A map that carries a storm channel is a storm's, also at a time its storm
-    // has not formed yet (a lifecycle's first frame): the edge stays the same
-    // through a sequence.
-    layer.edge = layer.ndf->find_channel("superstorm_coverage") >= 0 ? MapEdge::Empty : MapEdge::Wrap;
+    // Every NDF set carries a storm channel (all zero in a weather map, so
+    // its presence says nothing); a storm's graph also gives an anvil map or
+    // vortex rings, which stay at frames where its storm has not formed yet
+    // (a lifecycle's first and last): the edge holds through a sequence.
+    bool storm = in.anvil != nullptr || in.vortex_table != nullptr;
+    if (const int cs = layer.ndf->find_channel("superstorm_coverage"); cs >= 0 && !storm)
+        for (float v : layer.ndf->channel(cs)) storm = storm || v > 0;
+    layer.edge = storm ? MapEdge::Empty : MapEdge::Wrap;
     validate_layer_scene(layer);
     return layer;
 }

@@ -166,8 +166,8 @@ struct Integrator {
 
     // In-scattered radiance weight per channel from every point light at p
     // (inverse square, window, Beer toward the light, dual-lobe HG).
-    void point_light_radiance(const Vec3d& p, const Vec3d& view, double out[3]) const {
-        detail::point_light_radiance(s, lights, light_core2, p, view, [&](const Vec3d& q, const Vec3d& d, double len) { return light_depth(q, d, len); },
+    void point_light_radiance(const Vec3d& p, const Vec3d& view, double half_step, double out[3]) const {
+        detail::point_light_radiance(s, lights, light_core2, p, view, half_step, [&](const Vec3d& q, const Vec3d& d, double len) { return light_depth(q, d, len); },
                                      out);
     }
 
@@ -226,7 +226,7 @@ struct Integrator {
                     for (int c = 0; c < 3; ++c) rgb[c] += w * (sun_w * s.sun_colour[c] + sky_w * sky.light(c, sky_field));
                     if constexpr (kLights) {
                         double glow[3];
-                        point_light_radiance(p, dir, glow);
+                        point_light_radiance(p, dir, 0.5 * dt, glow);
                         for (int c = 0; c < 3; ++c) rgb[c] += w * glow[c];
                     }
                     trans *= std::exp(-sigma * dt);
