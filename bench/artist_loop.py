@@ -63,14 +63,15 @@ def main():
     ap.add_argument("--size", default="960x540")
     ap.add_argument("--proxy", type=int, default=4)
     ap.add_argument("--pixel-size", type=int, default=1, help="the preview's pixel_size for the proxy steps (full steps: 1)")
+    ap.add_argument("--quality", type=float, default=1.0, help="the preview's quality for the proxy steps (0.5: the 2.5D draft)")
     ap.add_argument("--atlas", default=None, help="the atlas CLI for the cold cook (default: next to the module's build)")
     ap.add_argument("--graphs", nargs="*", default=None)
     a = ap.parse_args()
     w, h = (int(x) for x in a.size.split("x"))
     opts = {"size": (w, h)}
-    proxy_opts = {"size": (w, h), "pixel_size": a.pixel_size}
+    proxy_opts = {"size": (w, h), "pixel_size": a.pixel_size, "quality": a.quality}
     cli = a.atlas or str(pathlib.Path(atlas.__file__).resolve().parents[2] / "bin" / "atlas")
-    print(f"# load {open('/proc/loadavg').read().split()[:3]}, {os.cpu_count()} cores, {a.size}, proxy {a.proxy}, pixel size {a.pixel_size} at the proxy")
+    print(f"# load {open('/proc/loadavg').read().split()[:3]}, {os.cpu_count()} cores, {a.size}, proxy {a.proxy}, pixel size {a.pixel_size} and quality {a.quality} at the proxy")
     print("graph | step | seconds | RSS MB | peak MB")
     print("---|---|---|---|---")
     for graph, edits in CASES:
