@@ -87,6 +87,35 @@ void BM_Peer3D_Atlas(benchmark::State& state) {
 BENCHMARK(BM_Peer3D_Atlas)->ArgsProduct({{int64_t(Kernel::Gradient), int64_t(Kernel::Worley)}, {32, 64, 128}, {1, 2, 3}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Peer3D_Atlas)->Name("BM_Peer3D_Atlas_Smoke")->Args({0, 8, 0})->Args({2, 8, 0});
 
+// Perlin on lattices too large to tabulate (issue 49: period > 128 per axis, or an
+// FBM's high octaves): BM_GradientLattice/<period>/<octaves>/<path>, 128^3, one
+// thread; period 128 is tabulated, 256 hashed; period 8 with 8 octaves reaches
+// 1024 cells per edge at the last octave.
+void BM_GradientLattice(benchmark::State& state) {
+    const int period = int(state.range(0)), octaves = int(state.range(1));
+    const SimdPath p = state.range(2) > 0 ? SimdPath(state.range(2)) : SimdPath::Auto;
+    const auto paths = supported_simd_paths();
+    if (p != SimdPath::Auto && std::find(paths.begin(), paths.end(), p) == paths.end()) {
+        state.SkipWithError("SIMD path not supported here");
+        return;
+    }
+    set_simd_path(p);
+    const int n = 128;
+    Field3D f({{n, n, n}}, 1, Box3d{{{0, 0, 0}}, {{1, 1, 1}}});
+    NoiseSpec s = kernel_spec(Kernel::Gradient);
+    s.period = {{period, period, period}};
+    s.fractal.octaves = octaves;
+    tbb::task_arena arena(1);
+    for (auto _ : state) {
+        arena.execute([&] { fill_noise(f, 0, s); });
+        benchmark::DoNotOptimize(f.channel(0).data());
+    }
+    state.SetItemsProcessed(state.iterations() * int64_t(n) * n * n);
+    state.SetLabel("period " + std::to_string(period) + ", " + std::to_string(octaves) + " octave(s), " + simd_path_name(simd_path()));
+    set_simd_path(SimdPath::Auto);
+}
+BENCHMARK(BM_GradientLattice)->ArgsProduct({{128, 256}, {1}, {1, 2, 3}})->Args({8, 8, 1})->Args({8, 8, 2})->Args({8, 8, 3})->Unit(benchmark::kMillisecond);
+
 #if defined(ATLAS_BENCH_FNL)
 } // namespace
 namespace atlas_peer {

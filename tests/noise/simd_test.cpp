@@ -4,6 +4,7 @@
 // lookups (hashed lattices) at huge and tiny coordinates; a few million
 // samples per path.
 #include "noise_test_util.h"
+#include "../../libatlas/src/noise/lattice.h"
 
 #include "atlas/core/error.h"
 #include "atlas/noise/recipes.h"
@@ -155,3 +156,30 @@ TEST(NoiseSimd, RecipesHaveTheSameBytesOnEveryPath) {
 
 } // namespace
 } // namespace atlas::noise
+
+// The hashed lattices' corners (corner_bits3, shared by the scalar cell cache and
+// every SIMD path) against lattice_bits itself, corner by corner: the chain
+// shared between corners must give hash_coords' bits, also at negative and
+// huge coordinates; first_i = 1 leaves the x0 face as the caller had it.
+TEST(NoiseLattice, SharedHashChainGivesEachCornersOwnBits) {
+    using namespace atlas::noise::detail;
+    const int coords[] = {0, 1, 7, 127, 128, 255, -1, -129, 1 << 20, 2147483647, -2147483647 - 1};
+    size_t checked = 0;
+    for (uint32_t seed : {0u, 1u, 0xDEADBEEFu})
+        for (uint32_t stream : {0u, 3u})
+            for (int a : coords)
+                for (int b : coords) {
+                    const int xs[2] = {a, b}, ys[2] = {b, a ^ 5}, zs[2] = {a / 3, b / 2};
+                    int out[8];
+                    corner_bits3(seed, stream, xs, ys, zs, 15u, 0, out);
+                    for (int k = 0; k < 8; ++k) {
+                        const uint64_t want = lattice_bits(seed, stream, xs[k & 1], ys[(k >> 1) & 1], zs[k >> 2]) & 15u;
+                        ASSERT_EQ(uint64_t(out[k]), want) << seed << " " << a << " " << b << " corner " << k;
+                        ++checked;
+                    }
+                    int kept[8] = {-1, -1, -1, -1, -1, -1, -1, -1};
+                    corner_bits3(seed, stream, xs, ys, zs, 15u, 1, kept);
+                    for (int k = 0; k < 8; ++k) EXPECT_EQ(kept[k], k % 2 == 0 ? -1 : out[k]) << k;
+                }
+    EXPECT_EQ(checked, size_t(3 * 2 * 11 * 11 * 8));
+}

@@ -63,8 +63,13 @@ void worley_octave(const Lattice<D>& L, const std::array<const double*, D>& u, s
 
 uint64_t view_bits(const void* l, int x, int y, int z) { return static_cast<const Lattice<3>*>(l)->bits(x, y, z); }
 
+void view_corners(const void* l, const int (&xs)[2], const int (&ys)[2], const int (&zs)[2], int first_i, int (&out)[8]) {
+    const auto& L = *static_cast<const Lattice<3>*>(l);
+    corner_bits3(L.seed(), L.stream(), xs, ys, zs, 15u, first_i, out);
+}
+
 LatticeView view_of(const Lattice<3>& L) {
-    return {L.table(), L.period()[0], L.period()[1], L.period()[2], &L, &view_bits};
+    return {L.table(), L.period()[0], L.period()[1], L.period()[2], &L, &view_bits, &view_corners};
 }
 
 // The SIMD path of a 3D octave (simd.h): true when it wrote out.

@@ -31,8 +31,13 @@ struct GradCache3 {
         cy = sy.cell;
         cz = sz.cell;
         const int xs[2] = {sx.cell, sx.next}, ys[2] = {sy.cell, sy.next}, zs[2] = {sz.cell, sz.next};
+        int idx[8];
+        if (L.table())
+            for (int c = 0; c < 8; ++c) idx[c] = int(L.bits(xs[c & 1], ys[(c >> 1) & 1], zs[c >> 2]) & 15u);
+        else
+            corner_bits3(L.seed(), L.stream(), xs, ys, zs, 15u, 0, idx);
         for (int c = 0; c < 8; ++c) {
-            const float* gr = kGrad3[L.bits(xs[c & 1], ys[(c >> 1) & 1], zs[c >> 2]) & 15u];
+            const float* gr = kGrad3[idx[c]];
             g[c][0] = gr[0];
             g[c][1] = gr[1];
             g[c][2] = gr[2];

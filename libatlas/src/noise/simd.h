@@ -22,6 +22,9 @@ struct LatticeView {
     int px = 1, py = 1, pz = 1;
     const void* lattice = nullptr;
     uint64_t (*bits)(const void* lattice, int x, int y, int z) = nullptr;
+    // A hashed lattice's cell corners (corner_bits3 of lattice.h, & 15), compiled
+    // with the baseline flags like bits: no inline code is shared with the ISA files.
+    void (*corners)(const void* lattice, const int (&xs)[2], const int (&ys)[2], const int (&zs)[2], int first_i, int (&out)[8]) = nullptr;
 };
 
 // One ISA's kernels. u[a][i] * scale is sample i's lattice coordinate on axis

@@ -67,13 +67,16 @@ constexpr uint64_t mix64(uint64_t x) {
 // Deterministic random bits from a seed and integer coordinates. This is the
 // only source of randomness Atlas uses: results never depend on thread count,
 // tile split or evaluation order.
+// hash_coords as a chain of steps (seed, x, y, z, w), so a caller hashing
+// neighbouring points can share the steps of their common prefix.
+constexpr uint64_t hash_begin(uint32_t seed) { return mix64(seed ^ 0xA0761D6478BD642Full); }
+constexpr uint64_t hash_step_x(uint64_t h, int32_t x) { return mix64(h ^ static_cast<uint32_t>(x)); }
+constexpr uint64_t hash_step_y(uint64_t h, int32_t y) { return mix64(h ^ (static_cast<uint64_t>(static_cast<uint32_t>(y)) << 21)); }
+constexpr uint64_t hash_step_z(uint64_t h, int32_t z) { return mix64(h ^ (static_cast<uint64_t>(static_cast<uint32_t>(z)) << 42)); }
+constexpr uint32_t hash_end(uint64_t h, uint32_t w) { return static_cast<uint32_t>(mix64(h ^ w) >> 32); }
+
 constexpr uint32_t hash_coords(uint32_t seed, int32_t x, int32_t y = 0, int32_t z = 0, uint32_t w = 0) {
-    uint64_t h = mix64(seed ^ 0xA0761D6478BD642Full);
-    h = mix64(h ^ static_cast<uint32_t>(x));
-    h = mix64(h ^ (static_cast<uint64_t>(static_cast<uint32_t>(y)) << 21));
-    h = mix64(h ^ (static_cast<uint64_t>(static_cast<uint32_t>(z)) << 42));
-    h = mix64(h ^ w);
-    return static_cast<uint32_t>(h >> 32);
+    return hash_end(hash_step_z(hash_step_y(hash_step_x(hash_begin(seed), x), y), z), w);
 }
 
 // Uniform float in [0, 1) from hash bits (24 bits of mantissa).
