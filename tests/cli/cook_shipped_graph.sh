@@ -15,7 +15,7 @@ rm -rf "$work/graphs/cumulus_out"
 cd "$work"
 quick=(--set cloud.resolution=[32,32,32] --set cloud.dx=125)
 case "$graph" in
-  graphs/cumulus_growth.yaml|graphs/periodic_cumulus_field.yaml)   # solver graphs: their documented quick size
+  graphs/cumulus_growth.yaml|graphs/periodic_cumulus_field.yaml|graphs/cumulus_sequence.yaml)   # solver graphs: their quick size
     exec "$atlas" cook "$graph" --out out --no-cache --quiet "${quick[@]}" ;;
   graphs/cumulus_cloudscape.yaml|graphs/cumulus_side_view.yaml)
     "$atlas" cook graphs/cumulus_growth.yaml --out graphs/cumulus_out --no-cache --quiet "${quick[@]}" >/dev/null ;;
