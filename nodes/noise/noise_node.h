@@ -5,6 +5,7 @@
 #include "atlas/graph/node.h"
 #include "common/grid.h"
 #include "atlas/noise/fill.h"
+#include "atlas/noise/loop.h"
 
 #include <string>
 
@@ -37,6 +38,9 @@ inline void declare_common(NodeDeclaration& d, Vec3i period = {{4, 4, 4}}) {
     d.param_float2("out_range", {{0, 1}}).describe("remap target range (also the normalize target)");
     d.param_bool("clamp", true).describe("clamp remapped values to out_range");
     d.param_bool("normalize", false).describe("stretch the measured min..max to out_range (use the full range)");
+    d.param_float3("loop_shift", {{0, 0, 0}}).with_unit("cells")
+        .describe("a loop in time (docs/noise.md, \"Loops\"): how far the pattern drifts over one loop while it is crossfaded into the next; 0: no loop");
+    d.param_float("loop_phase", 0).range(0, 1).describe("where in the loop (key it from 0 to 1 over the loop's time; 0 and 1 give the same field)");
 }
 
 // Reads the common parameters into `spec` (kernel-specific fields already
@@ -66,6 +70,17 @@ inline void cook_noise(CookContext& ctx, noise::NoiseSpec spec) {
     // Library errors need no wrapping: the evaluator prefixes them with the node.
     spec.validate(two_d ? 2 : 3);
     const int comps = noise::noise_components(spec.kernel, two_d ? 2 : 3);
+    // A loop in time (atlas/noise/loop.h): this field shifted by phase * D, crossfaded
+    // into the one shifted by (phase - 1) * D.
+    const Vec3d shift = ctx.get_float3("loop_shift");
+    const double phase = ctx.get_float("loop_phase");
+    const bool looped = shift[0] != 0 || shift[1] != 0 || shift[2] != 0;
+    noise::NoiseSpec next = spec;
+    if (looped)
+        for (int a = 0; a < 3; ++a) {
+            spec.offset[a] += phase * shift[a];
+            next.offset[a] += (phase - 1) * shift[a];
+        }
     // A tiled cook's window of the grid (docs/scale.md), else the whole grid.
     const TileWindow* w = ctx.window();
     const noise::FillWindow fw = w ? noise::FillWindow{w->x0, w->y0, res[0], res[1]} : noise::FillWindow{0, 0, res[0], res[1]};
@@ -75,6 +90,11 @@ inline void cook_noise(CookContext& ctx, noise::NoiseSpec spec) {
         if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in x and y");
         auto f = ctx.make_field2d(wres, comps, w ? w->bounds() : box);
         noise::fill_noise(*f, 0, spec, &ctx.progress_sink(), &fw);
+        if (looped) {
+            Field2D g(f->resolution(), comps, f->bounds(), f->channel_names(), &ctx.budget());
+            noise::fill_noise(g, 0, next, nullptr, &fw);
+            for (int c = 0; c < comps; ++c) noise::loop_crossfade(f->channel(c), g.channel(c), phase);
+        }
         ctx.set_output("out", Field2DPtr(f));
     } else {
         Box3d box{lo, hi};
@@ -82,6 +102,11 @@ inline void cook_noise(CookContext& ctx, noise::NoiseSpec spec) {
         if (w) box = {{{w->bounds().min[0], w->bounds().min[1], lo[2]}}, {{w->bounds().max[0], w->bounds().max[1], hi[2]}}};
         auto f = ctx.make_field3d({{wres[0], wres[1], res[2]}}, comps, box);
         noise::fill_noise(*f, 0, spec, &ctx.progress_sink(), &fw);
+        if (looped) {
+            Field3D g(f->resolution(), comps, f->bounds(), f->channel_names(), &ctx.budget());
+            noise::fill_noise(g, 0, next, nullptr, &fw);
+            for (int c = 0; c < comps; ++c) noise::loop_crossfade(f->channel(c), g.channel(c), phase);
+        }
         ctx.set_output("out", Field3DPtr(f));
     }
 }
