@@ -26,6 +26,19 @@ NoiseSpec kernel_spec(Kernel k) {
     return s;
 }
 
+// Selects the SIMD path a benchmark asks for (0 = auto); false (and the
+// benchmark skipped) when this machine lacks it.
+bool use_path(benchmark::State& state, int64_t path) {
+    const SimdPath p = path > 0 ? SimdPath(path) : SimdPath::Auto;
+    const auto paths = supported_simd_paths();
+    if (p != SimdPath::Auto && std::find(paths.begin(), paths.end(), p) == paths.end()) {
+        state.SkipWithError("SIMD path not supported here");
+        return false;
+    }
+    set_simd_path(p);
+    return true;
+}
+
 // state.range(0): kernel, range(1): threads (0 = all), range(2): edge,
 // range(3): SimdPath (0 = auto; ATLAS_SIMD also selects it); always given, since
 // reading an argument past the registered ones reads past Benchmark's vector.
@@ -33,13 +46,7 @@ void BM_Kernel3D(benchmark::State& state) {
     const Kernel k = Kernel(state.range(0));
     const int threads = state.range(1) == 0 ? tbb::info::default_concurrency() : int(state.range(1));
     const int n = int(state.range(2));
-    const SimdPath path = state.range(3) > 0 ? SimdPath(state.range(3)) : SimdPath::Auto;
-    const auto paths = supported_simd_paths();
-    if (path != SimdPath::Auto && std::find(paths.begin(), paths.end(), path) == paths.end()) {
-        state.SkipWithError("SIMD path not supported here");
-        return;
-    }
-    set_simd_path(path);
+    if (!use_path(state, state.range(3))) return;
     Field3D f({{n, n, n}}, noise_components(k, 3), Box3d{{{0, 0, 0}}, {{1, 1, 1}}});
     const NoiseSpec s = kernel_spec(k);
     tbb::task_arena arena(threads);
@@ -66,13 +73,7 @@ BENCHMARK(BM_Kernel3D)->Name("BM_Kernel3D_Smoke")->Apply([](auto* b) { kernel_ar
 // Kernels: 0 Perlin, 2 Worley F1 Euclidean (Kernel enum values).
 void BM_Peer3D_Atlas(benchmark::State& state) {
     const int64_t k = state.range(0), n = state.range(1), path = state.range(2);
-    const SimdPath p = path > 0 ? SimdPath(path) : SimdPath::Auto;
-    const auto paths = supported_simd_paths();
-    if (p != SimdPath::Auto && std::find(paths.begin(), paths.end(), p) == paths.end()) {
-        state.SkipWithError("SIMD path not supported here");
-        return;
-    }
-    set_simd_path(p);
+    if (!use_path(state, path)) return;
     Field3D f({{int(n), int(n), int(n)}}, 1, Box3d{{{0, 0, 0}}, {{1, 1, 1}}});
     const NoiseSpec s = kernel_spec(Kernel(k));
     tbb::task_arena arena(1);
@@ -93,13 +94,7 @@ BENCHMARK(BM_Peer3D_Atlas)->Name("BM_Peer3D_Atlas_Smoke")->Args({0, 8, 0})->Args
 // 1024 cells per edge at the last octave.
 void BM_GradientLattice(benchmark::State& state) {
     const int period = int(state.range(0)), octaves = int(state.range(1));
-    const SimdPath p = state.range(2) > 0 ? SimdPath(state.range(2)) : SimdPath::Auto;
-    const auto paths = supported_simd_paths();
-    if (p != SimdPath::Auto && std::find(paths.begin(), paths.end(), p) == paths.end()) {
-        state.SkipWithError("SIMD path not supported here");
-        return;
-    }
-    set_simd_path(p);
+    if (!use_path(state, state.range(2))) return;
     const int n = 128;
     Field3D f({{n, n, n}}, 1, Box3d{{{0, 0, 0}}, {{1, 1, 1}}});
     NoiseSpec s = kernel_spec(Kernel::Gradient);
