@@ -445,8 +445,8 @@ struct LayerIntegrator {
         int steps = 0;
         // A bound on a ray's work that a grazing ray through the layer (over
         // 200 km of shell) at any quality stays under.
-        const int kMaxSteps = static_cast<int>(4096 * std::max(1.0, step_quality));
-        for (int si = 0; si < nseg && steps < kMaxSteps; ++si) {
+        const int max_steps = static_cast<int>(4096 * std::max(1.0, step_quality));
+        for (int si = 0; si < nseg && steps < max_steps; ++si) {
             double t = seg[2 * si];
             const double t_end = seg[2 * si + 1];
             bool first = true, searching = true;
@@ -456,7 +456,7 @@ struct LayerIntegrator {
             // storm whose mean free path is 25 m put each pixel's surface at a
             // random depth, a grain that 16x the samples did not show.
             double tau_cap = std::numeric_limits<double>::infinity();
-            while (t < t_end && steps < kMaxSteps) {
+            while (t < t_end && steps < max_steps) {
                 ++steps;
                 double dt = step_at(t, seg[0]);
                 if (first) dt *= 0.5 + 0.5 * jitter; // jittered start
@@ -481,7 +481,7 @@ struct LayerIntegrator {
                                 const double len = std::min(search_stride(dt), t_end - t);
                                 if (!(t + 0.5 * len < end)) break; // this stride's sample may see cloud
                                 t += len;
-                                if (!(t < t_end && steps < kMaxSteps)) {
+                                if (!(t < t_end && steps < max_steps)) {
                                     ended = true; // where the march would have ended
                                     break;
                                 }
@@ -716,8 +716,8 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
                        lights,
                        25.0, // a 5 m core keeps the inverse square finite at the light
                        diffusion.get()};
-    // Six fixed directions in [-1, 1]^3 spread the light cone (the talk's noise kernel).
     in.detail_step = 2.0 * model.detail_texel() / step_quality;
+    // Six fixed directions in [-1, 1]^3 spread the light cone (the talk's noise kernel).
     for (int i = 0; i < 6; ++i)
         for (int a = 0; a < 3; ++a) in.cone_kernel[i][a] = 2.0 * hash_to_unit(hash_coords(0x636f6e65u, i, a)) - 1.0;
 
