@@ -3,6 +3,7 @@
 #include "progress_bar.h"
 
 #include "atlas/core/files.h"
+#include "atlas/core/hash.h"
 #include "atlas/core/memory.h"
 #include "atlas/graph/evaluator.h"
 #include "atlas/graph/tiling.h"
@@ -138,6 +139,42 @@ int run_cook_tiled(const Args& a, CookOptions o) {
     for (const auto& p : r.written) std::cout << p.string() << "\n";
     return 0;
 }
+// A frame's output value in frames.json: a field's bounds and the channels the
+// file holds (its `channels` option, else all), each with whether it changed
+// since the frame before (`previous`: that frame's channel hashes, updated;
+// in the first frame every channel counts as changed).
+void describe_field_value(const Value& v, const std::string& channels_option, bool first, std::vector<Hash128>& previous, nlohmann::json& entry) {
+    std::set<std::string> wanted;
+    for (std::stringstream ss(channels_option); ss.good();) {
+        std::string name;
+        std::getline(ss, name, ',');
+        name.erase(0, name.find_first_not_of(' '));
+        name.erase(name.find_last_not_of(' ') + 1);
+        if (!name.empty()) wanted.insert(name);
+    }
+    auto describe = [&](const auto& field, std::vector<double> lo, std::vector<double> hi) {
+        entry["bounds"] = {{"min", lo}, {"max", hi}};
+        std::vector<Hash128> now;
+        nlohmann::json channels = nlohmann::json::array();
+        for (int c = 0; c < field.channels(); ++c) {
+            now.push_back(Hasher().add_floats(field.channel(c)).finish());
+            const std::string& name = field.channel_names()[size_t(c)];
+            if (!wanted.empty() && !wanted.count(name)) continue;
+            const bool changed = first || previous.size() != size_t(field.channels()) || !(previous[size_t(c)] == now.back());
+            channels.push_back({{"name", name}, {"changed", changed}});
+        }
+        entry["channels"] = channels;
+        previous = std::move(now);
+    };
+    if (const auto* f3 = std::get_if<Field3DPtr>(&v); f3 && *f3) {
+        const Box3d b = (*f3)->bounds();
+        describe(**f3, {b.min[0], b.min[1], b.min[2]}, {b.max[0], b.max[1], b.max[2]});
+    } else if (const auto* f2 = std::get_if<Field2DPtr>(&v); f2 && *f2) {
+        const Box2d b = (*f2)->bounds();
+        describe(**f2, {b.min[0], b.min[1]}, {b.max[0], b.max[1]});
+    }
+}
+
 } // namespace
 
 // `atlas cook GRAPH --frames A:B`: the graph's time sequence (its `time:` block),
@@ -191,6 +228,7 @@ int run_cook_frames(const Args& a, CookOptions o) {
                                {"frames", nlohmann::json::array()}};
     std::vector<std::pair<std::string, CookResult>> cooks;
     std::map<std::string, std::string> last_hashes; // output file -> its files' content hashes in the frame before
+    std::map<std::string, std::vector<Hash128>> last_channels; // output file -> its value's channel hashes in the frame before
     std::set<std::string> changing;                 // outputs whose bytes changed after the first frame
     for (int f = first; f <= last; ++f) {
         bar.begin_part(f - first, last - first + 1);
@@ -230,7 +268,15 @@ int run_cook_frames(const Args& a, CookOptions o) {
             const auto prev = last_hashes.find(o2.file);
             const bool changed = f == first || prev == last_hashes.end() || prev->second != hashes;
             if (changed && f != first) changing.insert(o2.file);
-            outputs.push_back({{"file", o2.file}, {"node", o2.node}, {"format", o2.format}, {"changed", changed}, {"files", of}});
+            nlohmann::json entry = {{"file", o2.file}, {"node", o2.node}, {"format", o2.format}, {"changed", changed}, {"files", of}};
+            // A field's world bounds and which of its channels differ from the frame
+            // before (all of them in the first frame): what a streaming engine places
+            // and re-uploads. The value is the session's, in memory.
+            std::string channels_option;
+            for (const GraphOutput& go : g.outputs)
+                if (go.file == o2.file && go.options.count("channels")) channels_option = go.options.at("channels");
+            describe_field_value(session.get(o2.node, o2.port, fo), channels_option, f == first, last_channels[o2.file], entry);
+            outputs.push_back(std::move(entry));
             last_hashes[o2.file] = hashes;
         }
         manifest["frames"].push_back(

@@ -117,6 +117,13 @@ with tempfile.TemporaryDirectory() as d:
     check(changes.get("superstorm_ndf_set.exr") is True and changes.get("superstorm_anvil.exr") is False, f"which outputs change: {changes}")
     f3 = {o["file"]: o for o in m["frames"][1]["outputs"]}
     check(not f3["superstorm_anvil.exr"]["changed"] and f3["vortex_rings.json"]["changed"], "per frame: the anvil bias unchanged, the rings changed")
+    # Per channel (what an engine re-uploads) and the world bounds.
+    ch = {o["file"]: {c["name"]: c["changed"] for c in o["channels"]} for o in m["frames"][1]["outputs"]}
+    check(ch["superstorm_anvil.exr"] == {"anvil_bias": False, "anvil_lift": False}, f"the anvil's channels unchanged: {ch['superstorm_anvil.exr']}")
+    check(ch["superstorm_ndf_set.exr"]["coverage"] and not ch["superstorm_ndf_set.exr"]["precipitation"], f"the set's coverage changes, its rain does not: {ch['superstorm_ndf_set.exr']}")
+    check(sorted(ch["superstorm_coverage_type_bottomtype.png"]) == ["bottom_type", "coverage", "type"], "a PNG lists the channels it holds")
+    check(all(all(c["changed"] for c in o["channels"]) for o in m["frames"][0]["outputs"]), "in the first frame every channel counts as changed")
+    check(f3["superstorm_ndf_set.exr"]["bounds"] == {"min": [0.0, 0.0], "max": [40000.0, 40000.0]}, f"the set's bounds: {f3['superstorm_ndf_set.exr'].get('bounds')}")
     check(all(os.path.exists(os.path.join(out, x["path"])) and os.path.getsize(os.path.join(out, x["path"])) == x["bytes"]
               for fr in m["frames"] for o in fr["outputs"] for x in o["files"]), "every listed file exists with its size")
     # The tower grows: its coverage sum rises from frame to frame (read with OpenImageIO).
