@@ -7,6 +7,7 @@
 #include "atlas/core/memory.h"
 #include "atlas/graph/evaluator.h"
 #include "atlas/graph/tiling.h"
+#include "atlas/io/output_options.h"
 
 #include <nlohmann/json.hpp>
 
@@ -139,32 +140,34 @@ int run_cook_tiled(const Args& a, CookOptions o) {
     for (const auto& p : r.written) std::cout << p.string() << "\n";
     return 0;
 }
-// A frame's output value in frames.json: a field's bounds and the channels the
-// file holds (its `channels` option, else all), each with whether it changed
-// since the frame before (`previous`: that frame's channel hashes, updated;
-// in the first frame every channel counts as changed).
-void describe_field_value(const Value& v, const std::string& channels_option, bool first, std::vector<Hash128>& previous, nlohmann::json& entry) {
-    std::set<std::string> wanted;
-    for (std::stringstream ss(channels_option); ss.good();) {
-        std::string name;
-        std::getline(ss, name, ',');
-        name.erase(0, name.find_first_not_of(' '));
-        name.erase(name.find_last_not_of(' ') + 1);
-        if (!name.empty()) wanted.insert(name);
-    }
+// A field's content hash per channel (none for other values): what frames.json
+// compares between frames.
+std::vector<Hash128> channel_hashes(const Value& v) {
+    std::vector<Hash128> h;
+    auto add = [&](const auto& field) {
+        for (int c = 0; c < field.channels(); ++c) h.push_back(Hasher().add_floats(field.channel(c)).finish());
+    };
+    if (const auto* f3 = std::get_if<Field3DPtr>(&v); f3 && *f3) add(**f3);
+    if (const auto* f2 = std::get_if<Field2DPtr>(&v); f2 && *f2) add(**f2);
+    return h;
+}
+
+// A frame's output value in frames.json: a field's world bounds and the
+// channels the file holds (`wanted`, its `channels` option; empty: all), each
+// with whether its hash differs from `before` (the frame before's; null in the
+// first frame, where every channel counts as changed).
+void describe_field_value(const Value& v, const std::vector<std::string>& wanted, const std::vector<Hash128>& now,
+                          const std::vector<Hash128>* before, nlohmann::json& entry) {
     auto describe = [&](const auto& field, std::vector<double> lo, std::vector<double> hi) {
         entry["bounds"] = {{"min", lo}, {"max", hi}};
-        std::vector<Hash128> now;
         nlohmann::json channels = nlohmann::json::array();
         for (int c = 0; c < field.channels(); ++c) {
-            now.push_back(Hasher().add_floats(field.channel(c)).finish());
             const std::string& name = field.channel_names()[size_t(c)];
-            if (!wanted.empty() && !wanted.count(name)) continue;
-            const bool changed = first || previous.size() != size_t(field.channels()) || !(previous[size_t(c)] == now.back());
+            if (!wanted.empty() && std::find(wanted.begin(), wanted.end(), name) == wanted.end()) continue;
+            const bool changed = !before || before->size() != now.size() || !((*before)[size_t(c)] == now[size_t(c)]);
             channels.push_back({{"name", name}, {"changed", changed}});
         }
         entry["channels"] = channels;
-        previous = std::move(now);
     };
     if (const auto* f3 = std::get_if<Field3DPtr>(&v); f3 && *f3) {
         const Box3d b = (*f3)->bounds();
@@ -228,7 +231,9 @@ int run_cook_frames(const Args& a, CookOptions o) {
                                {"frames", nlohmann::json::array()}};
     std::vector<std::pair<std::string, CookResult>> cooks;
     std::map<std::string, std::string> last_hashes; // output file -> its files' content hashes in the frame before
-    std::map<std::string, std::vector<Hash128>> last_channels; // output file -> its value's channel hashes in the frame before
+    // node.port -> its value's channel hashes, in the frame before and in this one
+    // (outputs of one value, an EXR and a PNG of the same set, hash it once).
+    std::map<std::string, std::vector<Hash128>> last_channels, channels_now;
     std::set<std::string> changing;                 // outputs whose bytes changed after the first frame
     for (int f = first; f <= last; ++f) {
         bar.begin_part(f - first, last - first + 1);
@@ -272,15 +277,21 @@ int run_cook_frames(const Args& a, CookOptions o) {
             // A field's world bounds and which of its channels differ from the frame
             // before (all of them in the first frame): what a streaming engine places
             // and re-uploads. The value is the session's, in memory.
-            std::string channels_option;
+            std::vector<std::string> wanted;
             for (const GraphOutput& go : g.outputs)
-                if (go.file == o2.file && go.options.count("channels")) channels_option = go.options.at("channels");
-            describe_field_value(session.get(o2.node, o2.port, fo), channels_option, f == first, last_channels[o2.file], entry);
+                if (go.file == o2.file) wanted = io::OptionReader(go.options, go.file).list("channels");
+            const Value value = session.get(o2.node, o2.port, fo);
+            const std::string key = o2.node + "." + o2.port;
+            if (!channels_now.count(key)) channels_now[key] = channel_hashes(value);
+            const auto before = last_channels.find(key);
+            describe_field_value(value, wanted, channels_now[key], before == last_channels.end() ? nullptr : &before->second, entry);
             outputs.push_back(std::move(entry));
             last_hashes[o2.file] = hashes;
         }
         manifest["frames"].push_back(
             {{"frame", f}, {"time", t}, {"folder", folder}, {"cooked", r.with_status("cooked")}, {"files", files}, {"outputs", outputs}});
+        last_channels = std::move(channels_now);
+        channels_now.clear();
         if (!quiet)
             std::fprintf(stderr, "frame %d (t = %s s): cooked %zu, cached %zu nodes\n", f, format_param_value(t).c_str(), r.with_status("cooked").size(),
                          r.with_status("cached").size());

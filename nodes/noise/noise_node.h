@@ -8,6 +8,7 @@
 #include "atlas/noise/loop.h"
 
 #include <string>
+#include <type_traits>
 
 namespace atlas::noise_nodes {
 
@@ -71,10 +72,10 @@ inline void cook_noise(CookContext& ctx, noise::NoiseSpec spec) {
     spec.validate(two_d ? 2 : 3);
     const int comps = noise::noise_components(spec.kernel, two_d ? 2 : 3);
     // A loop in time (atlas/noise/loop.h): this field shifted by phase * D, crossfaded
-    // into the one shifted by (phase - 1) * D.
+    // into the one shifted by (phase - 1) * D; phase 0 and 1 are the unshifted field.
     const Vec3d shift = ctx.get_float3("loop_shift");
     const double phase = ctx.get_float("loop_phase");
-    const bool looped = shift[0] != 0 || shift[1] != 0 || shift[2] != 0;
+    const bool looped = (shift[0] != 0 || shift[1] != 0 || shift[2] != 0) && phase > 0 && phase < 1;
     noise::NoiseSpec next = spec;
     if (looped)
         for (int a = 0; a < 3; ++a) {
@@ -85,28 +86,26 @@ inline void cook_noise(CookContext& ctx, noise::NoiseSpec spec) {
     const TileWindow* w = ctx.window();
     const noise::FillWindow fw = w ? noise::FillWindow{w->x0, w->y0, res[0], res[1]} : noise::FillWindow{0, 0, res[0], res[1]};
     const Vec2i wres = w ? w->size() : Vec2i{{res[0], res[1]}};
+    // Fills f (the field shifted by phase * D) and, looping, crossfades the next one into it.
+    auto fill = [&](auto& f) {
+        noise::fill_noise(f, 0, spec, &ctx.progress_sink(), &fw);
+        if (!looped) return;
+        std::decay_t<decltype(f)> g(f.resolution(), comps, f.bounds(), f.channel_names(), &ctx.budget());
+        noise::fill_noise(g, 0, next, nullptr, &fw);
+        for (int c = 0; c < comps; ++c) noise::loop_crossfade(f.channel(c), g.channel(c), phase);
+    };
     if (two_d) {
         Box2d box{{{lo[0], lo[1]}}, {{hi[0], hi[1]}}};
         if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in x and y");
         auto f = ctx.make_field2d(wres, comps, w ? w->bounds() : box);
-        noise::fill_noise(*f, 0, spec, &ctx.progress_sink(), &fw);
-        if (looped) {
-            Field2D g(f->resolution(), comps, f->bounds(), f->channel_names(), &ctx.budget());
-            noise::fill_noise(g, 0, next, nullptr, &fw);
-            for (int c = 0; c < comps; ++c) noise::loop_crossfade(f->channel(c), g.channel(c), phase);
-        }
+        fill(*f);
         ctx.set_output("out", Field2DPtr(f));
     } else {
         Box3d box{lo, hi};
         if (!box.valid()) ctx.fail("bounds_max must be greater than bounds_min in every axis");
         if (w) box = {{{w->bounds().min[0], w->bounds().min[1], lo[2]}}, {{w->bounds().max[0], w->bounds().max[1], hi[2]}}};
         auto f = ctx.make_field3d({{wres[0], wres[1], res[2]}}, comps, box);
-        noise::fill_noise(*f, 0, spec, &ctx.progress_sink(), &fw);
-        if (looped) {
-            Field3D g(f->resolution(), comps, f->bounds(), f->channel_names(), &ctx.budget());
-            noise::fill_noise(g, 0, next, nullptr, &fw);
-            for (int c = 0; c < comps; ++c) noise::loop_crossfade(f->channel(c), g.channel(c), phase);
-        }
+        fill(*f);
         ctx.set_output("out", Field3DPtr(f));
     }
 }

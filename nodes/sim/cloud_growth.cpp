@@ -3,6 +3,7 @@
 // for the 'vdb-sequence' output format. The node is a thin adapter: the
 // physics is in libatlas/sim (docs/solver.md).
 #include "atlas/sim/resample.h"
+#include "atlas/sim/sequence.h"
 #include "atlas/sim/simulation.h"
 #include "atlas/sim/sounding_options.h"
 #include "sim_params.h"
@@ -403,16 +404,9 @@ void cook(CookContext& ctx) {
     apply_initial_state(ctx, sim, origin);
 
     std::vector<std::string> seq_names;
-    for (int f = 1; f <= frames; ++f) {
-        char prefix[16];
-        std::snprintf(prefix, sizeof prefix, "%04d:", f);
-        for (const auto& g : grids) {
-            if (g == "vel")
-                for (const char* a : {"vel.x", "vel.y", "vel.z"}) seq_names.push_back(prefix + std::string(a));
-            else
-                seq_names.push_back(prefix + g);
-        }
-    }
+    for (int f = 1; f <= frames; ++f)
+        for (const auto& g : grids)
+            for (const std::string& c : sim::sequence_grid_channels(g)) seq_names.push_back(sim::sequence_channel_name(f, c));
     auto sequence = ctx.make_field3d(res, int(seq_names.size()), box, seq_names);
     int next_channel = 0;
     auto keep_frame = [&] {

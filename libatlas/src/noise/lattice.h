@@ -17,10 +17,8 @@ using IVec = std::array<int, D>;
 
 // High 32 bits: hash_coords itself (so value noise matches value_noise()),
 // low 32 bits: a remix of them (offsets, magnitudes).
-inline uint64_t lattice_bits(uint32_t seed, uint32_t stream, int x, int y, int z) {
-    const uint32_t h = hash_coords(seed, x, y, z, stream);
-    return (uint64_t(h) << 32) | (mix64(h) & 0xFFFFFFFFull);
-}
+inline uint64_t lattice_bits_of(uint32_t h) { return (uint64_t(h) << 32) | (mix64(h) & 0xFFFFFFFFull); }
+inline uint64_t lattice_bits(uint32_t seed, uint32_t stream, int x, int y, int z) { return lattice_bits_of(hash_coords(seed, x, y, z, stream)); }
 
 // lattice_bits(seed, stream, x, y, z) & mask for a cell's corners x in xs,
 // y in ys, z in zs, into out[i + 2j + 4k], from x = xs[first_i] on (1: the
@@ -34,8 +32,7 @@ inline void corner_bits3(uint32_t seed, uint32_t stream, const int (&xs)[2], con
         for (int j = 0; j < 2; ++j) {
             const uint64_t hxy = hash_step_y(hx, ys[j]);
             for (int k = 0; k < 2; ++k) {
-                const uint32_t h = hash_end(hash_step_z(hxy, zs[k]), stream);
-                out[i + 2 * j + 4 * k] = int((mix64(h) & 0xFFFFFFFFull) & mask); // lattice_bits' low word
+                out[i + 2 * j + 4 * k] = int(lattice_bits_of(hash_end(hash_step_z(hxy, zs[k]), stream)) & mask);
             }
         }
     }

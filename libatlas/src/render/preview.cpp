@@ -91,8 +91,10 @@ LayerScene layer_preview_scene(const LayerPreviewInputs& in) {
     // vortex rings, which stay at frames where its storm has not formed yet
     // (a lifecycle's first and last): the edge holds through a sequence.
     bool storm = in.anvil != nullptr || in.vortex_table != nullptr;
-    if (const int cs = layer.ndf->find_channel("superstorm_coverage"); cs >= 0 && !storm)
-        for (float v : layer.ndf->channel(cs)) storm = storm || v > 0;
+    if (const int cs = layer.ndf->find_channel("superstorm_coverage"); cs >= 0 && !storm) {
+        const auto ch = layer.ndf->channel(cs);
+        storm = std::any_of(ch.begin(), ch.end(), [](float v) { return v > 0; });
+    }
     layer.edge = storm ? MapEdge::Empty : MapEdge::Wrap;
     validate_layer_scene(layer);
     return layer;

@@ -8,23 +8,19 @@
 #include <cstdlib>
 
 namespace atlas::sim {
-namespace {
-
-std::vector<std::string> grid_channels(const std::string& grid) {
+std::vector<std::string> sequence_grid_channels(const std::string& grid) {
     if (grid == "vel") return {"vel.x", "vel.y", "vel.z"};
     return {grid};
 }
 
-std::string frame_name(int f, const std::string& channel) {
+std::string sequence_channel_name(int frame, const std::string& channel) {
     char prefix[16];
-    std::snprintf(prefix, sizeof prefix, "%04d:", f);
+    std::snprintf(prefix, sizeof prefix, "%04d:", frame);
     return prefix + channel;
 }
 
-} // namespace
-
 std::vector<int> sequence_frames(const Field3D& sequence, const std::string& grid) {
-    const std::string first = grid_channels(grid).front();
+    const std::string first = sequence_grid_channels(grid).front();
     std::vector<int> frames;
     for (const std::string& name : sequence.channel_names()) {
         const size_t colon = name.find(':');
@@ -52,10 +48,10 @@ Field3D sequence_frame(const Field3D& sequence, const std::string& grid, double 
                     std::to_string(last) + ")");
     const int f0 = int(std::floor(frame)), f1 = std::min(last, f0 + 1);
     const float u = float(frame - f0);
-    const std::vector<std::string> channels = grid_channels(grid);
+    const std::vector<std::string> channels = sequence_grid_channels(grid);
     Field3D out(sequence.resolution(), int(channels.size()), sequence.bounds(), channels, budget);
     for (size_t c = 0; c < channels.size(); ++c) {
-        const int a = sequence.find_channel(frame_name(f0, channels[c])), b = sequence.find_channel(frame_name(f1, channels[c]));
+        const int a = sequence.find_channel(sequence_channel_name(f0, channels[c])), b = sequence.find_channel(sequence_channel_name(f1, channels[c]));
         if (a < 0 || b < 0) throw Error("sequence: frame " + std::to_string(a < 0 ? f0 : f1) + " has no channel '" + channels[c] + "'");
         const auto va = sequence.channel(a), vb = sequence.channel(b);
         auto o = out.channel(int(c));

@@ -64,9 +64,6 @@ constexpr uint64_t mix64(uint64_t x) {
     return x ^ (x >> 31);
 }
 
-// Deterministic random bits from a seed and integer coordinates. This is the
-// only source of randomness Atlas uses: results never depend on thread count,
-// tile split or evaluation order.
 // hash_coords as a chain of steps (seed, x, y, z, w), so a caller hashing
 // neighbouring points can share the steps of their common prefix.
 constexpr uint64_t hash_begin(uint32_t seed) { return mix64(seed ^ 0xA0761D6478BD642Full); }
@@ -75,6 +72,9 @@ constexpr uint64_t hash_step_y(uint64_t h, int32_t y) { return mix64(h ^ (static
 constexpr uint64_t hash_step_z(uint64_t h, int32_t z) { return mix64(h ^ (static_cast<uint64_t>(static_cast<uint32_t>(z)) << 42)); }
 constexpr uint32_t hash_end(uint64_t h, uint32_t w) { return static_cast<uint32_t>(mix64(h ^ w) >> 32); }
 
+// Deterministic random bits from a seed and integer coordinates. This is the
+// only source of randomness Atlas uses: results never depend on thread count,
+// tile split or evaluation order.
 constexpr uint32_t hash_coords(uint32_t seed, int32_t x, int32_t y = 0, int32_t z = 0, uint32_t w = 0) {
     return hash_end(hash_step_z(hash_step_y(hash_step_x(hash_begin(seed), x), y), z), w);
 }

@@ -14,6 +14,13 @@
 
 namespace atlas::sim {
 
+// The channels of one grid in a frame: "vel" is vel.x, vel.y, vel.z; every other
+// grid is one channel of its own name.
+std::vector<std::string> sequence_grid_channels(const std::string& grid);
+
+// A frame's channel name: frame 7's "density" is "0007:density".
+std::string sequence_channel_name(int frame, const std::string& channel);
+
 // The frame numbers the sequence holds for `grid` ("density", "temperature",
 // "vapor", "vel": vel.x, vel.y, vel.z), ascending; empty when it holds none.
 std::vector<int> sequence_frames(const Field3D& sequence, const std::string& grid);
