@@ -2,8 +2,10 @@
 // returns cloud water as density, optional extra fields, and a frame sequence
 // for the 'vdb-sequence' output format. The node is a thin adapter: the
 // physics is in libatlas/sim (docs/solver.md).
+#include "atlas/graph/option_params.h"
 #include "atlas/sim/resample.h"
 #include "atlas/sim/sequence.h"
+#include "atlas/sim/sim_options.h"
 #include "atlas/sim/simulation.h"
 #include "atlas/sim/sounding_options.h"
 #include "sim_params.h"
@@ -62,43 +64,10 @@ void declare(NodeDeclaration& d) {
                   "and stays closed)");
     d.param_float("duration", 300).range(1e-6, 1e7).with_unit("s").describe("simulated time");
     d.param_float("frame_dt", 10).range(1e-6, 1e5).with_unit("s").describe("time per step (one report row, one potential sequence frame)");
-    d.param_float("cfl", 1).range(0.1, 5).with_unit("cells").describe("max cells travelled per substep");
-    d.param_enum("time_scheme", {"trapezoidal", "split"}, "trapezoidal")
-        .describe("trapezoidal: second-order (forces half at the departure, half at the arrival point, time-centred "
-                  "trajectories; 24 B more per cell); split: the first-order advect-then-project split");
-    d.param_float("step_error_tolerance", 0).range(0, 1).with_unit("cells")
-        .describe("accuracy step control (trapezoidal): substeps are shortened so the embedded back-trace error estimate "
-                  "stays below this (0 = CFL limits only); reported per step as step_error");
-    d.param_int("max_substeps", 64).range(1, 10000).describe("substep budget per step (more is an error naming the node)");
-    d.param_enum("scheme", {"maccormack", "semi_lagrangian", "cubic_limited"}, "maccormack")
-        .describe("advection scheme: maccormack (limited), semi_lagrangian (trilinear, most diffusive), cubic_limited "
-                  "(Catmull-Rom read clamped to its 8 neighbours: one read, less smearing)");
-    d.param_bool("advection_reflection", false)
-        .describe("advection-reflection stepping (Zehnder et al. 2018): keeps kinetic energy; a second projection per "
-                  "substep and 12 B more per cell");
-    d.param_bool("reversible_theta_e", false)
-        .describe("Bryan & Fritsch reversible thermodynamics: the saturation adjustment keeps theta_e (liquid heat "
-                  "capacity counted) instead of theta_l; a saturated sounding (total_water > 0) is built with the "
-                  "linearised adjustment, so it is not exactly neutral in this mode");
-    d.param_bool("rain", false)
-        .describe("Kessler warm rain (needs moist): autoconversion, accretion, evaporation and fallout through the floor; "
-                  "rain loads the buoyancy; 8 B more per cell; output 'rain'");
-    d.param_float("rain_autoconversion_rate", 1e-3).range(0, 1).with_unit("1/s").describe("Kessler k1: cloud water to rain above the threshold");
-    d.param_float("rain_autoconversion_threshold", 1e-3).range(0, 0.01).with_unit("kg/kg").describe("Kessler a: cloud water needed before rain forms");
-    d.param_float("rain_accretion_rate", 2.2).range(0, 100).with_unit("1/s").describe("Kessler k2: collection of cloud water by rain");
-    d.param_bool("rain_evaporation", true).describe("rain evaporates in subsaturated air (cooling it)");
-    d.param_bool("rain_sedimentation", true).describe("rain falls at its terminal speed and leaves through the floor");
-    d.param_bool("anelastic", true).describe("false: Boussinesq (constant reference density)");
-    d.param_bool("moist", true).describe("false: dry (vapour and cloud water are passive)");
-    d.param_float("pressure_tolerance", 1e-6).range(1e-12, 0.1).describe("relative residual of the pressure solve");
-    d.param_int("pressure_max_iterations", 200).range(1, 10000).describe("CG iteration cap per projection");
-    d.param_bool("multigrid", true).describe("multigrid-preconditioned CG (false: Jacobi-preconditioned)");
-    d.param_float("condensation_rate", 0).range(0, 1e9).with_unit("1/s").describe("0: instantaneous saturation adjustment");
-    d.param_float("vorticity_confinement", 0).range(0, 0.2).describe(
-        "dimensionless epsilon of vorticity confinement, f = eps dx |omega| (N x omega) (billowy detail; 0.1..0.2 typical)");
-    d.param_float("viscosity", 0).range(0, 1e4).with_unit("m^2/s").describe("explicit kinematic viscosity");
-    d.param_float("diffusivity", 0).range(0, 1e4).with_unit("m^2/s").describe("explicit diffusivity of theta', qv, qc");
-    d.param_float("wind", 0).range(-200, 200).with_unit("m/s").describe("ambient x wind at the ground");
+    // The solver's options: names, defaults, ranges, units and docs are the library's
+    // schema (sim_options.h), which SimOptions::validate checks too.
+    declare_text_options(d, sim::sim_options());
+    d.param_float("wind", 0).range(-sim::kSimMaxWind, sim::kSimMaxWind).with_unit("m/s").describe("ambient x wind at the ground");
     d.param_float("wind_shear", 0).range(-1, 1).with_unit("1/s").describe("change of the x wind per metre of height");
     d.param_float("patch_radius", 0).range(0, 1e9).with_unit("m").describe("built-in ground patch radius (0 = none)");
     d.param_float2("patch_center", {{0, 0}}).with_unit("m").describe("world x, y of the patch centre");
@@ -141,34 +110,10 @@ std::vector<std::string> split_grids(const CookContext& ctx) {
 
 sim::SimOptions options_from(const CookContext& ctx, int nz, double dx) {
     sim::SimOptions o;
-    o.anelastic = ctx.get_bool("anelastic");
-    o.moist = ctx.get_bool("moist");
-    const std::string& scheme = ctx.get_string("scheme");
-    o.scheme = scheme == "maccormack"      ? sim::AdvectionScheme::MacCormack
-               : scheme == "cubic_limited" ? sim::AdvectionScheme::CubicLimited
-                                           : sim::AdvectionScheme::SemiLagrangian;
-    o.advection_reflection = ctx.get_bool("advection_reflection");
-    o.reversible_theta_e = ctx.get_bool("reversible_theta_e");
-    o.rain = ctx.get_bool("rain");
-    o.kessler.autoconversion_rate = ctx.get_float("rain_autoconversion_rate");
-    o.kessler.autoconversion_threshold = ctx.get_float("rain_autoconversion_threshold");
-    o.kessler.accretion_rate = ctx.get_float("rain_accretion_rate");
-    o.kessler.evaporation = ctx.get_bool("rain_evaporation");
-    o.kessler.sedimentation = ctx.get_bool("rain_sedimentation");
-    o.cfl = ctx.get_float("cfl");
-    o.time_scheme = ctx.get_string("time_scheme") == "split" ? sim::TimeScheme::Split : sim::TimeScheme::Trapezoidal;
-    o.step_error_tolerance = ctx.get_float("step_error_tolerance");
-    o.max_substeps = int(ctx.get_int("max_substeps"));
-    o.condensation_rate = ctx.get_float("condensation_rate");
-    o.vorticity_confinement = ctx.get_float("vorticity_confinement");
-    o.viscosity = ctx.get_float("viscosity");
-    o.diffusivity = ctx.get_float("diffusivity");
-    o.projection.tolerance = ctx.get_float("pressure_tolerance");
-    o.projection.max_iterations = int(ctx.get_int("pressure_max_iterations"));
-    o.projection.multigrid = ctx.get_bool("multigrid");
+    read_text_options(ctx, sim::sim_options(), o);
     const double wind = ctx.get_float("wind"), shear = ctx.get_float("wind_shear");
     if (wind != 0 || shear != 0)
-        for (int k = 0; k < nz; ++k) o.wind.push_back(std::clamp(wind + shear * (k + 0.5) * dx, -200.0, 200.0));
+        for (int k = 0; k < nz; ++k) o.wind.push_back(std::clamp(wind + shear * (k + 0.5) * dx, -sim::kSimMaxWind, sim::kSimMaxWind));
     return o;
 }
 

@@ -46,15 +46,8 @@ Value python_to_value(const py::handle& o);
 Value field_from_array(const py::array& a, int dims, const py::object& bounds, const py::object& channel_names,
                        const MemoryBudget* budget);
 
-// Parameters (module.cpp): Python values <-> ParamValue.
-py::object param_to_python(const ParamValue& v, ParamType type);
-ParamValue param_from_python(const py::handle& o, ParamType type, const std::string& what);
-// A declaration as plain data (dicts and lists), the shape add_python_node takes.
-py::dict declaration_to_python(const NodeType& type);
-
-// A Python exception as one line for an atlas::Error: "ValueError: message
-// (at file.py:12 in cook)"; an atlas.Error raised in Python keeps its text.
-std::string python_error_message(py::error_already_set& e);
+// Errors (errors.h) and parameters (params.h) have headers of their own: the module
+// and the Python node types both use them.
 
 // Python node types (python_nodes.cpp).
 void bind_python_nodes(py::module_& m);

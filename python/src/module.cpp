@@ -1,6 +1,8 @@
 // The atlas Python module (_atlas, wrapped by python/atlas/__init__.py):
 // Session, errors as exceptions, declarations as plain data.
 #include "bindings.h"
+#include "errors.h"
+#include "params.h"
 
 #include "atlas/graph/node_docs.h"
 #include "atlas/preview/graph_preview.h"
@@ -9,43 +11,10 @@
 #include <pybind11/numpy.h>
 
 #include <atomic>
-#include <cmath>
 
 namespace atlas::python {
 
 namespace {
-
-// Exception classes (created once per interpreter; the module holds them).
-PyObject* g_error = nullptr;
-PyObject* g_parse_error = nullptr;
-PyObject* g_cancelled = nullptr;
-PyObject* g_memory = nullptr;
-
-void raise_with(PyObject* type, const std::string& message, const SourceLocation* where, const std::string* detail) {
-    py::object exc = py::reinterpret_borrow<py::object>(type)(message);
-    if (where) {
-        exc.attr("file") = where->file;
-        exc.attr("line") = where->line;
-        exc.attr("column") = where->column;
-        exc.attr("where") = where->str();
-    }
-    if (detail) exc.attr("detail") = *detail;
-    PyErr_SetObject(type, exc.ptr());
-}
-
-void translate(std::exception_ptr p) {
-    try {
-        if (p) std::rethrow_exception(p);
-    } catch (const ParseError& e) {
-        raise_with(g_parse_error, e.what(), &e.where(), &e.detail());
-    } catch (const CancelledError& e) {
-        raise_with(g_cancelled, e.what(), nullptr, nullptr);
-    } catch (const MemoryBudgetError& e) {
-        raise_with(g_memory, e.what(), nullptr, nullptr);
-    } catch (const Error& e) {
-        raise_with(g_error, e.what(), nullptr, nullptr);
-    }
-}
 
 const ParamDecl* find_decl(const Session& s, const std::string& node, const std::string& param) {
     const GraphNode* n = s.graph().find(node);
@@ -204,116 +173,6 @@ private:
 
 } // namespace
 
-std::string python_error_message(py::error_already_set& e) {
-    std::string msg = py::str(e.value()).cast<std::string>();
-    if (!PyErr_GivenExceptionMatches(e.type().ptr(), g_error))
-        msg = py::str(e.type().attr("__name__")).cast<std::string>() + ": " + msg;
-    // The innermost Python frame: where a TD's node code failed.
-    py::object tb = e.trace() ? py::reinterpret_borrow<py::object>(e.trace()) : py::none();
-    py::object last = py::none();
-    while (!tb.is_none()) {
-        last = tb;
-        tb = tb.attr("tb_next");
-    }
-    if (!last.is_none()) {
-        py::object code = last.attr("tb_frame").attr("f_code");
-        msg += " (at " + py::str(code.attr("co_filename")).cast<std::string>() + ":" +
-               py::str(last.attr("tb_lineno")).cast<std::string>() + " in " + py::str(code.attr("co_name")).cast<std::string>() + ")";
-    }
-    return msg;
-}
-
-py::object param_to_python(const ParamValue& v, ParamType type) {
-    if (auto* b = std::get_if<bool>(&v)) return py::bool_(*b);
-    if (auto* i = std::get_if<int64_t>(&v)) return py::int_(*i);
-    if (auto* d = std::get_if<double>(&v)) return py::float_(*d);
-    if (auto* s = std::get_if<std::string>(&v)) return py::str(*s);
-    const auto& vec = std::get<std::vector<double>>(v);
-    py::list l;
-    const bool ints = type == ParamType::Int2 || type == ParamType::Int3;
-    for (double x : vec) {
-        if (ints) l.append(py::int_(int64_t(x)));
-        else l.append(py::float_(x));
-    }
-    return l;
-}
-
-ParamValue param_from_python(const py::handle& o, ParamType type, const std::string& what) {
-    auto bad = [&](const char* expected) {
-        return py::type_error(what + ": expected " + expected + ", got " + py::str(py::type::handle_of(o).attr("__name__")).cast<std::string>() +
-                              " " + py::repr(o).cast<std::string>());
-    };
-    switch (type) {
-    case ParamType::Bool:
-        if (!py::isinstance<py::bool_>(o)) throw bad("a bool");
-        return o.cast<bool>();
-    case ParamType::Int:
-        if (py::isinstance<py::bool_>(o)) throw bad("an int");
-        if (py::isinstance<py::int_>(o)) return o.cast<int64_t>();
-        if (py::isinstance<py::float_>(o)) {
-            double d = o.cast<double>();
-            if (std::isfinite(d) && std::floor(d) == d && std::fabs(d) < 9.0e15) return int64_t(d);
-        }
-        throw bad("an int");
-    case ParamType::Float:
-        if (py::isinstance<py::bool_>(o) || !(py::isinstance<py::int_>(o) || py::isinstance<py::float_>(o)))
-            throw bad("a number");
-        return o.cast<double>();
-    case ParamType::String:
-    case ParamType::Enum:
-    case ParamType::Path:
-        if (py::hasattr(o, "__fspath__")) return py::str(o.attr("__fspath__")()).cast<std::string>();
-        if (!py::isinstance<py::str>(o)) throw bad("a str");
-        return o.cast<std::string>();
-    default: {
-        if (py::isinstance<py::str>(o) || !py::isinstance<py::sequence>(o)) throw bad("a sequence of numbers");
-        std::vector<double> v;
-        for (auto item : o) {
-            if (py::isinstance<py::bool_>(item) || !(py::isinstance<py::int_>(item) || py::isinstance<py::float_>(item)))
-                throw bad("a sequence of numbers");
-            v.push_back(item.cast<double>());
-        }
-        return v;
-    }
-    }
-}
-
-py::dict declaration_to_python(const NodeType& t) {
-    auto ports = [](const std::deque<PortDecl>& list) {
-        py::list l;
-        for (const PortDecl& p : list) {
-            py::dict d;
-            d["name"] = p.name;
-            d["type"] = std::string(port_type_name(p.type));
-            d["doc"] = p.doc;
-            d["optional"] = p.optional;
-            l.append(d);
-        }
-        return l;
-    };
-    py::list params;
-    for (const ParamDecl& p : t.decl.params()) {
-        py::dict d;
-        d["name"] = p.name;
-        d["type"] = std::string(param_type_name(p.type));
-        d["default"] = param_to_python(p.default_value, p.type);
-        d["min"] = p.min ? py::object(py::float_(*p.min)) : py::object(py::none());
-        d["max"] = p.max ? py::object(py::float_(*p.max)) : py::object(py::none());
-        d["unit"] = p.unit;
-        d["doc"] = p.doc;
-        d["choices"] = p.choices;
-        params.append(d);
-    }
-    py::dict d;
-    d["name"] = t.name;
-    d["version"] = t.version;
-    d["doc"] = t.decl.doc();
-    d["inputs"] = ports(t.decl.inputs());
-    d["outputs"] = ports(t.decl.outputs());
-    d["params"] = params;
-    return d;
-}
-
 // A Python value as the text of a preview option ("640,360" for (640, 360)).
 std::string option_text(const py::handle& v) {
     if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
@@ -372,20 +231,7 @@ PYBIND11_MODULE(_atlas, m) {
     (void)py::dtype::of<float>();
     (void)py::array_t<float>(std::vector<py::ssize_t>{0});
 
-    g_error = PyErr_NewExceptionWithDoc("atlas.Error", "Any Atlas failure; str(e) is the full message (file:line:col, node, parameter).",
-                                        PyExc_RuntimeError, nullptr);
-    g_parse_error = PyErr_NewExceptionWithDoc("atlas.ParseError",
-                                              "A graph file or text that cannot be used: .file, .line, .column, .where ('file:line:col'), .detail.",
-                                              g_error, nullptr);
-    g_cancelled = PyErr_NewExceptionWithDoc("atlas.CancelledError", "The cancel callback asked to stop.", g_error, nullptr);
-    g_memory = PyErr_NewExceptionWithDoc("atlas.MemoryBudgetError", "An allocation past the memory budget was refused.", g_error, nullptr);
-    // The module keeps references for the interpreter's lifetime.
-    m.attr("Error") = py::handle(g_error);
-    m.attr("ParseError") = py::handle(g_parse_error);
-    m.attr("CancelledError") = py::handle(g_cancelled);
-    m.attr("MemoryBudgetError") = py::handle(g_memory);
-    py::register_exception_translator(translate);
-
+    bind_errors(m);
     bind_fields(m);
     bind_python_nodes(m);
 

@@ -3,104 +3,56 @@
 // CookContext (NumPy in, NumPy out). They are hashed (type, version,
 // parameters, inputs, and the cook function's code) and cached like any other.
 #include "bindings.h"
+#include "errors.h"
+#include "params.h"
 
 #include "atlas/core/hash.h"
+#include "atlas/graph/node_builder.h"
 
 namespace atlas::python {
 
 namespace {
-
-PortType port_type_from(const std::string& s) {
-    for (PortType t : {PortType::Field2D, PortType::Field3D, PortType::Field, PortType::Mesh, PortType::Points})
-        if (port_type_name(t) == s) return t;
-    throw py::value_error("unknown port type '" + s + "' (expected field2d, field3d, field, mesh or points)");
-}
-
-ParamType param_type_from(const std::string& s) {
-    for (ParamType t : {ParamType::Float, ParamType::Int, ParamType::Bool, ParamType::String, ParamType::Enum,
-                        ParamType::Path, ParamType::Float2, ParamType::Float3, ParamType::Int2, ParamType::Int3})
-        if (param_type_name(t) == s) return t;
-    throw py::value_error("unknown parameter type '" + s + "' (expected float, int, bool, string, enum, path, float2, float3, int2 or int3)");
-}
 
 template <typename T>
 T get_or(const py::dict& d, const char* key, T def) {
     return d.contains(key) && !d[key].is_none() ? d[key].cast<T>() : def;
 }
 
-// The declaration, parsed from Python data once (with the GIL) at registration.
-struct PlainDecl {
-    std::string doc;
-    std::vector<PortDecl> inputs, outputs;
-    std::vector<ParamDecl> params;
-};
-
-PlainDecl parse_declaration(const std::string& node, const std::string& doc, const py::list& inputs,
-                            const py::list& outputs, const py::list& params) {
-    PlainDecl d;
-    d.doc = doc;
-    auto ports = [&](const py::list& list, std::vector<PortDecl>& out) {
+// The declaration, read from Python data once (with the GIL) at registration: the
+// Python values become the library builder's plain data (atlas/graph/node_builder.h),
+// which checks them as it checks the C API's JSON. Its refusals are ValueErrors.
+NodeDeclarationBuilder parse_declaration(const std::string& node, const std::string& doc, const py::list& inputs,
+                                         const py::list& outputs, const py::list& params) {
+    NodeDeclarationBuilder d(node, doc);
+    auto ports = [&](const py::list& list, bool is_input) {
         for (auto item : list) {
             auto p = item.cast<py::dict>();
             if (!p.contains("name")) throw py::value_error(node + ": a port needs a 'name'");
-            out.push_back({p["name"].cast<std::string>(), port_type_from(get_or<std::string>(p, "type", "field")),
-                           get_or<std::string>(p, "doc", ""), get_or<bool>(p, "optional", false)});
+            PortDecl port{p["name"].cast<std::string>(), port_type_named(get_or<std::string>(p, "type", "field")),
+                          get_or<std::string>(p, "doc", ""), get_or<bool>(p, "optional", false)};
+            if (is_input) d.input(std::move(port));
+            else d.output(std::move(port));
         }
     };
-    ports(inputs, d.inputs);
-    ports(outputs, d.outputs);
-    if (d.outputs.empty()) throw py::value_error(node + ": a node needs at least one output");
+    ports(inputs, true);
+    ports(outputs, false);
+    d.check_ports();
     for (auto item : params) {
         auto p = item.cast<py::dict>();
         if (!p.contains("name") || !p.contains("type") || !p.contains("default"))
             throw py::value_error(node + ": a parameter needs 'name', 'type' and 'default'");
         ParamDecl pd;
         pd.name = p["name"].cast<std::string>();
-        pd.type = param_type_from(p["type"].cast<std::string>());
+        pd.type = param_type_named(p["type"].cast<std::string>());
         pd.default_value = param_from_python(p["default"], pd.type, node + "." + pd.name + " default");
-        if (pd.type == ParamType::Int2 || pd.type == ParamType::Int3 || pd.type == ParamType::Float2 || pd.type == ParamType::Float3) {
-            const auto& v = std::get<std::vector<double>>(pd.default_value);
-            if (int(v.size()) != param_components(pd.type))
-                throw py::value_error(node + "." + pd.name + ": default needs " + std::to_string(param_components(pd.type)) + " values");
-        }
         if (p.contains("min") && !p["min"].is_none()) pd.min = p["min"].cast<double>();
         if (p.contains("max") && !p["max"].is_none()) pd.max = p["max"].cast<double>();
         pd.unit = get_or<std::string>(p, "unit", "");
         pd.doc = get_or<std::string>(p, "doc", "");
         pd.choices = get_or<std::vector<std::string>>(p, "choices", {});
-        if (std::string err = pd.check(pd.default_value); !err.empty())
-            throw py::value_error(node + "." + pd.name + ": default: " + err);
-        d.params.push_back(std::move(pd));
+        d.param(std::move(pd));
     }
     return d;
-}
-
-void declare_from(const PlainDecl& p, NodeDeclaration& d) {
-    d.doc(p.doc);
-    for (const PortDecl& in : p.inputs) d.input(in.name, in.type, in.doc).optional = in.optional;
-    for (const PortDecl& out : p.outputs) d.output(out.name, out.type, out.doc);
-    for (const ParamDecl& pd : p.params) {
-        ParamDecl* q = nullptr;
-        switch (pd.type) {
-        case ParamType::Float: q = &d.param_float(pd.name, std::get<double>(pd.default_value)); break;
-        case ParamType::Int: q = &d.param_int(pd.name, std::get<int64_t>(pd.default_value)); break;
-        case ParamType::Bool: q = &d.param_bool(pd.name, std::get<bool>(pd.default_value)); break;
-        case ParamType::String: q = &d.param_string(pd.name, std::get<std::string>(pd.default_value)); break;
-        case ParamType::Enum: q = &d.param_enum(pd.name, pd.choices, std::get<std::string>(pd.default_value)); break;
-        case ParamType::Path: q = &d.param_path(pd.name, std::get<std::string>(pd.default_value)); break;
-        default: {
-            const auto& v = std::get<std::vector<double>>(pd.default_value);
-            if (pd.type == ParamType::Float2) q = &d.param_float2(pd.name, Vec2d{{v[0], v[1]}});
-            else if (pd.type == ParamType::Float3) q = &d.param_float3(pd.name, Vec3d{{v[0], v[1], v[2]}});
-            else if (pd.type == ParamType::Int2) q = &d.param_int2(pd.name, Vec2i{{int(v[0]), int(v[1])}});
-            else q = &d.param_int3(pd.name, Vec3i{{int(v[0]), int(v[1]), int(v[2])}});
-        }
-        }
-        q->min = pd.min;
-        q->max = pd.max;
-        q->unit = pd.unit;
-        q->doc = pd.doc;
-    }
 }
 
 // What a Python cook function sees. Valid only during the cook call.
@@ -220,16 +172,21 @@ std::string code_identity(const py::object& fn) {
 void add_python_node(NodeRegistry& registry, const std::string& name, const py::object& cook, int version,
                      const std::string& doc, const py::list& inputs, const py::list& outputs, const py::list& params) {
     if (!PyCallable_Check(cook.ptr())) throw py::type_error(name + ": cook must be callable");
-    auto decl = std::make_shared<const PlainDecl>(parse_declaration(name, doc, inputs, outputs, params));
+    std::shared_ptr<const NodeDeclarationBuilder> decl;
+    try {
+        decl = std::make_shared<const NodeDeclarationBuilder>(parse_declaration(name, doc, inputs, outputs, params));
+    } catch (const DeclarationError& e) {
+        throw py::value_error(e.what());
+    }
     const std::string code = code_identity(cook);
     SharedPyObject fn(cook);
     // The same declaration the registry builds, for the cook context's lookups.
     auto built = std::make_shared<NodeDeclaration>();
-    declare_from(*decl, *built);
+    decl->declare(*built);
     NodeType t;
     t.name = name;
     t.version = version;
-    t.declare = [decl](NodeDeclaration& d) { declare_from(*decl, d); };
+    t.declare = [decl](NodeDeclaration& d) { decl->declare(d); };
     t.cook = [fn, built](CookContext& ctx) {
         // Runs on a worker thread with the GIL released by Session.cook.
         py::gil_scoped_acquire gil;

@@ -6,6 +6,7 @@
   no file streams, no std::filesystem, no core/files.h. Files are opened in io
   (and by the nodes and the CLI that compose io with the algorithms).
 - Each module includes only the modules its CMake line links (libatlas/CMakeLists.txt).
+- The Python binding files (python/src) call each other's functions without a circle.
 """
 import os
 import pathlib
@@ -97,3 +98,61 @@ def test_includes_follow_the_link_lines():
                 if m and m.group(1) in deps and m.group(1) not in reach:
                     bad.append(f"{p.relative_to(ROOT)}:{n}: {module} includes atlas/{m.group(1)} but does not link it")
     assert not bad, "\n".join(bad)
+
+
+def python_binding_uses():
+    """python/src: {file: files whose functions it calls}, for the functions its headers declare
+    at namespace scope (a use is the name in a file's code; the definer is the .cpp that defines it)."""
+    src = ROOT / "python/src"
+    declared = set()
+    for h in sorted(src.glob("*.h")):
+        declared |= set(re.findall(r"^(?:[\w:<>]+[\s*&]+)+(\w+)\(", h.read_text(), re.M))
+    cpps = sorted(src.glob("*.cpp"))
+    definer = {}
+    for p in cpps:
+        for _, line in code_lines(p):
+            m = re.match(r"^[^\s#].*?\b(\w+)\([^;]*$", line)
+            if m and m.group(1) in declared:
+                definer[m.group(1)] = p.name
+    uses = {p.name: set() for p in cpps}
+    for p in cpps:
+        code = "\n".join(line for _, line in code_lines(p))
+        for name, where in definer.items():
+            if where != p.name and re.search(rf"\b{name}\b", code):
+                uses[p.name].add(where)
+    return uses, definer
+
+
+def circle(uses):
+    """A list of files that use each other in a circle, or None."""
+    state = {}
+
+    def visit(n, path):
+        state[n] = "open"
+        for d in sorted(uses.get(n, ())):
+            if state.get(d) == "open":
+                return path[path.index(d):] + [d] if d in path else [n, d]
+            if d not in state:
+                found = visit(d, path + [d])
+                if found:
+                    return found
+        state[n] = "done"
+        return None
+
+    for n in sorted(uses):
+        if n not in state:
+            found = visit(n, [n])
+            if found:
+                return found
+    return None
+
+
+def test_python_binding_files_form_no_circle():
+    # module.cpp binds the Python node types (python_nodes.cpp); what both use (errors,
+    # parameters as Python data) lives in files of its own, so neither uses the other back.
+    uses, definer = python_binding_uses()
+    assert {"bind_python_nodes", "python_error_message", "param_from_python", "declaration_to_python"} <= set(definer)
+    assert "python_nodes.cpp" in uses["module.cpp"]
+    found = circle(uses)
+    assert not found, "python/src files use each other in a circle: " + " -> ".join(found)
+    assert circle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]  # the check can fail

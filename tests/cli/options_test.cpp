@@ -3,6 +3,7 @@
 //  - compress: `atlas compress` flags (the program, run as a script runs it) and a
 //    graph's dds output options (checked as a graph load checks them);
 //  - sounding: the sim/sounding node's parameters and Sounding::validate();
+//  - solver: the sim/cloud_growth node's parameters and the SimOptions checks;
 //  - grid parameters: one declaration for every node that has them;
 //  - preview: `atlas preview` flags (the program) and the render/preview node's
 //    parameters (checked as a graph load checks them), values and defaults.
@@ -13,6 +14,7 @@
 #include "atlas/graph/option_params.h"
 #include "atlas/io/writers.h"
 #include "atlas/render/preview_options.h"
+#include "atlas/sim/sim_options.h"
 #include "atlas/sim/sounding_options.h"
 
 #include "../support/cli_run.h"
@@ -185,6 +187,61 @@ TEST(OptionsSchema, SoundingNodeAndLibraryAcceptTheSameValues) {
             }
             // The graph refuses non-finite numbers when it parses them.
             const bool node = p->check(ParamValue(v)).empty() && std::isfinite(v);
+            EXPECT_EQ(node, library) << o.name << " = " << v;
+        }
+    }
+}
+
+// sim/cloud_growth declares the solver's options from sim::sim_options() with the
+// library's defaults (SimOptions{}), and the library check of each number refuses
+// exactly what the node's parameter refuses: SimOptions::validate its own members,
+// KesslerOptions::validate (with rain) the rain_* ones, the pressure solver the
+// pressure_* ones.
+TEST(OptionsSchema, SimNodeAndLibraryAcceptTheSameValues) {
+    const NodeDeclaration d = declaration_of("sim/cloud_growth");
+    const sim::SimOptions defaults;
+    EXPECT_NO_THROW(defaults.validate(8));
+    sim::GridSpec grid;
+    grid.nx = grid.ny = grid.nz = 4;
+    grid.dx = 100;
+    sim::PressureSolver solver(grid);
+    for (const TextOption<sim::SimOptions>& o : sim::sim_options()) {
+        const ParamDecl* p = d.find_param(o.name);
+        ASSERT_TRUE(p) << o.name;
+        EXPECT_EQ(p->type, text_option_param_type(o)) << o.name;
+        EXPECT_EQ(p->unit, o.unit) << o.name;
+        EXPECT_EQ(p->doc, o.doc) << o.name;
+        OptionValue node_default;
+        ASSERT_TRUE(parse_text_option(o, text_option_text(o, p->default_value), node_default)) << o.name;
+        EXPECT_EQ(option_value_text(o, node_default), option_value_text(o, o.value_of(defaults))) << o.name;
+        if (o.kind != OptionKind::Number && o.kind != OptionKind::Integer) continue;
+        const bool integer = o.kind == OptionKind::Integer;
+        std::vector<double> values{0.0, -1.0, 0.5, 1.0, 64, 1e9, -1e9};
+        for (double b : {o.min, o.max})
+            for (double x : {b, std::nextafter(b, -INFINITY), std::nextafter(b, INFINITY), b - 1, b + 1}) values.push_back(x);
+        if (!integer) values.insert(values.end(), {std::nan(""), std::numeric_limits<double>::infinity()});
+        for (double v : values) {
+            if (integer && v != std::floor(v)) continue;
+            sim::SimOptions s = defaults;
+            OptionValue value;
+            value.number = v;
+            o.apply(s, value);
+            bool library = true;
+            try {
+                const std::string_view name = o.name;
+                if (name.starts_with("pressure_")) {
+                    sim::MacVelocity vel(grid);
+                    solver.project(vel, s.projection);
+                } else {
+                    s.rain = name.starts_with("rain_");
+                    s.validate(8);
+                }
+            } catch (const Error&) {
+                library = false;
+            }
+            // The graph refuses non-finite numbers when it parses them.
+            const ParamValue param = integer ? ParamValue(int64_t(v)) : ParamValue(v);
+            const bool node = p->check(param).empty() && std::isfinite(v);
             EXPECT_EQ(node, library) << o.name << " = " << v;
         }
     }

@@ -2,7 +2,8 @@
 #include "atlas/compress/bc4.h"
 
 #include "test_blocks.h"
-#include "../../libatlas/src/compress/bc4_eval.h" // internal: the fast / normal evaluation paths
+#include "../../libatlas/src/compress/bc4_eval.h"       // internal: the fast / normal evaluation paths
+#include "../../libatlas/src/compress/bc4_test_hooks.h" // internal: the encoder's test hooks
 
 #include <gtest/gtest.h>
 
@@ -258,7 +259,7 @@ TEST(Bc4Eval, LineKeysEqualFullKeys) {
                     case 3: x = float(-2.0 + 4.0 * w); break;                                     // anywhere within +-2
                     default: x = float(lo + int(w * (hi - lo + 1))) / scale; break;               // on the levels
                     }
-                    blocks.push_back(x == 0.0f ? 0.0f : x); // -0.0 takes the full path (bc4.cpp)
+                    blocks.push_back(x == 0.0f ? 0.0f : x); // -0.0 takes the full path (bc4_avx2.cpp)
                 }
             EXPECT_EQ(detail::bc4_line_mismatches(snorm, blocks.data(), blocks.size() / 16, lo, hi), 0)
                 << (snorm ? "snorm" : "unorm") << " pair " << lo << ", " << hi;

@@ -171,5 +171,54 @@ TEST(OptionSchema, VectorsTakeCountPartsEachAsTheScalarKind) {
     EXPECT_FALSE(parse_text_option(text, "a!", v));
 }
 
+// option_value_text (how a struct's own value becomes a default_text) is read back by
+// the parser as the same value: numbers bit for bit, every kind.
+TEST(OptionSchema, ValueTextReadsBackAsTheSameValue) {
+    const TextOptionSpec number{"n", nullptr, "", OptionKind::Number, ""};
+    const TextOptionSpec integer{"i", nullptr, "", OptionKind::Integer, "", -1e15, 1e15, {"full"}};
+    TextOptionSpec pair{"p", nullptr, "WxH", OptionKind::Number, ""};
+    pair.count = 2;
+    pair.separator = 'x';
+    for (double x : {0.0, -0.0, 0.1, 1e-6, 1e-12, 2.2, 1e9, 1e-310, -123.456, 4294967295.0, 1.0 / 3.0}) {
+        OptionValue in, out;
+        in.number = x;
+        ASSERT_TRUE(parse_text_option(number, option_value_text(number, in), out)) << x;
+        EXPECT_EQ(std::signbit(out.number), std::signbit(x)) << x;
+        EXPECT_EQ(out.number, x) << option_value_text(number, in);
+        in.numbers = {x, -x};
+        ASSERT_TRUE(parse_text_option(pair, option_value_text(pair, in), out)) << x;
+        EXPECT_EQ(out.numbers, in.numbers);
+    }
+    for (double x : {0.0, 64.0, -1.0, 1e14}) {
+        OptionValue in, out;
+        in.number = x;
+        ASSERT_TRUE(parse_text_option(integer, option_value_text(integer, in), out)) << x;
+        EXPECT_EQ(out.number, x);
+    }
+    OptionValue word;
+    word.word = "full";
+    EXPECT_EQ(option_value_text(integer, word), "full");
+    const TextOptionSpec flag{"f", nullptr, "", OptionKind::Flag, ""};
+    const TextOptionSpec choice{"c", nullptr, "", OptionKind::Choice, "", -INFINITY, INFINITY, {"a", "bb"}};
+    const TextOptionSpec list{"l", nullptr, "", OptionKind::List, ""};
+    const TextOptionSpec range{"r", nullptr, "LO,HI", OptionKind::Range, ""};
+    OptionValue in, out;
+    in.flag = true;
+    EXPECT_TRUE(parse_text_option(flag, option_value_text(flag, in), out) && out.flag);
+    in.flag = false;
+    EXPECT_TRUE(parse_text_option(flag, option_value_text(flag, in), out) && !out.flag);
+    in.word = "bb";
+    EXPECT_TRUE(parse_text_option(choice, option_value_text(choice, in), out));
+    EXPECT_EQ(out.word, "bb");
+    in.items = {"x", "y"};
+    EXPECT_TRUE(parse_text_option(list, option_value_text(list, in), out));
+    EXPECT_EQ(out.items, in.items);
+    in.lo = -0.1;
+    in.hi = 2.5;
+    EXPECT_TRUE(parse_text_option(range, option_value_text(range, in), out));
+    EXPECT_EQ(out.lo, -0.1);
+    EXPECT_EQ(out.hi, 2.5);
+}
+
 } // namespace
 } // namespace atlas

@@ -8,6 +8,7 @@
 // (atlas::Error) stays one and the same inside a shared libatlas.
 #pragma GCC visibility push(default)
 #include "atlas/graph/evaluator.h"
+#include "atlas/graph/node_builder.h"
 #pragma GCC visibility pop
 
 #include <nlohmann/json.hpp>
@@ -522,27 +523,7 @@ struct AtlasCookContext {
 
 namespace {
 
-// The declaration, parsed from JSON once, at registration.
-struct JsonDeclaration {
-    std::string doc;
-    std::vector<atlas::PortDecl> inputs, outputs;
-    std::vector<atlas::ParamDecl> params;
-};
-
-atlas::PortType port_type_from(const std::string& s) {
-    for (atlas::PortType t : {atlas::PortType::Field2D, atlas::PortType::Field3D, atlas::PortType::Field,
-                              atlas::PortType::Mesh, atlas::PortType::Points})
-        if (atlas::port_type_name(t) == s) return t;
-    throw InvalidArgument("unknown port type '" + s + "' (expected field2d, field3d, field, mesh or points)");
-}
-
-atlas::ParamType param_type_from(const std::string& s) {
-    using T = atlas::ParamType;
-    for (T t : {T::Float, T::Int, T::Bool, T::String, T::Enum, T::Path, T::Float2, T::Float3, T::Int2, T::Int3})
-        if (atlas::param_type_name(t) == s) return t;
-    throw InvalidArgument("unknown parameter type '" + s + "'");
-}
-
+// A JSON default as the ParamValue of type t; `what` names it in the message.
 atlas::ParamValue param_from_json(const nlohmann::json& j, atlas::ParamType t, const std::string& what) {
     using T = atlas::ParamType;
     auto bad = [&](const char* expected) { return InvalidArgument(what + ": expected " + expected + ", got " + j.dump()); };
@@ -574,66 +555,41 @@ atlas::ParamValue param_from_json(const nlohmann::json& j, atlas::ParamType t, c
     }
 }
 
-JsonDeclaration parse_declaration(const nlohmann::json& j, const std::string& node) {
-    JsonDeclaration d;
-    d.doc = j.value("doc", "");
-    auto ports = [&](const char* key, std::vector<atlas::PortDecl>& out) {
+// The declaration, read from JSON once, at registration: the JSON values become the
+// library builder's plain data (atlas/graph/node_builder.h), which checks them as it
+// checks Python's add_python_node.
+atlas::NodeDeclarationBuilder parse_declaration(const nlohmann::json& j, const std::string& node) {
+    atlas::NodeDeclarationBuilder d(node, j.value("doc", ""));
+    auto ports = [&](const char* key, bool inputs) {
         if (!j.contains(key)) return;
         for (const auto& p : j.at(key)) {
             if (!p.contains("name")) throw InvalidArgument(node + ": a port needs a \"name\"");
-            out.push_back({p.at("name").get<std::string>(), port_type_from(p.value("type", "field")), p.value("doc", ""),
-                           p.value("optional", false)});
+            atlas::PortDecl port{p.at("name").get<std::string>(), atlas::port_type_named(p.value("type", "field")), p.value("doc", ""),
+                                 p.value("optional", false)};
+            if (inputs) d.input(std::move(port));
+            else d.output(std::move(port));
         }
     };
-    ports("inputs", d.inputs);
-    ports("outputs", d.outputs);
-    if (d.outputs.empty()) throw InvalidArgument(node + ": a node needs at least one output");
+    ports("inputs", true);
+    ports("outputs", false);
+    d.check_ports();
     if (j.contains("params")) {
         for (const auto& p : j.at("params")) {
             if (!p.contains("name") || !p.contains("type") || !p.contains("default"))
                 throw InvalidArgument(node + ": a parameter needs \"name\", \"type\" and \"default\"");
             atlas::ParamDecl pd;
             pd.name = p.at("name").get<std::string>();
-            pd.type = param_type_from(p.at("type").get<std::string>());
+            pd.type = atlas::param_type_named(p.at("type").get<std::string>());
             pd.default_value = param_from_json(p.at("default"), pd.type, node + "." + pd.name + " default");
             if (p.contains("min") && !p.at("min").is_null()) pd.min = p.at("min").get<double>();
             if (p.contains("max") && !p.at("max").is_null()) pd.max = p.at("max").get<double>();
             pd.unit = p.value("unit", "");
             pd.doc = p.value("doc", "");
             if (p.contains("choices")) pd.choices = p.at("choices").get<std::vector<std::string>>();
-            if (std::string err = pd.check(pd.default_value); !err.empty())
-                throw InvalidArgument(node + "." + pd.name + ": default: " + err);
-            d.params.push_back(std::move(pd));
+            d.param(std::move(pd));
         }
     }
     return d;
-}
-
-void declare_from(const JsonDeclaration& j, atlas::NodeDeclaration& d) {
-    using T = atlas::ParamType;
-    d.doc(j.doc);
-    for (const auto& in : j.inputs) d.input(in.name, in.type, in.doc).optional = in.optional;
-    for (const auto& out : j.outputs) d.output(out.name, out.type, out.doc);
-    for (const auto& pd : j.params) {
-        atlas::ParamDecl* q = nullptr;
-        const auto* v = std::get_if<std::vector<double>>(&pd.default_value);
-        switch (pd.type) {
-        case T::Float: q = &d.param_float(pd.name, std::get<double>(pd.default_value)); break;
-        case T::Int: q = &d.param_int(pd.name, std::get<int64_t>(pd.default_value)); break;
-        case T::Bool: q = &d.param_bool(pd.name, std::get<bool>(pd.default_value)); break;
-        case T::String: q = &d.param_string(pd.name, std::get<std::string>(pd.default_value)); break;
-        case T::Enum: q = &d.param_enum(pd.name, pd.choices, std::get<std::string>(pd.default_value)); break;
-        case T::Path: q = &d.param_path(pd.name, std::get<std::string>(pd.default_value)); break;
-        case T::Float2: q = &d.param_float2(pd.name, atlas::Vec2d{{(*v)[0], (*v)[1]}}); break;
-        case T::Float3: q = &d.param_float3(pd.name, atlas::Vec3d{{(*v)[0], (*v)[1], (*v)[2]}}); break;
-        case T::Int2: q = &d.param_int2(pd.name, atlas::Vec2i{{int((*v)[0]), int((*v)[1])}}); break;
-        case T::Int3: q = &d.param_int3(pd.name, atlas::Vec3i{{int((*v)[0]), int((*v)[1]), int((*v)[2])}}); break;
-        }
-        q->min = pd.min;
-        q->max = pd.max;
-        q->unit = pd.unit;
-        q->doc = pd.doc;
-    }
 }
 
 // Runs `body` for an atlas_cook_* call: an exception becomes the node's failure.
@@ -682,13 +638,13 @@ AtlasStatus atlas_registry_add_node(AtlasRegistry* r, const char* declaration_js
         if (!j.is_object() || !j.contains("name") || !j.at("name").is_string())
             throw InvalidArgument("declaration: an object with a \"name\" string");
         const std::string name = j.at("name").get<std::string>();
-        auto parsed = std::make_shared<const JsonDeclaration>(parse_declaration(j, name));
+        auto parsed = std::make_shared<const atlas::NodeDeclarationBuilder>(parse_declaration(j, name));
         auto built = std::make_shared<atlas::NodeDeclaration>();
-        declare_from(*parsed, *built);
+        parsed->declare(*built);
         atlas::NodeType t;
         t.name = name;
         t.version = j.value("version", 1);
-        t.declare = [parsed](atlas::NodeDeclaration& d) { declare_from(*parsed, d); };
+        t.declare = [parsed](atlas::NodeDeclaration& d) { parsed->declare(d); };
         t.cook = [cook, user, built](atlas::CookContext& ctx) {
             AtlasCookContext c;
             c.ctx = &ctx;
@@ -703,6 +659,9 @@ AtlasStatus atlas_registry_add_node(AtlasRegistry* r, const char* declaration_js
         r->registry.add(std::move(t));
         return ATLAS_OK;
     } catch (const InvalidArgument& e) {
+        r->error = e.what();
+        return ATLAS_INVALID_ARGUMENT;
+    } catch (const atlas::DeclarationError& e) {
         r->error = e.what();
         return ATLAS_INVALID_ARGUMENT;
     } catch (const nlohmann::json::exception& e) {

@@ -5,7 +5,7 @@
 // (errors are >= 0, so their bits order like the floats; the 3 bits break ties by index
 // and cost at most 7 ulps of precision in the comparison). A candidate is ranked by the
 // largest key error, then by the float sum of the squared key errors; the winner's exact
-// errors are recomputed from its indices (bc4.cpp). One pass replaces select_indices'
+// errors are recomputed from its indices (bc4_search.cpp). One pass replaces select_indices'
 // two (minimum, then the squared-error choice), which is what `best` keeps.
 //
 // The SSE2 path and the portable path perform the same IEEE operations in the same order
@@ -273,7 +273,7 @@ __attribute__((target("avx2"))) inline bool bc4_keys_avx2(const Palette<1>& p, c
 // as all 8 (test
 // Bc4Eval.LineKeysEqualFullKeys). Entries with the same value (a constant on a grid end)
 // tie on the error and the grid end, with the lower index, wins in both evaluations
-// (texels -0.0 excepted: bc4.cpp keeps them off this path).
+// (texels -0.0 excepted: bc4_avx2.cpp keeps them off this path).
 struct Bc4LinePalette {
     __m256 lo, hi, ref;    // ascending (used only in AVX2 functions)
     const int32_t* index;  // BC4 index of each position
@@ -299,7 +299,7 @@ struct Bc4LineResult {
 // feasible entry (not for the Reference decoder's two-sided errors, the only use).
 // Each sum is formed in its evaluation's order.
 // SixGrid (8-value palettes): also each texel's distance to the 6-value grid of the same
-// ends, from the same position (5 steps for 7), for six_may_tie in bc4.cpp.
+// ends, from the same position (5 steps for 7), for six_may_tie in bc4_avx2.cpp.
 template <int N, bool SixGrid = false>
 __attribute__((target("avx2"))) inline void bc4_line_select_avx2(const Bc4LinePalette* const p[N], const float* const src[N], Bc4LineResult* const out[N],
                                                                bool ok[N]) {
@@ -384,7 +384,7 @@ __attribute__((target("avx2"))) inline void bc4_line_select_avx2(const Bc4LinePa
 // feasible) and the squared Reference error in double, summed in exact_selection's
 // order (lanes of texels j, 4 + j, 8 + j, 12 + j, then (0 + 1) + (2 + 3)); the block's
 // max error is the max over all texels, which equals the max over the texels whose key
-// error is the largest (bc4.cpp).
+// error is the largest (bc4_search.cpp).
 __attribute__((target("avx2"))) inline void bc4_exact_avx2(const Palette<1>& p, const float* src, const Bc4Keys& k, float& max_err,
                                                            double& sum_sq, uint64_t& bits) {
     static_assert(sizeof(p.lo) == 8 * sizeof(float), "one channel: 8 contiguous entries");
@@ -429,18 +429,5 @@ inline bool bc4_keys(const Palette<1>& p, const float* src, float stop, float in
     return bc4_keys_portable<OneSided>(p, src, stop, inc_sum, out);
 #endif
 }
-
-// Test hook (bc4.cpp): builds an encoder's tables for (snorm, set) and returns how many
-// entries of the 65,536 pair palettes differ (bitwise) from the palettes fast / normal
-// assemble from the per-entry tables; 0 when they are the same floats.
-long bc4_entry_table_mismatches(bool snorm, DecoderSet set);
-
-// Test hook (bc4.cpp): for each block (texels finite, within +-2, none -0.0), the level
-// pair (lo, hi)'s line-palette evaluations (8-value and 6-value mode) against the full
-// evaluation and exact pass of the same pairs' palettes: keys, key max and sum, exact max
-// error, squared error, index field, endpoints_only; and that six_may_tie skips only
-// 6-value pairs whose evaluation against the 8-value result returns false. Returns the
-// number of differences (0 also without AVX2, where there is no line path).
-long bc4_line_mismatches(bool snorm, const float* blocks, size_t count, int lo, int hi);
 
 } // namespace atlas::compress::detail

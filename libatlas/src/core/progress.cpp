@@ -4,7 +4,21 @@
 
 #include <chrono>
 
+#include <sys/resource.h>
+
 namespace atlas {
+
+double process_cpu_seconds() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+uint64_t process_peak_rss_bytes() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return uint64_t(u.ru_maxrss) * 1024; // Linux: kilobytes
+}
 
 void ProgressSink::poll() const {
     if (cancelled()) throw CancelledError();

@@ -2,6 +2,7 @@
 // serve from cache, cook the rest level by level in parallel, write outputs
 // atomically.
 #include "atlas/graph/evaluator.h"
+#include "cook_steps.h"
 #include "graph_walk.h"
 
 #include "atlas/core/files.h"
@@ -266,29 +267,53 @@ Value Session::get(const std::string& node, const std::string& port, const CookO
     return values.at(0);
 }
 
-CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std::string, std::string>>* want_value,
-                        std::vector<Value>* values_out) {
-    const auto t_start = std::chrono::steady_clock::now();
-    // Filled as the cook goes, so that a failed cook still reports what happened.
-    last_ = CookResult{};
-    CookResult& result = last_;
-    result.checked = opt.checked;
-    const Graph& g = graph();
-    result.texture_budget_mb = g.texture_budget_mb;
-    if (opt.proxy < 1 || opt.proxy > 64) throw Error("proxy: expected a factor 1..64, got " + std::to_string(opt.proxy));
-    if (opt.proxy > 1 && opt.write_outputs && !want_value)
-        throw Error("a proxy cook (proxy " + std::to_string(opt.proxy) +
-                    ") is for interaction: its results are never written as final outputs; cook without proxy to write them");
-    result.proxy = opt.proxy;
-    const int jobs = opt.jobs > 0 ? opt.jobs : hardware_threads();
-    // One budget per session: the live total of this cook's fields and values
-    // and of the in-memory cache; before refusing it drops cache entries.
-    const MemoryBudget budget(opt.memory_budget);
-    const detail::MemoryLedger& ledger = cache_->ledger();
-    const detail::MemoryLedger::Attachment attached(budget, ledger);
-    ledger.reset_peak();
-    ledger.set_evictor([cache = cache_.get()](uint64_t missing) { cache->evict(missing); });
-    result.memory_budget = opt.memory_budget;
+namespace {
+
+using Wanted = std::vector<std::pair<std::string, std::string>>;
+
+// An output to write, as planned before anything cooks.
+struct OutputPlan {
+    const GraphOutput* out = nullptr;
+    std::filesystem::path root, rel;
+    std::string name; // the record's name: rel, generic form
+    std::string spec; // hash of everything in the key but the source
+    Hash128 key;
+    // The files on disk were written with this spec from a value that may
+    // be the same as the one cooked now (an upstream change that did not
+    // change this port): compare value hashes before writing.
+    const OutputRecord* same_spec = nullptr;
+    enum { write, current, restore } action = write;
+    const OutputRecord* record = nullptr;
+    std::optional<disk_cache::CachedFiles> cached;
+};
+
+// One cook, step by step as docs/architecture.md names them: plan, resolve, hash,
+// plan the writes, fetch (from the caches), cook, report, write. Session::run calls
+// the steps in that order; the tiled cook shares plan, resolve, cook and write's
+// placing (cook_steps.h).
+class CookRun {
+public:
+    CookRun(const Graph& g, const NodeRegistry& reg, ValueCache& cache, std::map<std::pair<std::string, int>, Hash128>& last_hashes,
+            const CookOptions& opt, CookResult& result);
+
+    void plan(const Wanted* want_value); // 1. the targets: graph outputs or node ports
+    void resolve();                      // 2. what they need, in order
+    void hash();                         // 3. every needed node's hash, before anything cooks
+    void plan_writes();                  // 3b. outputs already on disk or in the disk cache
+    void fetch();                        // 4. consumers before producers: cached or to cook
+    void cook();                         // 5-6. level by level, a level's nodes in parallel
+    void report(bool for_values);        // 7. every node of the graph; the memory cache trimmed
+    void values_for(std::vector<Value>& out) const;
+    void write();                        // 8. the outputs, staged and committed together
+    CookResult finish();
+
+private:
+    void progress_step(const std::string& task, const std::string& node, double node_fraction, bool finished);
+    void warn(std::string message) { result_.warnings.push_back(std::move(message)); }
+    void check_texture_budget();
+    void record_written();
+    const std::string& value_hash(const GraphOutput* o);
+
     struct EvictorReset {
         const detail::MemoryLedger& l;
         CookResult& r;
@@ -299,119 +324,131 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             l.set_evictor(nullptr);
             r.memory_peak = l.peak();
         }
-    } evictor_reset{ledger, result};
+    };
+    struct Written {
+        size_t report; // index into result.outputs
+        OutputPlan* plan;
+        StagedOutputs* stage;
+        std::vector<std::filesystem::path> staged;
+    };
 
-    // 1. Targets: the requested graph outputs, or explicit node ports.
-    std::vector<const GraphOutput*> outputs;
-    std::vector<std::pair<std::string, std::string>> targets;
+    const std::chrono::steady_clock::time_point t_start_ = std::chrono::steady_clock::now();
+    const Graph& g_;
+    const NodeRegistry& reg_;
+    ValueCache& cache_;
+    std::map<std::pair<std::string, int>, Hash128>& last_hashes_;
+    const CookOptions& opt_;
+    CookResult& result_;
+    const int jobs_;
+    // One budget per session: the live total of this cook's fields and values
+    // and of the in-memory cache; before refusing it drops cache entries.
+    const MemoryBudget budget_;
+    const detail::MemoryLedger& ledger_;
+    const detail::MemoryLedger::Attachment attached_;
+    EvictorReset evictor_reset_;
+
+    std::vector<const GraphOutput*> outputs_;
+    Wanted targets_;
+    std::map<std::string, NodeState> state_;
+    std::vector<const GraphNode*> order_;
+    std::vector<OutputPlan> plans_;
+    std::map<std::filesystem::path, std::unique_ptr<OutputRecords>> records_;
+    // What no output may replace: the graph file and every file the cook reads.
+    std::vector<ProtectedFile> protect_;
+    std::set<std::string> feeds_writes_; // nodes some output to write depends on
+    bool cache_writable_ = false;
+    std::map<std::string, std::shared_ptr<const NodeOutputs>> values_;
+    std::map<std::string, uint64_t> released_bytes_;
+    // Progress: one unit per node to cook and per output to write; each running node
+    // adds what it reported of itself (never going back), and the fraction sent never
+    // decreases: one 0..1 run per cook.
+    std::mutex progress_mutex_;
+    int units_ = 0, done_ = 0;
+    std::map<std::string, double> in_flight_;
+    double shown_ = 0;
+    // Staged outputs and what they record.
+    std::map<std::filesystem::path, std::unique_ptr<StagedOutputs>> staging_;
+    std::vector<Written> written_;
+    std::vector<std::pair<OutputPlan*, OutputRecord>> rekeyed_;
+    std::map<std::pair<std::string, std::string>, std::string> value_hashes_;
+};
+
+CookRun::CookRun(const Graph& g, const NodeRegistry& reg, ValueCache& cache, std::map<std::pair<std::string, int>, Hash128>& last_hashes,
+                 const CookOptions& opt, CookResult& result)
+    : g_(g), reg_(reg), cache_(cache), last_hashes_(last_hashes), opt_(opt), result_(result), jobs_(opt.jobs > 0 ? opt.jobs : hardware_threads()),
+      budget_(opt.memory_budget), ledger_(cache.ledger()), attached_(budget_, ledger_), evictor_reset_{ledger_, result} {
+    ledger_.reset_peak();
+    ledger_.set_evictor([c = &cache_](uint64_t missing) { c->evict(missing); });
+    result_.memory_budget = opt.memory_budget;
+    result_.proxy = opt.proxy;
+}
+
+void CookRun::plan(const Wanted* want_value) {
     if (want_value) {
         for (const auto& [node, port] : *want_value) {
-            const GraphNode* n = g.find(node);
+            const GraphNode* n = g_.find(node);
             if (!n) throw Error("unknown node '" + node + "'");
-            const NodeType* t = registry_.find(n->type);
+            const NodeType* t = reg_.find(n->type);
             std::string p = port.empty() ? t->decl.outputs().front().name : port;
             if (!t->decl.find_output(p)) throw Error("node '" + node + "' (" + n->type + ") has no output '" + p + "'");
-            targets.emplace_back(node, p);
+            targets_.emplace_back(node, p);
         }
     } else {
-        std::set<std::string> requested(opt.outputs.begin(), opt.outputs.end());
-        std::set<std::string> matched;
-        for (const auto& o : g.outputs) {
-            bool take = requested.empty() || requested.count(o.file) || requested.count(o.node);
-            if (requested.count(o.file)) matched.insert(o.file);
-            if (requested.count(o.node)) matched.insert(o.node);
-            if (take) {
-                outputs.push_back(&o);
-                targets.emplace_back(o.node, o.port);
-            }
-        }
-        for (const auto& r : requested) {
-            if (matched.count(r)) continue;
-            std::vector<std::string> names;
-            for (const auto& o : g.outputs) names.push_back(o.file);
-            throw Error("unknown output '" + r + "'" + name_hint(r, names, "the graph writes"));
-        }
+        outputs_ = detail::select_outputs(g_, opt_.outputs);
+        for (const GraphOutput* o : outputs_) targets_.emplace_back(o->node, o->port);
     }
+}
 
-    // 2. What the targets need, in topological order.
-    std::map<std::string, NodeState> state;
-    for (const auto& n : g.nodes) state[n.name] = {&n, registry_.find(n.type)};
-    std::function<void(const std::string&)> mark = [&](const std::string& name) {
-        NodeState& s = state.at(name);
-        if (s.needed) return;
-        s.needed = true;
-        for (const auto& [port, b] : s.node->inputs) mark(b.node);
-    };
-    for (const auto& t : targets) mark(t.first);
-    std::vector<const GraphNode*> order;
-    for (const GraphNode* n : topological_order(g))
-        if (state.at(n->name).needed) order.push_back(n);
+void CookRun::resolve() {
+    for (const auto& n : g_.nodes) state_[n.name] = {&n, reg_.find(n.type)};
+    std::vector<std::string> nodes;
+    for (const auto& t : targets_) nodes.push_back(t.first);
+    order_ = detail::needed_nodes(g_, nodes);
+    for (const GraphNode* n : order_) state_.at(n->name).needed = true;
+}
 
-    // 3. Hash before compute (only what is needed: an unused import node's
-    //    missing file is not an error).
+// Only what is needed is hashed: an unused import node's missing file is not an error.
+void CookRun::hash() {
     std::map<std::string, Hash128> hashes;
-    for (const GraphNode* n : order) {
-        NodeState& s = state.at(n->name);
+    for (const GraphNode* n : order_) {
+        NodeState& s = state_.at(n->name);
         std::vector<FileRead> reads;
         {
             // What hash_extra reads: the cook's input files (none larger than the budget; Ctrl-C stops a long hash).
             FileReadRecorder recorder(&reads);
-            const detail::FileReadLimits limits(opt.memory_budget, opt.progress.is_cancelled);
+            const detail::FileReadLimits limits(opt_.memory_budget, opt_.progress.is_cancelled);
             try {
-                s.hash = node_hash(g, registry_, *n, *s.type, hashes, opt.proxy);
+                s.hash = node_hash(g_, reg_, *n, *s.type, hashes, opt_.proxy);
             } catch (...) {
-                result.error_node = n->name;
-                result.error_where = n->where.str();
+                result_.error_node = n->name;
+                result_.error_where = n->where.str();
                 throw;
             }
         }
-        for (const auto& r : reads) result.inputs.push_back({r.path, r.bytes, r.hash.hex(), n->name});
+        for (const auto& r : reads) result_.inputs.push_back({r.path, r.bytes, r.hash.hex(), n->name});
         hashes[n->name] = s.hash;
     }
+}
 
-    // 3b. Outputs already on disk: an output whose key is unchanged and whose
-    //     files still match needs no value (nothing cooks or loads for it);
-    //     one whose encoded files the disk cache holds is copied from there.
-    const bool reuse = opt.write_outputs && opt.reuse_outputs && !opt.checked;
-    bool cache_writable = bool(opt.cache_dir);
-    auto warn = [&](std::string message) { result.warnings.push_back(std::move(message)); };
-    struct OutputPlan {
-        const GraphOutput* out = nullptr;
-        std::filesystem::path root, rel;
-        std::string name; // the record's name: rel, generic form
-        std::string spec; // hash of everything in the key but the source
-        Hash128 key;
-        // The files on disk were written with this spec from a value that may
-        // be the same as the one cooked now (an upstream change that did not
-        // change this port): compare value hashes before writing.
-        const OutputRecord* same_spec = nullptr;
-        enum { write, current, restore } action = write;
-        const OutputRecord* record = nullptr;
-        std::optional<disk_cache::CachedFiles> cached;
-    };
-    std::vector<OutputPlan> plans;
-    std::map<std::filesystem::path, std::unique_ptr<OutputRecords>> records;
-    // What no output may replace: the graph file and every file the cook reads.
-    std::vector<ProtectedFile> protect;
-    if (!g.file.empty()) protect.push_back({g.file, "the graph file"});
-    for (const auto& in : result.inputs) protect.push_back({in.path, "an input file of the cook (node '" + in.node + "')"});
-    if (opt.write_outputs && !outputs.empty()) {
-        if (opt.cache_dir) remove_stale_staging(*opt.cache_dir);
-        for (const GraphOutput* o : outputs) {
+// An output whose key is unchanged and whose files still match needs no value (nothing
+// cooks or loads for it); one whose encoded files the disk cache holds is copied from there.
+void CookRun::plan_writes() {
+    const bool reuse = opt_.write_outputs && opt_.reuse_outputs && !opt_.checked;
+    cache_writable_ = bool(opt_.cache_dir);
+    if (!g_.file.empty()) protect_.push_back({g_.file, "the graph file"});
+    for (const auto& in : result_.inputs) protect_.push_back({in.path, "an input file of the cook (node '" + in.node + "')"});
+    if (opt_.write_outputs && !outputs_.empty()) {
+        if (opt_.cache_dir) remove_stale_staging(*opt_.cache_dir);
+        for (const GraphOutput* o : outputs_) {
             OutputPlan p;
             p.out = o;
             try {
-                std::filesystem::path final_path = resolve_output_path(opt.out_dir, o->file, opt.allow_outside_out);
-                check_destination(final_path, protect);
-                p.root = opt.out_dir;
-                p.rel = std::filesystem::path(o->file).lexically_normal();
-                if (std::filesystem::path(o->file).is_absolute() || p.rel.begin()->string() == "..") {
-                    p.root = final_path.parent_path();
-                    p.rel = final_path.filename();
-                }
+                const detail::OutputPlace place = detail::output_place(opt_.out_dir, *o, opt_.allow_outside_out, protect_);
+                p.root = place.root;
+                p.rel = place.rel;
             } catch (const std::exception& e) {
-                result.error_output = o->file;
-                result.error_where = o->where.str();
+                result_.error_output = o->file;
+                result_.error_where = o->where.str();
                 throw Error(o->where.str() + ": " + e.what());
             }
             p.name = p.rel.generic_string();
@@ -419,8 +456,8 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
             spec.add("atlas-output").add(int64_t(kOutputFormatVersion)).add(int64_t(writer_version(o->format))).add(o->port).add(o->format).add(p.name);
             for (const auto& [k, v] : o->options) spec.add(k).add(v);
             p.spec = spec.finish().hex();
-            p.key = Hasher(spec).add(state.at(o->node).hash).finish();
-            auto& rec = records[p.root];
+            p.key = Hasher(spec).add(state_.at(o->node).hash).finish();
+            auto& rec = records_[p.root];
             if (!rec) {
                 remove_stale_staging(p.root); // what killed cooks left
                 rec = std::make_unique<OutputRecords>(p.root);
@@ -430,10 +467,10 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                     p.action = OutputPlan::current;
                 } else if (const OutputRecord* r = rec->on_disk(p.name); r && r->spec == p.spec && !r->value_hash.empty()) {
                     p.same_spec = r;
-                } else if (opt.cache_dir && kCachedOutputFormats.count(o->format) &&
-                           std::filesystem::exists(disk_cache::files_entry_path(*opt.cache_dir, p.key))) {
+                } else if (opt_.cache_dir && kCachedOutputFormats.count(o->format) &&
+                           std::filesystem::exists(disk_cache::files_entry_path(*opt_.cache_dir, p.key))) {
                     std::string why;
-                    p.cached = disk_cache::load_files(*opt.cache_dir, p.key, &why);
+                    p.cached = disk_cache::load_files(*opt_.cache_dir, p.key, &why);
                     // Only the files this output writes: its own name and its sidecars beside it.
                     if (p.cached)
                         for (const auto& [name, bytes] : p.cached->files) {
@@ -448,37 +485,37 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                         p.action = OutputPlan::restore;
                     } else {
                         std::error_code ec;
-                        std::filesystem::remove(disk_cache::files_entry_path(*opt.cache_dir, p.key), ec);
-                        warn("disk cache: the encoded files of output '" + o->file + "' (" + disk_cache::files_entry_path(*opt.cache_dir, p.key).string() +
+                        std::filesystem::remove(disk_cache::files_entry_path(*opt_.cache_dir, p.key), ec);
+                        warn("disk cache: the encoded files of output '" + o->file + "' (" + disk_cache::files_entry_path(*opt_.cache_dir, p.key).string() +
                              ") are unusable (" + why + "); discarded, the output is written again");
                     }
                 }
             }
-            plans.push_back(std::move(p));
+            plans_.push_back(std::move(p));
         }
         // Only the outputs to write need values.
-        targets.clear();
-        for (const auto& p : plans)
-            if (p.action == OutputPlan::write) targets.emplace_back(p.out->node, p.out->port);
+        targets_.clear();
+        for (const auto& p : plans_)
+            if (p.action == OutputPlan::write) targets_.emplace_back(p.out->node, p.out->port);
     }
-    std::set<std::string> feeds_writes; // nodes some output to write depends on
     std::function<void(const std::string&)> mark_writes = [&](const std::string& name) {
-        if (!feeds_writes.insert(name).second) return;
-        for (const auto& [port, b] : state.at(name).node->inputs) mark_writes(b.node);
+        if (!feeds_writes_.insert(name).second) return;
+        for (const auto& [port, b] : state_.at(name).node->inputs) mark_writes(b.node);
     };
-    for (const auto& t : targets) mark_writes(t.first);
+    for (const auto& t : targets_) mark_writes(t.first);
+}
 
-    // 4. Decide, consumers before producers, what must be present and cooked.
-    for (const auto& t : targets) state.at(t.first).required = true;
-    for (auto it = order.rbegin(); it != order.rend(); ++it) {
-        NodeState& s = state.at((*it)->name);
+void CookRun::fetch() {
+    for (const auto& t : targets_) state_.at(t.first).required = true;
+    for (auto it = order_.rbegin(); it != order_.rend(); ++it) {
+        NodeState& s = state_.at((*it)->name);
         if (!s.required) continue;
-        if (auto hit = cache_->find(s.hash)) {
+        if (auto hit = cache_.find(s.hash)) {
             s.cached = hit;
             s.cache_source = "memory cache";
-        } else if (opt.cache_dir && disk_cache::contains(*opt.cache_dir, s.hash)) {
+        } else if (opt_.cache_dir && disk_cache::contains(*opt_.cache_dir, s.hash)) {
             std::string why;
-            auto loaded = disk_cache::load(*opt.cache_dir, s.hash, &why);
+            auto loaded = disk_cache::load(*opt_.cache_dir, s.hash, &why);
             // Every port the node declares, or the entry is not this node's.
             if (loaded)
                 for (const auto& out : s.type->decl.outputs())
@@ -488,81 +525,71 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
                         break;
                     }
             if (loaded) {
-                s.cached = held_outputs(std::move(*loaded), ledger);
+                s.cached = held_outputs(std::move(*loaded), ledger_);
                 s.cache_source = "disk cache";
-                cache_->put(s.hash, s.cached);
+                cache_.put(s.hash, s.cached);
             } else {
                 // A damaged entry is never used: remove it and cook again.
-                const auto path = disk_cache::entry_path(*opt.cache_dir, s.hash);
+                const auto path = disk_cache::entry_path(*opt_.cache_dir, s.hash);
                 std::error_code ec;
                 std::filesystem::remove(path, ec);
                 warn("disk cache: entry " + path.string() + " of node '" + (*it)->name + "' is unusable (" + why +
                      "); discarded, the node cooks again");
             }
         }
-        s.cook = opt.checked || !s.cached;
+        s.cook = opt_.checked || !s.cached;
         if (s.cook)
-            for (const auto& [port, b] : (*it)->inputs) state.at(b.node).required = true;
+            for (const auto& [port, b] : (*it)->inputs) state_.at(b.node).required = true;
     }
+    for (const GraphNode* n : order_) {
+        const NodeState& s = state_.at(n->name);
+        if (s.required && !s.cook) values_[n->name] = s.cached;
+    }
+}
 
-    // 5. Levels: a node cooks after every producer it cooks from.
+void CookRun::progress_step(const std::string& task, const std::string& node, double node_fraction, bool finished) {
+    if (!opt_.progress.on_progress) return;
+    std::lock_guard<std::mutex> lock(progress_mutex_);
+    if (finished) {
+        ++done_;
+        in_flight_.erase(node);
+    } else if (!node.empty()) {
+        double& f = in_flight_[node];
+        f = std::max(f, std::clamp(node_fraction, 0.0, 1.0));
+    }
+    double sum = done_;
+    for (const auto& [name, f] : in_flight_) sum += f;
+    shown_ = std::max(shown_, units_ ? std::min(1.0, sum / units_) : 1.0);
+    opt_.progress.on_progress({task, shown_, done_, units_});
+}
+
+void CookRun::cook() {
+    // Levels: a node cooks after every producer it cooks from.
     std::vector<std::vector<const GraphNode*>> levels;
-    for (const GraphNode* n : order) {
-        NodeState& s = state.at(n->name);
+    for (const GraphNode* n : order_) {
+        NodeState& s = state_.at(n->name);
         if (!s.cook) continue;
         int lvl = 0;
         for (const auto& [port, b] : n->inputs) {
-            const NodeState& src = state.at(b.node);
+            const NodeState& src = state_.at(b.node);
             if (src.cook) lvl = std::max(lvl, src.level + 1);
         }
         s.level = lvl;
         if (int(levels.size()) <= lvl) levels.resize(size_t(lvl) + 1);
         levels[size_t(lvl)].push_back(n);
+        ++units_;
     }
-    int total = 0;
-    for (const auto& l : levels) total += int(l.size());
+    result_.jobs = jobs_;
+    for (const auto& p : plans_) units_ += p.action != OutputPlan::current;
 
-    result.jobs = jobs;
-    std::map<std::string, std::shared_ptr<const NodeOutputs>> values;
-    for (const GraphNode* n : order) {
-        const NodeState& s = state.at(n->name);
-        if (s.required && !s.cook) values[n->name] = s.cached;
-    }
-
-    // 6. Cook, level by level; nodes of one level in parallel.
-    // Progress: one unit per node to cook and per output to write; each
-    // running node adds what it reported of itself (never going back), and
-    // the fraction sent never decreases: one 0..1 run per cook.
-    int units = total;
-    for (const auto& p : plans) units += p.action != OutputPlan::current;
-    std::mutex progress_mutex;
-    int done = 0;
-    std::map<std::string, double> in_flight;
-    double shown = 0;
-    auto progress_step = [&](const std::string& task, const std::string& node, double node_fraction, bool finished) {
-        if (!opt.progress.on_progress) return;
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        if (finished) {
-            ++done;
-            in_flight.erase(node);
-        } else if (!node.empty()) {
-            double& f = in_flight[node];
-            f = std::max(f, std::clamp(node_fraction, 0.0, 1.0));
-        }
-        double sum = done;
-        for (const auto& [name, f] : in_flight) sum += f;
-        shown = std::max(shown, units ? std::min(1.0, sum / units) : 1.0);
-        opt.progress.on_progress({task, shown, done, units});
-    };
     auto report_progress = [&](const std::string& name, double node_fraction) { progress_step("node '" + name + "'", name, node_fraction, false); };
     std::map<std::string, int> pending; // consumers still to cook, per producer
     for (const auto& level : levels)
         for (const GraphNode* n : level)
             for (const auto& [port, b] : n->inputs) ++pending[b.node];
     std::set<std::string> target_nodes;
-    for (const auto& t : targets) target_nodes.insert(t.first);
-    std::map<std::string, uint64_t> released_bytes;
-    ThreadLimit arena(jobs);
+    for (const auto& t : targets_) target_nodes.insert(t.first);
+    ThreadLimit arena(jobs_);
     for (const auto& level : levels) {
         std::vector<std::exception_ptr> errors(level.size());
         std::vector<NodeReport> reports(level.size());
@@ -570,38 +597,28 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         arena.run([&] {
             parallel_for_each(level.size(), 1, [&](size_t i) {
                 const GraphNode& n = *level[i];
-                const NodeState& s = state.at(n.name);
+                const NodeState& s = state_.at(n.name);
                 try {
-                    opt.progress.poll();
+                    opt_.progress.poll();
                     std::map<std::string, Value> inputs;
-                    // `values` is only written between levels, so reading it here needs no lock.
-                    for (const auto& [port, b] : n.inputs) inputs[port] = values.at(b.node)->at(source_port(g, registry_, b));
-                    NodeParams params(&s.type->decl, resolved_params(n, *s.type, opt.proxy), g.base_dir);
+                    // `values_` is only written between levels, so reading it here needs no lock.
+                    for (const auto& [port, b] : n.inputs) inputs[port] = values_.at(b.node)->at(source_port(g_, reg_, b));
+                    NodeParams params(&s.type->decl, resolved_params(n, *s.type, opt_.proxy), g_.base_dir);
                     ProgressSink node_progress;
-                    node_progress.is_cancelled = opt.progress.is_cancelled;
+                    node_progress.is_cancelled = opt_.progress.is_cancelled;
                     node_progress.on_progress = [&, name = n.name](const ProgressEvent& e) { report_progress(name, e.fraction); };
                     // The node's own budget: what it allocates counts against the
                     // live total until its cook ends (issue 17 item 6).
-                    const MemoryBudget node_budget(budget.limit());
-                    std::optional<detail::MemoryLedger::ScratchScope> scratch(std::in_place, node_budget, ledger);
-                    CookContext ctx(n.name, n.type, s.type->decl, params, std::move(inputs), node_budget, node_progress);
+                    const MemoryBudget node_budget(budget_.limit());
+                    std::optional<detail::MemoryLedger::ScratchScope> scratch(std::in_place, node_budget, ledger_);
                     report_progress(n.name, 0.0);
-                    const auto t0 = std::chrono::steady_clock::now();
-                    {
-                        // The node's parallel loops poll Ctrl-C between blocks.
-                        const detail::CancelScope cancel_scope(&opt.progress.is_cancelled);
-                        s.type->cook(ctx);
-                    }
-                    reports[i].seconds = seconds_since(t0);
-                    for (const auto& out : s.type->decl.outputs())
-                        if (!ctx.outputs().count(out.name))
-                            throw Error("internal: node did not set its output '" + out.name + "'");
+                    detail::NodeRun run = detail::cook_node(n, *s.type, params, std::move(inputs), node_budget, node_progress);
                     // The outputs leave the node's scratch for their own tokens (counted once).
                     scratch.reset();
-                    auto outs = held_outputs(ctx.outputs(), ledger);
-                    reports[i].metrics = ctx.metrics();
-                    reports[i].warnings = ctx.warnings();
-                    produced[i] = outs;
+                    produced[i] = held_outputs(std::move(run.outputs), ledger_);
+                    reports[i].seconds = run.seconds;
+                    reports[i].metrics = std::move(run.metrics);
+                    reports[i].warnings = std::move(run.warnings);
                 } catch (...) {
                     errors[i] = std::current_exception();
                 }
@@ -611,63 +628,64 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         // Deterministic error choice: the first failing node in level order.
         for (size_t i = 0; i < level.size(); ++i)
             if (errors[i]) {
-                result.error_node = level[i]->name;
-                result.error_where = level[i]->where.str();
+                result_.error_node = level[i]->name;
+                result_.error_where = level[i]->where.str();
                 rethrow_for_node(level[i]->name, level[i]->type, level[i]->where.str(), errors[i]);
             }
         for (size_t i = 0; i < level.size(); ++i) {
             const GraphNode& n = *level[i];
-            NodeState& s = state.at(n.name);
-            if (opt.checked && s.cached) {
+            NodeState& s = state_.at(n.name);
+            if (opt_.checked && s.cached) {
                 for (const auto& [port, v] : *s.cached) {
                     auto it = produced[i]->find(port);
                     if (it == produced[i]->end() || !values_equal(v, it->second)) {
-                        result.error_node = n.name;
-                        result.error_where = n.where.str();
+                        result_.error_node = n.name;
+                        result_.error_where = n.where.str();
                         throw Error("checked mode: node '" + n.name + "' (" + n.type + "): output '" + port +
                                     "' differs from the cached result with the same hash; the node's hash misses something its cook reads");
                     }
                 }
             }
-            values[n.name] = produced[i];
-            cache_->put(s.hash, produced[i]);
-            if (cache_writable) {
+            values_[n.name] = produced[i];
+            cache_.put(s.hash, produced[i]);
+            if (cache_writable_) {
                 try {
-                    disk_cache::store(*opt.cache_dir, s.hash, *produced[i]);
+                    disk_cache::store(*opt_.cache_dir, s.hash, *produced[i]);
                 } catch (const std::exception& e) {
                     // A full or unwritable cache disk costs speed, not the cook.
-                    cache_writable = false;
+                    cache_writable_ = false;
                     warn("disk cache: cannot store node '" + n.name + "' (" + e.what() + "); cooking on without writing the cache");
                 }
             }
             NodeReport& r = reports[i];
             r.status = "cooked";
-            r.reason = opt.checked && s.cached ? "checked mode: re-cooked and matched the " + s.cache_source : "";
-            result.nodes[n.name] = std::move(r);
+            r.reason = opt_.checked && s.cached ? "checked mode: re-cooked and matched the " + s.cache_source : "";
+            result_.nodes[n.name] = std::move(r);
         }
         // A value no node still to cook reads, and no target, is let go here
         // (the in-memory cache may keep it, and give it up under the budget).
         for (const GraphNode* n : level)
             for (const auto& [port, b] : n->inputs)
-                if (--pending[b.node] == 0 && !target_nodes.count(b.node) && values.count(b.node)) {
-                    for (const auto& [p, v] : *values.at(b.node)) released_bytes[b.node] += value_bytes(v);
-                    values.erase(b.node);
+                if (--pending[b.node] == 0 && !target_nodes.count(b.node) && values_.count(b.node)) {
+                    for (const auto& [p, v] : *values_.at(b.node)) released_bytes_[b.node] += value_bytes(v);
+                    values_.erase(b.node);
                 }
     }
+}
 
-    // 7. Report every node of the graph.
+void CookRun::report(bool for_values) {
     std::unordered_set<Hash128, Hash128Hasher> keep;
-    for (const auto& n : g.nodes) {
-        const NodeState& s = state.at(n.name);
-        NodeReport& r = result.nodes[n.name];
+    for (const auto& n : g_.nodes) {
+        const NodeState& s = state_.at(n.name);
+        NodeReport& r = result_.nodes[n.name];
         r.type = n.type;
         if (s.needed) {
             r.hash = s.hash.hex();
             keep.insert(s.hash);
         }
-        if (values.count(n.name) && values.at(n.name))
-            for (const auto& [port, v] : *values.at(n.name)) r.bytes += value_bytes(v);
-        if (released_bytes.count(n.name)) r.bytes = released_bytes.at(n.name);
+        if (values_.count(n.name) && values_.at(n.name))
+            for (const auto& [port, v] : *values_.at(n.name)) r.bytes += value_bytes(v);
+        if (released_bytes_.count(n.name)) r.bytes = released_bytes_.at(n.name);
         if (s.cook) continue;
         if (!s.needed) {
             r.status = "skipped";
@@ -675,7 +693,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
         } else if (s.required) {
             r.status = "cached";
             r.reason = s.cache_source;
-        } else if (!feeds_writes.count(n.name) && !want_value) {
+        } else if (!feeds_writes_.count(n.name) && !for_values) {
             r.status = "skipped";
             r.reason = "not needed: the outputs it feeds are up to date";
         } else {
@@ -687,180 +705,208 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     // or not), at full resolution and at each proxy factor used (an artist
     // switches between them); drop stale ones (old parameter values, removed nodes).
     for (const auto& [key, h] : last_hashes_)
-        if (g.find(key.first) && !(key.second == opt.proxy && state.at(key.first).needed)) keep.insert(h);
-    for (const auto& n : g.nodes)
-        if (state.at(n.name).needed) last_hashes_[{n.name, opt.proxy}] = state.at(n.name).hash;
-    cache_->retain_only(keep);
+        if (g_.find(key.first) && !(key.second == opt_.proxy && state_.at(key.first).needed)) keep.insert(h);
+    for (const auto& n : g_.nodes)
+        if (state_.at(n.name).needed) last_hashes_[{n.name, opt_.proxy}] = state_.at(n.name).hash;
+    cache_.retain_only(keep);
+}
 
-    // 8. Values for the host, or files (all staged, committed together).
-    if (values_out)
-        for (const auto& t : targets) values_out->push_back(values.at(t.first)->at(t.second));
-    if (opt.write_outputs && !outputs.empty()) {
-        std::map<std::filesystem::path, std::unique_ptr<StagedOutputs>> staging;
-        struct Written {
-            size_t report;     // index into result.outputs
-            OutputPlan* plan;
-            StagedOutputs* stage;
-            std::vector<std::filesystem::path> staged;
-        };
-        std::vector<Written> written;
-        // Content hash of each value written, once per node port.
-        std::map<std::pair<std::string, std::string>, std::string> value_hashes;
-        auto value_hash = [&](const GraphOutput* o) -> const std::string& {
-            auto [it, fresh] = value_hashes.try_emplace({o->node, o->port});
-            if (fresh) it->second = disk_cache::content_hash(values.at(o->node)->at(o->port)).hex();
-            return it->second;
-        };
-        std::vector<std::pair<OutputPlan*, OutputRecord>> rekeyed;
-        for (OutputPlan& p : plans) {
-            const GraphOutput* o = p.out;
-            OutputReport orep{o->node, o->port, o->file, o->format, {}, {}, {}, {}, {}, 0.0};
-            if (p.same_spec && p.same_spec->value_hash == value_hash(o)) {
-                // Upstream changed, this port did not: the files already hold it.
-                p.action = OutputPlan::current;
-                p.record = p.same_spec;
-                OutputRecord r = *p.same_spec;
-                r.key = p.key.hex();
-                rekeyed.emplace_back(&p, std::move(r));
-                progress_step("up to date: " + o->file, "", 0.0, true);
+void CookRun::values_for(std::vector<Value>& out) const {
+    for (const auto& t : targets_) out.push_back(values_.at(t.first)->at(t.second));
+}
+
+void CookRun::write() {
+    if (!opt_.write_outputs || outputs_.empty()) {
+        for (const GraphOutput* o : outputs_) result_.outputs.push_back({o->node, o->port, o->file, o->format, {}, {}, {}, {}});
+        return;
+    }
+    for (OutputPlan& p : plans_) {
+        const GraphOutput* o = p.out;
+        OutputReport orep{o->node, o->port, o->file, o->format, {}, {}, {}, {}, {}, 0.0};
+        if (p.same_spec && p.same_spec->value_hash == value_hash(o)) {
+            // Upstream changed, this port did not: the files already hold it.
+            p.action = OutputPlan::current;
+            p.record = p.same_spec;
+            OutputRecord r = *p.same_spec;
+            r.key = p.key.hex();
+            rekeyed_.emplace_back(&p, std::move(r));
+            progress_step("up to date: " + o->file, "", 0.0, true);
+        }
+        if (p.action == OutputPlan::current) {
+            orep.status = "up to date";
+            orep.metrics = p.record->metrics;
+            for (const auto& f : p.record->files) orep.files.push_back({p.root / f.path, f.bytes, f.hash});
+            result_.outputs.push_back(orep);
+            continue;
+        }
+        const auto t_write = std::chrono::steady_clock::now();
+        try {
+            opt_.progress.poll();
+            auto& st = staging_[p.root];
+            if (!st) {
+                st = std::make_unique<StagedOutputs>(p.root);
+                st->protect(protect_);
             }
-            if (p.action == OutputPlan::current) {
-                orep.status = "up to date";
-                orep.metrics = p.record->metrics;
-                for (const auto& f : p.record->files) orep.files.push_back({p.root / f.path, f.bytes, f.hash});
-                result.outputs.push_back(orep);
+            progress_step("writing " + o->file, "", 0.0, false);
+            Written w{result_.outputs.size(), &p, st.get(), {}};
+            if (p.action == OutputPlan::restore) {
+                orep.status = "restored";
+                orep.metrics = p.cached->metrics;
+                for (const auto& [name, bytes] : p.cached->files) {
+                    const auto staged = st->stage(name);
+                    write_file_checked(staged, bytes.data(), bytes.size());
+                    w.staged.push_back(staged);
+                }
+                p.cached.reset();
+            } else {
+                orep.status = "written";
+                // A writer may copy the value (a slice stack, a half-float frame): room for one copy;
+                // the DDS encoder holds its channels and blocks besides (cloudscape's modeling.dds
+                // peaked 490 MB of RSS over the one copy counted), so two.
+                const uint64_t scratch = value_bytes(values_.at(o->node)->at(o->port)) * (o->format == "dds" ? 2 : 1);
+                budget_.check(scratch, "output '" + o->file + "': the writer's copy of the value");
+                const auto scratch_held = ledger_.hold(&scratch, scratch);
+                w.staged = io::write_value(values_.at(o->node)->at(o->port), st->stage(p.rel), o->format, o->options, &orep.metrics);
+            }
+            for (const auto& staged : w.staged) {
+                // What is on disk is what gets reported and recorded.
+                std::error_code ec;
+                const uint64_t bytes = std::filesystem::file_size(staged, ec);
+                if (ec) throw Error("'" + staged.string() + "' was not written: " + ec.message());
+                const auto final_path = st->final_path(staged);
+                orep.written.push_back(final_path);
+                orep.files.push_back({final_path, bytes, file_content_hash(staged).hex()});
+            }
+            if (p.action == OutputPlan::write && cache_writable_ && kCachedOutputFormats.count(o->format)) {
+                std::vector<std::pair<std::string, std::filesystem::path>> files;
+                for (size_t k = 0; k < w.staged.size(); ++k)
+                    files.emplace_back(orep.files[k].path.lexically_relative(p.root).generic_string(), w.staged[k]);
+                try {
+                    disk_cache::store_files(*opt_.cache_dir, p.key, files, orep.metrics);
+                } catch (const std::exception& e) {
+                    cache_writable_ = false;
+                    warn("disk cache: cannot store the encoded files of output '" + o->file + "' (" + e.what() +
+                         "); cooking on without writing the cache");
+                }
+            }
+            orep.seconds = seconds_since(t_write);
+            result_.outputs.push_back(orep);
+            written_.push_back(std::move(w));
+            progress_step("wrote " + o->file, "", 0.0, true);
+        } catch (const CancelledError&) {
+            throw;
+        } catch (const std::exception& e) {
+            // The output failed, not the node that fed it: the report marks the output.
+            const std::string msg = e.what();
+            orep.status = "failed";
+            orep.error = msg;
+            orep.written.clear();
+            orep.files.clear();
+            orep.seconds = seconds_since(t_write);
+            result_.outputs.push_back(orep);
+            if (opt_.keep_going) {
+                if (auto st = staging_.find(p.root); st != staging_.end() && st->second) st->second->discard(p.rel);
+                warn("output '" + o->file + "' (" + o->where.str() + ") was not written (keep going): " + msg);
                 continue;
             }
-            const auto t_write = std::chrono::steady_clock::now();
-            try {
-                opt.progress.poll();
-                auto& st = staging[p.root];
-                if (!st) {
-                    st = std::make_unique<StagedOutputs>(p.root);
-                    st->protect(protect);
-                }
-                progress_step("writing " + o->file, "", 0.0, false);
-                Written w{result.outputs.size(), &p, st.get(), {}};
-                if (p.action == OutputPlan::restore) {
-                    orep.status = "restored";
-                    orep.metrics = p.cached->metrics;
-                    for (const auto& [name, bytes] : p.cached->files) {
-                        const auto staged = st->stage(name);
-                        write_file_checked(staged, bytes.data(), bytes.size());
-                        w.staged.push_back(staged);
-                    }
-                    p.cached.reset();
-                } else {
-                    orep.status = "written";
-                    // A writer may copy the value (a slice stack, a half-float frame): room for one copy;
-                    // the DDS encoder holds its channels and blocks besides (cloudscape's modeling.dds
-                    // peaked 490 MB of RSS over the one copy counted), so two.
-                    const uint64_t scratch = value_bytes(values.at(o->node)->at(o->port)) * (o->format == "dds" ? 2 : 1);
-                    budget.check(scratch, "output '" + o->file + "': the writer's copy of the value");
-                    const auto scratch_held = ledger.hold(&scratch, scratch);
-                    w.staged = io::write_value(values.at(o->node)->at(o->port), st->stage(p.rel), o->format, o->options, &orep.metrics);
-                }
-                for (const auto& staged : w.staged) {
-                    // What is on disk is what gets reported and recorded.
-                    std::error_code ec;
-                    const uint64_t bytes = std::filesystem::file_size(staged, ec);
-                    if (ec) throw Error("'" + staged.string() + "' was not written: " + ec.message());
-                    const auto final_path = st->final_path(staged);
-                    orep.written.push_back(final_path);
-                    orep.files.push_back({final_path, bytes, file_content_hash(staged).hex()});
-                }
-                if (p.action == OutputPlan::write && cache_writable && kCachedOutputFormats.count(o->format)) {
-                    std::vector<std::pair<std::string, std::filesystem::path>> files;
-                    for (size_t k = 0; k < w.staged.size(); ++k)
-                        files.emplace_back(orep.files[k].path.lexically_relative(p.root).generic_string(), w.staged[k]);
-                    try {
-                        disk_cache::store_files(*opt.cache_dir, p.key, files, orep.metrics);
-                    } catch (const std::exception& e) {
-                        cache_writable = false;
-                        warn("disk cache: cannot store the encoded files of output '" + o->file + "' (" + e.what() +
-                             "); cooking on without writing the cache");
-                    }
-                }
-                orep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
-                result.outputs.push_back(orep);
-                written.push_back(std::move(w));
-                progress_step("wrote " + o->file, "", 0.0, true);
-            } catch (const CancelledError&) {
-                throw;
-            } catch (const std::exception& e) {
-                // Writers already name the output ("output 'x.png': ..."); add the graph position.
-                // The output failed, not the node that fed it: the report marks the output.
-                const std::string msg = e.what();
-                orep.status = "failed";
-                orep.error = msg;
-                orep.written.clear();
-                orep.files.clear();
-                orep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
-                result.outputs.push_back(orep);
-                if (opt.keep_going) {
-                    if (auto st = staging.find(p.root); st != staging.end() && st->second) st->second->discard(p.rel);
-                    warn("output '" + o->file + "' (" + o->where.str() + ") was not written (keep going): " + msg);
-                    continue;
-                }
-                result.error_output = o->file;
-                result.error_where = o->where.str();
-                throw Error(o->where.str() + ": " + (msg.rfind("output '", 0) == 0 ? msg : "output '" + o->file + "': " + msg));
-            }
+            result_.error_output = o->file;
+            result_.error_where = o->where.str();
+            throw Error(detail::output_error(*o, msg));
         }
-        // The graph's texture budget, on what is staged or already up to date, before anything moves.
-        if (g.texture_budget_mb) {
-            const uint64_t texture_total = result.texture_bytes();
-            const double limit = *g.texture_budget_mb * 1e6;
-            if (double(texture_total) > limit) {
-                std::vector<std::pair<uint64_t, std::string>> textures;
-                for (const OutputReport& o : result.outputs)
-                    if (const uint64_t b = o.texture_bytes()) textures.emplace_back(b, o.file);
-                std::sort(textures.rbegin(), textures.rend());
-                auto mb = [](double bytes) {
-                    std::ostringstream os;
-                    os.precision(3);
-                    os << bytes / 1e6 << " MB";
-                    return os.str();
-                };
-                std::string list;
-                for (const auto& [b, file] : textures) list += (list.empty() ? "" : ", ") + file + " " + mb(double(b));
-                result.error_where = g.budget_where.str();
-                throw Error(g.budget_where.str() + ": budget: the textures take " + mb(double(texture_total)) + ", over texture_mb " +
-                            detail::number_text(*g.texture_budget_mb) + " by " + mb(double(texture_total) - limit) + " (largest first: " + list +
-                            "); nothing was written");
-            }
-        }
-        // Everything written: move it into place.
-        // Every root's destinations checked and journaled before any file moves.
-        for (auto& [root, st] : staging) st->prepare();
-        for (auto& [root, st] : staging) st->commit();
-        // Record what is on disk now (renames keep the mtime).
-        for (auto& [plan, rec] : rekeyed) records.at(plan->root)->set(plan->name, std::move(rec));
-        for (const auto& w : written) {
-            OutputRecord rec;
-            rec.key = w.plan->key.hex();
-            rec.spec = w.plan->spec;
-            if (w.plan->action == OutputPlan::write) rec.value_hash = value_hash(w.plan->out);
-            const OutputReport& orep = result.outputs[w.report];
-            rec.metrics = orep.metrics;
-            for (const auto& f : orep.files)
-                rec.files.push_back({f.path.lexically_relative(w.plan->root).generic_string(), f.bytes, file_mtime_ns(f.path), f.hash});
-            records.at(w.plan->root)->set(w.plan->name, std::move(rec));
-        }
-        for (auto& [root, rec] : records) {
-            try {
-                rec->save();
-            } catch (const std::exception& e) {
-                warn("cannot record the outputs written in '" + root.string() + "' (" + e.what() + "); the next cook writes them again");
-            }
-        }
-    } else {
-        for (const GraphOutput* o : outputs) result.outputs.push_back({o->node, o->port, o->file, o->format, {}, {}, {}, {}});
     }
-    if (opt.cache_dir && opt.cache_max_bytes > 0) disk_cache::prune(*opt.cache_dir, opt.cache_max_bytes);
-    result.seconds = seconds_since(t_start);
-    result.memory_peak = ledger.peak();
-    return result;
+    check_texture_budget();
+    // Everything written: move it into place.
+    // Every root's destinations checked and journaled before any file moves.
+    for (auto& [root, st] : staging_) st->prepare();
+    for (auto& [root, st] : staging_) st->commit();
+    record_written();
+}
+
+// Content hash of the value an output writes, once per node port.
+const std::string& CookRun::value_hash(const GraphOutput* o) {
+    auto [it, fresh] = value_hashes_.try_emplace({o->node, o->port});
+    if (fresh) it->second = disk_cache::content_hash(values_.at(o->node)->at(o->port)).hex();
+    return it->second;
+}
+
+// The graph's texture budget, on what is staged or already up to date, before anything moves.
+void CookRun::check_texture_budget() {
+    if (!g_.texture_budget_mb) return;
+    const uint64_t texture_total = result_.texture_bytes();
+    const double limit = *g_.texture_budget_mb * 1e6;
+    if (double(texture_total) <= limit) return;
+    std::vector<std::pair<uint64_t, std::string>> textures;
+    for (const OutputReport& o : result_.outputs)
+        if (const uint64_t b = o.texture_bytes()) textures.emplace_back(b, o.file);
+    std::sort(textures.rbegin(), textures.rend());
+    auto mb = [](double bytes) {
+        std::ostringstream os;
+        os.precision(3);
+        os << bytes / 1e6 << " MB";
+        return os.str();
+    };
+    std::string list;
+    for (const auto& [b, file] : textures) list += (list.empty() ? "" : ", ") + file + " " + mb(double(b));
+    result_.error_where = g_.budget_where.str();
+    throw Error(g_.budget_where.str() + ": budget: the textures take " + mb(double(texture_total)) + ", over texture_mb " +
+                detail::number_text(*g_.texture_budget_mb) + " by " + mb(double(texture_total) - limit) + " (largest first: " + list +
+                "); nothing was written");
+}
+
+// Records what is on disk now (renames keep the mtime).
+void CookRun::record_written() {
+    for (auto& [plan, rec] : rekeyed_) records_.at(plan->root)->set(plan->name, std::move(rec));
+    for (const auto& w : written_) {
+        OutputRecord rec;
+        rec.key = w.plan->key.hex();
+        rec.spec = w.plan->spec;
+        if (w.plan->action == OutputPlan::write) rec.value_hash = value_hash(w.plan->out);
+        const OutputReport& orep = result_.outputs[w.report];
+        rec.metrics = orep.metrics;
+        for (const auto& f : orep.files)
+            rec.files.push_back({f.path.lexically_relative(w.plan->root).generic_string(), f.bytes, file_mtime_ns(f.path), f.hash});
+        records_.at(w.plan->root)->set(w.plan->name, std::move(rec));
+    }
+    for (auto& [root, rec] : records_) {
+        try {
+            rec->save();
+        } catch (const std::exception& e) {
+            warn("cannot record the outputs written in '" + root.string() + "' (" + e.what() + "); the next cook writes them again");
+        }
+    }
+}
+
+CookResult CookRun::finish() {
+    if (opt_.cache_dir && opt_.cache_max_bytes > 0) disk_cache::prune(*opt_.cache_dir, opt_.cache_max_bytes);
+    result_.seconds = seconds_since(t_start_);
+    result_.memory_peak = ledger_.peak();
+    return result_;
+}
+
+} // namespace
+
+CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std::string, std::string>>* want_value,
+                        std::vector<Value>* values_out) {
+    // Filled as the cook goes, so that a failed cook still reports what happened.
+    last_ = CookResult{};
+    last_.checked = opt.checked;
+    const Graph& g = graph();
+    last_.texture_budget_mb = g.texture_budget_mb;
+    if (opt.proxy < 1 || opt.proxy > 64) throw Error("proxy: expected a factor 1..64, got " + std::to_string(opt.proxy));
+    if (opt.proxy > 1 && opt.write_outputs && !want_value)
+        throw Error("a proxy cook (proxy " + std::to_string(opt.proxy) +
+                    ") is for interaction: its results are never written as final outputs; cook without proxy to write them");
+    CookRun cook(g, registry_, *cache_, last_hashes_, opt, last_);
+    cook.plan(want_value);
+    cook.resolve();
+    cook.hash();
+    cook.plan_writes();
+    cook.fetch();
+    cook.cook();
+    cook.report(want_value != nullptr);
+    if (values_out) cook.values_for(*values_out);
+    cook.write();
+    return cook.finish();
 }
 
 std::vector<std::filesystem::path> CookResult::depends(const std::filesystem::path& graph_file) const {

@@ -2,6 +2,7 @@
 // crops, tile files, fragments, the tile index and assembly.
 #include "atlas/core/progress.h"
 #include "atlas/graph/tiling.h"
+#include "cook_steps.h"
 #include "graph_walk.h"
 
 #include "atlas/core/files.h"
@@ -17,7 +18,6 @@
 #include <functional>
 #include <set>
 
-#include <sys/resource.h>
 
 namespace atlas {
 
@@ -49,28 +49,11 @@ std::string node_label(const GraphNode& n) {
 
 Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::string>& wanted) {
     Plan p;
-    std::set<std::string> requested(wanted.begin(), wanted.end()), matched;
-    for (const auto& o : g.outputs) {
-        const bool take = requested.empty() || requested.count(o.file) || requested.count(o.node);
-        if (requested.count(o.file)) matched.insert(o.file);
-        if (requested.count(o.node)) matched.insert(o.node);
-        if (take) p.outputs.push_back(&o);
-    }
-    for (const auto& r : requested)
-        if (!matched.count(r)) {
-            std::vector<std::string> names;
-            for (const auto& o : g.outputs) names.push_back(o.file);
-            throw Error("unknown output '" + r + "'" + name_hint(r, names, "the graph writes"));
-        }
+    p.outputs = detail::select_outputs(g, wanted);
     if (p.outputs.empty()) throw Error("tiling: the graph writes no outputs");
-    std::set<std::string> needed;
-    std::function<void(const std::string&)> mark = [&](const std::string& name) {
-        if (!needed.insert(name).second) return;
-        for (const auto& [port, b] : g.find(name)->inputs) mark(b.node);
-    };
-    for (const GraphOutput* o : p.outputs) mark(o->node);
-    for (const GraphNode* n : topological_order(g))
-        if (needed.count(n->name)) p.order.push_back(n);
+    std::vector<std::string> targets;
+    for (const GraphOutput* o : p.outputs) targets.push_back(o->node);
+    p.order = detail::needed_nodes(g, targets);
     for (const GraphNode* n : p.order)
         for (const auto& [port, b] : n->inputs) p.last_use[b.node] = n->name;
     for (const GraphOutput* o : p.outputs) p.output_nodes.insert(o->node);
@@ -191,56 +174,11 @@ fs::path tile_rel(const GraphOutput& o, Vec2i t) {
 
 fs::path fragment_rel(Vec2i t) { return fs::path("tiles") / (std::to_string(t[0]) + "_" + std::to_string(t[1]) + ".json"); }
 
-// SHA-256 (FIPS 180-4) of a file, hex: the tile index's standard hash for engines.
-std::string file_sha256(const fs::path& path) {
-    static const uint32_t k[64] = {
-        0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4, 0xab1c5ed5, 0xd807aa98, 0x12835b01, 0x243185be,
-        0x550c7dc3, 0x72be5d74, 0x80deb1fe, 0x9bdc06a7, 0xc19bf174, 0xe49b69c1, 0xefbe4786, 0x0fc19dc6, 0x240ca1cc, 0x2de92c6f, 0x4a7484aa,
-        0x5cb0a9dc, 0x76f988da, 0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7, 0xc6e00bf3, 0xd5a79147, 0x06ca6351, 0x14292967, 0x27b70a85,
-        0x2e1b2138, 0x4d2c6dfc, 0x53380d13, 0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85, 0xa2bfe8a1, 0xa81a664b, 0xc24b8b70, 0xc76c51a3,
-        0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070, 0x19a4c116, 0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a, 0x5b9cca4f,
-        0x682e6ff3, 0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2};
-    uint32_t h[8] = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a, 0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
-    auto rotr = [](uint32_t x, int n) { return (x >> n) | (x << (32 - n)); };
-    auto block = [&](const unsigned char* p) {
-        uint32_t w[64];
-        for (int i = 0; i < 16; ++i) w[i] = uint32_t(p[4 * i]) << 24 | uint32_t(p[4 * i + 1]) << 16 | uint32_t(p[4 * i + 2]) << 8 | p[4 * i + 3];
-        for (int i = 16; i < 64; ++i) {
-            const uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
-            const uint32_t s1 = rotr(w[i - 2], 17) ^ rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
-            w[i] = w[i - 16] + s0 + w[i - 7] + s1;
-        }
-        uint32_t a = h[0], b = h[1], c = h[2], d = h[3], e = h[4], f = h[5], g = h[6], hh = h[7];
-        for (int i = 0; i < 64; ++i) {
-            const uint32_t t1 = hh + (rotr(e, 6) ^ rotr(e, 11) ^ rotr(e, 25)) + ((e & f) ^ (~e & g)) + k[i] + w[i];
-            const uint32_t t2 = (rotr(a, 2) ^ rotr(a, 13) ^ rotr(a, 22)) + ((a & b) ^ (a & c) ^ (b & c));
-            hh = g, g = f, f = e, e = d + t1, d = c, c = b, b = a, a = t1 + t2;
-        }
-        h[0] += a, h[1] += b, h[2] += c, h[3] += d, h[4] += e, h[5] += f, h[6] += g, h[7] += hh;
-    };
-    const std::string data = read_file_bytes(path);
-    const uint64_t n = data.size();
-    size_t i = 0;
-    for (; i + 64 <= n; i += 64) block(reinterpret_cast<const unsigned char*>(data.data()) + i);
-    unsigned char tail[128] = {};
-    const size_t rest = size_t(n - i);
-    std::copy(data.begin() + std::ptrdiff_t(i), data.end(), tail);
-    tail[rest] = 0x80;
-    const size_t len = rest + 9 <= 64 ? 64 : 128;
-    for (int b = 0; b < 8; ++b) tail[len - 1 - size_t(b)] = static_cast<unsigned char>((n * 8) >> (8 * b));
-    for (size_t o = 0; o < len; o += 64) block(tail + o);
-    static const char* hex = "0123456789abcdef";
-    std::string out;
-    for (uint32_t v : h)
-        for (int b = 28; b >= 0; b -= 4) out += hex[(v >> b) & 0xf];
-    return out;
-}
-
 json file_entry(const fs::path& root, const fs::path& final_path, const fs::path& on_disk) {
     return {{"path", final_path.lexically_relative(root).generic_string()},
             {"bytes", uint64_t(fs::file_size(on_disk))},
             {"hash", file_content_hash(on_disk).hex()},
-            {"sha256", file_sha256(on_disk)}};
+            {"sha256", sha256_hex(read_file_bytes(on_disk))}};
 }
 
 // A fragment's files are all present with the recorded sizes and hashes.
@@ -283,18 +221,6 @@ Grid grid_from_json(const json& j) {
     return g;
 }
 
-double cpu_seconds() {
-    rusage u{};
-    getrusage(RUSAGE_SELF, &u);
-    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
-uint64_t peak_rss_bytes() {
-    rusage u{};
-    getrusage(RUSAGE_SELF, &u);
-    return uint64_t(u.ru_maxrss) * 1024; // Linux: kilobytes
-}
-
 // Bytes of the values, each field counted once (crops that are the whole value share it).
 uint64_t distinct_bytes(const std::vector<Value>& values) {
     std::set<const void*> seen;
@@ -319,7 +245,7 @@ TileReport tile_report(Vec2i t, TileRect texels, std::string status, double seco
     r.seconds = seconds;
     r.cpu_seconds = cpu;
     r.value_bytes_peak = value_peak;
-    r.rss_peak_bytes = peak_rss_bytes();
+    r.rss_peak_bytes = process_peak_rss_bytes();
     if (!frag) return r;
     auto add = [&](const json& f) {
         r.files.push_back({f.at("path").get<std::string>(), f.at("bytes").get<uint64_t>(), f.at("hash").get<std::string>(),
@@ -543,7 +469,7 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
             for (const auto& [port, b] : n.inputs) region[b.node] = unite(region[b.node], need);
         }
         std::map<std::pair<std::string, std::string>, Held> held;
-        const double cpu0 = cpu_seconds();
+        const double cpu0 = process_cpu_seconds();
         uint64_t value_peak = 0;
         try {
             for (const GraphNode* n : plan.order) {
@@ -565,10 +491,8 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
                 NodeParams params(&type.decl, resolved_params(*n, type), g.base_dir);
                 ProgressSink node_progress;
                 node_progress.is_cancelled = opt.progress.is_cancelled;
-                CookContext ctx(n->name, n->type, type.decl, params, std::move(inputs), budget, node_progress);
                 const TileWindow in_window = window_of(grid, in_rect);
-                if (windowed) ctx.set_window(&window);
-                else if (plan.reads_window.count(n->name)) ctx.set_window(&in_window);
+                const TileWindow* node_window = windowed ? &window : plan.reads_window.count(n->name) ? &in_window : nullptr;
                 {
                     // Memory: what is held for later nodes, this node's inputs and (below) its outputs.
                     std::vector<Value> alive;
@@ -576,8 +500,9 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
                     for (const auto& [port, v] : inputs) alive.push_back(v);
                     value_peak = std::max(value_peak, distinct_bytes(alive));
                 }
+                detail::NodeRun run;
                 try {
-                    arena.run([&] { type.cook(ctx); });
+                    arena.run([&] { run = detail::cook_node(*n, type, params, std::move(inputs), budget, node_progress, node_window); });
                 } catch (const CancelledError&) {
                     throw;
                 } catch (const std::exception& e) {
@@ -590,13 +515,12 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
                 {
                     std::vector<Value> alive;
                     for (const auto& [key, h] : held) alive.push_back(h.v);
-                    for (const auto& [port, v] : ctx.outputs()) alive.push_back(v);
+                    for (const auto& [port, v] : run.outputs) alive.push_back(v);
                     value_peak = std::max(value_peak, distinct_bytes(alive));
                 }
                 const Box2d want = rect_bounds(grid, in_rect);
                 for (const auto& out : type.decl.outputs()) {
-                    auto it = ctx.outputs().find(out.name);
-                    if (it == ctx.outputs().end()) throw Error(node_label(*n) + ": internal: node did not set its output '" + out.name + "'");
+                    auto it = run.outputs.find(out.name);
                     if (!is_field(it->second)) {
                         throw Error(node_label(*n) + ": output '" + out.name + "' is not a field, so it does not tile");
                     }
@@ -630,7 +554,7 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
                 try {
                     staged = io::write_value(v, st.stage(tile_rel(*o, t)), o->format, o->options, &metrics);
                 } catch (const std::exception& e) {
-                    throw Error(o->where.str() + ": output '" + o->file + "': " + e.what());
+                    throw Error(detail::output_error(*o, e.what()));
                 }
                 json files = json::array();
                 for (const auto& s : staged) files.push_back(file_entry(root, st.final_path(s), s));
@@ -652,7 +576,7 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
             fragments[{t[0], t[1]}] = std::move(frag);
         } catch (const std::exception& e) {
             TileReport failed = tile_report(t, tr, dynamic_cast<const CancelledError*>(&e) ? "cancelled" : "failed", seconds_since(t0),
-                                            cpu_seconds() - cpu0, value_peak, nullptr, root);
+                                            process_cpu_seconds() - cpu0, value_peak, nullptr, root);
             failed.error = e.what();
             result.tiles_done.push_back(std::move(failed));
             result.seconds = seconds_since(t_start);
@@ -662,7 +586,7 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
             throw Error(tname + ": " + msg);
         }
         result.tiles_done.push_back(
-            tile_report(t, tr, "cooked", seconds_since(t0), cpu_seconds() - cpu0, value_peak, &fragments.at({t[0], t[1]}), root));
+            tile_report(t, tr, "cooked", seconds_since(t0), process_cpu_seconds() - cpu0, value_peak, &fragments.at({t[0], t[1]}), root));
         ++tiles_finished;
         if (opt.progress.on_progress) opt.progress.on_progress({tname, double(tiles_finished) / total_tiles, tiles_finished, total_tiles});
     }
@@ -748,12 +672,7 @@ void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& top
                             throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' holds no field");
                         }
                     }
-                fs::path final_path = resolve_output_path(root, o->file, opt.allow_outside_out);
-                fs::path out_root = root, rel = fs::path(o->file).lexically_normal();
-                if (fs::path(o->file).is_absolute() || rel.begin()->string() == "..") {
-                    out_root = final_path.parent_path();
-                    rel = final_path.filename();
-                }
+                const auto [out_root, rel] = detail::output_place(root, *o, opt.allow_outside_out);
                 auto& st = staging[out_root];
                 if (!st) {
                     st = std::make_unique<StagedOutputs>(out_root);

@@ -2,6 +2,7 @@
 #include "atlas/sim/kessler.h"
 
 #include "atlas/core/error.h"
+#include "atlas/sim/sim_options.h"
 #include "atlas/sim/thermo.h"
 #include "atlas/core/parallel.h"
 
@@ -21,6 +22,12 @@ void check(double v, double lo, double hi, const char* what) {
     }
 }
 
+// Member `member` against the bounds of its node option rain_<member> (sim_options.h).
+void check_option(double v, const std::string& member) {
+    const TextOption<SimOptions>& o = sim_option("rain_" + member);
+    check(v, o.min, o.max, (member + " (" + o.unit + ")").c_str());
+}
+
 void check_finite(std::span<const float> a, const char* what) {
     for (size_t n = 0; n < a.size(); ++n)
         if (!std::isfinite(a[n]))
@@ -35,9 +42,9 @@ void check_sizes(const GridSpec& s, size_t n, size_t nrho) {
 } // namespace
 
 void KesslerOptions::validate() const {
-    check(autoconversion_rate, 0, 1, "autoconversion_rate (1/s)");
-    check(autoconversion_threshold, 0, 0.01, "autoconversion_threshold (kg/kg)");
-    check(accretion_rate, 0, 100, "accretion_rate (1/s)");
+    check_option(autoconversion_rate, "autoconversion_rate");
+    check_option(autoconversion_threshold, "autoconversion_threshold");
+    check_option(accretion_rate, "accretion_rate");
     if (!(sedimentation_cfl > 0 && sedimentation_cfl <= 1)) check(sedimentation_cfl, 1e-9, 1, "sedimentation_cfl");
 }
 

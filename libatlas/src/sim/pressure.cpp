@@ -2,15 +2,28 @@
 #include "atlas/sim/pressure.h"
 
 #include "atlas/core/error.h"
+#include "atlas/sim/sim_options.h"
 
 #include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 namespace atlas::sim {
 namespace {
 
+// Member `member` of ProjectionOptions against the bounds of its node option
+// pressure_<member> (sim_options.h).
+void check_option(double v, const std::string& member) {
+    const TextOption<SimOptions>& o = sim_option("pressure_" + member);
+    if (!(v >= o.min && v <= o.max)) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "sim pressure: %s expected in [%g, %g]", member.c_str(), o.min, o.max);
+        throw Error(buf);
+    }
+}
 
 // Sum of per-slice partial sums, added in slice order (deterministic).
 template <class F>
@@ -343,8 +356,8 @@ ProjectionReport PressureSolver::project(MacVelocity& vel, const ProjectionOptio
     const GridSpec& s = m.spec;
     if (vel.spec.nx != s.nx || vel.spec.ny != s.ny || vel.spec.nz != s.nz)
         throw Error("sim pressure: velocity grid does not match the solver grid");
-    if (!(opt.tolerance >= 1e-12 && opt.tolerance <= 1e-1)) throw Error("sim pressure: tolerance expected in [1e-12, 0.1]");
-    if (opt.max_iterations < 1 || opt.max_iterations > 10000) throw Error("sim pressure: max_iterations expected in [1, 10000]");
+    check_option(opt.tolerance, "tolerance");
+    check_option(opt.max_iterations, "max_iterations");
     if (!std::isfinite(vel.max_abs())) throw Error("sim pressure: velocity holds NaN or Inf");
     vel.enforce_walls();
     ProjectionReport rep;

@@ -1,6 +1,7 @@
 // The cloud-growth Simulation: sounding, sources, forces, stepping (see simulation.h).
 #include "atlas/core/progress.h"
 #include "atlas/sim/simulation.h"
+#include "atlas/sim/sim_options.h"
 #include "atlas/sim/sounding_options.h"
 
 #include "atlas/core/error.h"
@@ -165,15 +166,18 @@ ReferenceProfile make_reference(const Sounding& s, int nz, double dx) {
 }
 
 void SimOptions::validate(int nz) const {
-    check_range(cfl, 0.1, 5, "options.cfl");
-    check_range(step_error_tolerance, 0, 1, "options.step_error_tolerance (cells)");
-    check_range(max_substeps, 1, 10000, "options.max_substeps");
-    check_range(condensation_rate, 0, 1e9, "options.condensation_rate (1/s)");
-    check_range(vorticity_confinement, 0, 0.2, "options.vorticity_confinement (dimensionless)");
-    check_range(viscosity, 0, 1e4, "options.viscosity (m^2/s)");
-    check_range(diffusivity, 0, 1e4, "options.diffusivity (m^2/s)");
+    // The bounds sim/cloud_growth declares (sim_options.h), for SimOptions' own numbers;
+    // the rain_* ones are KesslerOptions' (kessler.validate() below, only with rain), the
+    // pressure_* ones ProjectionOptions' (checked by the pressure solver).
+    for (const TextOption<SimOptions>& o : sim_options()) {
+        const std::string_view name = o.name;
+        if ((o.kind != OptionKind::Number && o.kind != OptionKind::Integer) || name.starts_with("rain_") || name.starts_with("pressure_"))
+            continue;
+        const std::string what = "options." + std::string(name) + (*o.unit ? std::string(" (") + o.unit + ")" : "");
+        check_range(o.value_of(*this).number, o.min, o.max, what.c_str());
+    }
     if (!wind.empty() && wind.size() != size_t(nz)) throw Error("sim: options.wind needs nz entries (one per cell row)");
-    for (double w : wind) check_range(w, -200, 200, "options.wind (m/s)");
+    for (double w : wind) check_range(w, -kSimMaxWind, kSimMaxWind, "options.wind (m/s)");
     if (rain) kessler.validate();
     if (rain && !moist) throw Error("sim: options.rain needs options.moist");
 }

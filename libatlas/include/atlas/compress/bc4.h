@@ -3,6 +3,10 @@
 // Block: byte 0 = endpoint e0, byte 1 = e1 (uint8 for UNORM, int8 for SNORM; -128
 // reads as -127), then 16 3-bit indices, texel 0 in the lowest bits. e0 > e1 selects
 // 8 interpolated values, otherwise 6 plus the exact 0 (SNORM: -1) and 1.
+//
+// Implemented in bc4_decode.cpp (the decoders), bc4_tables.cpp (Bc4Encoder's tables and
+// constructor), bc4_search.cpp (encode, encode_blocks, encode_exhaustive) and bc4_avx2.cpp
+// (encode's AVX2 path), under libatlas/src/compress.
 #pragma once
 
 #include "atlas/compress/block.h"
@@ -19,14 +23,6 @@ void decode_bc4_block(const uint8_t block[8], bool snorm, Decoder d, float out[1
 
 // The worst-case interval [lo, hi] of every texel of a block over a decoder set.
 void decode_bc4_interval(const uint8_t block[8], bool snorm, DecoderSet set, float lo[16], float hi[16]);
-
-namespace detail {
-// Test hook: of `count` blocks (16 texels each), how many an encoder with these options
-// encodes differently (bytes or result) with its same-bytes shortcuts (the flat-block
-// table, skipping a candidate that cannot win) than without them; 0 when they only save
-// time.
-long bc4_shortcut_mismatches(bool snorm, const BlockOptions& options, const float* blocks, size_t count);
-} // namespace detail
 
 // Encodes BC4 blocks. Construction precomputes the palettes of all 65,536 endpoint
 // pairs for the decoder set (about 12 MB with the search-pruning tables); encode() is const and thread-safe.
@@ -53,10 +49,7 @@ public:
     const BlockOptions& options() const { return options_; }
 
 private:
-    friend long detail::bc4_shortcut_mismatches(bool snorm, const BlockOptions& options, const float* blocks, size_t count);
     struct Tables;
-    // `shared` false: tables of its own (the test hook switches their shortcuts off).
-    Bc4Encoder(bool snorm, const BlockOptions& options, bool shared);
     bool snorm_;
     BlockOptions options_;
     std::shared_ptr<Tables> tables_;

@@ -82,4 +82,8 @@ constexpr uint32_t hash_coords(uint32_t seed, int32_t x, int32_t y = 0, int32_t 
 // Uniform float in [0, 1) from hash bits (24 bits of mantissa).
 constexpr float hash_to_unit(uint32_t h) { return static_cast<float>(h >> 8) * (1.0f / 16777216.0f); }
 
+// SHA-256 (FIPS 180-4) of `data`, lowercase hex: the standard hash an engine checks
+// a streamed file against (the tile index records it beside the Hash128).
+std::string sha256_hex(std::string_view data);
+
 } // namespace atlas

@@ -246,9 +246,45 @@ inline bool parse_text_option(const TextOptionSpec& o, std::string_view text, Op
     return false;
 }
 
+// `v` as the text option `o` parses back to the same value (numbers exactly, in their
+// shortest round-trip form; locale-independent): a library struct's own value as text.
+inline std::string option_value_text(const TextOptionSpec& o, const OptionValue& v) {
+    auto number = [&](double x) {
+        char buf[64];
+        const auto r = o.kind == OptionKind::Integer ? std::to_chars(buf, buf + sizeof buf, static_cast<long long>(x))
+                                                     : std::to_chars(buf, buf + sizeof buf, x);
+        return std::string(buf, r.ptr);
+    };
+    auto joined = [](const std::vector<std::string>& parts, char sep) {
+        std::string s;
+        for (size_t i = 0; i < parts.size(); ++i) s += (i == 0 ? "" : std::string(1, sep)) + parts[i];
+        return s;
+    };
+    switch (o.kind) {
+    case OptionKind::Number:
+    case OptionKind::Integer: {
+        if (!v.word.empty()) return v.word;
+        if (o.count == 1) return number(v.number);
+        std::vector<std::string> parts;
+        for (double x : v.numbers) parts.push_back(number(x));
+        return joined(parts, o.separator);
+    }
+    case OptionKind::Flag: return v.flag ? "true" : "false";
+    case OptionKind::Choice: return v.word;
+    case OptionKind::List: return joined(v.items, ',');
+    case OptionKind::Range: return number(v.lo) + "," + number(v.hi);
+    case OptionKind::Text: return v.text;
+    }
+    return "";
+}
+
 template <class T>
 struct TextOption : TextOptionSpec {
     void (*apply)(T& out, const OptionValue& value) = nullptr; // fills T from a parsed value
+    // Optional, apply's inverse: this option's value in a T. A schema that has it takes its
+    // defaults from T{} (default_text = option_value_text(value_of(T{}))) and the library
+    // checks a T against the bounds the front ends parse with (e.g. sim::sim_options()).
+    OptionValue (*value_of)(const T& from) = nullptr;
 };
 
 // Parses `text` as option `o` and applies it to `out`; false (out untouched) when

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <string>
 
@@ -17,6 +18,11 @@ namespace atlas {
 inline double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
+
+// This process's CPU seconds (user + system) and peak resident set so far: what a
+// tile report records of its own cost.
+double process_cpu_seconds();
+uint64_t process_peak_rss_bytes();
 
 struct ProgressEvent {
     std::string task;     // what is running, e.g. "node 'clouds'"

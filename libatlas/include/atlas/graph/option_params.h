@@ -6,8 +6,8 @@
 #include "atlas/core/option_schema.h"
 #include "atlas/graph/node.h"
 
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <initializer_list>
 #include <span>
 #include <string>
@@ -75,10 +75,10 @@ inline ParamType text_option_param_type(const TextOptionSpec& o) {
 
 // A parameter value as option `o`'s text ("" for a value of the wrong type).
 inline std::string text_option_text(const TextOptionSpec& o, const ParamValue& v) {
-    auto number = [](double x) {
+    auto number = [](double x) { // printf's "%.17g" in the C locale, whatever the host's locale is
         char buf[64];
-        std::snprintf(buf, sizeof buf, "%.17g", x);
-        return std::string(buf);
+        const auto r = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::general, 17);
+        return std::string(buf, r.ptr);
     };
     if (const auto* d = std::get_if<double>(&v)) return number(*d);
     if (const auto* i = std::get_if<int64_t>(&v)) return std::to_string(*i);

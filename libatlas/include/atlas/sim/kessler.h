@@ -28,10 +28,12 @@
 
 namespace atlas::sim {
 
+// Bounds, units and docs of the first five: the rain_* options of sim::sim_options()
+// (sim_options.h), which validate() checks.
 struct KesslerOptions {
-    double autoconversion_rate = 1e-3;      // k1, 1/s, [0, 1]
-    double autoconversion_threshold = 1e-3; // a, kg/kg, [0, 0.01]
-    double accretion_rate = 2.2;            // k2, 1/s, [0, 100]
+    double autoconversion_rate = 1e-3;      // k1, 1/s
+    double autoconversion_threshold = 1e-3; // a, kg/kg
+    double accretion_rate = 2.2;            // k2, 1/s
     bool evaporation = true;
     bool sedimentation = true;
     double sedimentation_cfl = 0.9;         // cells per sedimentation substep, (0, 1]

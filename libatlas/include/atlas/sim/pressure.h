@@ -24,9 +24,11 @@
 
 namespace atlas::sim {
 
+// Bounds and docs: the pressure_* options of sim::sim_options() (sim_options.h),
+// which PressureSolver::project checks.
 struct ProjectionOptions {
-    double tolerance = 1e-6;  // relative residual, in [1e-12, 1e-1]
-    int max_iterations = 200; // CG iterations, in [1, 10000]
+    double tolerance = 1e-6;  // relative residual
+    int max_iterations = 200; // CG iterations
     bool multigrid = true;    // false: Jacobi-preconditioned CG (for comparison)
 };
 

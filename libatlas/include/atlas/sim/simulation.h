@@ -100,27 +100,30 @@ struct GroundPatch {
 //     mutably has no history and is first order (a start-up step).
 enum class TimeScheme { Split, Trapezoidal };
 
+// The defaults are the member initializers; every member a graph sets has its
+// bounds, unit and doc in the schema sim::sim_options() (sim_options.h), which
+// validate() checks and the sim/cloud_growth node declares.
 struct SimOptions {
     bool anelastic = true;                // false: Boussinesq (rho0 = const)
     bool moist = true;                    // false: dry (qv, qc stay passive)
     AdvectionScheme scheme = AdvectionScheme::MacCormack;
     TimeScheme time_scheme = TimeScheme::Trapezoidal; // ignored when advection_reflection is on
-    double cfl = 1.0;                     // max cells travelled per substep, [0.1, 5]
+    double cfl = 1.0;                     // max cells travelled per substep
     // Accuracy-based step control (Trapezoidal only; 0 = off): the embedded
     // estimate of the back-trace error, max |u_trace - (u^n + u^{n+1}) / 2| dt / dx
     // (cells; O(dt^3)), is kept below this by limiting the next substep to
     // 0.9 dt (tol / err)^(1/3) (at most 2x the last substep); a start-up
-    // substep (no history) is kept to sqrt(2 tol dx / max|b|). [0, 1] cells.
+    // substep (no history) is kept to sqrt(2 tol dx / max|b|). In cells.
     // Off by default: at CFL 1 the Trapezoidal peak w of a density current is
     // within 1 % of the time-converged value (docs/solver.md); 0.02 is the
     // setting measured there for sharp fronts at larger CFL.
     double step_error_tolerance = 0.0;
-    int max_substeps = 64;                // [1, 10000]
+    int max_substeps = 64;
     double condensation_rate = 0;         // 1/s; 0 = instantaneous equilibrium, else relax 1 - exp(-rate dt)
-    double vorticity_confinement = 0;     // epsilon, dimensionless, [0, 0.2] (confinement.h; at 0.1 a test bubble's max w is 1.14-1.18x the eps = 0 run)
-    double viscosity = 0;                 // nu, m^2/s, [0, 1e4] (explicit; limits dt to dx^2/(8 nu))
-    double diffusivity = 0;               // kappa for theta', qv, qc, m^2/s, [0, 1e4]
-    std::vector<double> wind;             // optional ambient u(z) per cell row (nz entries), m/s, relaxed to at open x faces
+    double vorticity_confinement = 0;     // epsilon, dimensionless (confinement.h; at 0.1 a test bubble's max w is 1.14-1.18x the eps = 0 run)
+    double viscosity = 0;                 // nu, m^2/s (explicit; limits dt to dx^2/(8 nu))
+    double diffusivity = 0;               // kappa for theta', qv, qc, m^2/s
+    std::vector<double> wind;             // optional ambient u(z) per cell row (nz entries), m/s, |u| <= kSimMaxWind, relaxed to at open x faces
     ProjectionOptions projection;
     // Kessler warm rain (kessler.h): qr is advected, made from qc by
     // autoconversion and accretion, evaporates in subsaturated air, loads the
@@ -139,8 +142,12 @@ struct SimOptions {
     // second projection and 12 B/cell (kSimReflectionBytesPerCell). Default off.
     // Bryan & Fritsch dry at 100 m, dt 5 s: max w 12.9 -> 14.3 m/s (paper 14.5).
     bool advection_reflection = false;
+    // Throws atlas::Error naming the member out of range.
     void validate(int nz) const;
 };
+
+// Bound of |SimOptions::wind| (m/s), also of the sim/cloud_growth node's ground wind.
+constexpr double kSimMaxWind = 200;
 
 // Extra bytes per cell with TimeScheme::Trapezoidal (without advection_reflection):
 // the previous velocity u^{n-1} and the projection's removed gradient (two MAC velocities).
