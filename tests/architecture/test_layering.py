@@ -156,3 +156,42 @@ def test_python_binding_files_form_no_circle():
     found = circle(uses)
     assert not found, "python/src files use each other in a circle: " + " -> ".join(found)
     assert circle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]  # the check can fail
+
+
+def header_sources(header, text=None):
+    """The sources a public header leads to: its namesake under libatlas/src, or the files its
+    opening comment names ("Implemented in a.cpp, b.cpp (src/module/)"); "Header-only." is []."""
+    text = header.read_text(encoding="utf-8") if text is None else text
+    module = header.parent.name if header.parent.name != "atlas" else None
+    namesakes = list((LIB / "src").rglob(header.stem + ".cpp"))
+    if namesakes:
+        return namesakes
+    head = "\n".join(text.splitlines()[:60])
+    if re.search(r"Header-only[.,]", head):
+        return []
+    m = re.search(r"Implemented in (.*?)(\n\s*(//|\*)?\s*\n|#pragma)", head, re.S)  # to the end of its paragraph
+    if not m:
+        return None
+    found = []
+    for name in re.findall(r"[\w/]+\.cpp", m.group(1)):
+        hits = [p for p in (LIB / "src").rglob(pathlib.Path(name).name) if module is None or p.parent.name == module]
+        if not hits:
+            raise AssertionError(f"{os.path.relpath(header, ROOT)} names {name}, which does not exist")
+        found += hits
+    return found or None
+
+
+def test_every_public_header_leads_to_its_source():
+    # Issue 47 item 4: a newcomer opening a header finds its code by the name.
+    headers = sorted((LIB / "include/atlas").rglob("*.h"))
+    assert len(headers) > 80
+    lost = [os.path.relpath(h, ROOT) for h in headers if header_sources(h) is None]
+    assert not lost, "public headers with no source of their name and no 'Implemented in ...' / 'Header-only.' note:\n" + "\n".join(lost)
+    # Negative control: a header that says nothing is caught, and a named file must exist.
+    fake = LIB / "include/atlas/core/zz_fake.h"
+    assert header_sources(fake, "// atlas/core/zz_fake.h - nothing.\n#pragma once\n") is None
+    try:
+        header_sources(fake, "// atlas/core/zz_fake.h - x.\n// Implemented in no_such_file.cpp.\n#pragma once\n")
+        raise RuntimeError("a missing source was accepted")
+    except AssertionError:
+        pass

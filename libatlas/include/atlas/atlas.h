@@ -29,7 +29,10 @@
  *
  * This is the stable ABI across versions: functions are only added, and
  * AtlasCookOptions only grows at its end (its struct_size field says which
- * members a caller knows). */
+ * members a caller knows).
+ *
+ * Implemented in src/capi/atlas_c.cpp.
+ */
 #ifndef ATLAS_ATLAS_H
 #define ATLAS_ATLAS_H
 

@@ -4,7 +4,10 @@
  * compiled with hidden visibility, so only what carries ATLAS_API is visible;
  * the shared library's version script (libatlas/atlas.map) also exports the
  * C++ API (namespace atlas) and hides everything else. With the static
- * libraries the macro changes nothing. */
+ * libraries the macro changes nothing.
+ *
+ * Header-only.
+ */
 #ifndef ATLAS_EXPORT_H
 #define ATLAS_EXPORT_H
 

@@ -64,6 +64,27 @@ inline bool bc4_keys_better(const Bc4Keys& a, const Bc4Keys& b) {
 // only grow, so each path drops such a candidate as soon as a texel ties and its partial
 // sum reaches inc_sum, and all paths return the same.
 // src: 16 finite texels within +-1e30. Returns false when some texel has no feasible entry or a key error exceeds `stop`.
+// One texel's key: the palette entry with the least error (the error's float bits
+// above the entry's index, so comparing keys as floats breaks ties by the lowest index).
+template <bool OneSided>
+inline uint32_t bc4_texel_key(const Palette<1>& p, float s) {
+    uint32_t best = 0;
+    float best_f = 0;
+    for (int i = 0; i < p.n; ++i) {
+        const float a = p.hi[i][0] - s, b = s - p.lo[i][0];
+        float e = a > b ? a : b;
+        if constexpr (OneSided)
+            if (p.hi[i][0] > s) e = kBc4Infeasible;
+        uint32_t bits;
+        std::memcpy(&bits, &e, 4);
+        const uint32_t key = (bits & kBc4KeyMask) | uint32_t(i);
+        float kf;
+        std::memcpy(&kf, &key, 4);
+        if (i == 0 || kf < best_f) { best = key; best_f = kf; }
+    }
+    return best;
+}
+
 template <bool OneSided>
 inline bool bc4_keys_portable(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
     float acc[4] = {0, 0, 0, 0}, mx = 0;
@@ -71,21 +92,7 @@ inline bool bc4_keys_portable(const Palette<1>& p, const float* src, float stop,
         float qmax = 0;
         for (int j = 0; j < 4; ++j) {
             const int t = 4 * q + j;
-            const float s = src[t];
-            uint32_t best = 0xffffffffu;
-            float best_f = 0;
-            for (int i = 0; i < p.n; ++i) {
-                const float a = p.hi[i][0] - s, b = s - p.lo[i][0];
-                float e = a > b ? a : b;
-                if constexpr (OneSided)
-                    if (p.hi[i][0] > s) e = kBc4Infeasible;
-                uint32_t bits;
-                std::memcpy(&bits, &e, 4);
-                const uint32_t key = (bits & kBc4KeyMask) | uint32_t(i);
-                float kf;
-                std::memcpy(&kf, &key, 4);
-                if (i == 0 || kf < best_f) { best = key; best_f = kf; }
-            }
+            const uint32_t best = bc4_texel_key<OneSided>(p, src[t]);
             out.key[t] = best;
             const float ek = bc4_key_error(best);
             qmax = ek > qmax ? ek : qmax;
@@ -146,21 +153,7 @@ inline bool bc4_keys_sse2(const Palette<1>& p, const float* src, float stop, flo
 // so the same keys, maxima and sums as the 16-texel paths.
 template <bool OneSided>
 inline bool bc4_keys_flat(const Palette<1>& p, const float* src, float stop, float inc_sum, Bc4Keys& out) {
-    const float s = src[0];
-    uint32_t best = 0;
-    float best_f = 0;
-    for (int i = 0; i < p.n; ++i) {
-        const float a = p.hi[i][0] - s, b = s - p.lo[i][0];
-        float e = a > b ? a : b;
-        if constexpr (OneSided)
-            if (p.hi[i][0] > s) e = kBc4Infeasible;
-        uint32_t bits;
-        std::memcpy(&bits, &e, 4);
-        const uint32_t key = (bits & kBc4KeyMask) | uint32_t(i);
-        float kf;
-        std::memcpy(&kf, &key, 4);
-        if (i == 0 || kf < best_f) { best = key; best_f = kf; }
-    }
+    const uint32_t best = bc4_texel_key<OneSided>(p, src[0]);
     const float ek = bc4_key_error(best);
     if (ek > stop || !(ek < kBc4Infeasible)) return false;
     {

@@ -1,4 +1,4 @@
-// Internal: the in-memory and on-disk caches of node results, keyed by hash.
+// Internal: the in-memory (value_cache.cpp) and on-disk (disk_cache.cpp) caches of node results, keyed by hash.
 #pragma once
 
 #include "atlas/core/hash.h"

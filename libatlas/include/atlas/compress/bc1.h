@@ -4,6 +4,8 @@
 // 16 2-bit indices, texel 0 in the lowest bits. c0 > c1 (as integers) selects the
 // 4-colour palette {c0, c1, (2c0+c1)/3, (c0+2c1)/3}, otherwise the 3-colour palette
 // {c0, c1, (c0+c1)/2, black} (Atlas writes no alpha; index 3 decodes to RGB 0).
+//
+// Implemented in bc1_encode.cpp, bc1_palette.cpp, bc1_scalar.cpp (src/compress/).
 #pragma once
 
 #include "atlas/compress/block.h"

@@ -7,6 +7,8 @@
 // every conforming decoder produces the same halves: there is no decoder tolerance and
 // DecoderSet does not apply. Texels are row-major in the block (t = x + 4*y), channel c
 // of texel t at [3*t + c]. All functions are pure: thread-safe, deterministic.
+//
+// Implemented in bc6h_encode.cpp, bc6h_decode.cpp (src/compress/).
 #pragma once
 
 #include "atlas/compress/block.h"

@@ -7,6 +7,8 @@
 // Determinism: the written bytes depend only on the field and the options, never
 // on the thread count (blocks are encoded independently, reductions are ordered).
 // Thread-safety: the functions are reentrant; they use TBB internally.
+//
+// Implemented in texture_encode.cpp, texture_decode.cpp, texture_format.cpp, manifest.cpp (src/compress/).
 #pragma once
 
 #include "atlas/compress/block.h"

@@ -1,5 +1,7 @@
 // atlas/core/math.h - the few small vector types Atlas's public API uses.
 // World coordinates are metres, in double; per-voxel data is float.
+//
+// Header-only.
 #pragma once
 
 #include <algorithm>

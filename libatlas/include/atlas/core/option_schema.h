@@ -5,6 +5,8 @@
 //
 // Defaults are not repeated here: they are the struct's default member initializers,
 // read through `member` from a default-constructed T.
+//
+// Header-only.
 #pragma once
 
 #include "atlas/core/error.h"

@@ -11,6 +11,8 @@
 // Thread-safety: fn is called concurrently from several threads for different blocks;
 // it must not write state shared between blocks. An exception thrown by fn propagates
 // out of the loop (TBB cancels the remaining blocks).
+//
+// Header-only.
 #pragma once
 
 #include "atlas/core/progress.h"

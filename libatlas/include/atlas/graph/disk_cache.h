@@ -1,4 +1,4 @@
-// atlas/graph/disk_cache.h - maintenance of an on-disk cache directory.
+// atlas/graph/disk_cache.h - maintenance of an on-disk cache directory (disk_cache.cpp).
 //
 // A cache directory (`atlas cook --cache DIR`) holds one checksummed file per
 // node result (<hash>.atlascache) and per encoded output (<key>.atlasout).

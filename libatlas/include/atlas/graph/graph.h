@@ -10,6 +10,8 @@
 //     - { node: shaped, port: out, file: density.exr }
 //
 // Every error is a ParseError naming file:line:col and what was expected.
+//
+// Implemented in graph_file.cpp, graph_validate.cpp (src/graph/).
 #pragma once
 
 #include "atlas/core/error.h"

@@ -298,7 +298,8 @@ private:
 };
 
 // The node types built into Atlas (every file under nodes/). Returns a new
-// registry each call: there is no global registry.
+// registry each call: there is no global registry. Defined in the file nodes/CMakeLists.txt
+// generates from the node sources (build/nodes/builtin_nodes.cpp).
 NodeRegistry builtin_nodes();
 
 } // namespace atlas

@@ -1,6 +1,8 @@
 // atlas/graph/option_params.h - node parameters declared from, and read into, a
 // library option schema (atlas/core/option_schema.h): a node never restates a
 // default, range, unit or doc the library owns.
+//
+// Header-only.
 #pragma once
 
 #include "atlas/core/option_schema.h"

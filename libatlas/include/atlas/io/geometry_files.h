@@ -6,6 +6,8 @@
 // Points: PLY through CGAL, XYZ text here. Coordinates are taken as metres.
 // Only regular files are read (a device or FIFO is refused before reading).
 // Thread-safety: safe to call concurrently on distinct files.
+//
+// Implemented in mesh_file.cpp, point_file.cpp (src/io/).
 #pragma once
 
 #include "atlas/core/files.h"

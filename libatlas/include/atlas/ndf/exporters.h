@@ -7,6 +7,8 @@
 // Every output is linear data (no sRGB, no premultiplication); texels are
 // cell-centred. All functions are pure, thread-safe, and give the same bytes
 // for any thread count (rows split over tasks, each texel written once).
+//
+// Implemented in unity_cloud_map.cpp, unity_cloud_lut.cpp, unity_cloud_layer.cpp, unreal_weather_map.cpp (src/ndf/).
 #pragma once
 
 #include "atlas/core/field.h"

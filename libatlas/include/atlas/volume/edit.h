@@ -5,6 +5,8 @@
 // grid the density is 0 (empty sky). Deterministic: each output voxel depends
 // only on its inputs (no reductions across voxels), so results are identical
 // for any thread count. Thread-safe (pure).
+//
+// Implemented in composite.cpp, erosion.cpp, filters.cpp, transform.cpp (src/volume/).
 #pragma once
 
 #include "atlas/core/field.h"

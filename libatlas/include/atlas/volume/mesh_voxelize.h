@@ -18,6 +18,8 @@
 // Meshes must pass validate_mesh (non-finite vertices and empty meshes throw
 // atlas::Error). Orientation matters: run repair_mesh first on foreign meshes.
 // Deterministic for any thread count; thread-safe (pure).
+//
+// Implemented in mesh_sdf.cpp, mesh_line_hits.cpp, mesh_sdf_openvdb.cpp, mesh_voxelize_winding.cpp (src/volume/).
 #pragma once
 
 #include "atlas/core/field.h"

@@ -17,6 +17,8 @@
 //   surface on the grid faces.
 // - Deterministic: every grid line is an independent computation, so the result
 //   is bit-identical for any thread count. Thread-safe: pure functions.
+//
+// Implemented in sdf_edt.cpp, sdf_fast_sweeping.cpp, sdf_reference.cpp (src/volume/).
 #pragma once
 
 #include "atlas/core/field.h"
