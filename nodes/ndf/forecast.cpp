@@ -52,5 +52,5 @@ void hash_extra(const NodeParams& p, Hasher& h) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "ndf/forecast", .version = 1, .declare = declare, .cook = cook, .hash_extra = hash_extra});
+    registry.add({.name = "ndf/forecast", .version = 2, .declare = declare, .cook = cook, .hash_extra = hash_extra});
 }

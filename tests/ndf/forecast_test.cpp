@@ -172,6 +172,71 @@ TEST(Forecast, TransitionIsSmoothstepOverTheLastHoursBeforeAKey) {
     EXPECT_NEAR(forecast_blend(g, 0, 5).weight, 0.5, 1e-12);
 }
 
+TEST(Forecast, FieldsTransitionOverTheirOwnHours) {
+    // 002: a storm is preceded by darkening clouds: coverage ramps over 8 h, rain over the
+    // last hour, the wind over 2 h, every other field over transition_hours (4 h).
+    std::string text = kForecast;
+    text.replace(text.find("regions:"), 0, "field_transition_hours: {cumulus_coverage: 8, rain_intensity: 1, wind: 2}\n");
+    const Forecast f = parse_forecast(text, "forecast.yaml", test_presets());
+    ASSERT_EQ(f.field_transition_hours.size(), 3u);
+    const auto smooth = [](double u) { return u <= 0 ? 0.0 : u >= 1 ? 1.0 : u * u * (3 - 2 * u); };
+    const WeatherPreset& breezy = f.presets[1];
+    const WeatherPreset& storm = f.presets[2];
+    // Breezy (key 10) -> storm (key 50), two hours before the storm.
+    const double h = 48;
+    EXPECT_NEAR(forecast_blend(f, 0, h).weight, smooth(0.5), 1e-12);
+    EXPECT_NEAR(forecast_field_weight(f, 0, h, "cumulus_coverage"), smooth((h - 42) / 8), 1e-12);
+    EXPECT_EQ(forecast_field_weight(f, 0, h, "rain_intensity"), 0.0);
+    EXPECT_NEAR(forecast_field_weight(f, 0, h, "fog"), smooth(0.5), 1e-12); // no override: transition_hours
+    const WeatherPreset p = forecast_preset(f, 0, h);
+    EXPECT_NEAR(p.cumulus_coverage, breezy.cumulus_coverage + (storm.cumulus_coverage - breezy.cumulus_coverage) * smooth(0.75), 1e-12);
+    EXPECT_EQ(p.rain_intensity, breezy.rain_intensity); // the rain has not started
+    EXPECT_NEAR(p.lightning, storm.lightning * smooth(0.5), 1e-12);
+    EXPECT_EQ(p.wind_speed, breezy.wind_speed); // the wind turns in the last 2 h
+    EXPECT_EQ(forecast_preset(f, 0, 49.5).rain_intensity, smooth(0.5) * storm.rain_intensity);
+    // A keyed hour still gives its preset exactly, every field.
+    const WeatherPreset k = forecast_preset(f, 0, 50);
+    for (const auto& fi : preset_fields()) EXPECT_EQ(k.*fi.member, storm.*fi.member) << fi.name;
+    // The drift integrates the wind at its own transition (midpoint rule, as above).
+    const Vec2d size{{12000, 12000}};
+    const int n = 120000;
+    const double dt = 120.0 / n;
+    Vec2d total{}, at{};
+    for (int i = 0; i < n; ++i) {
+        total = total + wind_velocity(forecast_preset(f, 0, (i + 0.5) * dt)) * (dt * 3600);
+        if (std::abs((i + 1) * dt - 55.55) < 0.5 * dt) at = total;
+    }
+    Vec2d ref;
+    for (int a = 0; a < 2; ++a) ref[a] = at[a] - 55.55 / 120 * (total[a] - std::round(total[a] / size[a]) * size[a]);
+    EXPECT_LT(torus_distance(forecast_drift(f, 0, 55.55, size), ref, size), 1.0);
+    // Both manifests carry every field's transition length and the overridden fields' weights.
+    const auto j = nlohmann::json::parse(forecast_manifest_json(f, small_spec(), 48, 1, 2));
+    EXPECT_EQ(j["field_transition_hours"]["cumulus_coverage"], 8.0);
+    EXPECT_EQ(j["field_transition_hours"]["rain_intensity"], 1.0);
+    EXPECT_EQ(j["field_transition_hours"]["wind"], 2.0);
+    EXPECT_EQ(j["field_transition_hours"]["heights"], 4.0);
+    EXPECT_EQ(j["field_transition_hours"].size(), transition_fields().size());
+    EXPECT_NEAR(j["frames"][0]["regions"][0]["field_weights"]["cumulus_coverage"].get<double>(), smooth(0.75), 1e-12);
+    EXPECT_EQ(j["frames"][0]["regions"][0]["values"]["rain_intensity"], 0.0);
+    const Field2D t = forecast_manifest_table(f, small_spec(), 48, 1, 2);
+    EXPECT_EQ(t.at(t.find_channel("transition:rain_intensity"), 0, 0), 1.0f);
+    EXPECT_EQ(t.at(t.find_channel("transition:fog"), 1, 1), 4.0f);
+    EXPECT_NEAR(t.at(t.find_channel("weight:cumulus_coverage"), 0, 0), smooth(0.75), 1e-6);
+    EXPECT_EQ(t.at(t.find_channel("weight:rain_intensity"), 0, 0), 0.0f);
+    // Bad names and lengths, at their lines.
+    const std::string head = "atlas_forecast: 1\npresets: p.yaml\n";
+    const std::string tail = "regions:\n  - {name: r, keys: [[0, calm]]}\n";
+    ParseError e = forecast_error(head + "field_transition_hours:\n  wind_speed: 2\n" + tail);
+    EXPECT_EQ(e.where().line, 4);
+    EXPECT_NE(e.detail().find("'wind_speed' is not a transition field"), std::string::npos) << e.what();
+    EXPECT_NE(e.detail().find("wind"), std::string::npos);
+    EXPECT_NE(forecast_error(head + "field_transition_hours: {fog: -1}\n" + tail).detail().find("fog = -1 must be >= 0"), std::string::npos);
+    EXPECT_NE(forecast_error(head + "field_transition_hours: 3\n" + tail).detail().find("must be a map"), std::string::npos);
+    Forecast bad = f;
+    bad.field_transition_hours["heights"] = std::nan("");
+    EXPECT_THROW(validate_forecast(bad), Error);
+}
+
 TEST(Forecast, DriftIntegratesTheWindAndLoops) {
     const Forecast f = test_forecast();
     const Vec2d size{{12000, 12000}};

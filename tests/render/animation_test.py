@@ -111,12 +111,14 @@ with tempfile.TemporaryDirectory() as d:
     check(m["time"] == {"start": 0, "end": 480, "fps": 0.05, "frames": 25}, f"the time range {m['time']}")
     first, later = set(m["frames"][0]["cooked"]), [set(f["cooked"]) for f in m["frames"][1:]]
     check({"rings", "coverage_noise"} <= first, f"frame 2 cooks everything: {sorted(first)}")
-    check(all(c == {"mesocyclone", "volume", "rings"} for c in later),
-          f"later frames re-cook only the keyed tower, its bake and the rings: {[sorted(c) for c in later]}")
+    check(all(c == {"mesocyclone", "volume", "rings", "lightning"} for c in later),
+          f"later frames re-cook only the keyed tower, its bake, the rings and the frame's lightning: {[sorted(c) for c in later]}")
     changes = {o["file"]: o["changes"] for o in m["outputs"]}
     check(changes.get("superstorm_ndf_set.exr") is True and changes.get("superstorm_anvil.exr") is False, f"which outputs change: {changes}")
     f3 = {o["file"]: o for o in m["frames"][1]["outputs"]}
     check(not f3["superstorm_anvil.exr"]["changed"] and f3["vortex_rings.json"]["changed"], "per frame: the anvil bias unchanged, the rings changed")
+    # Before the tower tops out (40-80 s) there is no lightning: an unchanged table of none.
+    check(not f3["lightning.json"]["changed"], "no lightning while the storm forms")
     # Per channel (what an engine re-uploads) and the world bounds.
     ch = {o["file"]: {c["name"]: c["changed"] for c in o["channels"]} for o in m["frames"][1]["outputs"]}
     check(ch["superstorm_anvil.exr"] == {"anvil_bias": False, "anvil_lift": False}, f"the anvil's channels unchanged: {ch['superstorm_anvil.exr']}")

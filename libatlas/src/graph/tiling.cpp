@@ -117,6 +117,8 @@ struct Held {
     TileRect rect;
     bool whole = false;
 };
+// Held values by node and port.
+using HeldValues = std::map<std::pair<std::string, std::string>, Held>;
 
 Value crop(const Value& v, const TileRect& have, const TileRect& want, const Grid& g, const MemoryBudget& budget) {
     if (have == want) return v;
@@ -263,6 +265,408 @@ TileReport tile_report(Vec2i t, TileRect texels, std::string status, double seco
     return r;
 }
 
+// The tile counts and the one tile asked for are in range.
+void check_tile_counts(const TileOptions& topt) {
+    const Vec2i tiles = topt.tiles;
+    if (tiles[0] < 1 || tiles[1] < 1 || tiles[0] > 4096 || tiles[1] > 4096)
+        throw Error("--tiles " + tile_name(tiles) + ": tile counts must be in [1, 4096]");
+    if (topt.only && ((*topt.only)[0] < 0 || (*topt.only)[0] >= tiles[0] || (*topt.only)[1] < 0 || (*topt.only)[1] >= tiles[1]))
+        throw Error("--tile " + tile_name(*topt.only) + " is out of range: --tiles " + tile_name(tiles) + " has tiles 0.." +
+                    std::to_string(tiles[0] - 1) + ", 0.." + std::to_string(tiles[1] - 1));
+    if (topt.only && topt.assemble) throw Error("--assemble needs every tile: it cannot be combined with --tile");
+}
+
+// A tiled cook, step by step: select the tiles (those on disk and current are kept),
+// cook the generators whole, check the grid, cook and write each tile, then the
+// index and (optionally) the assembled outputs. It shares plan, resolve, a node's cook
+// and the outputs' placing with the untiled cook (cook_steps.h).
+struct TiledCook {
+    TiledCook(Session& s, const CookOptions& o, const TileOptions& to, TiledCookResult& r);
+    void select_tiles();
+    void cook_sources();
+    void check_grid();
+    void cook_tiles();
+    void write_index();
+    void assemble();
+
+    std::string tile_key(Vec2i t) const;
+    HeldValues cook_tile(const TileRect& tr, ThreadLimit& arena, uint64_t& value_peak);
+    json write_tile(Vec2i t, const TileRect& tr, const HeldValues& held);
+
+    const std::chrono::steady_clock::time_point t_start = std::chrono::steady_clock::now();
+    Session& session;
+    const CookOptions& opt;
+    const TileOptions& topt;
+    TiledCookResult& result;
+    const Graph& g;
+    const NodeRegistry& reg;
+    const Vec2i tiles;
+    Plan plan;
+    const MemoryBudget budget;
+    const fs::path root;
+    std::map<std::string, Hash128> hashes;
+    std::vector<Vec2i> selection, to_cook;
+    std::map<std::pair<int, int>, json> fragments; // per tile, cooked now or found current
+    HeldValues sources; // generators cooked whole
+    Grid grid;
+};
+
+TiledCook::TiledCook(Session& s, const CookOptions& o, const TileOptions& to, TiledCookResult& r)
+    : session(s), opt(o), topt(to), result(r), g(s.graph()), reg(s.registry()), tiles(to.tiles),
+      plan((check_tile_counts(to), make_plan(g, reg, o.outputs))), budget(o.memory_budget), root(o.out_dir) {
+    remove_stale_staging(root);
+    result = TiledCookResult{};
+    result.tiles = tiles;
+    result.jobs = opt.jobs > 0 ? opt.jobs : hardware_threads();
+    hashes = session.node_hashes();
+}
+
+std::string TiledCook::tile_key(Vec2i t) const {
+    Hasher h;
+    h.add("atlas-tile").add(int64_t(kTileFormatVersion)).add(int64_t(tiles[0])).add(int64_t(tiles[1])).add(int64_t(t[0])).add(int64_t(t[1]));
+    for (const GraphOutput* o : plan.outputs) {
+        h.add(hashes.at(o->node)).add(o->port).add(o->format).add(o->file).add(int64_t(io::output_formats().size()));
+        for (const auto& f : io::output_formats())
+            if (f.name == o->format) h.add(int64_t(f.version));
+        for (const auto& [k, v] : o->options) h.add(k).add(v);
+    }
+    return h.finish().hex();
+}
+
+// The tiles asked for; those on disk and current (e.g. cooked by other workers) are kept.
+void TiledCook::select_tiles() {
+    if (topt.only) selection.push_back(*topt.only);
+    else
+        for (int j = 0; j < tiles[1]; ++j)
+            for (int i = 0; i < tiles[0]; ++i) selection.push_back({{i, j}});
+
+    for (Vec2i t : selection) {
+        if (opt.reuse_outputs && !opt.checked)
+            if (auto f = current_fragment(root, t, tile_key(t))) {
+                fragments[{t[0], t[1]}] = std::move(*f);
+                continue;
+            }
+        to_cook.push_back(t);
+    }
+}
+
+// Generators: cooked whole (through the session's caches) and cropped per tile; they set the XY grid.
+void TiledCook::cook_sources() {
+    if (!to_cook.empty()) {
+        for (const GraphNode* n : plan.order) {
+            if (!n->inputs.empty()) continue;
+            if (auto it = plan.windowed.find(n->name); it != plan.windowed.end()) {
+                const TileGrid& tg = it->second;
+                if (grid.from.empty()) {
+                    grid = {tg.res, tg.bounds.min, tg.bounds.max, n->name};
+                } else if (tg.res != grid.res || tg.bounds.min != grid.lo || tg.bounds.max != grid.hi) {
+                    throw Error(node_label(*n) + ": tiling needs one XY grid for the whole graph, but its " + xy_text(tg.res) +
+                                " grid over its bounds differs from the " + xy_text(grid.res) + " grid of node '" + grid.from + "'");
+                }
+                continue; // cooked per tile, on the tile's window
+            }
+            std::set<std::string> ports;
+            for (const GraphNode* m : plan.order)
+                for (const auto& [port, b] : m->inputs)
+                    if (b.node == n->name) ports.insert(source_port(g, reg, b));
+            for (const GraphOutput* o : plan.outputs)
+                if (o->node == n->name) ports.insert(o->port);
+            for (const std::string& port : ports) {
+                Value v = session.get(n->name, port, opt);
+                if (!is_field(v))
+                    throw Error(node_label(*n) + ": output '" + port + "' is a " + std::string(port_type_name(value_type(v))) +
+                                ", which does not tile (only fields do)");
+                Vec2i res;
+                Vec2d lo, hi;
+                field_xy(v, res, lo, hi);
+                if (grid.from.empty()) {
+                    grid = {res, lo, hi, n->name};
+                } else if (res != grid.res || lo != grid.lo || hi != grid.hi) {
+                    throw Error(node_label(*n) + ": tiling needs one XY grid for the whole graph, but its " + xy_text(res) +
+                                " grid over its bounds differs from the " + xy_text(grid.res) + " grid of node '" + grid.from + "'");
+                }
+                sources[{n->name, port}] = {v, {0, 0, res[0], res[1]}, false};
+            }
+        }
+    } else {
+        grid = grid_from_json(fragments.begin()->second.at("grid"));
+    }
+    result.grid = grid.res;
+}
+
+void TiledCook::check_grid() {
+    // The tile count must divide the grid; BC-compressed outputs need 4x4-block-aligned tiles.
+    for (int a = 0; a < 2; ++a)
+        if (grid.res[a] % tiles[a] != 0)
+            throw Error("--tiles " + tile_name(tiles) + ": the " + xy_text(grid.res) + " grid (of node '" + grid.from + "') does not divide into " +
+                        std::to_string(tiles[a]) + " tiles along " + (a ? "y" : "x") + " (" + std::to_string(grid.res[a]) + " is not a multiple of " +
+                        std::to_string(tiles[a]) + ")");
+    const Vec2i tile_size{{grid.res[0] / tiles[0], grid.res[1] / tiles[1]}};
+    // Halos in world units (e.g. a clipped SDF's max_distance) become texels of this grid.
+    for (const std::string& name : plan.grid_halo) {
+        const GraphNode& n = *g.find(name);
+        const NodeType* t = reg.find(n.type);
+        NodeParams params(&t->decl, resolved_params(n, *t), g.base_dir);
+        const int h = t->decl.tiling().grid_halo(params, TileGrid{grid.res, {grid.lo, grid.hi}});
+        if (h < 0) throw Error(node_label(n) + ": internal: negative tiling halo");
+        plan.halo[name] = h;
+    }
+    for (const GraphOutput* o : plan.outputs)
+        if (o->format == "dds" && (tile_size[0] % 4 || tile_size[1] % 4))
+            throw Error(o->where.str() + ": --tiles " + tile_name(tiles) + ": output '" + o->file +
+                        "' is BC-compressed in 4x4 blocks, and tiles of " + xy_text(tile_size) + " texels are not block-aligned");
+}
+
+void TiledCook::cook_tiles() {
+    ThreadLimit arena(opt.jobs);
+    const int total_tiles = int(selection.size());
+    int tiles_finished = int(selection.size() - to_cook.size());
+
+    for (Vec2i t : to_cook) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::string tname = "tile " + tile_name(t);
+        opt.progress.poll();
+        if (opt.progress.on_progress) opt.progress.on_progress({tname, double(tiles_finished) / total_tiles, tiles_finished, total_tiles});
+        const TileRect tr = tile_rect(grid.res, tiles, t);
+        const double cpu0 = process_cpu_seconds();
+        uint64_t value_peak = 0;
+        try {
+            const auto held = cook_tile(tr, arena, value_peak);
+            fragments[{t[0], t[1]}] = write_tile(t, tr, held);
+        } catch (const std::exception& e) {
+            TileReport failed = tile_report(t, tr, dynamic_cast<const CancelledError*>(&e) ? "cancelled" : "failed", seconds_since(t0),
+                                            process_cpu_seconds() - cpu0, value_peak, nullptr, root);
+            failed.error = e.what();
+            result.tiles_done.push_back(std::move(failed));
+            result.seconds = seconds_since(t_start);
+            if (dynamic_cast<const CancelledError*>(&e)) throw;
+            const std::string msg = e.what();
+            if (dynamic_cast<const MemoryBudgetError*>(&e)) throw MemoryBudgetError(tname + ": " + msg);
+            throw Error(tname + ": " + msg);
+        }
+        result.tiles_done.push_back(
+            tile_report(t, tr, "cooked", seconds_since(t0), process_cpu_seconds() - cpu0, value_peak, &fragments.at({t[0], t[1]}), root));
+        ++tiles_finished;
+        if (opt.progress.on_progress) opt.progress.on_progress({tname, double(tiles_finished) / total_tiles, tiles_finished, total_tiles});
+    }
+    for (Vec2i t : selection)
+        if (std::none_of(to_cook.begin(), to_cook.end(), [&](Vec2i c) { return c == t; }))
+            result.tiles_done.push_back(tile_report(t, tile_rect(grid.res, tiles, t), "up to date", 0, 0, 0, &fragments.at({t[0], t[1]}), root));
+}
+
+// A tile's values: every node on its region, the tile grown by the halos of the nodes downstream.
+HeldValues TiledCook::cook_tile(const TileRect& tr, ThreadLimit& arena, uint64_t& value_peak) {
+    // Regions: outputs need the tile; a node needs its region grown by its halo from each input.
+    std::map<std::string, TileRect> region;
+    for (const GraphOutput* o : plan.outputs) region[o->node] = unite(region[o->node], tr);
+    for (auto it = plan.order.rbegin(); it != plan.order.rend(); ++it) {
+        const GraphNode& n = **it;
+        const TileRect need = grow(region[n.name], plan.halo.at(n.name), grid.res);
+        for (const auto& [port, b] : n.inputs) region[b.node] = unite(region[b.node], need);
+    }
+    HeldValues held;
+    for (const GraphNode* n : plan.order) {
+        const TileRect r = region.at(n->name);
+        const bool windowed = plan.windowed.count(n->name) > 0;
+        if (n->inputs.empty() && !windowed) {
+            for (const auto& [key, h] : sources)
+                if (key.first == n->name) held[key] = {crop(h.v, h.rect, r, grid, budget), r, false};
+            continue;
+        }
+        const NodeType& type = *reg.find(n->type);
+        const TileRect in_rect = windowed ? r : grow(r, plan.halo.at(n->name), grid.res);
+        const TileWindow window = window_of(grid, r);
+        std::map<std::string, Value> inputs;
+        for (const auto& [port, b] : n->inputs) {
+            const Held& h = held.at({b.node, source_port(g, reg, b)});
+            inputs[port] = h.whole ? h.v : crop(h.v, h.rect, in_rect, grid, budget);
+        }
+        NodeParams params(&type.decl, resolved_params(*n, type), g.base_dir);
+        ProgressSink node_progress;
+        node_progress.is_cancelled = opt.progress.is_cancelled;
+        const TileWindow in_window = window_of(grid, in_rect);
+        const TileWindow* node_window = windowed ? &window : plan.reads_window.count(n->name) ? &in_window : nullptr;
+        {
+            // Memory: what is held for later nodes, this node's inputs and (below) its outputs.
+            std::vector<Value> alive;
+            for (const auto& [key, h] : held) alive.push_back(h.v);
+            for (const auto& [port, v] : inputs) alive.push_back(v);
+            value_peak = std::max(value_peak, distinct_bytes(alive));
+        }
+        detail::NodeRun run;
+        try {
+            arena.run([&] { run = detail::cook_node(*n, type, params, std::move(inputs), budget, node_progress, node_window); });
+        } catch (const CancelledError&) {
+            throw;
+        } catch (const std::exception& e) {
+            std::string msg = e.what();
+            // CookContext::fail already names the node: name it once, with its place.
+            const std::string own = "node '" + n->name + "' (" + n->type + "): ";
+            if (msg.rfind(own, 0) == 0) msg.erase(0, own.size());
+            throw Error(node_label(*n) + ": " + msg);
+        }
+        {
+            std::vector<Value> alive;
+            for (const auto& [key, h] : held) alive.push_back(h.v);
+            for (const auto& [port, v] : run.outputs) alive.push_back(v);
+            value_peak = std::max(value_peak, distinct_bytes(alive));
+        }
+        const Box2d want = rect_bounds(grid, in_rect);
+        for (const auto& out : type.decl.outputs()) {
+            auto it = run.outputs.find(out.name);
+            if (!is_field(it->second)) {
+                throw Error(node_label(*n) + ": output '" + out.name + "' is not a field, so it does not tile");
+            }
+            Vec2i res;
+            Vec2d lo, hi;
+            field_xy(it->second, res, lo, hi);
+            if (res != Vec2i{{in_rect.width(), in_rect.height()}} || lo != want.min || hi != want.max)
+                throw Error(node_label(*n) + ": its output '" + out.name + "' is not on the grid of its inputs (" + xy_text(res) +
+                            " texels for a " + xy_text({{in_rect.width(), in_rect.height()}}) +
+                            " region), so it cannot be cooked in tiles");
+            held[{n->name, out.name}] = {crop(it->second, in_rect, r, grid, budget), r, false};
+        }
+        // Memory: drop what no later node and no output reads.
+        for (const auto& [port, b] : n->inputs)
+            if (plan.last_use.at(b.node) == n->name && !plan.output_nodes.count(b.node))
+                for (auto h = held.begin(); h != held.end();) h = h->first.first == b.node ? held.erase(h) : std::next(h);
+    }
+    return held;
+}
+
+// A tile's files: every output in its format, the exact values, and the fragment that
+// records them (it lands after the files it names).
+json TiledCook::write_tile(Vec2i t, const TileRect& tr, const HeldValues& held) {
+    StagedOutputs st(root);
+    if (!g.file.empty()) st.protect({{g.file, "the graph file"}});
+    json frag = {{"atlas_tile", kTileFormatVersion}, {"key", tile_key(t)}, {"tile", {t[0], t[1]}},
+                 {"tiles", {tiles[0], tiles[1]}}, {"texels", {tr.x0, tr.y0, tr.x1, tr.y1}}, {"grid", grid_json(grid)},
+                 {"outputs", json::array()}};
+    const Box2d tb = rect_bounds(grid, tr);
+    for (const GraphOutput* o : plan.outputs) {
+        const Held& h = held.at({o->node, o->port});
+        const Value v = crop(h.v, h.rect, tr, grid, budget);
+        io::OutputMetrics metrics;
+        std::vector<fs::path> staged;
+        try {
+            staged = io::write_value(v, st.stage(tile_rel(*o, t)), o->format, o->options, &metrics);
+        } catch (const std::exception& e) {
+            throw Error(detail::output_error(*o, e.what()));
+        }
+        json files = json::array();
+        for (const auto& s : staged) files.push_back(file_entry(root, st.final_path(s), s));
+        // The exact values, once per node port (several outputs may write one).
+        const fs::path raw_rel = fs::path("tiles") / "values" / (o->node + "." + o->port + "." + std::to_string(t[0]) + "_" + std::to_string(t[1]) + ".atlastile");
+        const fs::path raw = st.stage(raw_rel);
+        if (!fs::exists(raw)) {
+            const std::string bytes = disk_cache::serialize({{"value", v}});
+            write_file_checked(raw, bytes.data(), bytes.size());
+        }
+        frag["outputs"].push_back({{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format},
+                                   {"bounds_min", {tb.min[0], tb.min[1]}}, {"bounds_max", {tb.max[0], tb.max[1]}},
+                                   {"files", files}, {"raw", file_entry(root, st.final_path(raw), raw)}});
+    }
+    const std::string text = frag.dump(2) + "\n";
+    // The fragment is the tile's record: it lands after the files it names.
+    write_file_checked(st.stage_last(fragment_rel(t)), text.data(), text.size());
+    for (const auto& p : st.commit()) result.written.push_back(p);
+    return frag;
+}
+
+// Every tile is present: the tile index.
+void TiledCook::write_index() {
+    json index = {{"atlas_tile_index", kTileFormatVersion}, {"graph", topt.graph_name}, {"tiles", {tiles[0], tiles[1]}},
+                  {"grid", grid_json(grid)}, {"outputs", json::array()}};
+    for (size_t k = 0; k < plan.outputs.size(); ++k) {
+        const GraphOutput* o = plan.outputs[k];
+        json entry = {{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format}, {"options", o->options}, {"tiles", json::array()}};
+        for (int j = 0; j < tiles[1]; ++j)
+            for (int i = 0; i < tiles[0]; ++i) {
+                const json& f = fragments.at({i, j});
+                const json& fo = f.at("outputs").at(k);
+                entry["tiles"].push_back({{"tile", {i, j}}, {"texels", f.at("texels")}, {"bounds_min", fo.at("bounds_min")},
+                                          {"bounds_max", fo.at("bounds_max")}, {"files", fo.at("files")}, {"raw", fo.at("raw")}});
+            }
+        index["outputs"].push_back(entry);
+    }
+    const fs::path p = root / "tiles" / "index.json";
+    const std::string text = index.dump(2) + "\n";
+    write_file_atomic(p, [&](const fs::path& tmp) { write_file_checked(tmp, text.data(), text.size()); });
+    result.index = p;
+    result.written.push_back(p);
+}
+
+// The untiled outputs, from the tiles' exact values.
+void TiledCook::assemble() {
+    std::map<fs::path, std::unique_ptr<StagedOutputs>> staging;
+    for (size_t k = 0; k < plan.outputs.size(); ++k) {
+        const GraphOutput* o = plan.outputs[k];
+        if (opt.progress.on_progress) opt.progress.on_progress({"assembling " + o->file, 1.0, int(selection.size()), int(selection.size())});
+        try {
+            std::shared_ptr<Field2D> full2;
+            std::shared_ptr<Field3D> full3;
+            for (int j = 0; j < tiles[1]; ++j)
+                for (int i = 0; i < tiles[0]; ++i) {
+                    const json& fo = fragments.at({i, j}).at("outputs").at(k);
+                    const fs::path raw = root / fo.at("raw").at("path").get<std::string>();
+                    std::string why;
+                    auto vals = disk_cache::deserialize(read_file_bytes(raw), &why);
+                    if (!vals || !vals->count("value")) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' is unreadable (" + why + ")");
+                    const Value& v = vals->at("value");
+                    const TileRect r = tile_rect(grid.res, tiles, {{i, j}});
+                    const Box2d gb = rect_bounds(grid, {0, 0, grid.res[0], grid.res[1]});
+                    if (auto t2 = std::get_if<Field2DPtr>(&v)) {
+                        const Field2D& f = **t2;
+                        if (f.resolution() != Vec2i{{r.width(), r.height()}}) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' has the wrong size");
+                        if (full3) throw Error("tile " + tile_name({{i, j}}) + ": a 2D tile among 3D ones");
+                        if (!full2) full2 = std::make_shared<Field2D>(grid.res, f.channels(), gb, f.channel_names(), &budget);
+                        Field2D& dst = *full2;
+                        if (dst.channels() != f.channels()) throw Error("tile " + tile_name({{i, j}}) + ": channel count differs from tile 0,0");
+                        for (int c = 0; c < f.channels(); ++c)
+                            for (int y = 0; y < r.height(); ++y) {
+                                const float* s = f.channel(c).data() + f.index(0, y);
+                                std::copy(s, s + r.width(), dst.channel(c).data() + dst.index(r.x0, r.y0 + y));
+                            }
+                    } else if (auto t3 = std::get_if<Field3DPtr>(&v)) {
+                        const Field3D& f = **t3;
+                        if (f.nx() != r.width() || f.ny() != r.height()) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' has the wrong size");
+                        if (full2) throw Error("tile " + tile_name({{i, j}}) + ": a 3D tile among 2D ones");
+                        if (!full3) {
+                            Box3d b{{{gb.min[0], gb.min[1], f.bounds().min[2]}}, {{gb.max[0], gb.max[1], f.bounds().max[2]}}};
+                            full3 = std::make_shared<Field3D>(Vec3i{{grid.res[0], grid.res[1], f.nz()}}, f.channels(), b, f.channel_names(), &budget);
+                        }
+                        Field3D& dst = *full3;
+                        if (dst.channels() != f.channels() || dst.nz() != f.nz()) throw Error("tile " + tile_name({{i, j}}) + ": shape differs from tile 0,0");
+                        for (int c = 0; c < f.channels(); ++c)
+                            for (int z = 0; z < f.nz(); ++z)
+                                for (int y = 0; y < r.height(); ++y) {
+                                    const float* s = f.channel(c).data() + f.index(0, y, z);
+                                    std::copy(s, s + r.width(), dst.channel(c).data() + dst.index(r.x0, r.y0 + y, z));
+                                }
+                    } else {
+                        throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' holds no field");
+                    }
+                }
+            const auto [out_root, rel] = detail::output_place(root, *o, opt.allow_outside_out);
+            auto& st = staging[out_root];
+            if (!st) {
+                st = std::make_unique<StagedOutputs>(out_root);
+                if (!g.file.empty()) st->protect({{g.file, "the graph file"}});
+            }
+            const Value full = full2 ? Value(Field2DPtr(full2)) : Value(Field3DPtr(full3));
+            for (const auto& f : io::write_value(full, st->stage(rel), o->format, o->options, nullptr))
+                result.assembled.push_back(st->final_path(f));
+        } catch (const CancelledError&) {
+            throw;
+        } catch (const std::exception& e) {
+            throw Error(o->where.str() + ": assembling output '" + o->file + "': " + e.what());
+        }
+    }
+    for (auto& [r, st] : staging) st->prepare(); // every root checked before any file moves
+    for (auto& [r, st] : staging)
+        for (const auto& p : st->commit()) result.written.push_back(p);
+}
+
 } // namespace
 
 std::string tiled_report_json(const TiledCookResult& r, const std::string& graph_file, const std::string& status, const std::string& error) {
@@ -335,363 +739,16 @@ TiledCookResult cook_tiled(Session& session, const CookOptions& opt, const TileO
 }
 
 void cook_tiled(Session& session, const CookOptions& opt, const TileOptions& topt, TiledCookResult& result) {
-    const auto t_start = std::chrono::steady_clock::now();
-    const Graph& g = session.graph();
-    const NodeRegistry& reg = session.registry();
-    const Vec2i tiles = topt.tiles;
-    if (tiles[0] < 1 || tiles[1] < 1 || tiles[0] > 4096 || tiles[1] > 4096)
-        throw Error("--tiles " + tile_name(tiles) + ": tile counts must be in [1, 4096]");
-    if (topt.only && ((*topt.only)[0] < 0 || (*topt.only)[0] >= tiles[0] || (*topt.only)[1] < 0 || (*topt.only)[1] >= tiles[1]))
-        throw Error("--tile " + tile_name(*topt.only) + " is out of range: --tiles " + tile_name(tiles) + " has tiles 0.." +
-                    std::to_string(tiles[0] - 1) + ", 0.." + std::to_string(tiles[1] - 1));
-    if (topt.only && topt.assemble) throw Error("--assemble needs every tile: it cannot be combined with --tile");
-    Plan plan = make_plan(g, reg, opt.outputs);
-    const MemoryBudget budget(opt.memory_budget);
-    const fs::path root = opt.out_dir;
-    remove_stale_staging(root);
-
-    result = TiledCookResult{};
-    result.tiles = tiles;
-    result.jobs = opt.jobs > 0 ? opt.jobs : hardware_threads();
-    const auto hashes = session.node_hashes();
-
-    std::vector<Vec2i> selection;
-    if (topt.only) selection.push_back(*topt.only);
-    else
-        for (int j = 0; j < tiles[1]; ++j)
-            for (int i = 0; i < tiles[0]; ++i) selection.push_back({{i, j}});
-
-    auto tile_key = [&](Vec2i t) {
-        Hasher h;
-        h.add("atlas-tile").add(int64_t(kTileFormatVersion)).add(int64_t(tiles[0])).add(int64_t(tiles[1])).add(int64_t(t[0])).add(int64_t(t[1]));
-        for (const GraphOutput* o : plan.outputs) {
-            h.add(hashes.at(o->node)).add(o->port).add(o->format).add(o->file).add(int64_t(io::output_formats().size()));
-            for (const auto& f : io::output_formats())
-                if (f.name == o->format) h.add(int64_t(f.version));
-            for (const auto& [k, v] : o->options) h.add(k).add(v);
-        }
-        return h.finish().hex();
-    };
-
-    // Tiles already on disk (e.g. cooked by other workers).
-    std::map<std::pair<int, int>, json> fragments;
-    std::vector<Vec2i> to_cook;
-    for (Vec2i t : selection) {
-        if (opt.reuse_outputs && !opt.checked)
-            if (auto f = current_fragment(root, t, tile_key(t))) {
-                fragments[{t[0], t[1]}] = std::move(*f);
-                continue;
-            }
-        to_cook.push_back(t);
+    TiledCook cook(session, opt, topt, result);
+    cook.select_tiles();
+    cook.cook_sources();
+    cook.check_grid();
+    cook.cook_tiles();
+    if (!topt.only) {
+        cook.write_index();
+        if (topt.assemble) cook.assemble();
     }
-
-    // Generators: cooked whole (through the session's caches) and cropped.
-    std::map<std::pair<std::string, std::string>, Held> sources;
-    Grid grid;
-    if (!to_cook.empty()) {
-        for (const GraphNode* n : plan.order) {
-            if (!n->inputs.empty()) continue;
-            if (auto it = plan.windowed.find(n->name); it != plan.windowed.end()) {
-                const TileGrid& tg = it->second;
-                if (grid.from.empty()) {
-                    grid = {tg.res, tg.bounds.min, tg.bounds.max, n->name};
-                } else if (tg.res != grid.res || tg.bounds.min != grid.lo || tg.bounds.max != grid.hi) {
-                    throw Error(node_label(*n) + ": tiling needs one XY grid for the whole graph, but its " + xy_text(tg.res) +
-                                " grid over its bounds differs from the " + xy_text(grid.res) + " grid of node '" + grid.from + "'");
-                }
-                continue; // cooked per tile, on the tile's window
-            }
-            std::set<std::string> ports;
-            for (const GraphNode* m : plan.order)
-                for (const auto& [port, b] : m->inputs)
-                    if (b.node == n->name) ports.insert(source_port(g, reg, b));
-            for (const GraphOutput* o : plan.outputs)
-                if (o->node == n->name) ports.insert(o->port);
-            for (const std::string& port : ports) {
-                Value v = session.get(n->name, port, opt);
-                if (!is_field(v))
-                    throw Error(node_label(*n) + ": output '" + port + "' is a " + std::string(port_type_name(value_type(v))) +
-                                ", which does not tile (only fields do)");
-                Vec2i res;
-                Vec2d lo, hi;
-                field_xy(v, res, lo, hi);
-                if (grid.from.empty()) {
-                    grid = {res, lo, hi, n->name};
-                } else if (res != grid.res || lo != grid.lo || hi != grid.hi) {
-                    throw Error(node_label(*n) + ": tiling needs one XY grid for the whole graph, but its " + xy_text(res) +
-                                " grid over its bounds differs from the " + xy_text(grid.res) + " grid of node '" + grid.from + "'");
-                }
-                sources[{n->name, port}] = {v, {0, 0, res[0], res[1]}, false};
-            }
-        }
-    } else {
-        grid = grid_from_json(fragments.begin()->second.at("grid"));
-    }
-    result.grid = grid.res;
-
-    // The tile count must divide the grid; BC-compressed outputs need 4x4-block-aligned tiles.
-    for (int a = 0; a < 2; ++a)
-        if (grid.res[a] % tiles[a] != 0)
-            throw Error("--tiles " + tile_name(tiles) + ": the " + xy_text(grid.res) + " grid (of node '" + grid.from + "') does not divide into " +
-                        std::to_string(tiles[a]) + " tiles along " + (a ? "y" : "x") + " (" + std::to_string(grid.res[a]) + " is not a multiple of " +
-                        std::to_string(tiles[a]) + ")");
-    const Vec2i tile_size{{grid.res[0] / tiles[0], grid.res[1] / tiles[1]}};
-    // Halos in world units (e.g. a clipped SDF's max_distance) become texels of this grid.
-    for (const std::string& name : plan.grid_halo) {
-        const GraphNode& n = *g.find(name);
-        const NodeType* t = reg.find(n.type);
-        NodeParams params(&t->decl, resolved_params(n, *t), g.base_dir);
-        const int h = t->decl.tiling().grid_halo(params, TileGrid{grid.res, {grid.lo, grid.hi}});
-        if (h < 0) throw Error(node_label(n) + ": internal: negative tiling halo");
-        plan.halo[name] = h;
-    }
-    for (const GraphOutput* o : plan.outputs)
-        if (o->format == "dds" && (tile_size[0] % 4 || tile_size[1] % 4))
-            throw Error(o->where.str() + ": --tiles " + tile_name(tiles) + ": output '" + o->file +
-                        "' is BC-compressed in 4x4 blocks, and tiles of " + xy_text(tile_size) + " texels are not block-aligned");
-
-    ThreadLimit arena(opt.jobs);
-    const int total_tiles = int(selection.size());
-    int tiles_finished = int(selection.size() - to_cook.size());
-
-    for (Vec2i t : to_cook) {
-        const auto t0 = std::chrono::steady_clock::now();
-        const std::string tname = "tile " + tile_name(t);
-        opt.progress.poll();
-        if (opt.progress.on_progress) opt.progress.on_progress({tname, double(tiles_finished) / total_tiles, tiles_finished, total_tiles});
-        const TileRect tr = tile_rect(grid.res, tiles, t);
-        // Regions: outputs need the tile; a node needs its region grown by its halo from each input.
-        std::map<std::string, TileRect> region;
-        for (const GraphOutput* o : plan.outputs) region[o->node] = unite(region[o->node], tr);
-        for (auto it = plan.order.rbegin(); it != plan.order.rend(); ++it) {
-            const GraphNode& n = **it;
-            const TileRect need = grow(region[n.name], plan.halo.at(n.name), grid.res);
-            for (const auto& [port, b] : n.inputs) region[b.node] = unite(region[b.node], need);
-        }
-        std::map<std::pair<std::string, std::string>, Held> held;
-        const double cpu0 = process_cpu_seconds();
-        uint64_t value_peak = 0;
-        try {
-            for (const GraphNode* n : plan.order) {
-                const TileRect r = region.at(n->name);
-                const bool windowed = plan.windowed.count(n->name) > 0;
-                if (n->inputs.empty() && !windowed) {
-                    for (const auto& [key, h] : sources)
-                        if (key.first == n->name) held[key] = {crop(h.v, h.rect, r, grid, budget), r, false};
-                    continue;
-                }
-                const NodeType& type = *reg.find(n->type);
-                const TileRect in_rect = windowed ? r : grow(r, plan.halo.at(n->name), grid.res);
-                const TileWindow window = window_of(grid, r);
-                std::map<std::string, Value> inputs;
-                for (const auto& [port, b] : n->inputs) {
-                    const Held& h = held.at({b.node, source_port(g, reg, b)});
-                    inputs[port] = h.whole ? h.v : crop(h.v, h.rect, in_rect, grid, budget);
-                }
-                NodeParams params(&type.decl, resolved_params(*n, type), g.base_dir);
-                ProgressSink node_progress;
-                node_progress.is_cancelled = opt.progress.is_cancelled;
-                const TileWindow in_window = window_of(grid, in_rect);
-                const TileWindow* node_window = windowed ? &window : plan.reads_window.count(n->name) ? &in_window : nullptr;
-                {
-                    // Memory: what is held for later nodes, this node's inputs and (below) its outputs.
-                    std::vector<Value> alive;
-                    for (const auto& [key, h] : held) alive.push_back(h.v);
-                    for (const auto& [port, v] : inputs) alive.push_back(v);
-                    value_peak = std::max(value_peak, distinct_bytes(alive));
-                }
-                detail::NodeRun run;
-                try {
-                    arena.run([&] { run = detail::cook_node(*n, type, params, std::move(inputs), budget, node_progress, node_window); });
-                } catch (const CancelledError&) {
-                    throw;
-                } catch (const std::exception& e) {
-                    std::string msg = e.what();
-                    // CookContext::fail already names the node: name it once, with its place.
-                    const std::string own = "node '" + n->name + "' (" + n->type + "): ";
-                    if (msg.rfind(own, 0) == 0) msg.erase(0, own.size());
-                    throw Error(node_label(*n) + ": " + msg);
-                }
-                {
-                    std::vector<Value> alive;
-                    for (const auto& [key, h] : held) alive.push_back(h.v);
-                    for (const auto& [port, v] : run.outputs) alive.push_back(v);
-                    value_peak = std::max(value_peak, distinct_bytes(alive));
-                }
-                const Box2d want = rect_bounds(grid, in_rect);
-                for (const auto& out : type.decl.outputs()) {
-                    auto it = run.outputs.find(out.name);
-                    if (!is_field(it->second)) {
-                        throw Error(node_label(*n) + ": output '" + out.name + "' is not a field, so it does not tile");
-                    }
-                    Vec2i res;
-                    Vec2d lo, hi;
-                    field_xy(it->second, res, lo, hi);
-                    if (res != Vec2i{{in_rect.width(), in_rect.height()}} || lo != want.min || hi != want.max)
-                        throw Error(node_label(*n) + ": its output '" + out.name + "' is not on the grid of its inputs (" + xy_text(res) +
-                                    " texels for a " + xy_text({{in_rect.width(), in_rect.height()}}) +
-                                    " region), so it cannot be cooked in tiles");
-                    held[{n->name, out.name}] = {crop(it->second, in_rect, r, grid, budget), r, false};
-                }
-                // Memory: drop what no later node and no output reads.
-                for (const auto& [port, b] : n->inputs)
-                    if (plan.last_use.at(b.node) == n->name && !plan.output_nodes.count(b.node))
-                        for (auto h = held.begin(); h != held.end();) h = h->first.first == b.node ? held.erase(h) : std::next(h);
-            }
-
-            // Write the tile: every output in its format, the exact values, the fragment.
-            StagedOutputs st(root);
-            if (!g.file.empty()) st.protect({{g.file, "the graph file"}});
-            json frag = {{"atlas_tile", kTileFormatVersion}, {"key", tile_key(t)}, {"tile", {t[0], t[1]}},
-                         {"tiles", {tiles[0], tiles[1]}}, {"texels", {tr.x0, tr.y0, tr.x1, tr.y1}}, {"grid", grid_json(grid)},
-                         {"outputs", json::array()}};
-            const Box2d tb = rect_bounds(grid, tr);
-            for (const GraphOutput* o : plan.outputs) {
-                const Held& h = held.at({o->node, o->port});
-                const Value v = crop(h.v, h.rect, tr, grid, budget);
-                io::OutputMetrics metrics;
-                std::vector<fs::path> staged;
-                try {
-                    staged = io::write_value(v, st.stage(tile_rel(*o, t)), o->format, o->options, &metrics);
-                } catch (const std::exception& e) {
-                    throw Error(detail::output_error(*o, e.what()));
-                }
-                json files = json::array();
-                for (const auto& s : staged) files.push_back(file_entry(root, st.final_path(s), s));
-                // The exact values, once per node port (several outputs may write one).
-                const fs::path raw_rel = fs::path("tiles") / "values" / (o->node + "." + o->port + "." + std::to_string(t[0]) + "_" + std::to_string(t[1]) + ".atlastile");
-                const fs::path raw = st.stage(raw_rel);
-                if (!fs::exists(raw)) {
-                    const std::string bytes = disk_cache::serialize({{"value", v}});
-                    write_file_checked(raw, bytes.data(), bytes.size());
-                }
-                frag["outputs"].push_back({{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format},
-                                           {"bounds_min", {tb.min[0], tb.min[1]}}, {"bounds_max", {tb.max[0], tb.max[1]}},
-                                           {"files", files}, {"raw", file_entry(root, st.final_path(raw), raw)}});
-            }
-            const std::string text = frag.dump(2) + "\n";
-            // The fragment is the tile's record: it lands after the files it names.
-            write_file_checked(st.stage_last(fragment_rel(t)), text.data(), text.size());
-            for (const auto& p : st.commit()) result.written.push_back(p);
-            fragments[{t[0], t[1]}] = std::move(frag);
-        } catch (const std::exception& e) {
-            TileReport failed = tile_report(t, tr, dynamic_cast<const CancelledError*>(&e) ? "cancelled" : "failed", seconds_since(t0),
-                                            process_cpu_seconds() - cpu0, value_peak, nullptr, root);
-            failed.error = e.what();
-            result.tiles_done.push_back(std::move(failed));
-            result.seconds = seconds_since(t_start);
-            if (dynamic_cast<const CancelledError*>(&e)) throw;
-            const std::string msg = e.what();
-            if (dynamic_cast<const MemoryBudgetError*>(&e)) throw MemoryBudgetError(tname + ": " + msg);
-            throw Error(tname + ": " + msg);
-        }
-        result.tiles_done.push_back(
-            tile_report(t, tr, "cooked", seconds_since(t0), process_cpu_seconds() - cpu0, value_peak, &fragments.at({t[0], t[1]}), root));
-        ++tiles_finished;
-        if (opt.progress.on_progress) opt.progress.on_progress({tname, double(tiles_finished) / total_tiles, tiles_finished, total_tiles});
-    }
-    for (Vec2i t : selection)
-        if (std::none_of(to_cook.begin(), to_cook.end(), [&](Vec2i c) { return c == t; }))
-            result.tiles_done.push_back(tile_report(t, tile_rect(grid.res, tiles, t), "up to date", 0, 0, 0, &fragments.at({t[0], t[1]}), root));
-
-    if (topt.only) {
-        result.seconds = seconds_since(t_start);
-        return;
-    }
-
-    // Every tile is present: the tile index, then (optionally) the untiled outputs.
-    {
-        json index = {{"atlas_tile_index", kTileFormatVersion}, {"graph", topt.graph_name}, {"tiles", {tiles[0], tiles[1]}},
-                      {"grid", grid_json(grid)}, {"outputs", json::array()}};
-        for (size_t k = 0; k < plan.outputs.size(); ++k) {
-            const GraphOutput* o = plan.outputs[k];
-            json entry = {{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format}, {"options", o->options}, {"tiles", json::array()}};
-            for (int j = 0; j < tiles[1]; ++j)
-                for (int i = 0; i < tiles[0]; ++i) {
-                    const json& f = fragments.at({i, j});
-                    const json& fo = f.at("outputs").at(k);
-                    entry["tiles"].push_back({{"tile", {i, j}}, {"texels", f.at("texels")}, {"bounds_min", fo.at("bounds_min")},
-                                              {"bounds_max", fo.at("bounds_max")}, {"files", fo.at("files")}, {"raw", fo.at("raw")}});
-                }
-            index["outputs"].push_back(entry);
-        }
-        const fs::path p = root / "tiles" / "index.json";
-        const std::string text = index.dump(2) + "\n";
-        write_file_atomic(p, [&](const fs::path& tmp) { write_file_checked(tmp, text.data(), text.size()); });
-        result.index = p;
-        result.written.push_back(p);
-    }
-
-    if (topt.assemble) {
-        std::map<fs::path, std::unique_ptr<StagedOutputs>> staging;
-        for (size_t k = 0; k < plan.outputs.size(); ++k) {
-            const GraphOutput* o = plan.outputs[k];
-            if (opt.progress.on_progress) opt.progress.on_progress({"assembling " + o->file, 1.0, total_tiles, total_tiles});
-            try {
-                std::shared_ptr<Field2D> full2;
-                std::shared_ptr<Field3D> full3;
-                for (int j = 0; j < tiles[1]; ++j)
-                    for (int i = 0; i < tiles[0]; ++i) {
-                        const json& fo = fragments.at({i, j}).at("outputs").at(k);
-                        const fs::path raw = root / fo.at("raw").at("path").get<std::string>();
-                        std::string why;
-                        auto vals = disk_cache::deserialize(read_file_bytes(raw), &why);
-                        if (!vals || !vals->count("value")) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' is unreadable (" + why + ")");
-                        const Value& v = vals->at("value");
-                        const TileRect r = tile_rect(grid.res, tiles, {{i, j}});
-                        const Box2d gb = rect_bounds(grid, {0, 0, grid.res[0], grid.res[1]});
-                        if (auto t2 = std::get_if<Field2DPtr>(&v)) {
-                            const Field2D& f = **t2;
-                            if (f.resolution() != Vec2i{{r.width(), r.height()}}) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' has the wrong size");
-                            if (full3) throw Error("tile " + tile_name({{i, j}}) + ": a 2D tile among 3D ones");
-                            if (!full2) full2 = std::make_shared<Field2D>(grid.res, f.channels(), gb, f.channel_names(), &budget);
-                            Field2D& dst = *full2;
-                            if (dst.channels() != f.channels()) throw Error("tile " + tile_name({{i, j}}) + ": channel count differs from tile 0,0");
-                            for (int c = 0; c < f.channels(); ++c)
-                                for (int y = 0; y < r.height(); ++y) {
-                                    const float* s = f.channel(c).data() + f.index(0, y);
-                                    std::copy(s, s + r.width(), dst.channel(c).data() + dst.index(r.x0, r.y0 + y));
-                                }
-                        } else if (auto t3 = std::get_if<Field3DPtr>(&v)) {
-                            const Field3D& f = **t3;
-                            if (f.nx() != r.width() || f.ny() != r.height()) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' has the wrong size");
-                            if (full2) throw Error("tile " + tile_name({{i, j}}) + ": a 3D tile among 2D ones");
-                            if (!full3) {
-                                Box3d b{{{gb.min[0], gb.min[1], f.bounds().min[2]}}, {{gb.max[0], gb.max[1], f.bounds().max[2]}}};
-                                full3 = std::make_shared<Field3D>(Vec3i{{grid.res[0], grid.res[1], f.nz()}}, f.channels(), b, f.channel_names(), &budget);
-                            }
-                            Field3D& dst = *full3;
-                            if (dst.channels() != f.channels() || dst.nz() != f.nz()) throw Error("tile " + tile_name({{i, j}}) + ": shape differs from tile 0,0");
-                            for (int c = 0; c < f.channels(); ++c)
-                                for (int z = 0; z < f.nz(); ++z)
-                                    for (int y = 0; y < r.height(); ++y) {
-                                        const float* s = f.channel(c).data() + f.index(0, y, z);
-                                        std::copy(s, s + r.width(), dst.channel(c).data() + dst.index(r.x0, r.y0 + y, z));
-                                    }
-                        } else {
-                            throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' holds no field");
-                        }
-                    }
-                const auto [out_root, rel] = detail::output_place(root, *o, opt.allow_outside_out);
-                auto& st = staging[out_root];
-                if (!st) {
-                    st = std::make_unique<StagedOutputs>(out_root);
-                    if (!g.file.empty()) st->protect({{g.file, "the graph file"}});
-                }
-                const Value full = full2 ? Value(Field2DPtr(full2)) : Value(Field3DPtr(full3));
-                for (const auto& f : io::write_value(full, st->stage(rel), o->format, o->options, nullptr))
-                    result.assembled.push_back(st->final_path(f));
-            } catch (const CancelledError&) {
-                throw;
-            } catch (const std::exception& e) {
-                throw Error(o->where.str() + ": assembling output '" + o->file + "': " + e.what());
-            }
-        }
-        for (auto& [r, st] : staging) st->prepare(); // every root checked before any file moves
-        for (auto& [r, st] : staging)
-            for (const auto& p : st->commit()) result.written.push_back(p);
-    }
-    result.seconds = seconds_since(t_start);
+    result.seconds = seconds_since(cook.t_start);
 }
 
 } // namespace atlas

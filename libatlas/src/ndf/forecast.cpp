@@ -37,7 +37,10 @@ struct Segment {
     double tau = 0, start = 0, end = 0, ramp = 0; // ramp: smoothstep length L ending at `end`
 };
 
-Segment find_segment(const Forecast& f, const ForecastRegion& r, double hour) {
+// The smoothstep length of a transition `length` (0: the whole gap) over a gap.
+double ramp_of(double length, double gap) { return length > 0 ? std::min(length, gap) : gap; }
+
+Segment find_segment(const Forecast& f, const ForecastRegion& r, double hour, double length) {
     const auto& k = r.keys;
     Segment s;
     s.tau = hour < k.front().hour ? hour + f.period_hours : hour;
@@ -49,8 +52,7 @@ Segment find_segment(const Forecast& f, const ForecastRegion& r, double hour) {
         }
     s.start = k[s.i].hour;
     s.end = s.i + 1 < k.size() ? k[s.i + 1].hour : k.front().hour + f.period_hours;
-    const double gap = s.end - s.start;
-    s.ramp = f.transition_hours > 0 ? std::min(f.transition_hours, gap) : gap;
+    s.ramp = ramp_of(length, s.end - s.start);
     return s;
 }
 
@@ -72,8 +74,9 @@ double smoothstep_integral(const Segment& s, double tau) {
     return 0.5 * s.ramp + (tau - s.end);
 }
 
-// Drift (unwrapped, metres) from h_0 to tau along the region's keys.
+// Drift (unwrapped, metres) from h_0 to tau along the region's keys (the wind's transitions).
 Vec2d raw_drift(const Forecast& f, const ForecastRegion& r, double tau) {
+    const double length = field_transition(f, "wind");
     Vec2d d{};
     const auto& k = r.keys;
     for (size_t i = 0; i < k.size(); ++i) {
@@ -81,8 +84,7 @@ Vec2d raw_drift(const Forecast& f, const ForecastRegion& r, double tau) {
         s.i = i;
         s.start = k[i].hour;
         s.end = i + 1 < k.size() ? k[i + 1].hour : k.front().hour + f.period_hours;
-        const double gap = s.end - s.start;
-        s.ramp = f.transition_hours > 0 ? std::min(f.transition_hours, gap) : gap;
+        s.ramp = ramp_of(length, s.end - s.start);
         if (tau <= s.start) break;
         const double t = std::min(tau, s.end);
         const Vec2d va = wind_velocity(f.presets[size_t(k[i].preset)]);
@@ -99,11 +101,50 @@ double wrap_metres(double v, double size) {
 }
 } // namespace
 
+const std::vector<TransitionField>& transition_fields() {
+    static const std::vector<TransitionField> names = [] {
+        std::vector<TransitionField> v;
+        for (const auto& fi : preset_fields()) {
+            const std::string n = fi.name;
+            if (n == "wind_direction" || n == "max_height") continue; // in their groups
+            if (n == "wind_speed") v.push_back({"wind", {"wind_speed", "wind_direction"}});
+            else if (n == "min_height") v.push_back({"heights", {"min_height", "max_height"}});
+            else v.push_back({n, {n}});
+        }
+        return v;
+    }();
+    return names;
+}
+
+double field_transition(const Forecast& f, const std::string& name) {
+    const auto it = f.field_transition_hours.find(name);
+    return it != f.field_transition_hours.end() ? it->second : f.transition_hours;
+}
+
+namespace {
+std::vector<std::string> transition_names() {
+    std::vector<std::string> v;
+    for (const auto& t : transition_fields()) v.push_back(t.name);
+    return v;
+}
+std::string transition_name_error(const std::string& name) {
+    std::string list;
+    for (const auto& n : transition_names()) list += (list.empty() ? "" : ", ") + n;
+    return "field_transition_hours: '" + name + "' is not a transition field (expected one of: " + list + ")";
+}
+} // namespace
+
 void validate_forecast(const Forecast& f) {
     if (!(std::isfinite(f.period_hours) && f.period_hours > 0 && f.period_hours <= 10000))
         throw Error("forecast: period_hours = " + num(f.period_hours) + " is out of range (0, 10000]");
     if (!(std::isfinite(f.transition_hours) && f.transition_hours >= 0))
         throw Error("forecast: transition_hours = " + num(f.transition_hours) + " must be >= 0");
+    for (const auto& [name, hours] : f.field_transition_hours) {
+        const auto names = transition_names();
+        if (std::find(names.begin(), names.end(), name) == names.end()) throw Error("forecast: " + transition_name_error(name));
+        if (!(std::isfinite(hours) && hours >= 0))
+            throw Error("forecast: field_transition_hours: " + name + " = " + num(hours) + " must be >= 0");
+    }
     if (f.presets.empty()) throw Error("forecast: no presets");
     for (const auto& p : f.presets) validate_preset(p);
     if (f.regions.empty()) throw Error("forecast: no regions (region 0 covers the whole map)");
@@ -130,8 +171,8 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
     const YAML::Node root = io::load_yaml(text, filename);
     io::require_versioned_map(root, filename, "atlas_forecast", "1", "expected a map with 'atlas_forecast: 1', 'presets' and 'regions'",
                               "expected 'atlas_forecast: 1' (the forecast file version)");
-    io::reject_unknown_keys(root, filename, {"atlas_forecast", "presets", "period_hours", "transition_hours", "regions"},
-                            "atlas_forecast, presets, period_hours, transition_hours, regions");
+    io::reject_unknown_keys(root, filename, {"atlas_forecast", "presets", "period_hours", "transition_hours", "field_transition_hours", "regions"},
+                            "atlas_forecast, presets, period_hours, transition_hours, field_transition_hours, regions");
     Forecast f;
     f.presets = std::move(presets);
     if (f.presets.empty()) throw ParseError({filename, 1, 1}, "no presets to key the forecast with");
@@ -144,6 +185,19 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
         f.transition_hours = as_number(filename, n, "transition_hours");
         if (!(f.transition_hours >= 0 && std::isfinite(f.transition_hours)))
             throw ParseError(io::yaml_location(filename, n), "transition_hours = " + num(f.transition_hours) + " must be >= 0");
+    }
+    if (const YAML::Node n = root["field_transition_hours"]) {
+        if (!n.IsMap()) throw ParseError(io::yaml_location(filename, n), "field_transition_hours must be a map of field: hours");
+        const auto names = transition_names();
+        for (const auto& kv : n) {
+            const std::string name = kv.first.Scalar();
+            if (std::find(names.begin(), names.end(), name) == names.end())
+                throw ParseError(io::yaml_location(filename, kv.first), transition_name_error(name));
+            const double hours = as_number(filename, kv.second, "field_transition_hours: " + name);
+            if (!(hours >= 0 && std::isfinite(hours)))
+                throw ParseError(io::yaml_location(filename, kv.second), "field_transition_hours: " + name + " = " + num(hours) + " must be >= 0");
+            f.field_transition_hours[name] = hours;
+        }
     }
     const YAML::Node regions = root["regions"];
     if (!regions || !regions.IsSequence() || regions.size() == 0)
@@ -220,7 +274,7 @@ std::string forecast_presets_entry(const std::string& text, const std::string& f
 PresetBlend forecast_blend(const Forecast& f, int region, double hour) {
     if (region < 0 || size_t(region) >= f.regions.size()) throw Error("forecast: region index " + std::to_string(region) + " out of range");
     const auto& r = f.regions[size_t(region)];
-    const Segment s = find_segment(f, r, wrap_hour(f, hour));
+    const Segment s = find_segment(f, r, wrap_hour(f, hour), f.transition_hours);
     PresetBlend b;
     b.from = r.keys[s.i].preset;
     b.to = r.keys[(s.i + 1) % r.keys.size()].preset;
@@ -229,9 +283,27 @@ PresetBlend forecast_blend(const Forecast& f, int region, double hour) {
     return b;
 }
 
+double forecast_field_weight(const Forecast& f, int region, double hour, const std::string& name) {
+    if (region < 0 || size_t(region) >= f.regions.size()) throw Error("forecast: region index " + std::to_string(region) + " out of range");
+    const auto& r = f.regions[size_t(region)];
+    if (r.keys.size() == 1) return 0.0;
+    const Segment s = find_segment(f, r, wrap_hour(f, hour), field_transition(f, name));
+    return smoothstep(s.end - s.ramp, s.end, s.tau);
+}
+
 WeatherPreset forecast_preset(const Forecast& f, int region, double hour) {
     const PresetBlend b = forecast_blend(f, region, hour);
-    return lerp_presets(f.presets[size_t(b.from)], f.presets[size_t(b.to)], b.weight);
+    const WeatherPreset& from = f.presets[size_t(b.from)];
+    const WeatherPreset& to = f.presets[size_t(b.to)];
+    WeatherPreset p = lerp_presets(from, to, b.weight);
+    for (const auto& t : transition_fields()) {
+        if (!f.field_transition_hours.count(t.name)) continue;
+        // The group's fields as lerp_presets blends them at the group's own weight.
+        const WeatherPreset q = lerp_presets(from, to, forecast_field_weight(f, region, hour, t.name));
+        for (const auto& fi : preset_fields())
+            if (std::find(t.fields.begin(), t.fields.end(), fi.name) != t.fields.end()) p.*fi.member = q.*fi.member;
+    }
+    return p;
 }
 
 Vec2d forecast_drift(const Forecast& f, int region, double hour, Vec2d map_size) {
@@ -409,6 +481,10 @@ std::string forecast_manifest_json(const Forecast& f, const WeatherMapSpec& spec
     j["atlas_forecast_sequence"] = 1;
     j["period_hours"] = f.period_hours;
     j["transition_hours"] = f.transition_hours;
+    // Every field's transition length (0: the whole gap between keys), overrides applied.
+    J lengths;
+    for (const auto& t : transition_fields()) lengths[t.name] = field_transition(f, t.name);
+    j["field_transition_hours"] = lengths;
     j["start_hour"] = start_hour;
     j["step_hours"] = step_hours;
     j["slices"] = slices;
@@ -439,13 +515,19 @@ std::string forecast_manifest_json(const Forecast& f, const WeatherMapSpec& spec
         J per = J::array();
         for (size_t r = 0; r < f.regions.size(); ++r) {
             const PresetBlend b = forecast_blend(f, int(r), hour);
-            const WeatherPreset p = lerp_presets(f.presets[size_t(b.from)], f.presets[size_t(b.to)], b.weight);
+            const WeatherPreset p = forecast_preset(f, int(r), hour);
             const Vec2d d = forecast_drift(f, int(r), hour, spec.bounds.size());
             J jr;
             jr["region"] = f.regions[r].name;
             jr["presets"] = J::array({J{{"name", f.presets[size_t(b.from)].name}, {"weight", 1 - b.weight}},
                                       J{{"name", f.presets[size_t(b.to)].name}, {"weight", b.weight}}});
             jr["drift_m"] = {d[0], d[1]};
+            if (!f.field_transition_hours.empty()) {
+                // The share of the second preset per overridden field (the others have the preset weight).
+                J weights;
+                for (const auto& [name, hours] : f.field_transition_hours) weights[name] = forecast_field_weight(f, int(r), hour, name);
+                jr["field_weights"] = weights;
+            }
             J values;
             for (const auto& fi : preset_fields()) values[fi.name] = p.*fi.member;
             jr["values"] = values;
@@ -464,13 +546,16 @@ Field2D forecast_manifest_table(const Forecast& f, const WeatherMapSpec& spec, d
     std::vector<std::string> names = {"hour", "from", "to", "weight", "drift_x", "drift_y"};
     for (const auto& p : f.presets) names.push_back("preset:" + p.name);
     for (const auto& fi : preset_fields()) names.push_back(fi.name);
+    // Per transition field: its length (hours; 0 = the whole gap) and its share of `to`.
+    for (const auto& tf : transition_fields()) names.push_back("transition:" + tf.name);
+    for (const auto& tf : transition_fields()) names.push_back("weight:" + tf.name);
     const int nr = int(f.regions.size());
     Field2D t({{slices, nr}}, int(names.size()), Box2d{{{0, 0}}, {{double(slices), double(nr)}}}, names);
     for (int i = 0; i < slices; ++i)
         for (int r = 0; r < nr; ++r) {
             const double hour = start_hour + i * step_hours;
             const PresetBlend b = forecast_blend(f, r, hour);
-            const WeatherPreset p = lerp_presets(f.presets[size_t(b.from)], f.presets[size_t(b.to)], b.weight);
+            const WeatherPreset p = forecast_preset(f, r, hour);
             const Vec2d d = forecast_drift(f, r, hour, spec.bounds.size());
             int c = 0;
             for (double v : {hour, double(b.from), double(b.to), b.weight, d[0], d[1]}) t.at(c++, i, r) = float(v);
@@ -478,6 +563,8 @@ Field2D forecast_manifest_table(const Forecast& f, const WeatherMapSpec& spec, d
             t.at(c + b.to, i, r) += float(b.weight);
             c += int(f.presets.size());
             for (const auto& fi : preset_fields()) t.at(c++, i, r) = float(p.*fi.member);
+            for (const auto& tf : transition_fields()) t.at(c++, i, r) = float(field_transition(f, tf.name));
+            for (const auto& tf : transition_fields()) t.at(c++, i, r) = float(forecast_field_weight(f, r, hour, tf.name));
         }
     return t;
 }

@@ -8,6 +8,9 @@
 //   presets: presets.yaml          # relative to this file
 //   period_hours: 120              # the forecast loops (5 days)
 //   transition_hours: 3            # 0: blend over the whole gap between keys
+//   field_transition_hours:        # optional, per field (transition_fields())
+//     cumulus_coverage: 6          #   clouds build up before the rain ...
+//     rain_intensity: 1            #   ... which starts late and fast
 //   regions:
 //     - name: central              # region 0 covers the whole map
 //       keys: [[0, mist], [6, broken_clouds], [30, light_rain]]
@@ -19,7 +22,8 @@
 // Time: hour t is taken modulo period_hours. Between key i (hour h_i) and
 // key i+1 (the last key wraps to the first + period) the preset is
 // lerp_presets(P_i, P_i+1, smoothstep(h_i+1 - L, h_i+1, t)), L = the gap, or
-// transition_hours when that is shorter. A keyed hour gives its preset
+// transition_hours when that is shorter; a field of field_transition_hours
+// blends over its own length the same way. A keyed hour gives its preset
 // exactly. Everything here is pure, thread-safe and deterministic.
 #pragma once
 
@@ -28,6 +32,7 @@
 #include "atlas/core/progress.h"
 #include "atlas/ndf/weather_preset.h"
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -49,13 +54,30 @@ struct ForecastRegion {
 struct Forecast {
     double period_hours = 120;   // (0, 10000]: the loop length
     double transition_hours = 0; // >= 0; 0 = the whole gap between keys
+    // Per-field lengths (hours >= 0; 0 = the whole gap) that override transition_hours,
+    // by transition_fields() name: 002's "natural transitions" (a storm preceded by
+    // darkening clouds) need coverage to change before the rain does.
+    std::map<std::string, double> field_transition_hours;
     std::vector<WeatherPreset> presets;
     std::vector<ForecastRegion> regions; // >= 1; later regions lie over earlier ones
 };
 
+// The names field_transition_hours takes, each with the preset fields it blends:
+// every preset field, but "wind" for wind_speed and wind_direction (one velocity,
+// which the drift integrates) and "heights" for min_height and max_height (kept
+// ordered).
+struct TransitionField {
+    std::string name;
+    std::vector<std::string> fields;
+};
+const std::vector<TransitionField>& transition_fields();
+// The transition length of a transition_fields() name: its override, else transition_hours.
+double field_transition(const Forecast& f, const std::string& name);
+
 // Throws atlas::Error naming the region/key: no regions, region 0 with a
 // rect, a later region without one, no keys, hours out of [0, period) or
-// not strictly increasing, preset indices out of range, bad period/transition.
+// not strictly increasing, preset indices out of range, bad period/transition,
+// a field_transition_hours name that is not a transition field or a length < 0.
 void validate_forecast(const Forecast& f);
 
 // Parses a forecast file's text; presets come from `presets` (the caller
@@ -76,8 +98,11 @@ struct PresetBlend {
     int from = 0, to = 0;
     double weight = 0;
 };
+// The weight is transition_hours' (the fields without an override).
 PresetBlend forecast_blend(const Forecast& f, int region, double hour);
-// The blended preset (lerp_presets of the blend above).
+// The share of `to` for one transition_fields() name (its own length).
+double forecast_field_weight(const Forecast& f, int region, double hour, const std::string& name);
+// The blended preset: lerp_presets of the blend above, each overridden field at its own weight.
 WeatherPreset forecast_preset(const Forecast& f, int region, double hour);
 
 // How far the region's weather map has scrolled with its wind at `hour`
