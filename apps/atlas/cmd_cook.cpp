@@ -261,7 +261,12 @@ int run_cook_frames(const Args& a, CookOptions o) {
         // (a streaming engine reloads only what changed; frame_NNNN holds every file,
         // so a frame loads without reading another).
         nlohmann::json files = nlohmann::json::array(), outputs = nlohmann::json::array();
-        for (const auto& o2 : r.outputs) {
+        // The outputs' values, the session's, in memory (one lookup for all).
+        std::vector<std::pair<std::string, std::string>> ports;
+        for (const auto& o2 : r.outputs) ports.emplace_back(o2.node, o2.port);
+        const std::vector<Value> values = session.get(ports, fo);
+        for (size_t k = 0; k < r.outputs.size(); ++k) {
+            const auto& o2 = r.outputs[k];
             nlohmann::json of = nlohmann::json::array();
             std::string hashes;
             for (const auto& file : o2.files) {
@@ -276,11 +281,11 @@ int run_cook_frames(const Args& a, CookOptions o) {
             nlohmann::json entry = {{"file", o2.file}, {"node", o2.node}, {"format", o2.format}, {"changed", changed}, {"files", of}};
             // A field's world bounds and which of its channels differ from the frame
             // before (all of them in the first frame): what a streaming engine places
-            // and re-uploads. The value is the session's, in memory.
+            // and re-uploads.
             std::vector<std::string> wanted;
             for (const GraphOutput& go : g.outputs)
                 if (go.file == o2.file) wanted = io::OptionReader(go.options, go.file).list("channels");
-            const Value value = session.get(o2.node, o2.port, fo);
+            const Value& value = values[k];
             const std::string key = o2.node + "." + o2.port;
             if (!channels_now.count(key)) channels_now[key] = channel_hashes(value);
             const auto before = last_channels.find(key);

@@ -246,6 +246,113 @@ outputs:
     EXPECT_GT(bytes[0][0].size(), 1000u);
 }
 
+// Outputs are encoded together (up to the cook's jobs) and finished in graph order: the
+// same bytes, the same report and the same failure as one at a time.
+TEST_F(Fixture, OutputsWrittenTogetherMatchOneAtATime) {
+    const std::string g = R"(atlas: 1
+nodes:
+  n:
+    type: noise/value
+    params: {resolution: [32, 32, 8], octaves: 3, seed: 5}
+  m:
+    type: noise/value
+    params: {resolution: [32, 32, 8], octaves: 2, seed: 6}
+outputs:
+  - {node: n, file: a.exr}
+  - {node: m, file: b.vdb}
+  - {node: n, file: c.dds, options: {encoding: bc4, max_error: 0.00001}}
+  - {node: m, file: d.png}
+  - {node: n, file: e/slice, format: tga-slices}
+  - {node: m, file: f.exr, options: {half: true}}
+)";
+    std::vector<std::vector<std::string>> reports;
+    std::vector<std::map<std::string, std::string>> files;
+    for (int jobs : {1, 2, 4}) {
+        Session s = session(g);
+        CookOptions o = options();
+        o.jobs = jobs;
+        o.keep_going = true;
+        o.out_dir = dir / ("j" + std::to_string(jobs));
+        const CookResult r = s.cook(o);
+        std::vector<std::string> rep;
+        for (const auto& out : r.outputs) rep.push_back(out.file + " " + out.status + " " + std::to_string(out.files.size()));
+        reports.push_back(rep);
+        std::map<std::string, std::string> bytes;
+        for (const auto& e : fs::recursive_directory_iterator(o.out_dir))
+            if (e.is_regular_file() && e.path().filename() != ".atlas-outputs.json")
+                bytes[e.path().lexically_relative(o.out_dir).generic_string()] = slurp(e.path());
+        files.push_back(bytes);
+    }
+    ASSERT_EQ(reports[0].size(), 6u);
+    EXPECT_EQ(reports[0][2], "c.dds failed 0");
+    EXPECT_EQ(reports[0][4], "e/slice written 8");
+    EXPECT_GT(files[0].size(), 8u); // 8 slices and the other files
+    EXPECT_EQ(files[0].count("c.dds"), 0u);
+    for (size_t k = 1; k < reports.size(); ++k) {
+        EXPECT_EQ(reports[k], reports[0]) << "jobs run " << k;
+        EXPECT_EQ(files[k], files[0]) << "jobs run " << k;
+    }
+    // Without keep going the cook stops at c.dds (its report ends there) and writes nothing.
+    Session s = session(g);
+    CookOptions o = options();
+    o.jobs = 2;
+    o.out_dir = dir / "strict";
+    EXPECT_THROW(s.cook(o), Error);
+    const CookResult& r = s.last_result();
+    ASSERT_EQ(r.outputs.size(), 3u);
+    EXPECT_EQ(r.outputs[2].status, "failed");
+    EXPECT_EQ(r.error_output, "c.dds");
+    EXPECT_FALSE(fs::exists(o.out_dir / "a.exr"));
+}
+
+// A sequence's next frame (issue 43 item 6): an output whose key is the one the session's
+// last cook wrote into another folder is copied from there, not encoded again; files that
+// changed since are not copied.
+TEST_F(Fixture, UnchangedOutputsAreCopiedFromTheLastCooksFolder) {
+    const std::string g = R"(atlas: 1
+nodes:
+  n:
+    type: noise/value
+    params: {resolution: [32, 32, 8], octaves: 3, seed: 5}
+  m:
+    type: noise/value
+    params: {resolution: [32, 32, 8], octaves: 2, seed: 6}
+outputs:
+  - {node: n, file: n.exr}
+  - {node: n, file: n.dds, options: {encoding: bc4}}
+  - {node: m, file: m.png}
+)";
+    Session s = session(g);
+    auto cook_into = [&](const std::string& folder) {
+        CookOptions o = options();
+        o.out_dir = dir / folder;
+        std::map<std::string, std::string> status;
+        for (const auto& out : s.cook(o).outputs) status[out.file] = out.status;
+        return status;
+    };
+    EXPECT_EQ(cook_into("f0")["n.exr"], "written");
+    s.set("m", "seed", int64_t(7));
+    auto st = cook_into("f1");
+    EXPECT_EQ(st["n.exr"], "copied");
+    EXPECT_EQ(st["n.dds"], "copied");
+    EXPECT_EQ(st["m.png"], "written");
+    for (const char* f : {"n.exr", "n.dds", "n.dds.json"}) EXPECT_EQ(slurp(dir / "f1" / f), slurp(dir / "f0" / f)) << f;
+    EXPECT_NE(slurp(dir / "f1" / "m.png"), slurp(dir / "f0" / "m.png"));
+    // f1's n.exr changed behind the session's back: the next folder gets it encoded again.
+    { std::ofstream(dir / "f1" / "n.exr", std::ios::app) << "x"; }
+    s.set("m", "seed", int64_t(8));
+    st = cook_into("f2");
+    EXPECT_EQ(st["n.exr"], "written");
+    EXPECT_EQ(st["n.dds"], "copied");
+    EXPECT_EQ(slurp(dir / "f2" / "n.exr"), slurp(dir / "f0" / "n.exr"));
+    // With rewrite asked for, nothing is copied.
+    s.set("m", "seed", int64_t(9));
+    CookOptions o = options();
+    o.out_dir = dir / "f3";
+    o.reuse_outputs = false;
+    for (const auto& out : s.cook(o).outputs) EXPECT_EQ(out.status, "written") << out.file;
+}
+
 TEST_F(Fixture, FailedCookWritesNothingAndKeepsOldFiles) {
     fs::create_directories(dir / "out");
     { std::ofstream f(dir / "out" / "sum.exr"); f << "previous good file"; }

@@ -82,7 +82,8 @@ struct NodeState {
 
 // ------------------------------------------------------------------ Session
 
-Session::Session(NodeRegistry registry) : registry_(std::move(registry)), cache_(std::make_unique<ValueCache>()) {}
+Session::Session(NodeRegistry registry)
+    : registry_(std::move(registry)), cache_(std::make_unique<ValueCache>()), earlier_(std::make_unique<EarlierOutputs>()) {}
 Session::~Session() = default;
 Session::Session(Session&&) noexcept = default;
 Session& Session::operator=(Session&&) noexcept = default;
@@ -259,12 +260,15 @@ CookResult Session::cook(const CookOptions& options) {
 }
 
 Value Session::get(const std::string& node, const std::string& port, const CookOptions& options) {
+    return get({{node, port}}, options).at(0);
+}
+
+std::vector<Value> Session::get(const std::vector<std::pair<std::string, std::string>>& ports, const CookOptions& options) {
     CookOptions o = options;
     o.write_outputs = false;
-    std::vector<std::pair<std::string, std::string>> want{{node, port}};
     std::vector<Value> values;
-    run(o, &want, &values);
-    return values.at(0);
+    run(o, &ports, &values);
+    return values;
 }
 
 namespace {
@@ -282,8 +286,9 @@ struct OutputPlan {
     // be the same as the one cooked now (an upstream change that did not
     // change this port): compare value hashes before writing.
     const OutputRecord* same_spec = nullptr;
-    enum { write, current, restore } action = write;
+    enum { write, current, restore, copy } action = write;
     const OutputRecord* record = nullptr;
+    EarlierOutput* earlier = nullptr; // copy: the same output an earlier cook wrote elsewhere
     std::optional<disk_cache::CachedFiles> cached;
 };
 
@@ -293,7 +298,7 @@ struct OutputPlan {
 // placing (cook_steps.h).
 class CookRun {
 public:
-    CookRun(const Graph& g, const NodeRegistry& reg, ValueCache& cache, std::map<std::pair<std::string, int>, Hash128>& last_hashes,
+    CookRun(const Graph& g, const NodeRegistry& reg, ValueCache& cache, std::map<std::pair<std::string, int>, Hash128>& last_hashes, EarlierOutputs& earlier,
             const CookOptions& opt, CookResult& result);
 
     void plan(const Wanted* want_value); // 1. the targets: graph outputs or node ports
@@ -310,6 +315,10 @@ public:
 private:
     void progress_step(const std::string& task, const std::string& node, double node_fraction, bool finished);
     void warn(std::string message) { result_.warnings.push_back(std::move(message)); }
+    struct PendingWrite;
+    void encode(std::vector<PendingWrite>& batch);
+    void finish_write(PendingWrite& w);
+    void fail_output(PendingWrite& w, const std::string& msg);
     void check_texture_budget();
     void record_written();
     const std::string& value_hash(const GraphOutput* o);
@@ -331,12 +340,26 @@ private:
         StagedOutputs* stage;
         std::vector<std::filesystem::path> staged;
     };
+    // An output on its way: staged, then encoded (with others), then finished.
+    struct PendingWrite {
+        OutputPlan* plan;
+        size_t report; // index into result.outputs
+        StagedOutputs* stage;
+        std::filesystem::path target; // the writer's staged path
+        std::vector<std::filesystem::path> staged;
+        std::shared_ptr<void> scratch_held;
+        std::chrono::steady_clock::time_point start;
+        double encode_seconds; // staging and writing (restoring) the files
+        std::exception_ptr error;
+        uint64_t scratch = 0;
+    };
 
     const std::chrono::steady_clock::time_point t_start_ = std::chrono::steady_clock::now();
     const Graph& g_;
     const NodeRegistry& reg_;
     ValueCache& cache_;
     std::map<std::pair<std::string, int>, Hash128>& last_hashes_;
+    EarlierOutputs& earlier_;
     const CookOptions& opt_;
     CookResult& result_;
     const int jobs_;
@@ -373,9 +396,9 @@ private:
     std::map<std::pair<std::string, std::string>, std::string> value_hashes_;
 };
 
-CookRun::CookRun(const Graph& g, const NodeRegistry& reg, ValueCache& cache, std::map<std::pair<std::string, int>, Hash128>& last_hashes,
+CookRun::CookRun(const Graph& g, const NodeRegistry& reg, ValueCache& cache, std::map<std::pair<std::string, int>, Hash128>& last_hashes, EarlierOutputs& earlier,
                  const CookOptions& opt, CookResult& result)
-    : g_(g), reg_(reg), cache_(cache), last_hashes_(last_hashes), opt_(opt), result_(result), jobs_(opt.jobs > 0 ? opt.jobs : hardware_threads()),
+    : g_(g), reg_(reg), cache_(cache), last_hashes_(last_hashes), earlier_(earlier), opt_(opt), result_(result), jobs_(opt.jobs > 0 ? opt.jobs : hardware_threads()),
       budget_(opt.memory_budget), ledger_(cache.ledger()), attached_(budget_, ledger_), evictor_reset_{ledger_, result} {
     ledger_.reset_peak();
     ledger_.set_evictor([c = &cache_](uint64_t missing) { c->evict(missing); });
@@ -463,8 +486,13 @@ void CookRun::plan_writes() {
                 rec = std::make_unique<OutputRecords>(p.root);
             }
             if (reuse) {
+                const auto earlier = earlier_.by_key.find(p.key.hex());
                 if ((p.record = rec->current(p.name, p.key.hex()))) {
                     p.action = OutputPlan::current;
+                } else if (earlier != earlier_.by_key.end() && earlier->second.root != p.root &&
+                           files_unchanged(earlier->second.root, earlier->second.record.files)) {
+                    p.action = OutputPlan::copy;
+                    p.earlier = &earlier->second;
                 } else if (const OutputRecord* r = rec->on_disk(p.name); r && r->spec == p.spec && !r->value_hash.empty()) {
                     p.same_spec = r;
                 } else if (opt_.cache_dir && kCachedOutputFormats.count(o->format) &&
@@ -715,11 +743,23 @@ void CookRun::values_for(std::vector<Value>& out) const {
     for (const auto& t : targets_) out.push_back(values_.at(t.first)->at(t.second));
 }
 
+// Outputs are staged in plan order, encoded in parallel (each writer makes its own
+// files from a value nothing changes any more, so the bytes do not depend on what
+// else runs), then finished in plan order: sizes, hashes, the disk cache, the report.
 void CookRun::write() {
     if (!opt_.write_outputs || outputs_.empty()) {
         for (const GraphOutput* o : outputs_) result_.outputs.push_back({o->node, o->port, o->file, o->format, {}, {}, {}, {}});
         return;
     }
+    std::vector<PendingWrite> batch;
+    batch.reserve(plans_.size());
+    // Writers' copies are held together while they run; one the budget refuses
+    // beside the others waits for them (the same decisions whatever the thread count).
+    auto flush = [&] {
+        encode(batch);
+        for (PendingWrite& w : batch) finish_write(w);
+        batch.clear();
+    };
     for (OutputPlan& p : plans_) {
         const GraphOutput* o = p.out;
         OutputReport orep{o->node, o->port, o->file, o->format, {}, {}, {}, {}, {}, 0.0};
@@ -739,7 +779,23 @@ void CookRun::write() {
             result_.outputs.push_back(orep);
             continue;
         }
-        const auto t_write = std::chrono::steady_clock::now();
+        PendingWrite w{&p, result_.outputs.size(), nullptr, {}, {}, {}, std::chrono::steady_clock::now(), 0.0, {}};
+        result_.outputs.push_back(orep);
+        const std::string what = "output '" + o->file + "': the writer's copy of the value";
+        if (p.action == OutputPlan::write) {
+            // A writer may copy the value (a slice stack, a half-float frame): room for one copy;
+            // the DDS encoder holds its channels and blocks besides (cloudscape's modeling.dds
+            // peaked 490 MB of RSS over the one copy counted), so two.
+            w.scratch = value_bytes(values_.at(o->node)->at(o->port)) * (o->format == "dds" ? 2 : 1);
+            bool fits = true;
+            try {
+                budget_.check(w.scratch, what);
+            } catch (const MemoryBudgetError&) {
+                fits = false;
+            }
+            if (!fits) flush(); // the writers before it finish first, then it is checked alone
+        }
+        std::optional<std::string> failure;
         try {
             opt_.progress.poll();
             auto& st = staging_[p.root];
@@ -747,79 +803,157 @@ void CookRun::write() {
                 st = std::make_unique<StagedOutputs>(p.root);
                 st->protect(protect_);
             }
-            progress_step("writing " + o->file, "", 0.0, false);
-            Written w{result_.outputs.size(), &p, st.get(), {}};
+            w.stage = st.get();
             if (p.action == OutputPlan::restore) {
-                orep.status = "restored";
-                orep.metrics = p.cached->metrics;
+                progress_step("writing " + o->file, "", 0.0, false);
+                OutputReport& r = result_.outputs[w.report];
+                r.status = "restored";
+                r.metrics = p.cached->metrics;
                 for (const auto& [name, bytes] : p.cached->files) {
                     const auto staged = st->stage(name);
                     write_file_checked(staged, bytes.data(), bytes.size());
                     w.staged.push_back(staged);
                 }
                 p.cached.reset();
-            } else {
-                orep.status = "written";
-                // A writer may copy the value (a slice stack, a half-float frame): room for one copy;
-                // the DDS encoder holds its channels and blocks besides (cloudscape's modeling.dds
-                // peaked 490 MB of RSS over the one copy counted), so two.
-                const uint64_t scratch = value_bytes(values_.at(o->node)->at(o->port)) * (o->format == "dds" ? 2 : 1);
-                budget_.check(scratch, "output '" + o->file + "': the writer's copy of the value");
-                const auto scratch_held = ledger_.hold(&scratch, scratch);
-                w.staged = io::write_value(values_.at(o->node)->at(o->port), st->stage(p.rel), o->format, o->options, &orep.metrics);
-            }
-            for (const auto& staged : w.staged) {
-                // What is on disk is what gets reported and recorded.
-                std::error_code ec;
-                const uint64_t bytes = std::filesystem::file_size(staged, ec);
-                if (ec) throw Error("'" + staged.string() + "' was not written: " + ec.message());
-                const auto final_path = st->final_path(staged);
-                orep.written.push_back(final_path);
-                orep.files.push_back({final_path, bytes, file_content_hash(staged).hex()});
-            }
-            if (p.action == OutputPlan::write && cache_writable_ && kCachedOutputFormats.count(o->format)) {
-                std::vector<std::pair<std::string, std::filesystem::path>> files;
-                for (size_t k = 0; k < w.staged.size(); ++k)
-                    files.emplace_back(orep.files[k].path.lexically_relative(p.root).generic_string(), w.staged[k]);
-                try {
-                    disk_cache::store_files(*opt_.cache_dir, p.key, files, orep.metrics);
-                } catch (const std::exception& e) {
-                    cache_writable_ = false;
-                    warn("disk cache: cannot store the encoded files of output '" + o->file + "' (" + e.what() +
-                         "); cooking on without writing the cache");
+                w.encode_seconds = seconds_since(w.start);
+            } else if (p.action == OutputPlan::copy) {
+                progress_step("writing " + o->file, "", 0.0, false);
+                OutputReport& r = result_.outputs[w.report];
+                r.status = "copied";
+                r.metrics = p.earlier->record.metrics;
+                for (const auto& f : p.earlier->record.files) {
+                    const auto staged = st->stage(f.path);
+                    std::filesystem::copy_file(p.earlier->root / f.path, staged, std::filesystem::copy_options::overwrite_existing);
+                    w.staged.push_back(staged);
                 }
+                w.encode_seconds = seconds_since(w.start);
+            } else {
+                budget_.check(w.scratch, what);
+                w.scratch_held = ledger_.hold(&p, w.scratch);
+                w.target = st->stage(p.rel);
             }
-            orep.seconds = seconds_since(t_write);
-            result_.outputs.push_back(orep);
-            written_.push_back(std::move(w));
-            progress_step("wrote " + o->file, "", 0.0, true);
         } catch (const CancelledError&) {
             throw;
         } catch (const std::exception& e) {
-            // The output failed, not the node that fed it: the report marks the output.
-            const std::string msg = e.what();
-            orep.status = "failed";
-            orep.error = msg;
-            orep.written.clear();
-            orep.files.clear();
-            orep.seconds = seconds_since(t_write);
-            result_.outputs.push_back(orep);
-            if (opt_.keep_going) {
-                if (auto st = staging_.find(p.root); st != staging_.end() && st->second) st->second->discard(p.rel);
-                warn("output '" + o->file + "' (" + o->where.str() + ") was not written (keep going): " + msg);
-                continue;
-            }
-            result_.error_output = o->file;
-            result_.error_where = o->where.str();
-            throw Error(detail::output_error(*o, msg));
+            failure = e.what();
         }
+        if (failure) {
+            // Flushed first, so that the report lists the outputs in plan order.
+            flush();
+            fail_output(w, *failure);
+            continue;
+        }
+        batch.push_back(std::move(w));
     }
+    flush();
     check_texture_budget();
     // Everything written: move it into place.
     // Every root's destinations checked and journaled before any file moves.
     for (auto& [root, st] : staging_) st->prepare();
     for (auto& [root, st] : staging_) st->commit();
     record_written();
+}
+
+// The batch's writers, up to the cook's jobs at a time.
+void CookRun::encode(std::vector<PendingWrite>& batch) {
+    std::vector<size_t> todo;
+    for (size_t i = 0; i < batch.size(); ++i)
+        if (batch[i].plan->action == OutputPlan::write) todo.push_back(i);
+    ThreadLimit arena(jobs_);
+    arena.run([&] {
+        parallel_for_each(todo.size(), 1, [&](size_t k) {
+            PendingWrite& w = batch[todo[k]];
+            const GraphOutput* o = w.plan->out;
+            const auto t0 = std::chrono::steady_clock::now();
+            try {
+                opt_.progress.poll();
+                progress_step("writing " + o->file, "", 0.0, false);
+                OutputReport& r = result_.outputs[w.report];
+                r.status = "written";
+                w.staged = io::write_value(values_.at(o->node)->at(o->port), w.target, o->format, o->options, &r.metrics);
+            } catch (...) {
+                w.error = std::current_exception();
+            }
+            w.encode_seconds = seconds_since(t0);
+            w.scratch_held.reset();
+        });
+    });
+}
+
+// One output after its writer: what is on disk is what gets reported and recorded.
+void CookRun::finish_write(PendingWrite& w) {
+    const auto t0 = std::chrono::steady_clock::now();
+    OutputPlan& p = *w.plan;
+    const GraphOutput* o = p.out;
+    OutputReport& orep = result_.outputs[w.report];
+    std::optional<std::string> failure;
+    if (w.error) {
+        try {
+            std::rethrow_exception(w.error);
+        } catch (const CancelledError&) {
+            throw;
+        } catch (const std::exception& e) {
+            failure = e.what();
+        }
+    } else {
+        try {
+            for (const auto& staged : w.staged) {
+                std::error_code ec;
+                const uint64_t bytes = std::filesystem::file_size(staged, ec);
+                if (ec) throw Error("'" + staged.string() + "' was not written: " + ec.message());
+                const auto final_path = w.stage->final_path(staged);
+                orep.written.push_back(final_path);
+                orep.files.push_back({final_path, bytes, file_content_hash(staged).hex()});
+            }
+            if (p.action == OutputPlan::copy)
+                for (size_t k = 0; k < orep.files.size(); ++k)
+                    if (orep.files[k].hash != p.earlier->record.files[k].hash)
+                        throw Error("'" + (p.earlier->root / p.earlier->record.files[k].path).string() + "', copied from an earlier cook, changed while it was read");
+        } catch (const CancelledError&) {
+            throw;
+        } catch (const std::exception& e) {
+            failure = e.what();
+        }
+    }
+    if (failure) {
+        fail_output(w, *failure);
+        return;
+    }
+    if (p.action == OutputPlan::write && cache_writable_ && kCachedOutputFormats.count(o->format)) {
+        std::vector<std::pair<std::string, std::filesystem::path>> files;
+        for (size_t k = 0; k < w.staged.size(); ++k) files.emplace_back(orep.files[k].path.lexically_relative(p.root).generic_string(), w.staged[k]);
+        try {
+            disk_cache::store_files(*opt_.cache_dir, p.key, files, orep.metrics);
+        } catch (const std::exception& e) {
+            cache_writable_ = false;
+            warn("disk cache: cannot store the encoded files of output '" + o->file + "' (" + e.what() + "); cooking on without writing the cache");
+        }
+    }
+    orep.seconds = w.encode_seconds + seconds_since(t0);
+    written_.push_back({w.report, &p, w.stage, std::move(w.staged)});
+    progress_step("wrote " + o->file, "", 0.0, true);
+}
+
+// The output failed, not the node that fed it: the report marks the output. With
+// keep going, the cook goes on without it; else nothing is written and the
+// report ends at this output.
+void CookRun::fail_output(PendingWrite& w, const std::string& msg) {
+    const GraphOutput* o = w.plan->out;
+    OutputReport& orep = result_.outputs[w.report];
+    orep.status = "failed";
+    orep.error = msg;
+    orep.written.clear();
+    orep.files.clear();
+    orep.seconds = w.encode_seconds;
+    if (opt_.keep_going) {
+        if (w.stage) w.stage->discard(w.plan->rel);
+        warn("output '" + o->file + "' (" + o->where.str() + ") was not written (keep going): " + msg);
+        return;
+    }
+    result_.outputs.resize(w.report + 1);
+    result_.error_output = o->file;
+    result_.error_where = o->where.str();
+    throw Error(detail::output_error(*o, msg));
 }
 
 // Content hash of the value an output writes, once per node port.
@@ -861,12 +995,19 @@ void CookRun::record_written() {
         rec.key = w.plan->key.hex();
         rec.spec = w.plan->spec;
         if (w.plan->action == OutputPlan::write) rec.value_hash = value_hash(w.plan->out);
+        if (w.plan->action == OutputPlan::copy) rec.value_hash = w.plan->earlier->record.value_hash;
         const OutputReport& orep = result_.outputs[w.report];
         rec.metrics = orep.metrics;
         for (const auto& f : orep.files)
             rec.files.push_back({f.path.lexically_relative(w.plan->root).generic_string(), f.bytes, file_mtime_ns(f.path), f.hash});
         records_.at(w.plan->root)->set(w.plan->name, std::move(rec));
     }
+    // What this cook leaves on disk, for the next cook of the session (issue 43 item 6).
+    EarlierOutputs now;
+    for (const OutputPlan& p : plans_)
+        if (const OutputRecord* r = records_.at(p.root)->find(p.name); r && r->key == p.key.hex() && !r->files.empty())
+            now.by_key[r->key] = {p.root, *r};
+    earlier_ = std::move(now);
     for (auto& [root, rec] : records_) {
         try {
             rec->save();
@@ -896,7 +1037,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     if (opt.proxy > 1 && opt.write_outputs && !want_value)
         throw Error("a proxy cook (proxy " + std::to_string(opt.proxy) +
                     ") is for interaction: its results are never written as final outputs; cook without proxy to write them");
-    CookRun cook(g, registry_, *cache_, last_hashes_, opt, last_);
+    CookRun cook(g, registry_, *cache_, last_hashes_, *earlier_, opt, last_);
     cook.plan(want_value);
     cook.resolve();
     cook.hash();

@@ -54,28 +54,38 @@ const OutputRecord* OutputRecords::current(const std::string& name, const std::s
     return on_disk(name);
 }
 
+bool files_unchanged(const std::filesystem::path& root, std::vector<OutputFileRecord>& files, bool* refreshed) {
+    for (auto& f : files) {
+        const std::filesystem::path p = root / f.path;
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(p, ec) || std::filesystem::file_size(p, ec) != f.bytes || ec) return false;
+        const int64_t m = file_mtime_ns(p);
+        if (m == f.mtime_ns) continue;
+        // Touched or copied: the bytes decide.
+        try {
+            if (file_content_hash(p).hex() != f.hash) return false;
+        } catch (const Error&) {
+            return false;
+        }
+        f.mtime_ns = m;
+        if (refreshed) *refreshed = true;
+    }
+    return true;
+}
+
 const OutputRecord* OutputRecords::on_disk(const std::string& name) {
     auto it = records_.find(name);
     if (it == records_.end() || it->second.files.empty()) return nullptr;
     OutputRecord& r = it->second;
     bool refreshed = false;
-    for (auto& f : r.files) {
-        const std::filesystem::path p = root_ / f.path;
-        std::error_code ec;
-        if (!std::filesystem::is_regular_file(p, ec) || std::filesystem::file_size(p, ec) != f.bytes || ec) return nullptr;
-        const int64_t m = file_mtime_ns(p);
-        if (m == f.mtime_ns) continue;
-        // Touched or copied: the bytes decide.
-        try {
-            if (file_content_hash(p).hex() != f.hash) return nullptr;
-        } catch (const Error&) {
-            return nullptr;
-        }
-        f.mtime_ns = m;
-        refreshed = true;
-    }
+    if (!files_unchanged(root_, r.files, &refreshed)) return nullptr;
     if (refreshed) updates_[name] = r;
     return &r;
+}
+
+const OutputRecord* OutputRecords::find(const std::string& name) const {
+    const auto it = records_.find(name);
+    return it == records_.end() ? nullptr : &it->second;
 }
 
 void OutputRecords::set(const std::string& name, OutputRecord record) {

@@ -46,6 +46,8 @@ public:
     // unchanged, whatever its key; null otherwise.
     const OutputRecord* on_disk(const std::string& name);
     void set(const std::string& name, OutputRecord record);
+    // The record of output `name` as known now, unchecked; null when none.
+    const OutputRecord* find(const std::string& name) const;
     // Writes the records (merged over what is on disk now, so two cooks into
     // one directory keep each other's). Throws atlas::Error on failure.
     void save();
@@ -58,6 +60,22 @@ private:
 
 // A record written with the same spec and value hash describes files that
 // already hold this output: the new key replaces the old without a write.
+
+// True when every file of `files` (relative to `root`) is on disk unchanged:
+// its size and mtime are the recorded ones, or, when the mtime moved, its
+// content hash is (the mtime is then refreshed in `files`; *refreshed set).
+bool files_unchanged(const std::filesystem::path& root, std::vector<OutputFileRecord>& files, bool* refreshed = nullptr);
+
+// What a session's last writing cook left on disk, by output key (issue 43 item 6):
+// the same output with the same key in another folder (the next frame of a
+// sequence) copies these files instead of encoding its value again.
+struct EarlierOutput {
+    std::filesystem::path root;
+    OutputRecord record;
+};
+struct EarlierOutputs {
+    std::map<std::string, EarlierOutput> by_key;
+};
 
 // The mtime of a file in nanoseconds (0 when it cannot be read).
 int64_t file_mtime_ns(const std::filesystem::path& p);

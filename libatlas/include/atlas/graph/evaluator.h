@@ -131,6 +131,7 @@ struct CookResult {
 std::string combined_report_json(const std::vector<std::pair<std::string, CookResult>>& cooks);
 
 class ValueCache; // in-memory cache, keyed by node hash
+struct EarlierOutputs; // the files the last writing cook left, by output key
 
 // A loaded graph plus its in-memory cache: the embedding API. A host keeps
 // one Session per open graph, edits parameters and re-cooks; only what
@@ -179,6 +180,8 @@ public:
     const CookResult& last_result() const { return last_; }
     // Cooks just what one node output needs and returns its value.
     Value get(const std::string& node, const std::string& port, const CookOptions& options = {});
+    // The same for several (node, port) pairs in one cook, values in their order.
+    std::vector<Value> get(const std::vector<std::pair<std::string, std::string>>& ports, const CookOptions& options = {});
 
     // Content hash of every node (for tests and tools).
     std::map<std::string, Hash128> node_hashes() const;
@@ -190,6 +193,7 @@ private:
     std::unique_ptr<Graph> graph_;
     std::unique_ptr<ValueCache> cache_;
     std::map<std::pair<std::string, int>, Hash128> last_hashes_; // (node, proxy) -> hash when last needed
+    std::unique_ptr<EarlierOutputs> earlier_;
     CookResult last_;
 };
 
