@@ -246,10 +246,8 @@ outputs:
     EXPECT_GT(bytes[0][0].size(), 1000u);
 }
 
-// Outputs are encoded together (up to the cook's jobs) and finished in graph order: the
-// same bytes, the same report and the same failure as one at a time.
-TEST_F(Fixture, OutputsWrittenTogetherMatchOneAtATime) {
-    const std::string g = R"(atlas: 1
+// Two noise fields for the output tests below; each adds its outputs.
+constexpr const char* kTwoNoises = R"(atlas: 1
 nodes:
   n:
     type: noise/value
@@ -258,7 +256,12 @@ nodes:
     type: noise/value
     params: {resolution: [32, 32, 8], octaves: 2, seed: 6}
 outputs:
-  - {node: n, file: a.exr}
+)";
+
+// Outputs are encoded together (up to the cook's jobs) and finished in graph order: the
+// same bytes, the same report and the same failure as one at a time.
+TEST_F(Fixture, OutputsWrittenTogetherMatchOneAtATime) {
+    const std::string g = std::string(kTwoNoises) + R"(  - {node: n, file: a.exr}
   - {node: m, file: b.vdb}
   - {node: n, file: c.dds, options: {encoding: bc4, max_error: 0.00001}}
   - {node: m, file: d.png}
@@ -309,16 +312,7 @@ outputs:
 // last cook wrote into another folder is copied from there, not encoded again; files that
 // changed since are not copied.
 TEST_F(Fixture, UnchangedOutputsAreCopiedFromTheLastCooksFolder) {
-    const std::string g = R"(atlas: 1
-nodes:
-  n:
-    type: noise/value
-    params: {resolution: [32, 32, 8], octaves: 3, seed: 5}
-  m:
-    type: noise/value
-    params: {resolution: [32, 32, 8], octaves: 2, seed: 6}
-outputs:
-  - {node: n, file: n.exr}
+    const std::string g = std::string(kTwoNoises) + R"(  - {node: n, file: n.exr}
   - {node: n, file: n.dds, options: {encoding: bc4}}
   - {node: m, file: m.png}
 )";

@@ -2,6 +2,7 @@
 #include "atlas/ndf/forecast.h"
 
 #include "atlas/core/error.h"
+#include "atlas/core/option_schema.h"
 #include "atlas/ndf/generators.h"
 #include "atlas/ndf/ndf_set.h"
 
@@ -11,16 +12,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace atlas::ndf {
 
 namespace {
-std::string num(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
 
 double as_number(const std::string& file, const YAML::Node& n, const std::string& what) {
     try {
@@ -57,7 +52,7 @@ Segment find_segment(const Forecast& f, const ForecastRegion& r, double hour, do
 }
 
 double wrap_hour(const Forecast& f, double hour) {
-    if (!std::isfinite(hour)) throw Error("forecast: hour " + num(hour) + " is not finite");
+    if (!std::isfinite(hour)) throw Error("forecast: hour " + detail::number_text(hour) + " is not finite");
     double h = std::fmod(hour, f.period_hours);
     if (h < 0) h += f.period_hours;
     return h >= f.period_hours ? 0.0 : h;
@@ -136,14 +131,14 @@ std::string transition_name_error(const std::string& name) {
 
 void validate_forecast(const Forecast& f) {
     if (!(std::isfinite(f.period_hours) && f.period_hours > 0 && f.period_hours <= 10000))
-        throw Error("forecast: period_hours = " + num(f.period_hours) + " is out of range (0, 10000]");
+        throw Error("forecast: period_hours = " + detail::number_text(f.period_hours) + " is out of range (0, 10000]");
     if (!(std::isfinite(f.transition_hours) && f.transition_hours >= 0))
-        throw Error("forecast: transition_hours = " + num(f.transition_hours) + " must be >= 0");
+        throw Error("forecast: transition_hours = " + detail::number_text(f.transition_hours) + " must be >= 0");
     for (const auto& [name, hours] : f.field_transition_hours) {
         const auto names = transition_names();
         if (std::find(names.begin(), names.end(), name) == names.end()) throw Error("forecast: " + transition_name_error(name));
         if (!(std::isfinite(hours) && hours >= 0))
-            throw Error("forecast: field_transition_hours: " + name + " = " + num(hours) + " must be >= 0");
+            throw Error("forecast: field_transition_hours: " + name + " = " + detail::number_text(hours) + " must be >= 0");
     }
     if (f.presets.empty()) throw Error("forecast: no presets");
     for (const auto& p : f.presets) validate_preset(p);
@@ -154,14 +149,14 @@ void validate_forecast(const Forecast& f) {
         if (r == 0 && !reg.whole_map) throw Error(who + ": the first region covers the whole map and takes no rect");
         if (r > 0 && reg.whole_map) throw Error(who + ": regions after the first need a rect");
         if (!reg.whole_map && !reg.rect.valid()) throw Error(who + ": rect must have xmin < xmax and ymin < ymax");
-        if (!(std::isfinite(reg.blend) && reg.blend >= 0)) throw Error(who + ": blend = " + num(reg.blend) + " must be >= 0 metres");
+        if (!(std::isfinite(reg.blend) && reg.blend >= 0)) throw Error(who + ": blend = " + detail::number_text(reg.blend) + " must be >= 0 metres");
         if (reg.keys.empty()) throw Error(who + ": no keys (expected [hour, preset] pairs)");
         for (size_t i = 0; i < reg.keys.size(); ++i) {
             const auto& k = reg.keys[i];
             if (!(std::isfinite(k.hour) && k.hour >= 0 && k.hour < f.period_hours))
-                throw Error(who + ": key hour " + num(k.hour) + " is out of range [0, " + num(f.period_hours) + ")");
+                throw Error(who + ": key hour " + detail::number_text(k.hour) + " is out of range [0, " + detail::number_text(f.period_hours) + ")");
             if (i > 0 && !(k.hour > reg.keys[i - 1].hour))
-                throw Error(who + ": key hour " + num(k.hour) + " is not after the previous key (" + num(reg.keys[i - 1].hour) + ")");
+                throw Error(who + ": key hour " + detail::number_text(k.hour) + " is not after the previous key (" + detail::number_text(reg.keys[i - 1].hour) + ")");
             if (k.preset < 0 || size_t(k.preset) >= f.presets.size()) throw Error(who + ": key preset index out of range");
         }
     }
@@ -179,12 +174,12 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
     if (const YAML::Node n = root["period_hours"]) {
         f.period_hours = as_number(filename, n, "period_hours");
         if (!(f.period_hours > 0 && f.period_hours <= 10000))
-            throw ParseError(io::yaml_location(filename, n), "period_hours = " + num(f.period_hours) + " is out of range (0, 10000]");
+            throw ParseError(io::yaml_location(filename, n), "period_hours = " + detail::number_text(f.period_hours) + " is out of range (0, 10000]");
     }
     if (const YAML::Node n = root["transition_hours"]) {
         f.transition_hours = as_number(filename, n, "transition_hours");
         if (!(f.transition_hours >= 0 && std::isfinite(f.transition_hours)))
-            throw ParseError(io::yaml_location(filename, n), "transition_hours = " + num(f.transition_hours) + " must be >= 0");
+            throw ParseError(io::yaml_location(filename, n), "transition_hours = " + detail::number_text(f.transition_hours) + " must be >= 0");
     }
     if (const YAML::Node n = root["field_transition_hours"]) {
         if (!n.IsMap()) throw ParseError(io::yaml_location(filename, n), "field_transition_hours must be a map of field: hours");
@@ -195,7 +190,7 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
                 throw ParseError(io::yaml_location(filename, kv.first), transition_name_error(name));
             const double hours = as_number(filename, kv.second, "field_transition_hours: " + name);
             if (!(hours >= 0 && std::isfinite(hours)))
-                throw ParseError(io::yaml_location(filename, kv.second), "field_transition_hours: " + name + " = " + num(hours) + " must be >= 0");
+                throw ParseError(io::yaml_location(filename, kv.second), "field_transition_hours: " + name + " = " + detail::number_text(hours) + " must be >= 0");
             f.field_transition_hours[name] = hours;
         }
     }
@@ -245,10 +240,10 @@ Forecast parse_forecast(const std::string& text, const std::string& filename, st
             k.hour = as_number(filename, hn, who + ": key hour");
             if (!(k.hour >= 0 && k.hour < f.period_hours))
                 throw ParseError(io::yaml_location(filename, hn),
-                                 who + ": key hour " + num(k.hour) + " is out of range [0, " + num(f.period_hours) + ")");
+                                 who + ": key hour " + detail::number_text(k.hour) + " is out of range [0, " + detail::number_text(f.period_hours) + ")");
             if (!reg.keys.empty() && !(k.hour > reg.keys.back().hour))
-                throw ParseError(io::yaml_location(filename, hn), who + ": key hour " + num(k.hour) + " is not after the previous key (" +
-                                                          num(reg.keys.back().hour) + "); keys must be in increasing hour order");
+                throw ParseError(io::yaml_location(filename, hn), who + ": key hour " + detail::number_text(k.hour) + " is not after the previous key (" +
+                                                          detail::number_text(reg.keys.back().hour) + "); keys must be in increasing hour order");
             if (!pn.IsScalar()) throw ParseError(io::yaml_location(filename, pn), who + ": key preset must be a preset name");
             try {
                 k.preset = find_preset(f.presets, pn.Scalar());
@@ -448,7 +443,7 @@ Field2D forecast_weather_map(const Forecast& f, const Field2D& noise, double hou
 namespace {
 void check_sequence(double start_hour, double step_hours, int slices) {
     if (!std::isfinite(start_hour)) throw Error("forecast: start_hour must be finite");
-    if (!(step_hours > 0 && std::isfinite(step_hours))) throw Error("forecast: step_hours = " + num(step_hours) + " must be > 0");
+    if (!(step_hours > 0 && std::isfinite(step_hours))) throw Error("forecast: step_hours = " + detail::number_text(step_hours) + " must be > 0");
     if (slices < 1 || slices > 100000) throw Error("forecast: slices = " + std::to_string(slices) + " is out of range [1, 100000]");
 }
 } // namespace

@@ -2,24 +2,19 @@
 #include "atlas/ndf/lightning.h"
 
 #include "atlas/core/error.h"
+#include "atlas/core/option_schema.h"
 #include "atlas/core/hash.h"
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace atlas::ndf {
 
 namespace {
 
-std::string num(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
 
 void check(bool ok, const std::string& what, double v, const std::string& range) {
-    if (!ok) throw Error("lightning: " + what + " = " + num(v) + " is out of range " + range);
+    if (!ok) throw Error("lightning: " + what + " = " + detail::number_text(v) + " is out of range " + range);
 }
 
 // A uniform number in [0, 1) for slot k, draw `what` (hash chain over the 64-bit slot index).

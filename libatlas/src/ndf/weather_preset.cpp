@@ -2,13 +2,13 @@
 #include "atlas/ndf/weather_preset.h"
 
 #include "atlas/core/error.h"
+#include "atlas/core/option_schema.h"
 #include "atlas/io/yaml_document.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <set>
-#include <sstream>
 
 namespace atlas::ndf {
 
@@ -35,17 +35,12 @@ const std::vector<PresetFieldInfo>& preset_fields() {
 }
 
 namespace {
-std::string num(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
 
 // Range check of one field; empty when fine, else the reason.
 std::string check_field(const PresetFieldInfo& f, double v) {
     const bool ok = std::isfinite(v) && v >= f.lo && (f.hi_open ? v < f.hi : v <= f.hi);
     if (ok) return {};
-    return std::string(f.name) + " = " + num(v) + " is out of range [" + num(f.lo) + ", " + num(f.hi) + (f.hi_open ? ")" : "]");
+    return std::string(f.name) + " = " + detail::number_text(v) + " is out of range [" + detail::number_text(f.lo) + ", " + detail::number_text(f.hi) + (f.hi_open ? ")" : "]");
 }
 
 size_t edit_distance(const std::string& a, const std::string& b) {
@@ -71,7 +66,7 @@ void validate_preset(const WeatherPreset& p) {
         if (!why.empty()) throw Error("preset '" + p.name + "': " + why);
     }
     if (p.min_height > p.max_height)
-        throw Error("preset '" + p.name + "': min_height = " + num(p.min_height) + " is above max_height = " + num(p.max_height));
+        throw Error("preset '" + p.name + "': min_height = " + detail::number_text(p.min_height) + " is above max_height = " + detail::number_text(p.max_height));
 }
 
 std::vector<WeatherPreset> parse_presets(const std::string& text, const std::string& filename) {
@@ -118,7 +113,7 @@ std::vector<WeatherPreset> parse_presets(const std::string& text, const std::str
         }
         if (p.min_height > p.max_height)
             throw ParseError(io::yaml_location(filename, entry.first),
-                             "preset '" + p.name + "': min_height = " + num(p.min_height) + " is above max_height = " + num(p.max_height));
+                             "preset '" + p.name + "': min_height = " + detail::number_text(p.min_height) + " is above max_height = " + detail::number_text(p.max_height));
         out.push_back(std::move(p));
     }
     return out;

@@ -1,23 +1,18 @@
 #include "atlas/noise/noise_spec.h"
 
 #include "atlas/core/error.h"
+#include "atlas/core/option_schema.h"
 
 #include <cmath>
-#include <sstream>
 #include <string>
 
 namespace atlas::noise {
 namespace {
 
-std::string num(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
 
 void check_range(const char* name, double v, double lo, double hi) {
     if (!(v >= lo && v <= hi))
-        throw Error(std::string("noise: ") + name + " = " + num(v) + " is out of range [" + num(lo) + ", " + num(hi) + "]");
+        throw Error(std::string("noise: ") + name + " = " + detail::number_text(v) + " is out of range [" + detail::number_text(lo) + ", " + detail::number_text(hi) + "]");
 }
 
 } // namespace
@@ -46,7 +41,7 @@ void OutputParams::validate() const {
     check_range("output.fold_count", fold_count, 0, 8);
     for (double v : {in_min, in_max, out_min, out_max})
         if (!std::isfinite(v)) throw Error("noise: output remap bounds must be finite");
-    if (remap && !(in_max != in_min)) throw Error("noise: output.in_max must differ from output.in_min (got both " + num(in_min) + ")");
+    if (remap && !(in_max != in_min)) throw Error("noise: output.in_max must differ from output.in_min (got both " + detail::number_text(in_min) + ")");
 }
 
 void NoiseSpec::validate(int dims) const {
@@ -73,7 +68,7 @@ void NoiseSpec::validate(int dims) const {
         double p = double(period[a]) * extra;
         for (int o = 1; o < fractal.octaves; ++o) p *= fractal.lacunarity;
         if (p > kMaxPeriod)
-            throw Error(std::string("noise: ") + pnames[a] + " x fractal.lacunarity^(octaves-1) = " + num(p) +
+            throw Error(std::string("noise: ") + pnames[a] + " x fractal.lacunarity^(octaves-1) = " + detail::number_text(p) +
                         " lattice cells exceeds 2^30; lower fractal.lacunarity, fractal.octaves or the period");
     }
     if (kernel == Kernel::Curl && fractal.combinator != Combinator::Fbm)
