@@ -292,8 +292,9 @@ const std::map<std::string, std::string> kPreviewSpelled = {
     {"flash_radius", "--lightning=2,1,{}"},
 };
 // Options the CLI sets only to one value (camera manual by --camera, mode reference by
-// --reference, lightning by --lightning): probed on the node side only.
-const std::vector<std::string> kPreviewNodeOnly = {"camera", "mode", "lightning"};
+// --reference, lightning by --lightning, flash_schedule off by --no-flash-schedule):
+// probed on the node side only.
+const std::vector<std::string> kPreviewNodeOnly = {"camera", "mode", "lightning", "flash_schedule"};
 // Options that need another one to mean anything: the flags the CLI probe adds (the
 // node checks each parameter alone when the graph loads).
 const std::map<std::string, std::string> kPreviewContext = {{"ms_octaves", "--artistic=off"}, {"ms_diffusion", "--artistic=off"}};

@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
 #include <variant>
 
@@ -196,4 +198,60 @@ TEST(GraphPreview, PixelSizeMarchesFewerRaysForTheSamePicture) {
     EXPECT_LT(diff / (64 * 36), 0.03);
     EXPECT_FALSE(full.image == coarse.image);
     EXPECT_THROW(preview::set_preview_options(po, {{"pixel_size", "9"}}), Error);
+}
+
+// Issue 43: a graph's lightning schedule (ndf/lightning's table) is drawn: the window's
+// longest strike sequence becomes point lights at its flashes, with their intensities;
+// flash_schedule false leaves them out, and a window without flashes adds none.
+TEST(GraphPreview, TheLightningScheduleLightsTheStorm) {
+    const std::string graph = R"(atlas: 1
+nodes:
+  set:
+    type: ndf/set
+    params: {resolution: [32, 32], bounds_max: [20000, 20000], coverage: 0.3, min_height: 1500, max_height: 4000}
+  storm:
+    type: ndf/superstorm
+    inputs: {in: set}
+    params: {center: [10000, 10000], radius: 5000, blend: 1, max_height: 12000, min_height: 800}
+  lightning:
+    type: ndf/lightning
+    inputs: {in: storm}
+    params: {time: 100, window: 60, rate: 20, intra_flashes: 3, ground_max: 2, intensity: 2e6, seed: 3}
+outputs:
+  - {node: storm, file: storm.exr}
+  - {node: lightning, port: table, file: lightning.json}
+)";
+    Session s(builtin_nodes());
+    s.load_text(graph, "storm.yaml", ".");
+    // The table itself, to know what to expect.
+    const Field2DPtr table = std::get<Field2DPtr>(s.get("lightning", "table", values(1)));
+    const int seq = table->find_channel("sequence"), in = table->find_channel("intensity");
+    std::map<double, int> per_sequence;
+    for (int i = 0; i < table->width(); ++i)
+        if (table->at(in, i, 0) > 0) ++per_sequence[table->at(seq, i, 0)];
+    ASSERT_GE(per_sequence.size(), 2u) << "the test wants a window with several sequences";
+    int longest = 0;
+    for (const auto& [k, n] : per_sequence) longest = std::max(longest, n);
+
+    preview::GraphPreviewOptions how;
+    render::PreviewOptions po = small_picture();
+    const preview::GraphPreview lit = preview::prepare_graph_preview(s, po, how, "storm.yaml");
+    ASSERT_TRUE(lit.layer);
+    ASSERT_EQ(int(lit.job.settings.lights.size()), longest);
+    for (const auto& l : lit.job.settings.lights) {
+        EXPECT_GT(l.intensity, 0.0);
+        EXPECT_LE(l.intensity, 2e6);
+        EXPECT_GE(l.position[2], 800.0 - 1e-6);
+        EXPECT_LE(l.position[2], 12000.0 + 1e-6);
+    }
+    const render::PreviewFrame with = render::render_preview(lit.job);
+
+    preview::set_preview_options(po, {{"flash_schedule", "false"}});
+    const preview::GraphPreview dark = preview::prepare_graph_preview(s, po, how, "storm.yaml");
+    EXPECT_TRUE(dark.job.settings.lights.empty());
+    EXPECT_FALSE(render::render_preview(dark.job).image == with.image) << "the flashes changed nothing on screen";
+
+    s.set_text("lightning", "rate", "0");
+    const preview::GraphPreview none = preview::prepare_graph_preview(s, small_picture(), how, "storm.yaml");
+    EXPECT_TRUE(none.job.settings.lights.empty());
 }

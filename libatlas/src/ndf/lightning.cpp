@@ -49,7 +49,14 @@ Columns storm_columns(const Field2D& set) {
     c.cdf.resize(set.voxel_count());
     double sum = 0;
     const auto d = set.channel(c.channel);
-    for (size_t i = 0; i < d.size(); ++i) c.cdf[i] = sum += std::max(0.0, double(d[i]));
+    // Weighted by the column's depth squared: flash rates climb steeply with convective depth
+    // (Price and Rind 1992: about the 5th power of the cloud top), so the deep tower flashes and
+    // the anvil sheet, storm channel too but 2-3 km thin, rarely does.
+    const auto lo = set.channel(c.min_height), hi = set.channel(c.max_height);
+    for (size_t i = 0; i < d.size(); ++i) {
+        const double depth_km = std::max(0.0, double(hi[i]) - double(lo[i])) * 1e-3;
+        c.cdf[i] = sum += std::max(0.0, double(d[i])) * depth_km * depth_km;
+    }
     return c;
 }
 

@@ -9,7 +9,9 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <mutex>
+#include <optional>
 #include <variant>
 
 namespace atlas::preview {
@@ -24,12 +26,14 @@ namespace {
 //   a 2D field with bottom, top (ndf/profile_lut)      -> the layer's profile LUT
 //   a 2D field with anvil_bias (ndf/superstorm anvil)  -> the storm's anvil spread
 //   ndf/vortex_rings' table (inner, outer, speed, ...)  -> the storm turns with --time
+//   ndf/lightning's table (time, duration, x, y, z, intensity, ...) -> flash lights
 //   a 2D field with apex_height, cone_ratio (ndf/cone_map) / ndf/distance_map -> envelope
 //   a 2D field with a 'cirrus' channel (ndf/cirrus)    -> a cirrus layer at 8 km
 //   otherwise the last 1-channel 2D field               -> a sky layer at 6 km (Quilez)
 struct GraphContent {
     Field3DPtr nvdf;
     Field2DPtr ndf, lut, cone, cirrus, sky2d, anvil, vortex;
+    Field2DPtr flashes; // ndf/lightning's table: x = flash
     Field3DPtr distance;
     Field3DPtr forecast; // ndf/forecast maps: z = time slice, channels coverage, precipitation, type, ...
     std::vector<std::string> written; // "node 'n' (type) port 'p' -> file"
@@ -117,6 +121,9 @@ GraphContent cook_graph(Session& session, const std::string& file, const GraphPr
             } else if (has_channels(f, {"inner", "outer", "speed", "overlap_end"})) {
                 render::check_finite(f, what);
                 if (!g.vortex) g.vortex = *f2;
+            } else if (has_channels(f, {"time", "duration", "x", "y", "z", "intensity", "ground"})) {
+                render::check_finite(f, what);
+                g.flashes = *f2; // the last one written
             } else if (has_channels(f, {"anvil_bias"})) {
                 render::check_finite(f, what);
                 g.anvil = *f2; // the last one written: the end of a stencil chain
@@ -218,6 +225,35 @@ void apply_noise(render::CloudScene& scene, const GraphPreviewOptions& how, Grap
     out.log.push_back("noise: none for a plain density grid (its own detail is kept); --noise nubis or FILE up-rezzes it anyway");
 }
 
+// One strike sequence of a lightning table's window (a frame's) as point lights:
+// its flashes come within a second or two, about one exposure, where every flash of a
+// 20-second frame at once lit the whole storm. A window without flashes is one row of
+// intensity 0.
+void add_flash_lights(const Field2D& table, render::PreviewOptions& options, GraphPreview& out) {
+    const int x = table.find_channel("x"), y = table.find_channel("y"), z = table.find_channel("z"), in = table.find_channel("intensity"),
+              seq = table.find_channel("sequence");
+    // The sequence with the most flashes in the window (the earliest of equals): one that
+    // started in the frame before shows only its tail here.
+    std::map<double, int> count;
+    std::optional<double> pick;
+    for (int i = 0; i < table.width(); ++i)
+        if (table.at(in, i, 0) > 0) {
+            const double s = seq >= 0 ? table.at(seq, i, 0) : 0.0;
+            const int c = ++count[s];
+            if (!pick || c > count[*pick] || (c == count[*pick] && s < *pick)) pick = s;
+        }
+    int n = 0;
+    for (int i = 0; i < table.width() && pick; ++i) {
+        const double intensity = table.at(in, i, 0);
+        if (!(intensity > 0) || (seq >= 0 && table.at(seq, i, 0) != *pick)) continue;
+        options.lights.push_back({{{table.at(x, i, 0), table.at(y, i, 0), table.at(z, i, 0)}}, options.flash_colour, intensity, options.flash_radius});
+        ++n;
+    }
+    out.log.push_back(n ? "lightning: the window's longest strike sequence drawn, " + std::to_string(n) + " flash" + (n == 1 ? "" : "es") +
+                              " as lights; --no-flash-schedule leaves it out"
+                        : "lightning: no flashes in the cooked window");
+}
+
 void finish(GraphPreview& out, std::optional<render::CloudScene> voxel, std::optional<render::LayerScene> layer, const render::PreviewOptions& options,
             render::PreviewLook look, const GraphPreviewOptions& how) {
     if (options.lightning && !layer) throw Error("lightning places flashes over a 2.5D layer; this preview has no NDF set");
@@ -286,7 +322,9 @@ GraphPreview prepare_graph_preview(Session& session, const render::PreviewOption
         li.sky_texture = g.sky2d;
         layer = render::layer_preview_scene(li);
     }
-    finish(out, std::move(voxel), std::move(layer), options, render::PreviewLook::Graph, how);
+    render::PreviewOptions lit = options;
+    if (g.flashes && options.flash_schedule) add_flash_lights(*g.flashes, lit, out);
+    finish(out, std::move(voxel), std::move(layer), lit, render::PreviewLook::Graph, how);
     return out;
 }
 

@@ -21,7 +21,7 @@ bool PreviewOptions::operator==(const PreviewOptions& o) const {
     return size == o.size && exposure == o.exposure && view == o.view && azimuth == o.azimuth && elevation == o.elevation &&
            manual_camera == o.manual_camera && position == o.position && look_at == o.look_at && fov == o.fov && sun_azimuth == o.sun_azimuth &&
            sun_elevation == o.sun_elevation && sun_colour == o.sun_colour && sky_colour == o.sky_colour && sky_horizon == o.sky_horizon &&
-           same_lights(lights, o.lights) && lightning == o.lightning && flash_seed == o.flash_seed && flash_index == o.flash_index &&
+           same_lights(lights, o.lights) && lightning == o.lightning && flash_schedule == o.flash_schedule && flash_seed == o.flash_seed && flash_index == o.flash_index &&
            flash_count == o.flash_count && flash_colour == o.flash_colour && flash_intensity == o.flash_intensity && flash_radius == o.flash_radius &&
            mode == o.mode && quality == o.quality && extinction == o.extinction && noise_tile == o.noise_tile && artistic == o.artistic &&
            ms_octaves == o.ms_octaves && ms_diffusion == o.ms_diffusion && ms_diffusion_sweeps == o.ms_diffusion_sweeps && light_grid == o.light_grid &&
@@ -169,6 +169,10 @@ std::vector<TextOption<P>> make_preview_options() {
              "2.5D, without flash_probability: flash lights placed by the set's superstorm_coverage (else precipitation, coverage), 20-60 % up "
              "its columns"},
             "false", "", [](P& p, const V& v) { p.lightning = v.flag; }),
+        opt({"flash_schedule", nullptr, "", K::Flag,
+             "a graph that writes an ndf/lightning table: each flash it lists (the cooked window, a frame's) is a light of flash_colour "
+             "at its x, y, z with its own intensity and flash_radius"},
+            "true", "", [](P& p, const V& v) { p.flash_schedule = v.flag; }),
         opt({"flash_seed", "--flash-seed", "N", K::Integer, "flash lights: seed of the position draws", 0, 4294967295.0}, "1", "",
             [](P& p, const V& v) { p.flash_seed = int64_t(v.number); }),
         opt({"flash_index", "--flash", "N", K::Integer, "flash lights: which flash (time); the same index gives the same positions", -2147483648.0,
@@ -327,6 +331,11 @@ std::span<const OptionSpelling> preview_cli_spellings() {
              const auto p = split(t, ',');
              if (p.size() != 6) return false;
              out = {{"sky_colour", join(p, 0, 3)}, {"sky_horizon", join(p, 3, 6)}};
+             return true;
+         }},
+        {"--no-flash-schedule", "", "do not draw the flashes of the graph's ndf/lightning table (flash_schedule false)",
+         [](std::string_view, Pairs& out) {
+             out = {{"flash_schedule", "false"}};
              return true;
          }},
         {"--reference", "", "render the reference mode instead of the fast mode (mode reference)",

@@ -47,6 +47,8 @@ struct PreviewOptions {
     // Flash lights: from the node's flash_probability field, or (lightning) placed
     // over the 2.5D set's storm, rain or coverage.
     bool lightning = false;
+    // A graph's ndf/lightning table (atlas/preview/graph_preview.h): its flashes as lights.
+    bool flash_schedule = true;
     int64_t flash_seed = 1, flash_index = 0, flash_count = 1;
     Vec3f flash_colour{{0.75f, 0.8f, 1.0f}};
     double flash_intensity = 1e5, flash_radius = 0;
