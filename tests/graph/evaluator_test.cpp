@@ -14,6 +14,8 @@
 #include <filesystem>
 #include <limits>
 #include <fstream>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -781,12 +783,30 @@ TEST_F(Fixture, StagingLeftByAKilledCookIsRemoved) {
         if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
     const std::string killed = ".atlas-staging-" + h + "-" + std::to_string(dead) + "-0123456789abcdef";
     const std::string alive = ".atlas-staging-" + h + "-" + std::to_string(::getpid()) + "-0123456789abcdef";
+    // Folders of today's Atlas: their marker is locked while the cook runs. One held by a
+    // cook in another PID namespace (its PID here names a dead process) is kept; one no
+    // process holds is removed, whatever PID its name gives.
+    const std::string held = ".atlas-staging-" + h + "-" + std::to_string(dead) + "-1111111111111111";
+    const std::string unheld = ".atlas-staging-" + h + "-" + std::to_string(::getpid()) + "-2222222222222222";
+    const std::string locked_marker = "atlas staging folder, locked while its cook runs; removed or completed by the next Atlas run\n";
+    std::vector<int> locks;
     for (const fs::path& root : {dir / "out", dir / "cache"}) {
+        // An older Atlas's folders (a marker without the lock), a minute old: by host and PID.
         fs::create_directories(root / killed / "nvdf");
         std::ofstream(root / killed / "nvdf" / "big.tga") << std::string(10000, 'k');
         std::ofstream(root / killed / ".atlas-staging") << "atlas staging folder"; // Atlas's marker: only marked folders are removed
         fs::create_directories(root / alive);
         std::ofstream(root / alive / ".atlas-staging") << "atlas staging folder";
+        for (const std::string& f : {killed, alive})
+            fs::last_write_time(root / f / ".atlas-staging", fs::file_time_type::clock::now() - std::chrono::minutes(5));
+        for (const std::string& f : {held, unheld}) {
+            fs::create_directories(root / f);
+            std::ofstream(root / f / ".atlas-staging") << locked_marker;
+        }
+        const int fd = ::open((root / held / ".atlas-staging").c_str(), O_RDONLY);
+        ASSERT_GE(fd, 0);
+        ASSERT_EQ(::flock(fd, LOCK_SH), 0);
+        locks.push_back(fd);
     }
     CookOptions o = options();
     o.cache_dir = dir / "cache";
@@ -794,7 +814,13 @@ TEST_F(Fixture, StagingLeftByAKilledCookIsRemoved) {
     for (const fs::path& root : {dir / "out", dir / "cache"}) {
         EXPECT_FALSE(fs::exists(root / killed)) << root;
         EXPECT_TRUE(fs::exists(root / alive)) << root;
+        EXPECT_TRUE(fs::exists(root / held)) << root;
+        EXPECT_FALSE(fs::exists(root / unheld)) << root;
     }
+    // Its cook ends (the lock dies with the process): the next cook removes it.
+    for (int fd : locks) ::close(fd);
+    session().cook(o);
+    for (const fs::path& root : {dir / "out", dir / "cache"}) EXPECT_FALSE(fs::exists(root / held)) << root;
 }
 
 // Inputs a node reads (through hash_file) are listed with their hashes; a

@@ -17,6 +17,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <system_error>
 #include <unistd.h>
@@ -64,6 +65,10 @@ namespace {
 // Inside a staging folder: the marker that Atlas made it, the journal of a
 // commit that has begun, and the files a commit replaced.
 constexpr char kMarkerName[] = ".atlas-staging";
+// A marker that starts with this is flock()ed by its cook for as long as the folder
+// lives: a folder whose marker nobody holds belongs to no running cook, whatever host
+// or PID namespace made it (the host-and-PID test is for older folders).
+constexpr char kLockedMarker[] = "atlas staging folder, locked while its cook runs";
 constexpr char kJournalName[] = ".atlas-commit";
 constexpr char kReplacedName[] = ".atlas-replaced";
 
@@ -128,7 +133,19 @@ uint64_t remove_stale_staging(const fs::path& dir) {
         if (!it->is_directory(e2) || it->is_symlink(e2)) continue;
         // Only a folder Atlas made: a user's folder that happens to have the name is theirs.
         if (!fs::is_regular_file(fs::symlink_status(it->path() / kMarkerName, e2))) continue;
-        bool stale = false;
+        // The marker's lock: held by a running cook (shared), so an exclusive try fails.
+        const int fd = ::open((it->path() / kMarkerName).c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+        if (fd < 0) continue;
+        char head[sizeof kLockedMarker - 1] = {};
+        const bool locked_kind = ::pread(fd, head, sizeof head, 0) == ssize_t(sizeof head) && std::memcmp(head, kLockedMarker, sizeof head) == 0;
+        const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+        ::close(fd);
+        if (!free) continue; // a cook is running in it
+        const auto age = now - fs::last_write_time(it->path() / kMarkerName, e2);
+        bool stale = locked_kind;
+        // An older Atlas's folder (no lock), or one whose marker is being written: by host
+        // and PID, once a minute old.
+        if (!stale && !e2 && age > std::chrono::minutes(1)) {
         // HOST-PID-HEX: parts from the end (older names have only HEX).
         const std::string rest = name.substr(sizeof kStagingPrefix - 1);
         const auto last = rest.rfind('-');
@@ -136,6 +153,7 @@ uint64_t remove_stale_staging(const fs::path& dir) {
         if (mid != std::string::npos && rest.substr(0, mid) == host) {
             const long long pid = std::atoll(rest.substr(mid + 1, last - mid - 1).c_str());
             stale = pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH;
+        }
         }
         if (!stale) {
             const auto t = fs::last_write_time(it->path(), e2);
@@ -267,19 +285,24 @@ StagedOutputs::StagedOutputs(fs::path root) : root_(std::move(root)) {
     staging_ = root_ / staging_name();
     fs::create_directories(staging_, ec);
     if (ec) throw Error("cannot create staging directory in '" + root_.string() + "': " + ec.message());
-    // The marker says Atlas made this folder (remove_stale_staging touches no other).
-    static const char marker[] = "atlas staging folder: removed or completed by the next Atlas run in this directory\n";
-    try {
-        write_file_checked(staging_ / kMarkerName, marker, sizeof marker - 1);
-    } catch (...) {
+    // The marker says Atlas made this folder (remove_stale_staging touches no other); it is
+    // locked before a byte is written and stays locked while this object lives.
+    static const std::string marker = std::string(kLockedMarker) + "; removed or completed by the next Atlas run in this directory\n";
+    const fs::path m = staging_ / kMarkerName;
+    lock_fd_ = ::open(m.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (lock_fd_ < 0 || ::flock(lock_fd_, LOCK_SH) != 0 || ::write(lock_fd_, marker.data(), marker.size()) != ssize_t(marker.size())) {
+        const std::string why = std::strerror(errno);
+        if (lock_fd_ >= 0) ::close(lock_fd_);
+        lock_fd_ = -1;
         fs::remove_all(staging_, ec);
-        throw;
+        throw Error("cannot create the staging marker '" + m.string() + "': " + why);
     }
 }
 
 StagedOutputs::~StagedOutputs() {
     std::error_code ec;
     fs::remove_all(staging_, ec); // best effort; never throws from a destructor
+    if (lock_fd_ >= 0) ::close(lock_fd_);
 }
 
 fs::path StagedOutputs::stage_last(const fs::path& relative) {

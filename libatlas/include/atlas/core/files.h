@@ -81,6 +81,7 @@ public:
 private:
     fs::path root_;
     fs::path staging_;
+    int lock_fd_ = -1; // the marker, flock()ed while this lives (remove_stale_staging)
     std::vector<fs::path> last_;
     std::vector<ProtectedFile> protect_;
     std::vector<fs::path> files_; // what prepare() checked and journaled
@@ -148,8 +149,11 @@ private:
 Hash128 file_content_hash(const fs::path& path);
 
 // Staging directories (".atlas-staging-HOST-PID-N") that a killed process
-// left in `dir`: those of this host whose process no longer runs, and any
-// older than a day. One whose commit had begun (its journal is there) is
+// left in `dir`: those whose marker no process holds locked (a running cook
+// holds its marker's flock, whatever host or PID namespace it runs in; the
+// lock dies with the process), and, for folders of older Atlas versions
+// (markers without the lock), those of this host whose process no longer
+// runs and any older than a day. One whose commit had begun (its journal is there) is
 // completed first: the files it had not yet moved are moved into place.
 // Removes them and returns how many bytes they held. Only folders that
 // Atlas made (they hold its marker file) are touched, whatever their name.
