@@ -170,8 +170,8 @@ std::vector<TextOption<P>> make_preview_options() {
              "its columns"},
             "false", "", [](P& p, const V& v) { p.lightning = v.flag; }),
         opt({"flash_schedule", nullptr, "", K::Flag,
-             "a graph that writes an ndf/lightning table: each flash it lists (the cooked window, a frame's) is a light of flash_colour "
-             "at its x, y, z with its own intensity and flash_radius"},
+             "a graph that writes an ndf/lightning table: the longest strike sequence of the cooked window (a frame's) is drawn, each "
+             "flash a light of flash_colour at its x, y, z with its own intensity and flash_radius"},
             "true", "", [](P& p, const V& v) { p.flash_schedule = v.flag; }),
         opt({"flash_seed", "--flash-seed", "N", K::Integer, "flash lights: seed of the position draws", 0, 4294967295.0}, "1", "",
             [](P& p, const V& v) { p.flash_seed = int64_t(v.number); }),
