@@ -119,6 +119,17 @@ void complete_commit(const fs::path& root, const fs::path& staging) {
         fs::rename(src, dst, ec);
     }
 }
+
+// A staging folder named HOST-PID-HEX (parts from the end; older names have only HEX)
+// whose host is this one and whose process no longer runs.
+bool named_for_a_dead_process(const std::string& name, const std::string& host) {
+    const std::string rest = name.substr(sizeof kStagingPrefix - 1);
+    const auto last = rest.rfind('-');
+    const auto mid = last == std::string::npos || last == 0 ? std::string::npos : rest.rfind('-', last - 1);
+    if (mid == std::string::npos || rest.substr(0, mid) != host) return false;
+    const long long pid = std::atoll(rest.substr(mid + 1, last - mid - 1).c_str());
+    return pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH;
+}
 } // namespace
 
 uint64_t remove_stale_staging(const fs::path& dir) {
@@ -145,16 +156,7 @@ uint64_t remove_stale_staging(const fs::path& dir) {
         bool stale = locked_kind;
         // An older Atlas's folder (no lock), or one whose marker is being written: by host
         // and PID, once a minute old.
-        if (!stale && !e2 && age > std::chrono::minutes(1)) {
-        // HOST-PID-HEX: parts from the end (older names have only HEX).
-        const std::string rest = name.substr(sizeof kStagingPrefix - 1);
-        const auto last = rest.rfind('-');
-        const auto mid = last == std::string::npos || last == 0 ? std::string::npos : rest.rfind('-', last - 1);
-        if (mid != std::string::npos && rest.substr(0, mid) == host) {
-            const long long pid = std::atoll(rest.substr(mid + 1, last - mid - 1).c_str());
-            stale = pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH;
-        }
-        }
+        if (!stale && !e2 && age > std::chrono::minutes(1)) stale = named_for_a_dead_process(name, host);
         if (!stale) {
             const auto t = fs::last_write_time(it->path(), e2);
             stale = !e2 && now - t > std::chrono::hours(24);

@@ -804,28 +804,25 @@ void CookRun::write() {
                 st->protect(protect_);
             }
             w.stage = st.get();
-            if (p.action == OutputPlan::restore) {
+            if (p.action == OutputPlan::restore || p.action == OutputPlan::copy) {
+                // Encoded files already exist: the disk cache's bytes, or the files an
+                // earlier cook of the session wrote elsewhere.
                 progress_step("writing " + o->file, "", 0.0, false);
                 OutputReport& r = result_.outputs[w.report];
-                r.status = "restored";
-                r.metrics = p.cached->metrics;
-                for (const auto& [name, bytes] : p.cached->files) {
-                    const auto staged = st->stage(name);
-                    write_file_checked(staged, bytes.data(), bytes.size());
-                    w.staged.push_back(staged);
-                }
+                const bool restore = p.action == OutputPlan::restore;
+                r.status = restore ? "restored" : "copied";
+                r.metrics = restore ? p.cached->metrics : p.earlier->record.metrics;
+                if (restore)
+                    for (const auto& [name, bytes] : p.cached->files) {
+                        w.staged.push_back(st->stage(name));
+                        write_file_checked(w.staged.back(), bytes.data(), bytes.size());
+                    }
+                else
+                    for (const auto& f : p.earlier->record.files) {
+                        w.staged.push_back(st->stage(f.path));
+                        std::filesystem::copy_file(p.earlier->root / f.path, w.staged.back(), std::filesystem::copy_options::overwrite_existing);
+                    }
                 p.cached.reset();
-                w.encode_seconds = seconds_since(w.start);
-            } else if (p.action == OutputPlan::copy) {
-                progress_step("writing " + o->file, "", 0.0, false);
-                OutputReport& r = result_.outputs[w.report];
-                r.status = "copied";
-                r.metrics = p.earlier->record.metrics;
-                for (const auto& f : p.earlier->record.files) {
-                    const auto staged = st->stage(f.path);
-                    std::filesystem::copy_file(p.earlier->root / f.path, staged, std::filesystem::copy_options::overwrite_existing);
-                    w.staged.push_back(staged);
-                }
                 w.encode_seconds = seconds_since(w.start);
             } else {
                 budget_.check(w.scratch, what);
