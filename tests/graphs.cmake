@@ -19,3 +19,11 @@ set_tests_properties(cook_quickstart PROPERTIES LABELS graph PASS_REGULAR_EXPRES
 add_test(NAME portable_simd_tiled_world COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/portable_simd_test.sh $<TARGET_FILE:atlas>
          ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/portable_simd)
 set_tests_properties(portable_simd_tiled_world PROPERTIES LABELS graph SKIP_RETURN_CODE 77)
+# Shipped graphs cooked in tiles (1x1, 2x2, 3x2, assembled) at reduced sizes: every file the
+# untiled cook's bytes (issue 46 item 2). atlas-dask does the same for the cloudscape (dask_driver).
+add_test(NAME shipped_tiles_cloudscape COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
+         ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/cloudscape graphs/cloudscape.yaml --set "world.resolution=[96,96,32]")
+add_test(NAME shipped_tiles_towering_cumulus COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
+         ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/towering_cumulus graphs/towering_cumulus.yaml
+         --set "density.resolution=[96,96,72]")
+set_tests_properties(shipped_tiles_cloudscape shipped_tiles_towering_cumulus PROPERTIES LABELS graph TIMEOUT 600)

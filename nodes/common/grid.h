@@ -50,6 +50,14 @@ inline void declare_map(NodeDeclaration& d, const MapDefaults& g) {
     declare_map_bounds(d, g.bounds_min, g.bounds_max);
 }
 
+// The XY grid a node with declare_grid's parameters makes: what a windowed
+// generator's TileRule returns (TileRule::windowed).
+inline TileGrid tile_grid(const NodeParams& p) {
+    const Vec3i r = p.get_int3("resolution");
+    const Vec3d lo = p.get_float3("bounds_min"), hi = p.get_float3("bounds_max");
+    return TileGrid{{{r[0], r[1]}}, Box2d{{{lo[0], lo[1]}}, {{hi[0], hi[1]}}}};
+}
+
 // The declared bounds; fails naming the node when they are empty in some axis.
 inline Box3d grid_bounds(const CookContext& ctx) {
     Box3d box{ctx.get_float3("bounds_min"), ctx.get_float3("bounds_max")};

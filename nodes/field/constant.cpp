@@ -7,11 +7,7 @@ using namespace atlas;
 
 void declare(NodeDeclaration& d) {
     d.doc("A 3D field of the given resolution and world bounds, every voxel set to `value`.");
-    d.tiling(TileRule::pointwise().windowed([](const NodeParams& p) -> std::optional<TileGrid> {
-        const Vec3i r = p.get_int3("resolution");
-        const Vec3d lo = p.get_float3("bounds_min"), hi = p.get_float3("bounds_max");
-        return TileGrid{{{r[0], r[1]}}, Box2d{{{lo[0], lo[1]}}, {{hi[0], hi[1]}}}};
-    }));
+    d.tiling(TileRule::pointwise().windowed([](const NodeParams& p) -> std::optional<TileGrid> { return grid_nodes::tile_grid(p); }));
     d.output("out", PortType::Field3D, "the constant field");
     grid_nodes::declare_grid(d, grid_nodes::kCoarseCloudscapeGrid);
     d.param_int("channels", 1).range(1, 16).describe("number of channels");

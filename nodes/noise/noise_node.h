@@ -17,9 +17,7 @@ inline void declare_common(NodeDeclaration& d, Vec3i period = {{4, 4, 4}}) {
     // normalize, which needs the whole field's min/max: cooked whole and cropped.
     d.tiling(TileRule::pointwise().windowed([](const NodeParams& p) -> std::optional<TileGrid> {
         if (p.get_bool("normalize")) return std::nullopt;
-        const Vec3i r = p.get_int3("resolution");
-        const Vec3d lo = p.get_float3("bounds_min"), hi = p.get_float3("bounds_max");
-        return TileGrid{{{r[0], r[1]}}, Box2d{{{lo[0], lo[1]}}, {{hi[0], hi[1]}}}};
+        return grid_nodes::tile_grid(p);
     }));
     d.output("out", PortType::Field, "the noise field (Field3D, or Field2D when dimensions = 2d)");
     d.param_enum("dimensions", {"3d", "2d"}, "3d").describe("Field3D, or Field2D over x, y");

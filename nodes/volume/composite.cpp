@@ -10,7 +10,8 @@ void declare(NodeDeclaration& d) {
           "`world`: max, add, over (c + w (1 - saturate(c))) or subtract (max(w - c, 0)).");
     d.input("world", PortType::Field3D, "the world grid");
     d.input("cloud", PortType::Field3D, "the cloud (any grid)");
-    d.tiling(TileRule::none("it resamples the cloud at world positions derived from the world grid's bounds, which a cropped tile changes in the last bit (docs/scale.md)"));
+    // The world tiles; the cloud, on its own grid, is passed whole and sampled at the whole grid's positions.
+    d.tiling(TileRule::pointwise().with_window().whole_input("cloud"));
     d.output("out", PortType::Field3D, "the world with the cloud");
     d.param_enum("op", {"max", "add", "over", "subtract"}, "max").describe("composite operation");
     d.param_float("opacity", 1).range(0, 1e6).describe("multiplies the cloud");
@@ -19,9 +20,10 @@ void declare(NodeDeclaration& d) {
 }
 
 void cook(CookContext& ctx) {
+    const GridFrame frame = ctx.frame(*ctx.input_field3d("world"));
     ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(volume::composite(
                               *ctx.input_field3d("world"), *ctx.input_field3d("cloud"), volume::parse_composite_op(ctx.get_string("op")),
-                              ctx.get_float("opacity"), int(ctx.get_int("world_channel")), int(ctx.get_int("cloud_channel")), &ctx.budget()))));
+                              ctx.get_float("opacity"), int(ctx.get_int("world_channel")), int(ctx.get_int("cloud_channel")), &ctx.budget(), &frame))));
 }
 } // namespace
 

@@ -16,6 +16,8 @@ void declare(NodeDeclaration& d) {
           "outputs to volume/nvdf's detail_type and density_scale.");
     d.input("sdf", PortType::Field3D, "the cloud's signed distance (m, negative inside)");
     d.output("detail_type", PortType::Field3D, "channel 'detail_type' (0 wispy .. 1 billowy)");
+    // The SDF's gradient reads one neighbour each way.
+    d.tiling(TileRule::with_halo([](const NodeParams&) { return 1; }).with_window());
     d.output("density_scale", PortType::Field3D, "channel 'density_scale'");
     d.param_float("base_height", 0).range(-1e9, 1e9).with_unit("m").describe("condensation height (the flat base)");
     d.param_float("billow_depth", 60).range(1e-3, 1e9).with_unit("m").describe("depth below an up-facing surface where detail type reaches 0");
@@ -38,16 +40,21 @@ void cook(CookContext& ctx) {
     s.skirt = ctx.get_float("skirt");
     s.scale_floor = ctx.get_float("scale_floor");
     s.scale_ramp = ctx.get_float("scale_ramp");
-    // A condensation height at or above the cloud's top leaves no cloud above its base.
+    // A condensation height at or above the cloud's top leaves no cloud above its base. A tile holds
+    // part of a cloud, so a tiled cook leaves the check to the untiled one (a tile of a cloud's skirt
+    // would be refused for the tile's own top).
     double top = -1e300;
-    for (int z = 0; z < sdf->nz(); ++z)
-        for (int y = 0; y < sdf->ny(); ++y)
-            for (int x = 0; x < sdf->nx(); ++x)
-                if (sdf->at(0, x, y, z) < 0) top = std::max(top, sdf->voxel_center(x, y, z)[2]);
+    if (!ctx.window()) {
+        for (int z = 0; z < sdf->nz(); ++z)
+            for (int y = 0; y < sdf->ny(); ++y)
+                for (int x = 0; x < sdf->nx(); ++x)
+                    if (sdf->at(0, x, y, z) < 0) top = std::max(top, sdf->voxel_center(x, y, z)[2]);
+    }
     if (top > -1e300 && s.base_height >= top)
         ctx.fail("'base_height' " + std::to_string(s.base_height) + " m is at or above the cloud's top (" + std::to_string(top) +
                  " m): the condensation height must lie below the cloud");
-    volume::CumulusChannels c = volume::cumulus_channels(*sdf, s, &ctx.budget());
+    const GridFrame frame = ctx.frame(*sdf);
+    volume::CumulusChannels c = volume::cumulus_channels(*sdf, s, &ctx.budget(), &frame);
     ctx.set_output("detail_type", Field3DPtr(std::make_shared<Field3D>(std::move(c.detail_type))));
     ctx.set_output("density_scale", Field3DPtr(std::make_shared<Field3D>(std::move(c.density_scale))));
 }

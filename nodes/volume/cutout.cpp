@@ -11,6 +11,7 @@ void declare(NodeDeclaration& d) {
     d.input("in", PortType::Field3D, "density (all channels are cut)");
     d.input("cutter", PortType::Field3D, "optional signed distance (metres) of the cutting volume, any grid").optional = true;
     d.output("out", PortType::Field3D, "the carved density");
+    d.tiling(TileRule::pointwise().with_window().whole_input("cutter"));
     d.param_enum("shape", {"sphere", "box", "capsule"}, "capsule").describe("cutting shape when no cutter is connected");
     d.param_float3("a", {{1024, 2048, 256}}).with_unit("m").describe("sphere/box centre, capsule first end");
     d.param_float3("b", {{3072, 2048, 256}}).with_unit("m").describe("capsule second end");
@@ -21,9 +22,10 @@ void declare(NodeDeclaration& d) {
 
 void cook(CookContext& ctx) {
     auto in = ctx.input_field3d("in");
+    const GridFrame frame = ctx.frame(*in);
     const double edge = ctx.get_float("edge");
     if (ctx.has_input("cutter")) {
-        ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(volume::cutout_density_by_sdf(*in, *ctx.input_field3d("cutter"), edge, &ctx.budget()))));
+        ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(volume::cutout_density_by_sdf(*in, *ctx.input_field3d("cutter"), edge, &ctx.budget(), &frame))));
         return;
     }
     volume::Shape s;
@@ -33,7 +35,7 @@ void cook(CookContext& ctx) {
     s.half_size = ctx.get_float3("half_size");
     s.radius = ctx.get_float("radius");
     if (s.kind == volume::ShapeKind::Box) s.radius = std::min(s.radius, std::min({s.half_size[0], s.half_size[1], s.half_size[2]}));
-    ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(volume::cutout_density(*in, s, edge, &ctx.budget()))));
+    ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(volume::cutout_density(*in, s, edge, &ctx.budget(), &frame))));
 }
 } // namespace
 

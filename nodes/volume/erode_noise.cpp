@@ -10,6 +10,7 @@ void declare(NodeDeclaration& d) {
           "d' = saturate((d - e) / (1 - e)). Thin density vanishes first; full density stays 1.");
     d.input("in", PortType::Field3D, "density");
     d.output("out", PortType::Field3D, "eroded density");
+    d.tiling(TileRule::pointwise().with_window());
     d.param_float("amount", 0.5).range(0, 1).describe("erosion strength");
     d.param_float("frequency", 1.0 / 128.0).range(1e-9, 1e6).with_unit("1/m").describe("noise cells per metre (tiles on the bounds when frequency x extent is an integer)");
     d.param_int("octaves", 3).range(1, 12).describe("fractal octaves (lacunarity 2, gain 0.5)");
@@ -24,7 +25,9 @@ void cook(CookContext& ctx) {
     o.octaves = int(ctx.get_int("octaves"));
     o.seed = uint32_t(ctx.get_int("seed"));
     o.channel = int(ctx.get_int("channel"));
-    ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(volume::erode_by_noise(*ctx.input_field3d("in"), o, &ctx.budget()))));
+    auto in = ctx.input_field3d("in");
+    const GridFrame frame = ctx.frame(*in);
+    ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(volume::erode_by_noise(*in, o, &ctx.budget(), &frame))));
 }
 } // namespace
 

@@ -18,6 +18,9 @@ void declare(NodeDeclaration& d) {
           "size use sphere, or a metaball radius 2.2 times the size wanted.");
     d.input("points", PortType::Points, "optional sphere centres; attributes 'radius' (m) and 'weight'").optional = true;
     d.output("out", PortType::Field3D, "density, channel 'density'");
+    // A world-space source: each tile splats the spheres that reach its window (the points are passed whole).
+    d.tiling(TileRule::pointwise().windowed([](const NodeParams& p) -> std::optional<TileGrid> { return grid_nodes::tile_grid(p); })
+                 .whole_input("points"));
     volume_nodes::declare_grid(d);
     volume_nodes::declare_spheres(d);
     d.param_enum("kernel", {"metaball", "sphere", "linear", "gaussian"}, "metaball").describe("falloff of each sphere");
@@ -30,7 +33,9 @@ void declare(NodeDeclaration& d) {
 void cook(CookContext& ctx) {
     const Vec3i res = ctx.get_int3("resolution");
     const Box3d box = volume_nodes::grid_bounds(ctx);
-    volume_nodes::check_grid_memory(ctx, res, 1);
+    std::optional<XYWindow> window; // a tiled cook's part of the grid
+    if (const TileWindow* w = ctx.window()) window = XYWindow{w->x0, w->y0, w->x1, w->y1};
+    volume_nodes::check_grid_memory(ctx, window ? Vec3i{{window->x1 - window->x0, window->y1 - window->y0, res[2]}} : res, 1);
     Points pts;
     if (ctx.has_input("points")) pts = *ctx.input_points("points");
     std::vector<float> radius = pts.attributes.count("radius") ? pts.attributes["radius"]
@@ -71,7 +76,7 @@ void cook(CookContext& ctx) {
         ctx.fail("every sphere lies outside " + where() + ": check 'spheres' (or the points) against 'bounds_min' and 'bounds_max'");
     if (outside) ctx.warn(std::to_string(outside) + " of " + std::to_string(pts.positions.size()) + " spheres lie outside " + where() + " and add nothing");
     if (cut) ctx.warn(std::to_string(cut) + " spheres cross the faces of " + where() + first_cut + ": the cloud is cut there ('bounds_min', 'bounds_max')");
-    ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(volume::splat_points(pts, res, box, o, &ctx.budget()))));
+    ctx.set_output("out", Field3DPtr(std::make_shared<Field3D>(volume::splat_points(pts, res, box, o, &ctx.budget(), window ? &*window : nullptr))));
 }
 } // namespace
 

@@ -48,6 +48,7 @@ void declare(NodeDeclaration& d) {
     d.input("sdf", PortType::Field3D, "signed distance, metres, negative inside");
     d.input("detail_type", PortType::Field3D, "optional detail type (0 wispy .. 1 billowy), same grid as sdf").optional = true;
     d.input("density_scale", PortType::Field3D, "optional density scale 0..1, same grid as sdf").optional = true;
+    d.tiling(TileRule::pointwise());
     d.output("modeling", PortType::Field3D, "3 channels: dimensional_profile, detail_type, density_scale (tga-slices with alpha 0 = the pack layout)");
     d.output("field_data", PortType::Field3D, "channel 'field_data': the encoded SDF, 0..1");
     d.output("vdb_set", PortType::Field3D, "4 channels: dimensional_profile, detail_type, density_scale, sdf (metres)");

@@ -14,6 +14,7 @@ void declare(NodeDeclaration& d) {
           "Use it for detail_type and density_scale.");
     d.input("like", PortType::Field3D, "any field on the target grid");
     d.output("out", PortType::Field3D, "the painted channel, clamped to 0..1");
+    d.tiling(TileRule::pointwise().with_window());
     d.param_string("name", "detail_type").describe("channel name");
     d.param_float("bottom", 0.5).range(0, 1).describe("value at z_min");
     d.param_float("top", 0.5).range(0, 1).describe("value at z_max");
@@ -34,6 +35,7 @@ void declare(NodeDeclaration& d) {
 void cook(CookContext& ctx) {
     auto like = ctx.input_field3d("like");
     auto out = ctx.make_field3d(like->resolution(), 1, like->bounds(), {ctx.get_string("name")});
+    const GridFrame frame = ctx.frame(*like); // a tiled cook's crop: the whole grid's positions
     const double z0 = ctx.get_float("z_min"), z1 = ctx.get_float("z_max");
     const double bottom = ctx.get_float("bottom"), top = ctx.get_float("top");
     const bool use_shape = ctx.get_string("shape") != "none";
@@ -52,7 +54,7 @@ void cook(CookContext& ctx) {
     for (int z = 0; z < out->nz(); ++z)
         for (int y = 0; y < out->ny(); ++y)
             for (int x = 0; x < out->nx(); ++x) {
-                const Vec3d p = out->voxel_center(x, y, z);
+                const Vec3d p = frame.voxel_center(x, y, z);
                 const double t = z1 > z0 ? std::clamp((p[2] - z0) / (z1 - z0), 0.0, 1.0) : (p[2] >= z0 ? 1.0 : 0.0);
                 double v = bottom + (top - bottom) * t;
                 if (use_shape) {

@@ -9,6 +9,7 @@ void declare(NodeDeclaration& d) {
     d.doc("Top-down preview: opacity 1 - exp(-extinction x sum of density x voxel height) along z, a 2D field.");
     d.input("in", PortType::Field3D, "density");
     d.output("out", PortType::Field2D, "channel 'opacity', 0..1");
+    d.tiling(TileRule::pointwise()); // column by column
     d.param_float("extinction", 0.01).range(1e-9, 1e6).with_unit("1/m").describe("extinction per unit density");
     d.param_int("channel", 0).range(0, 255).describe("density channel");
 }

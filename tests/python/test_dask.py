@@ -100,6 +100,23 @@ def test_local_cluster_matches_single_cook(single, tmp_path):
     assert json.loads((tmp_path / "report.json").read_text())["tile_results"][0]["atlas"]["files"]
 
 
+def test_shipped_cloudscape_on_a_cluster(tmp_path):
+    # The production voxel cloudscape (metaballs composited into the world, cutouts, erosion,
+    # SDF, anatomy paint, the NVDF set with BC6H/BC4 textures) at a reduced world grid: 3x2
+    # tiles on two worker processes assemble the untiled cook's bytes (issue 46 item 2).
+    graph = str(SOURCE_DIR / "graphs" / "cloudscape.yaml")
+    sets = ("--set", "world.resolution=[96,96,32]")
+    untiled = tmp_path / "untiled"
+    subprocess.run([ATLAS, "cook", graph, "--out", str(untiled), "--quiet", "--no-cache", *sets], check=True, capture_output=True)
+    out = tmp_path / "out"
+    summary = atlas_dask.run(graph, (3, 2), "local", str(out), atlas=ATLAS, workers=2, extra=sets)
+    assert len(summary["tile_results"]) == 6
+    files = files_under(untiled)
+    assert any(str(f).endswith(".dds") for f in files) and any(str(f).endswith(".vdb") for f in files)
+    for f in files:
+        assert (untiled / f).read_bytes() == (out / f).read_bytes(), f"{f} differs from the untiled cook"
+
+
 def test_failed_tile_is_retried(single, tmp_path):
     # Tile 1,0 fails on its first attempt only.
     atlas = wrapper(tmp_path, """

@@ -166,6 +166,8 @@ Vec3d Field3D::voxel_center(int x, int y, int z) const {
     return {{bounds_.min[0] + (x + 0.5) * s[0], bounds_.min[1] + (y + 0.5) * s[1], bounds_.min[2] + (z + 0.5) * s[2]}};
 }
 
+GridFrame Field3D::frame() const { return {res_, bounds_, {{0, 0, 0}}}; }
+
 float Field3D::sample_voxel(int c, double u, double v, double w, WrapMode wrap) const {
     int x0, x1, y0, y1, z0, z1;
     float tx, ty, tz;

@@ -197,6 +197,14 @@ void CookContext::progress(double fraction) const {
     if (progress_.on_progress) progress_.on_progress({"node '" + name_ + "'", std::clamp(fraction, 0.0, 1.0), 0, 0});
 }
 
+GridFrame CookContext::frame(const Field3D& f) const {
+    if (!window_) return f.frame();
+    const Box2d& b = window_->grid.bounds;
+    return {{{window_->grid.res[0], window_->grid.res[1], f.nz()}},
+            {{{b.min[0], b.min[1], f.bounds().min[2]}}, {{b.max[0], b.max[1], f.bounds().max[2]}}},
+            {{window_->x0, window_->y0, 0}}};
+}
+
 void CookContext::fail(const std::string& message) const { throw Error("node '" + name_ + "' (" + type_ + "): " + message); }
 
 // ---------------------------------------------------------------- NodeRegistry

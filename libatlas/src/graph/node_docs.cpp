@@ -30,11 +30,14 @@ std::string range_text(const ParamDecl& p) {
 std::string tiling_text(const NodeType& t) {
     const TileRule& r = t.decl.tiling();
     const bool source = t.decl.inputs().empty();
+    std::string whole;
+    for (const std::string& port : r.whole_inputs) whole += (whole.empty() ? "; '" : ", '") + port + "'";
+    if (!whole.empty()) whole += " passed whole (any grid; what feeds it is cooked untiled)";
     switch (r.kind) {
     case TileRule::Kind::Pointwise:
-        if (!source) return "pointwise";
+        if (!source) return "pointwise" + whole;
         return r.window_grid ? "generator, makes each tile's window" : "generator, cooked whole and cropped";
-    case TileRule::Kind::Halo: return "halo from its parameters";
+    case TileRule::Kind::Halo: return "halo from its parameters" + whole;
     case TileRule::Kind::None: break;
     }
     return "not tileable" + (r.why_not.empty() ? std::string() : ": " + r.why_not);

@@ -34,7 +34,12 @@ using detail::topological_order;
 // What the requested outputs need: the outputs and the nodes, inputs first.
 struct Plan {
     std::vector<const GraphOutput*> outputs;
-    std::vector<const GraphNode*> order;
+    std::vector<const GraphNode*> order; // the nodes cooked per tile, inputs first
+    // Values passed whole to every tile (TileRule::whole_inputs): node and port.
+    // They and what feeds them are cooked once through the session, untiled.
+    std::set<std::pair<std::string, std::string>> aside;
+    // Tiled nodes without tiled inputs (generators, and nodes whose inputs are all passed whole).
+    std::set<std::string> sources;
     std::map<std::string, int> halo; // per node
     std::set<std::string> grid_halo;  // nodes whose halo needs the grid (computed once it is known)
     std::set<std::string> reads_window; // nodes that get their input window (CookContext::window())
@@ -53,7 +58,26 @@ Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::s
     if (p.outputs.empty()) throw Error("tiling: the graph writes no outputs");
     std::vector<std::string> targets;
     for (const GraphOutput* o : p.outputs) targets.push_back(o->node);
-    p.order = detail::needed_nodes(g, targets);
+    // The nodes an output reaches through inputs that are not passed whole tile;
+    // the rest (a cloud on its own grid and its sources) are cooked whole.
+    const std::vector<const GraphNode*> needed = detail::needed_nodes(g, targets);
+    std::set<std::string> tiled(targets.begin(), targets.end());
+    for (auto it = needed.rbegin(); it != needed.rend(); ++it) {
+        const GraphNode& n = **it;
+        if (!tiled.count(n.name)) continue;
+        const TileRule& rule = reg.find(n.type)->decl.tiling();
+        for (const auto& [port, b] : n.inputs) {
+            if (rule.whole_inputs.count(port)) p.aside.insert({b.node, source_port(g, reg, b)});
+            else tiled.insert(b.node);
+        }
+    }
+    for (const GraphNode* n : needed) {
+        if (!tiled.count(n->name)) continue;
+        p.order.push_back(n);
+        const TileRule& rule = reg.find(n->type)->decl.tiling();
+        if (std::all_of(n->inputs.begin(), n->inputs.end(), [&](const auto& in) { return rule.whole_inputs.count(in.first) > 0; }))
+            p.sources.insert(n->name);
+    }
     for (const GraphNode* n : p.order)
         for (const auto& [port, b] : n->inputs) p.last_use[b.node] = n->name;
     for (const GraphOutput* o : p.outputs) p.output_nodes.insert(o->node);
@@ -75,14 +99,14 @@ Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::s
         if (rule.refuse)
             if (std::string why = rule.refuse(params); !why.empty()) throw Error(node_label(*n) + " cannot be cooked in tiles: " + why);
         int h = 0;
-        if (rule.kind == TileRule::Kind::Halo && !n->inputs.empty()) {
+        if (rule.kind == TileRule::Kind::Halo && !p.sources.count(n->name)) {
             if (rule.grid_halo) p.grid_halo.insert(n->name);
             else h = rule.halo(params);
         }
-        if (rule.reads_window && !n->inputs.empty()) p.reads_window.insert(n->name);
+        if (rule.reads_window && !p.sources.count(n->name)) p.reads_window.insert(n->name);
         if (h < 0) throw Error(node_label(*n) + ": internal: negative tiling halo");
         p.halo[n->name] = h;
-        if (n->inputs.empty() && rule.window_grid)
+        if (p.sources.count(n->name) && rule.window_grid)
             if (auto grid = rule.window_grid(params)) p.windowed[n->name] = *grid;
     }
     return p;
@@ -308,6 +332,7 @@ struct TiledCook {
     std::vector<Vec2i> selection, to_cook;
     std::map<std::pair<int, int>, json> fragments; // per tile, cooked now or found current
     HeldValues sources; // generators cooked whole
+    HeldValues aside;   // values passed whole to every tile (Plan::aside)
     Grid grid;
 };
 
@@ -354,7 +379,7 @@ void TiledCook::select_tiles() {
 void TiledCook::cook_sources() {
     if (!to_cook.empty()) {
         for (const GraphNode* n : plan.order) {
-            if (!n->inputs.empty()) continue;
+            if (!plan.sources.count(n->name)) continue;
             if (auto it = plan.windowed.find(n->name); it != plan.windowed.end()) {
                 const TileGrid& tg = it->second;
                 if (grid.from.empty()) {
@@ -368,7 +393,7 @@ void TiledCook::cook_sources() {
             std::set<std::string> ports;
             for (const GraphNode* m : plan.order)
                 for (const auto& [port, b] : m->inputs)
-                    if (b.node == n->name) ports.insert(source_port(g, reg, b));
+                    if (b.node == n->name && !reg.find(m->type)->decl.tiling().whole_inputs.count(port)) ports.insert(source_port(g, reg, b));
             for (const GraphOutput* o : plan.outputs)
                 if (o->node == n->name) ports.insert(o->port);
             for (const std::string& port : ports) {
@@ -388,6 +413,7 @@ void TiledCook::cook_sources() {
                 sources[{n->name, port}] = {v, {0, 0, res[0], res[1]}, false};
             }
         }
+        for (const auto& [node, port] : plan.aside) aside[{node, port}] = {session.get(node, port, opt), {}, true};
     } else {
         grid = grid_from_json(fragments.begin()->second.at("grid"));
     }
@@ -462,13 +488,15 @@ HeldValues TiledCook::cook_tile(const TileRect& tr, ThreadLimit& arena, uint64_t
     for (auto it = plan.order.rbegin(); it != plan.order.rend(); ++it) {
         const GraphNode& n = **it;
         const TileRect need = grow(region[n.name], plan.halo.at(n.name), grid.res);
-        for (const auto& [port, b] : n.inputs) region[b.node] = unite(region[b.node], need);
+        const auto& whole = reg.find(n.type)->decl.tiling().whole_inputs;
+        for (const auto& [port, b] : n.inputs)
+            if (!whole.count(port)) region[b.node] = unite(region[b.node], need);
     }
     HeldValues held;
     for (const GraphNode* n : plan.order) {
         const TileRect r = region.at(n->name);
         const bool windowed = plan.windowed.count(n->name) > 0;
-        if (n->inputs.empty() && !windowed) {
+        if (plan.sources.count(n->name) && !windowed) {
             for (const auto& [key, h] : sources)
                 if (key.first == n->name) held[key] = {crop(h.v, h.rect, r, grid, budget), r, false};
             continue;
@@ -478,6 +506,10 @@ HeldValues TiledCook::cook_tile(const TileRect& tr, ThreadLimit& arena, uint64_t
         const TileWindow window = window_of(grid, r);
         std::map<std::string, Value> inputs;
         for (const auto& [port, b] : n->inputs) {
+            if (type.decl.tiling().whole_inputs.count(port)) {
+                inputs[port] = aside.at({b.node, source_port(g, reg, b)}).v;
+                continue;
+            }
             const Held& h = held.at({b.node, source_port(g, reg, b)});
             inputs[port] = h.whole ? h.v : crop(h.v, h.rect, in_rect, grid, budget);
         }

@@ -24,7 +24,7 @@ float value_noise(double x, double y, double z, Vec3i period, uint32_t seed) {
     return v;
 }
 
-void value_noise_row(std::span<float> out, double x0, double dx, double y, double z, Vec3i period, uint32_t seed) {
+void value_noise_row(std::span<float> out, double x0, double dx, double y, double z, Vec3i period, uint32_t seed, int64_t first) {
     const int px = period[0] < 1 ? 1 : period[0];
     const int py = period[1] < 1 ? 1 : period[1];
     const int pz = period[2] < 1 ? 1 : period[2];
@@ -34,7 +34,7 @@ void value_noise_row(std::span<float> out, double x0, double dx, double y, doubl
     const int y0 = wrap(int64_t(fy), py), y1 = wrap(int64_t(fy) + 1, py);
     const int z0 = wrap(int64_t(fz), pz), z1 = wrap(int64_t(fz) + 1, pz);
     for (size_t i = 0; i < out.size(); ++i) {
-        const double x = x0 + dx * double(i);
+        const double x = x0 + dx * double(first + int64_t(i));
         const double fx = std::floor(x);
         const float tx = quintic(float(x - fx));
         const int xa = wrap(int64_t(fx), px), xb = wrap(int64_t(fx) + 1, px);

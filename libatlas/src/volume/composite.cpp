@@ -15,7 +15,6 @@ void check_channel(const Field3D& f, int c, const char* what) {
     if (c < 0 || c >= f.channels()) throw Error(std::string(what) + ": channel " + std::to_string(c) + " does not exist");
 }
 
-bool aligned(const Field3D& a, const Field3D& b) { return a.resolution() == b.resolution() && a.bounds() == b.bounds(); }
 
 float saturate(double v) { return float(std::clamp(v, 0.0, 1.0)); }
 
@@ -29,18 +28,20 @@ CompositeOp parse_composite_op(const std::string& n) {
     throw Error("unknown composite operation '" + n + "' (expected max, add, over or subtract)");
 }
 
-Field3D composite(const Field3D& world, const Field3D& cloud, CompositeOp op, double opacity, int wc, int cc, const MemoryBudget* budget) {
+Field3D composite(const Field3D& world, const Field3D& cloud, CompositeOp op, double opacity, int wc, int cc, const MemoryBudget* budget,
+                  const GridFrame* frame) {
+    const GridFrame fr = frame ? *frame : world.frame();
     check_channel(world, wc, "composite (world)");
     check_channel(cloud, cc, "composite (cloud)");
     if (!std::isfinite(opacity)) throw Error("composite: opacity must be finite");
     if (budget) budget->check(world.byte_size(), "composite: the world grid copy");
     Field3D out = world;
-    const bool same = aligned(world, cloud);
+    const bool same = fr.same_grid(cloud);
     const float op_f = float(opacity);
     parallel_for_index(world.nz(), [&](int z) {
         for (int y = 0; y < world.ny(); ++y)
             for (int x = 0; x < world.nx(); ++x) {
-                const float c = op_f * (same ? cloud.at(cc, x, y, z) : sample_or(cloud, cc, world.voxel_center(x, y, z)));
+                const float c = op_f * (same ? cloud.at(cc, x + fr.offset[0], y + fr.offset[1], z) : sample_or(cloud, cc, fr.voxel_center(x, y, z)));
                 float& w = out.at(wc, x, y, z);
                 switch (op) {
                 case CompositeOp::Max: w = std::max(w, c); break;
@@ -53,7 +54,8 @@ Field3D composite(const Field3D& world, const Field3D& cloud, CompositeOp op, do
     return out;
 }
 
-Field3D cutout_density(const Field3D& density, const Shape& shape, double edge, const MemoryBudget* budget) {
+Field3D cutout_density(const Field3D& density, const Shape& shape, double edge, const MemoryBudget* budget, const GridFrame* frame) {
+    const GridFrame fr = frame ? *frame : density.frame();
     validate_shape(shape);
     if (!(edge >= 0) || !std::isfinite(edge)) throw Error("cutout: edge must be finite and >= 0");
     if (budget) budget->check(density.byte_size(), "cutout: the density copy");
@@ -61,7 +63,7 @@ Field3D cutout_density(const Field3D& density, const Shape& shape, double edge, 
     parallel_for_index(density.nz(), [&](int z) {
         for (int y = 0; y < density.ny(); ++y)
             for (int x = 0; x < density.nx(); ++x) {
-                const double d = shape_distance(shape, density.voxel_center(x, y, z));
+                const double d = shape_distance(shape, fr.voxel_center(x, y, z));
                 const float k = edge > 0 ? saturate(d / edge) : (d > 0 ? 1.0f : 0.0f);
                 if (k == 1.0f) continue;
                 for (int c = 0; c < out.channels(); ++c) out.at(c, x, y, z) *= k;
@@ -85,15 +87,16 @@ Field3D subtract_shape_sdf(const Field3D& sdf, const Shape& shape, int channel, 
     return out;
 }
 
-Field3D cutout_density_by_sdf(const Field3D& density, const Field3D& cutter, double edge, const MemoryBudget* budget) {
+Field3D cutout_density_by_sdf(const Field3D& density, const Field3D& cutter, double edge, const MemoryBudget* budget, const GridFrame* frame) {
+    const GridFrame fr = frame ? *frame : density.frame();
     if (!(edge >= 0) || !std::isfinite(edge)) throw Error("cutout: edge must be finite and >= 0");
     if (budget) budget->check(density.byte_size(), "cutout: the density copy");
     Field3D out = density;
-    const bool same = aligned(density, cutter);
+    const bool same = fr.same_grid(cutter);
     parallel_for_index(density.nz(), [&](int z) {
         for (int y = 0; y < density.ny(); ++y)
             for (int x = 0; x < density.nx(); ++x) {
-                const double d = same ? cutter.at(0, x, y, z) : sample_or(cutter, 0, density.voxel_center(x, y, z), 1e30f);
+                const double d = same ? cutter.at(0, x + fr.offset[0], y + fr.offset[1], z) : sample_or(cutter, 0, fr.voxel_center(x, y, z), 1e30f);
                 const float k = edge > 0 ? saturate(d / edge) : (d > 0 ? 1.0f : 0.0f);
                 if (k == 1.0f) continue;
                 for (int c = 0; c < out.channels(); ++c) out.at(c, x, y, z) *= k;

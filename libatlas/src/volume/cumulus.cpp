@@ -179,7 +179,7 @@ Points spheres_from_sdf(const Field3D& sdf, const SphereFillSpec& s) {
     return out;
 }
 
-CumulusChannels cumulus_channels(const Field3D& sdf, const CumulusPaintSpec& s, const MemoryBudget* budget) {
+CumulusChannels cumulus_channels(const Field3D& sdf, const CumulusPaintSpec& s, const MemoryBudget* budget, const GridFrame* frame) {
     for (double v : {s.base_height, s.billow_depth, s.facing_low, s.facing_high, s.skirt, s.scale_floor, s.scale_ramp})
         if (!std::isfinite(v)) throw Error("cumulus_channels: every setting must be finite");
     if (!(s.billow_depth > 0)) throw Error("cumulus_channels: 'billow_depth' must be > 0");
@@ -189,7 +189,9 @@ CumulusChannels cumulus_channels(const Field3D& sdf, const CumulusPaintSpec& s, 
     if (sdf.channels() < 1) throw Error("cumulus_channels: the SDF has no channel");
     const Vec3i r = sdf.resolution();
     CumulusChannels out{Field3D(r, 1, sdf.bounds(), {"detail_type"}, budget), Field3D(r, 1, sdf.bounds(), {"density_scale"}, budget)};
-    const Vec3d h = sdf.voxel_size();
+    // Differences one-sided at the grid's own faces; a tiled cook's crop (grown by a voxel) has the rest as neighbours.
+    const GridFrame fr = frame ? *frame : sdf.frame();
+    const Vec3d h = fr.voxel_size();
     parallel_for_index(r[2], [&](int z) {
         for (int y = 0; y < r[1]; ++y)
             for (int x = 0; x < r[0]; ++x) {
@@ -205,7 +207,7 @@ CumulusChannels cumulus_channels(const Field3D& sdf, const CumulusPaintSpec& s, 
                 const double g[3] = {diff(0), diff(1), diff(2)};
                 const double len = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
                 const double up = len > 1e-9 ? g[2] / len : 0.0;
-                const double zc = sdf.voxel_center(x, y, z)[2];
+                const double zc = fr.voxel_center(x, y, z)[2];
                 const double height = zc - s.base_height;
                 double type = smoothstep(s.facing_low, s.facing_high, up) * std::clamp(1.0 - std::max(0.0, -d) / s.billow_depth, 0.0, 1.0);
                 type *= smoothstep(s.skirt * 0.5, s.skirt, height);

@@ -12,15 +12,16 @@
 
 namespace atlas::volume {
 
-Field3D erode_by_noise(const Field3D& density, const ErosionOptions& o, const MemoryBudget* budget) {
+Field3D erode_by_noise(const Field3D& density, const ErosionOptions& o, const MemoryBudget* budget, const GridFrame* frame) {
     if (o.channel < 0 || o.channel >= density.channels()) throw Error("erode_by_noise: channel " + std::to_string(o.channel) + " does not exist");
     if (!(o.amount >= 0 && o.amount <= 1)) throw Error("erode_by_noise: amount must be in [0, 1]");
     if (!(o.frequency > 0) || !std::isfinite(o.frequency)) throw Error("erode_by_noise: frequency must be finite and > 0 (cells per metre)");
     if (o.octaves < 1 || o.octaves > 12) throw Error("erode_by_noise: octaves must be in [1, 12]");
     if (budget) budget->check(density.byte_size(), "erode_by_noise: the density copy");
-    const Box3d& b = density.bounds();
-    const Vec3d h = density.voxel_size();
-    const Vec3d ext = b.size();
+    // The noise is laid over the whole grid (a tiled cook's crop is a window of it).
+    const GridFrame fr = frame ? *frame : density.frame();
+    const Vec3d h = fr.voxel_size();
+    const Vec3d ext = fr.bounds.size();
     for (int a = 0; a < 3; ++a)
         if (ext[a] * o.frequency * std::ldexp(1.0, o.octaves - 1) > 1e7)
             throw Error("erode_by_noise: frequency x extent is too large (over 1e7 noise cells per axis)");
@@ -40,8 +41,9 @@ Field3D erode_by_noise(const Field3D& density, const ErosionOptions& o, const Me
                              std::max(1, int(std::lround(ext[2] * f)))}};
                 r.x0 = 0.5 * h[0] * f;
                 r.dx = h[0] * f;
-                r.y = (y + 0.5) * h[1] * f;
-                r.z = (z + 0.5) * h[2] * f;
+                r.first = fr.offset[0];
+                r.y = ((y + fr.offset[1]) + 0.5) * h[1] * f;
+                r.z = ((z + fr.offset[2]) + 0.5) * h[2] * f;
                 return r;
             }, scratch);
             for (int x = 0; x < density.nx(); ++x) {

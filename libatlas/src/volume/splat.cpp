@@ -25,7 +25,7 @@ SplatBlend parse_splat_blend(const std::string& n) {
     throw Error("unknown splat blend '" + n + "' (expected add or max)");
 }
 
-Field3D splat_points(const Points& pts, Vec3i res, Box3d bounds, const SplatOptions& o, const MemoryBudget* budget) {
+Field3D splat_points(const Points& pts, Vec3i res, Box3d bounds, const SplatOptions& o, const MemoryBudget* budget, const XYWindow* window) {
     if (!(o.default_radius > 0) || !std::isfinite(o.default_radius)) throw Error("splat: default_radius must be finite and > 0");
     if (!(o.radius_scale > 0) || !std::isfinite(o.radius_scale)) throw Error("splat: radius_scale must be finite and > 0");
     if (!std::isfinite(o.weight)) throw Error("splat: weight must be finite");
@@ -36,8 +36,12 @@ Field3D splat_points(const Points& pts, Vec3i res, Box3d bounds, const SplatOpti
     if (auto it = pts.attributes.find(o.weight_attribute); it != pts.attributes.end()) weights = &it->second;
     if ((radii && radii->size() != n) || (weights && weights->size() != n))
         throw Error("splat: a point attribute's length differs from the number of points (" + std::to_string(n) + ")");
-    Field3D out(res, 1, bounds, {"density"}, budget);
-    const Vec3d h = out.voxel_size();
+    // Positions are the whole grid's; a window keeps voxels [x0, x1) x [y0, y1) of it.
+    const XYWindow win = window ? *window : XYWindow{0, 0, res[0], res[1]};
+    if (win.x0 < 0 || win.y0 < 0 || win.x1 > res[0] || win.y1 > res[1] || win.x1 <= win.x0 || win.y1 <= win.y0)
+        throw Error("splat: the window is not a part of the grid");
+    const Vec3d h = GridFrame{res, bounds, {{0, 0, 0}}}.voxel_size();
+    Field3D out({{win.x1 - win.x0, win.y1 - win.y0, res[2]}}, 1, window ? win.bounds(res, bounds) : bounds, {"density"}, budget);
     const double vmin = std::min({h[0], h[1], h[2]});
     struct Splat {
         Vec3d c;
@@ -72,10 +76,11 @@ Field3D splat_points(const Points& pts, Vec3i res, Box3d bounds, const SplatOpti
             const double dz = zc - s.c[2];
             if (std::abs(dz) >= s.support) continue;
             int lo[2], hi[2];
+            const int wlo[2] = {win.x0, win.y0}, whi[2] = {win.x1, win.y1};
             for (int a = 0; a < 2; ++a) {
                 // Clamped as doubles: a radius of 1e30 would overflow the int conversion (UB).
-                lo[a] = int(std::clamp(std::floor((s.c[a] - s.support - bounds.min[a]) / h[a] - 0.5), 0.0, double(res[a])));
-                hi[a] = int(std::clamp(std::ceil((s.c[a] + s.support - bounds.min[a]) / h[a] - 0.5), -1.0, double(res[a] - 1)));
+                lo[a] = int(std::clamp(std::floor((s.c[a] - s.support - bounds.min[a]) / h[a] - 0.5), double(wlo[a]), double(whi[a])));
+                hi[a] = int(std::clamp(std::ceil((s.c[a] + s.support - bounds.min[a]) / h[a] - 0.5), double(wlo[a] - 1), double(whi[a] - 1)));
             }
             for (int y = lo[1]; y <= hi[1]; ++y) {
                 const double dy = bounds.min[1] + (y + 0.5) * h[1] - s.c[1];
@@ -84,7 +89,7 @@ Field3D splat_points(const Points& pts, Vec3i res, Box3d bounds, const SplatOpti
                     const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
                     if (r >= s.support) continue;
                     const float v = float(s.w * kernel(r, s.r));
-                    float& d = out.at(0, x, y, z);
+                    float& d = out.at(0, x - win.x0, y - win.y0, z);
                     d = o.blend == SplatBlend::Add ? d + v : std::max(d, v);
                 }
             }

@@ -20,6 +20,7 @@ namespace atlas {
 
 class Hasher;
 class MemoryBudget;
+struct GridFrame;
 
 // How sampling treats coordinates outside the grid.
 enum class WrapMode {
@@ -132,6 +133,7 @@ public:
     float& at(int c, int x, int y, int z) { return channel(c)[index(x, y, z)]; }
 
     Vec3d voxel_center(int x, int y, int z) const;
+    GridFrame frame() const;
     // Trilinear sample at continuous voxel coordinates (voxel centres at i+0.5).
     float sample_voxel(int c, double u, double v, double w, WrapMode wrap) const;
     // Trilinear sample at a world position.
@@ -147,6 +149,48 @@ private:
 
 using Field2DPtr = std::shared_ptr<const Field2D>;
 using Field3DPtr = std::shared_ptr<const Field3D>;
+
+// Voxels [x0, x1) x [y0, y1), all of z, of a grid: the part of it a tiled
+// cook asks a generator for (graph's TileWindow, without the grid).
+struct XYWindow {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    // Texel edge i of n between lo and hi (exactly lo at 0, hi at n): the one
+    // formula for the bounds of every tile, crop and window.
+    static double edge(double lo, double hi, int i, int n) {
+        if (i <= 0) return lo;
+        if (i >= n) return hi;
+        return lo + (hi - lo) * double(i) / double(n);
+    }
+    // The window's bounds in a grid of `res` voxels over `b` (z whole).
+    Box3d bounds(Vec3i res, const Box3d& b) const {
+        return {{{edge(b.min[0], b.max[0], x0, res[0]), edge(b.min[1], b.max[1], y0, res[1]), b.min[2]}},
+                {{edge(b.min[0], b.max[0], x1, res[0]), edge(b.min[1], b.max[1], y1, res[1]), b.max[2]}}};
+    }
+};
+
+// Where a field's voxels sit in a grid it may be a window of: the whole
+// grid's resolution and bounds and the window's first voxel. A tiled cook
+// hands a node a crop of the world grid; positions computed through the
+// frame are the whole grid's to the last bit (a crop's own bounds are not),
+// so the tile's values are the untiled cook's. Field3D::frame() is a field's
+// own frame (offset 0): the same numbers as Field3D::voxel_center.
+struct GridFrame {
+    Vec3i res{{1, 1, 1}}; // the whole grid
+    Box3d bounds;         // the whole grid
+    Vec3i offset{{0, 0, 0}};
+    Vec3d voxel_size() const {
+        const Vec3d s = bounds.size();
+        return {{s[0] / res[0], s[1] / res[1], s[2] / res[2]}};
+    }
+    // Centre of the window's voxel (x, y, z): Field3D::voxel_center's arithmetic on the whole grid.
+    Vec3d voxel_center(int x, int y, int z) const {
+        const Vec3d s = voxel_size();
+        return {{bounds.min[0] + ((x + offset[0]) + 0.5) * s[0], bounds.min[1] + ((y + offset[1]) + 0.5) * s[1],
+                 bounds.min[2] + ((z + offset[2]) + 0.5) * s[2]}};
+    }
+    // The field is the whole grid, or the same window of it.
+    bool same_grid(const Field3D& f) const { return f.resolution() == res && f.bounds() == bounds; }
+};
 
 // Default channel names: "r", "g", "b", "a" for up to 4 channels, else "c0".. .
 std::vector<std::string> default_channel_names(int channels);

@@ -27,6 +27,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -65,13 +66,7 @@ struct TileWindow {
     TileGrid grid;
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
     Vec2i size() const { return {{x1 - x0, y1 - y0}}; }
-    // Texel edge i of n between lo and hi (exactly lo at 0, hi at n): the one
-    // formula for the bounds of every tile, crop and window.
-    static double edge(double lo, double hi, int i, int n) {
-        if (i <= 0) return lo;
-        if (i >= n) return hi;
-        return lo + (hi - lo) * double(i) / double(n);
-    }
+    static double edge(double lo, double hi, int i, int n) { return XYWindow::edge(lo, hi, i, n); }
     Box2d bounds() const {
         const Box2d& b = grid.bounds;
         return {{{edge(b.min[0], b.max[0], x0, grid.res[0]), edge(b.min[1], b.max[1], y0, grid.res[1])}},
@@ -98,6 +93,10 @@ struct TileRule {
     // can use the whole grid's texel size and tell the grid's own faces from a
     // crop's (null in an untiled cook).
     bool reads_window = false;
+    // Inputs on any grid of their own (a cloud composited into the world, a
+    // cutter): passed whole to every tile; the nodes feeding them are cooked
+    // whole once per process and need no tiling rule.
+    std::set<std::string> whole_inputs;
 
     TileRule& windowed(std::function<std::optional<TileGrid>(const NodeParams&)> grid) {
         window_grid = std::move(grid);
@@ -127,6 +126,10 @@ struct TileRule {
     }
     TileRule& with_window() {
         reads_window = true;
+        return *this;
+    }
+    TileRule& whole_input(std::string port) {
+        whole_inputs.insert(std::move(port));
         return *this;
     }
     static TileRule none(std::string why) {
@@ -256,6 +259,11 @@ public:
     // window its inputs cover (null otherwise, and in an untiled cook).
     const TileWindow* window() const { return window_; }
     void set_window(const TileWindow* w) { window_ = w; }
+    // Where a field on the tiled grid (an input or an output made like one)
+    // sits in the whole grid: its own frame untiled, the window's in a tiled
+    // cook (z is never tiled). Positions and voxel sizes taken from it are
+    // the untiled cook's to the last bit.
+    GridFrame frame(const Field3D& f) const;
 
 private:
     std::string name_, type_;

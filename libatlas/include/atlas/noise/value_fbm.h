@@ -34,9 +34,10 @@ struct ValueFbm {
 // w_o = gain^o / sum_k gain^k, o = 0..octaves-1 (as floats; they sum to 1 up to rounding).
 std::vector<float> fbm_weights(const ValueFbm& f);
 
-// Where octave o's row of samples sits: sample i at lattice (x0 + i dx, y, z), tiling period.
+// Where octave o's row of samples sits: sample i at lattice (x0 + (first + i) dx, y, z), tiling period.
 struct FbmRow {
     double x0 = 0, dx = 1, y = 0, z = 0;
+    int64_t first = 0; // sample i sits at x0 + (first + i) dx (a window of a longer row)
     Vec3i period{{1, 1, 1}};
 };
 
@@ -75,7 +76,7 @@ void atlas::noise::value_fbm_row(std::span<float> out, const ValueFbm& f, std::s
     std::fill(out.begin(), out.end(), 0.0f);
     for (int o = 0; o < f.octaves; ++o) {
         const FbmRow r = place(o);
-        value_noise_row(scratch, r.x0, r.dx, r.y, r.z, r.period, f.seed + uint32_t(o) * f.seed_step);
+        value_noise_row(scratch, r.x0, r.dx, r.y, r.z, r.period, f.seed + uint32_t(o) * f.seed_step, r.first);
         const float w = weights[size_t(o)];
         for (size_t i = 0; i < out.size(); ++i) out[i] += w * scratch[i];
     }

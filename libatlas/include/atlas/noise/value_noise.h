@@ -13,9 +13,10 @@
 namespace atlas::noise {
 
 // Evaluates value noise with quintic interpolation along one row of samples:
-// out[i] = noise(x0 + i*dx, y, z), coordinates in lattice cells.
+// out[i] = noise(x0 + (first + i) dx, y, z), coordinates in lattice cells (first > 0: a
+// window of a longer row, to the last bit).
 // period: lattice cells per tile in each axis (>= 1).
-void value_noise_row(std::span<float> out, double x0, double dx, double y, double z, Vec3i period, uint32_t seed);
+void value_noise_row(std::span<float> out, double x0, double dx, double y, double z, Vec3i period, uint32_t seed, int64_t first = 0);
 
 // Single sample (for tests and sparse lookups).
 float value_noise(double x, double y, double z, Vec3i period, uint32_t seed);

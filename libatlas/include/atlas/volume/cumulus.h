@@ -85,6 +85,9 @@ struct CumulusChannels {
 // Detail type and density scale on the SDF's grid (one channel each, named
 // so), defined everywhere (also outside the cloud, so that filtering at the
 // edge reads the cloud's values). Throws atlas::Error on bad settings.
-CumulusChannels cumulus_channels(const Field3D& sdf, const CumulusPaintSpec& spec, const MemoryBudget* budget = nullptr);
+// `frame`: the SDF's place in the grid it is a window of (a tiled cook's
+// crop grown by one voxel); null: its own grid.
+CumulusChannels cumulus_channels(const Field3D& sdf, const CumulusPaintSpec& spec, const MemoryBudget* budget = nullptr,
+                                 const GridFrame* frame = nullptr);
 
 } // namespace atlas::volume

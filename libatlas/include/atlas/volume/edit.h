@@ -52,13 +52,19 @@ CompositeOp parse_composite_op(const std::string& name); // "max", "add", "over"
 // channel `cloud_channel`, scaled by `opacity`) into channel `world_channel`
 // of a copy of `world`. Where the grids align voxel for voxel the sample is
 // the cloud's voxel value exactly.
+//
+// `frame` (composite, the cutouts, erode_by_noise): where the first field
+// sits in the grid it is a window of (a tiled cook's crop, CookContext::frame);
+// null: its own grid. Positions come from the frame, so a window's values
+// are the whole grid's.
 Field3D composite(const Field3D& world, const Field3D& cloud, CompositeOp op, double opacity = 1, int world_channel = 0,
-                  int cloud_channel = 0, const MemoryBudget* budget = nullptr);
+                  int cloud_channel = 0, const MemoryBudget* budget = nullptr, const GridFrame* frame = nullptr);
 
 // Cutout of a density: d' = d * saturate(shape_distance(p) / edge) (edge in
 // metres; edge = 0: hard cut, d' = 0 where the voxel centre is inside the
 // shape). All channels are cut.
-Field3D cutout_density(const Field3D& density, const Shape& shape, double edge = 0, const MemoryBudget* budget = nullptr);
+Field3D cutout_density(const Field3D& density, const Shape& shape, double edge = 0, const MemoryBudget* budget = nullptr,
+                       const GridFrame* frame = nullptr);
 
 // CSG on a signed distance field: max(sdf, -shape) (subtract the shape).
 // Exact inside the result and on its boundary; outside it is a lower bound
@@ -69,7 +75,7 @@ Field3D subtract_shape_sdf(const Field3D& sdf, const Shape& shape, int channel =
 // trilinearly at the density's voxel centres (outside the cutter's grid the
 // cutter is treated as far outside): d' = d * saturate(cutter / edge).
 Field3D cutout_density_by_sdf(const Field3D& density, const Field3D& cutter_sdf, double edge = 0,
-                              const MemoryBudget* budget = nullptr);
+                              const MemoryBudget* budget = nullptr, const GridFrame* frame = nullptr);
 
 // Value erosion as in the Nubis sampler: with n the noise in [0, 1] at the
 // voxel (fractal value noise, `octaves` >= 1, lacunarity 2, gain 0.5,
@@ -84,7 +90,8 @@ struct ErosionOptions {
     uint32_t seed = 1;
     int channel = 0;
 };
-Field3D erode_by_noise(const Field3D& density, const ErosionOptions& options, const MemoryBudget* budget = nullptr);
+Field3D erode_by_noise(const Field3D& density, const ErosionOptions& options, const MemoryBudget* budget = nullptr,
+                       const GridFrame* frame = nullptr);
 
 // Separable Gaussian blur, sigma in voxels (>= 0; 0 = copy), radius
 // ceil(3 sigma), edges clamped. All channels.

@@ -42,7 +42,11 @@ struct SplatOptions {
 // Splats the points into a one-channel "density" field of `res` voxels over
 // `bounds`. Throws atlas::Error on a non-finite position (naming the point),
 // a radius <= 0 or non-finite, an attribute of the wrong length.
+//
+// `window` (a tiled cook's): only voxels [x0, x1) x [y0, y1) of the grid,
+// as a field over the window's bounds, each voxel what the whole grid's
+// holds (the same positions and the same points in the same order).
 Field3D splat_points(const Points& points, Vec3i res, Box3d bounds, const SplatOptions& options,
-                     const MemoryBudget* budget = nullptr);
+                     const MemoryBudget* budget = nullptr, const XYWindow* window = nullptr);
 
 } // namespace atlas::volume
