@@ -27,3 +27,10 @@ add_test(NAME shipped_tiles_towering_cumulus COMMAND bash ${CMAKE_CURRENT_SOURCE
          ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/towering_cumulus graphs/towering_cumulus.yaml
          --set "density.resolution=[96,96,72]")
 set_tests_properties(shipped_tiles_cloudscape shipped_tiles_towering_cumulus PROPERTIES LABELS graph TIMEOUT 600)
+# The 2D graphs at full size (a second each): map-wide nodes cooked whole and cropped, outputs on
+# grids of their own (LUTs, the baked volume, the cirrus textures, the ring table) written whole.
+foreach(name superstorm superstorm_lifecycle envelope_mountain hzd_weather fc6_forecast)
+  add_test(NAME shipped_tiles_${name} COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
+           ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/${name} graphs/${name}.yaml)
+  set_tests_properties(shipped_tiles_${name} PROPERTIES LABELS graph TIMEOUT 600 ENVIRONMENT "TILES=1,1 2,2 4,2")
+endforeach()

@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("bakes a small 2D map into profile columns (no per-tile rule declared yet)"));
     d.doc("Bakes an NDF set into the voxel world's dimensional profile (Nubis3 2.5D authoring data). vertical_profile: coverage * "
           "bottom(bottom_type, f) * top(top_type, f); envelope: coverage * f^2 * (1 - f)^1.5; f = (z - min_height) / (max_height - "
           "min_height), 0 outside [0, 1]. The set is sampled bilinearly (clamped) at voxel centres.");

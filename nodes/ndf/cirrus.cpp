@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a texture of its own (laid over the sky, not the map grid)"));
     d.doc(
         "Tileable cirrus texture for the sky hemisphere (FC6, HZD): channel cirrostratus (soft veil), cirrus (fibrous streaks), "
         "cirrocumulus (billowy puffs), opacities in [0, 1], from the noise library. Streaks run along an integer lattice "

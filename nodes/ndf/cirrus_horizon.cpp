@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a horizon strip of its own"));
     d.doc("Cirrus horizon strip (FC6: 2048x128, mapped as a cylinder around the camera): x is the azimuth and tiles, row 0 is the "
           "horizon; layered stretched cirrus, denser toward the horizon, fading to 0 at the top (1 - smoothstep(fade_start, 1, v)).");
     d.output("out", PortType::Field2D, "strip (1 channel: cirrus_horizon)");

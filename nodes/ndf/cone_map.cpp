@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("each texel's cone reads the whole height map"));
     d.doc("Conservative cone-step map of a height channel (box-column heightfield), by branch and bound over a max-mip pyramid "
           "(equal to brute force bit for bit). `robust` (default): channels apex_height (m) and cone_ratio, safe under bilinear "
           "filtering of both; otherwise 1 channel cone_ratio with the apex at the texel's own height (nearest sampling).");

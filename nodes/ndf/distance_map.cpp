@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("each voxel's distance reads the whole height map"));
     d.doc("Exact Euclidean distance (m) from every voxel centre to the nearest voxel at or below the height map (GPU Gems 2 ch. 8 "
           "distance-step data), by linear-time separable sweeps.");
     d.input("in", PortType::Field2D, "height map");

@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("each hour's map scrolls noise across the whole map"));
     d.doc("Far Cry 6 forecast cooked into a weather-map sequence: slice i is the map at hour start_hour + i * step_hours (regions "
           "blended at their borders, presets blended by smoothstep in time, noise scrolled with each region's wind, looping every "
           "period). `maps` is a 3D field with z = slice (write it as a DDS texture array: format dds, option array: true); "

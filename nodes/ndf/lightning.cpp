@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a schedule of the whole storm"));
     d.doc("The lightning an engine plays over a superstorm (000, \"Lightning Effects\"): strike sequences of intra-cloud flashes "
           "rising in intensity, then 1 to ground_max ground discharges, in columns drawn from the NDF set's storm "
           "(superstorm_coverage, else precipitation, else coverage). Lists the flashes starting in [time, time + window): key "

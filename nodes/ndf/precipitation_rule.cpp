@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a small 2D map (no per-tile rule declared yet)"));
     d.doc("Horizon Zero Dawn's rain rule on an NDF set: w = smoothstep(rain_start, rain_full, precipitation); type and top_type "
           "move to storm_type and coverage to at least min_coverage by w.");
     d.input("in", PortType::Field2D, "NDF set");

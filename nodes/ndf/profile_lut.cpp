@@ -9,6 +9,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a LUT of its own"));
     d.doc("Vertical-profile LUT: x = cloud type (0 stratus, 1/3 stratocumulus, 2/3 cumulus, 1 cumulonimbus), y = height fraction; "
           "channels bottom (rise), top (fall), density (HZD blend). End-aligned texels: sample at texel (0.5 + type (W-1), "
           "0.5 + f (H-1)). Reports metric max_error: the largest |LUT - analytic| under that bilinear lookup.");

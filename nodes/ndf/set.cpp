@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("assembles a small 2D map (no per-tile rule declared yet)"));
     d.doc("Assembles an NDF set: channels coverage, type, top_type, bottom_type, min_height, max_height (m), precipitation, "
           "superstorm_coverage. Each channel comes from its optional 1-channel input (all inputs share one resolution; the map "
           "takes the first connected input's grid) or else from its constant parameter; top_type and bottom_type default to the "

@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a map-wide stencil"));
     d.doc("Paints shapes over a zero map, each texel taking the max over shapes of value x weight (1 inside, a smoothstep "
           "falloff outside). Entries separated by ';': `ellipse CX CY RX RY VALUE FALLOFF`, `polygon VALUE FALLOFF X Y X Y X Y ...`, "
           "`stroke WIDTH VALUE FALLOFF X Y X Y ...` (metres).");

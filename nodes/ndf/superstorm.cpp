@@ -8,6 +8,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a map-wide stencil"));
     d.doc("HFW superstorm stencil: raises coverage, type, top type and bottom type toward the centre, writes superstorm_coverage and "
           "blends min/max height toward the storm's by distorted radial gradients. Unchanged beyond `radius`; blend 0 is a no-op. "
           "Chain several to composite stencils. With `stretch` > 1 the footprint is a plume reaching stretch x radius downwind "

@@ -8,6 +8,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("the anvil spreads across the whole map"));
     d.doc("Anvil-spread map of an HFW superstorm stencil (the NDF set has no anvil channel): channel anvil_bias = "
           "max(anvil_in, anvil x blend x g(r)) and anvil_lift = max(anvil_in's, anvil_lift x anvil x blend x g(r)) metres on the set's grid, g(r) = 1 - smoothstep(core x radius, radius, r) as in "
           "ndf/superstorm (give both the same center, radius, core, blend, stretch and wind_direction). The 2.5D preview spreads the storm's top with it "

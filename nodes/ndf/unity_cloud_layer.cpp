@@ -9,6 +9,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a lat-long texture of its own"));
     d.doc("Unity HDRP cloud layer map: an RGBA lat-long texture of opacities R cumulus = coverage x w, G stratus = coverage x (1 - w) "
           "(w = clamp(1.5 type, 0, 1)), B cirrus and A wispy from the optional maps (sampled at world XY by their own bounds, e.g. "
           "ndf/cirrus with the weather map's bounds). The set's XY map lies on a flat plane "

@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a LUT of its own"));
     d.doc("Unity HDRP volumetric clouds, manual mode cloud LUT, sampled by HDRP at UV (cloud type, normalised height in the "
           "layer), cell-centred: R density = the vertical profile's HZD type blend, G erosion = 1 - erosion_core x density (full "
           "erosion at the thin edges, less in the dense core), B ambient = 1 - ao_strength x (fraction of the column's cloud mass "

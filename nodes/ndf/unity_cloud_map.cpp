@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a small 2D map (no per-tile rule declared yet)"));
     d.doc("Unity HDRP volumetric clouds, manual mode cloud map: R coverage, G rain (precipitation), B cloud type, A maximum cloud "
           "height normalised in the layer, (max_height - layer_bottom) / (layer_top - layer_bottom) clamped to [0, 1]. Write it "
           "linear, uncompressed (PNG 8-bit or EXR); in Unity import it with sRGB off and compression none.");

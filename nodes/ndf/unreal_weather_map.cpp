@@ -7,6 +7,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a small 2D map (no per-tile rule declared yet)"));
     d.doc("Unreal Engine volumetric cloud weather map (Atlas layout; Unreal publishes none): R coverage, G cloud type (the profile "
           "LUT's x), B min_height and A max_height normalised in the layer, (h - layer_bottom) / (layer_top - layer_bottom) "
           "clamped to [0, 1]. Linear; import with sRGB off. docs/ndf.md gives the material's HLSL (Custom node).");

@@ -9,6 +9,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a map-wide stencil"));
     d.doc("N nested vortex rings around a superstorm centre (rotation speed falling outward, overlapping, skewed). `map`: channels "
           "ring_index (-1 outside) and ring_blend (weight of the next ring in the overlap band). `table`: the sidecar the renderer "
           "reads, N x 1 texels, channels inner, outer (m), speed (rad/s), skew (rad), overlap_end (m, outer + overlap x width), "

@@ -9,6 +9,7 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("its noise scrolls across the whole map"));
     d.doc("Far Cry 6 weather preset as a tiling weather map: channels coverage, precipitation, type, cirrus_coverage, from a presets "
           "YAML file (docs/ndf.md). Optionally blends toward a second preset; the noise scrolls with the wind for `hour` hours.");
     d.output("out", PortType::Field2D, "weather map (coverage, precipitation, type, cirrus_coverage)");

@@ -21,6 +21,7 @@ using namespace atlas;
 const std::vector<std::string> kSequenceGrids = {"density", "temperature", "vapor", "vel"};
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("the solver couples the whole domain (pressure, advection)"));
     d.doc("Grows clouds by simulating rising moist air (anelastic, MAC grid, MacCormack or semi-Lagrangian or limited cubic advection, optional Kessler warm rain, "
           "multigrid-preconditioned CG projection, saturation adjustment; see docs/solver.md). The grid has 'resolution' "
           "cubic cells of 'dx' metres with its minimum corner at 'origin'. Runs ceil(duration / frame_dt) steps of frame_dt, "

@@ -6,6 +6,7 @@ namespace {
 using namespace atlas;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("it resamples the whole cloud (turned, squashed, moved)"));
     d.doc("p' = pivot + translate + Rz Ry Rx (scale * squash * (p - pivot)); squash s scales z by s and x, y by 1/sqrt(s) "
           "(volume kept). Resampled trilinearly onto the input's grid (or a new one); empty beyond the source.");
     d.input("in", PortType::Field3D, "cloud");

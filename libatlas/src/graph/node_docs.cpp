@@ -38,6 +38,7 @@ std::string tiling_text(const NodeType& t) {
         if (!source) return "pointwise" + whole;
         return r.window_grid ? "generator, makes each tile's window" : "generator, cooked whole and cropped";
     case TileRule::Kind::Halo: return "halo from its parameters" + whole;
+    case TileRule::Kind::Whole: return "cooked whole once per process and cropped" + (r.why_not.empty() ? std::string() : ": " + r.why_not);
     case TileRule::Kind::None: break;
     }
     return "not tileable" + (r.why_not.empty() ? std::string() : ": " + r.why_not);

@@ -66,6 +66,7 @@ Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::s
         const GraphNode& n = **it;
         if (!tiled.count(n.name)) continue;
         const TileRule& rule = reg.find(n.type)->decl.tiling();
+        if (rule.kind == TileRule::Kind::Whole) continue; // the session cooks what it reads
         for (const auto& [port, b] : n.inputs) {
             if (rule.whole_inputs.count(port)) p.aside.insert({b.node, source_port(g, reg, b)});
             else tiled.insert(b.node);
@@ -75,7 +76,8 @@ Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::s
         if (!tiled.count(n->name)) continue;
         p.order.push_back(n);
         const TileRule& rule = reg.find(n->type)->decl.tiling();
-        if (std::all_of(n->inputs.begin(), n->inputs.end(), [&](const auto& in) { return rule.whole_inputs.count(in.first) > 0; }))
+        if (rule.kind == TileRule::Kind::Whole ||
+            std::all_of(n->inputs.begin(), n->inputs.end(), [&](const auto& in) { return rule.whole_inputs.count(in.first) > 0; }))
             p.sources.insert(n->name);
     }
     for (const GraphNode* n : p.order)
@@ -313,6 +315,9 @@ struct TiledCook {
     void write_index();
     void assemble();
 
+    using Staging = std::map<fs::path, std::unique_ptr<StagedOutputs>>;
+    StagedOutputs& staged_in(Staging& staging, const fs::path& out_root) const;
+    void commit_all(Staging& staging);
     std::string tile_key(Vec2i t) const;
     HeldValues cook_tile(const TileRect& tr, ThreadLimit& arena, uint64_t& value_peak);
     json write_tile(Vec2i t, const TileRect& tr, const HeldValues& held);
@@ -333,6 +338,8 @@ struct TiledCook {
     std::map<std::pair<int, int>, json> fragments; // per tile, cooked now or found current
     HeldValues sources; // generators cooked whole
     HeldValues aside;   // values passed whole to every tile (Plan::aside)
+    // The outputs on the tiled grid, and those written whole once (on another grid, or not fields).
+    std::vector<const GraphOutput*> tiled_outputs, whole_outputs;
     Grid grid;
 };
 
@@ -376,47 +383,71 @@ void TiledCook::select_tiles() {
 }
 
 // Generators: cooked whole (through the session's caches) and cropped per tile; they set the XY grid.
+// A source some tiled node reads sets it before one only outputs read: such an output on another
+// grid (a LUT, a baked volume of its own size, a table) is not tiled but written whole, once.
 void TiledCook::cook_sources() {
-    if (!to_cook.empty()) {
-        for (const GraphNode* n : plan.order) {
-            if (!plan.sources.count(n->name)) continue;
-            if (auto it = plan.windowed.find(n->name); it != plan.windowed.end()) {
-                const TileGrid& tg = it->second;
-                if (grid.from.empty()) {
-                    grid = {tg.res, tg.bounds.min, tg.bounds.max, n->name};
-                } else if (tg.res != grid.res || tg.bounds.min != grid.lo || tg.bounds.max != grid.hi) {
-                    throw Error(node_label(*n) + ": tiling needs one XY grid for the whole graph, but its " + xy_text(tg.res) +
-                                " grid over its bounds differs from the " + xy_text(grid.res) + " grid of node '" + grid.from + "'");
-                }
-                continue; // cooked per tile, on the tile's window
-            }
-            std::set<std::string> ports;
+    std::set<std::pair<std::string, std::string>> whole; // outputs written whole: node, port
+    if (to_cook.empty()) {
+        const json& f = fragments.begin()->second;
+        grid = grid_from_json(f.at("grid"));
+        for (const auto& w : f.value("whole_outputs", json::array())) whole.insert({w.at(0).get<std::string>(), w.at(1).get<std::string>()});
+    } else {
+        auto read_by_tiled_node = [&](const std::string& name) {
             for (const GraphNode* m : plan.order)
                 for (const auto& [port, b] : m->inputs)
-                    if (b.node == n->name && !reg.find(m->type)->decl.tiling().whole_inputs.count(port)) ports.insert(source_port(g, reg, b));
-            for (const GraphOutput* o : plan.outputs)
-                if (o->node == n->name) ports.insert(o->port);
-            for (const std::string& port : ports) {
-                Value v = session.get(n->name, port, opt);
-                if (!is_field(v))
-                    throw Error(node_label(*n) + ": output '" + port + "' is a " + std::string(port_type_name(value_type(v))) +
-                                ", which does not tile (only fields do)");
-                Vec2i res;
-                Vec2d lo, hi;
-                field_xy(v, res, lo, hi);
-                if (grid.from.empty()) {
-                    grid = {res, lo, hi, n->name};
-                } else if (res != grid.res || lo != grid.lo || hi != grid.hi) {
-                    throw Error(node_label(*n) + ": tiling needs one XY grid for the whole graph, but its " + xy_text(res) +
-                                " grid over its bounds differs from the " + xy_text(grid.res) + " grid of node '" + grid.from + "'");
-                }
-                sources[{n->name, port}] = {v, {0, 0, res[0], res[1]}, false};
+                    if (b.node == name && !reg.find(m->type)->decl.tiling().whole_inputs.count(port)) return true;
+            return false;
+        };
+        auto off_grid = [&](const GraphNode& n, Vec2i res, Vec2d lo, Vec2d hi, bool only_outputs) {
+            if (grid.from.empty()) {
+                grid = {res, lo, hi, n.name};
+                return false;
             }
-        }
+            if (res == grid.res && lo == grid.lo && hi == grid.hi) return false;
+            if (only_outputs) return true;
+            throw Error(node_label(n) + ": tiling needs one XY grid for the whole graph, but its " + xy_text(res) +
+                        " grid over its bounds differs from the " + xy_text(grid.res) + " grid of node '" + grid.from +
+                        "' (cook the outputs of each grid in tiles separately: --output NAME)");
+        };
+        for (const bool feeding : {true, false})
+            for (const GraphNode* n : plan.order) {
+                if (!plan.sources.count(n->name) || read_by_tiled_node(n->name) != feeding) continue;
+                if (auto it = plan.windowed.find(n->name); it != plan.windowed.end()) {
+                    const TileGrid& tg = it->second;
+                    off_grid(*n, tg.res, tg.bounds.min, tg.bounds.max, false);
+                    continue; // cooked per tile, on the tile's window
+                }
+                std::set<std::string> ports;
+                for (const GraphNode* m : plan.order)
+                    for (const auto& [port, b] : m->inputs)
+                        if (b.node == n->name && !reg.find(m->type)->decl.tiling().whole_inputs.count(port)) ports.insert(source_port(g, reg, b));
+                for (const GraphOutput* o : plan.outputs)
+                    if (o->node == n->name) ports.insert(o->port);
+                for (const std::string& port : ports) {
+                    Value v = session.get(n->name, port, opt);
+                    if (!is_field(v)) {
+                        if (!feeding) {
+                            whole.insert({n->name, port});
+                            continue;
+                        }
+                        throw Error(node_label(*n) + ": output '" + port + "' is a " + std::string(port_type_name(value_type(v))) +
+                                    ", which does not tile (only fields do)");
+                    }
+                    Vec2i res;
+                    Vec2d lo, hi;
+                    field_xy(v, res, lo, hi);
+                    if (off_grid(*n, res, lo, hi, !feeding)) {
+                        whole.insert({n->name, port});
+                        continue;
+                    }
+                    sources[{n->name, port}] = {v, {0, 0, res[0], res[1]}, false};
+                }
+            }
+        if (grid.from.empty()) throw Error("tiling: no output of the graph is a field on a grid to tile");
         for (const auto& [node, port] : plan.aside) aside[{node, port}] = {session.get(node, port, opt), {}, true};
-    } else {
-        grid = grid_from_json(fragments.begin()->second.at("grid"));
     }
+    for (const GraphOutput* o : plan.outputs) (whole.count({o->node, o->port}) ? whole_outputs : tiled_outputs).push_back(o);
+    if (tiled_outputs.empty()) throw Error("tiling: no output of the graph is on the tiled grid");
     result.grid = grid.res;
 }
 
@@ -437,7 +468,7 @@ void TiledCook::check_grid() {
         if (h < 0) throw Error(node_label(n) + ": internal: negative tiling halo");
         plan.halo[name] = h;
     }
-    for (const GraphOutput* o : plan.outputs)
+    for (const GraphOutput* o : tiled_outputs)
         if (o->format == "dds" && (tile_size[0] % 4 || tile_size[1] % 4))
             throw Error(o->where.str() + ": --tiles " + tile_name(tiles) + ": output '" + o->file +
                         "' is BC-compressed in 4x4 blocks, and tiles of " + xy_text(tile_size) + " texels are not block-aligned");
@@ -484,7 +515,7 @@ void TiledCook::cook_tiles() {
 HeldValues TiledCook::cook_tile(const TileRect& tr, ThreadLimit& arena, uint64_t& value_peak) {
     // Regions: outputs need the tile; a node needs its region grown by its halo from each input.
     std::map<std::string, TileRect> region;
-    for (const GraphOutput* o : plan.outputs) region[o->node] = unite(region[o->node], tr);
+    for (const GraphOutput* o : tiled_outputs) region[o->node] = unite(region[o->node], tr);
     for (auto it = plan.order.rbegin(); it != plan.order.rend(); ++it) {
         const GraphNode& n = **it;
         const TileRect need = grow(region[n.name], plan.halo.at(n.name), grid.res);
@@ -573,9 +604,10 @@ json TiledCook::write_tile(Vec2i t, const TileRect& tr, const HeldValues& held) 
     if (!g.file.empty()) st.protect({{g.file, "the graph file"}});
     json frag = {{"atlas_tile", kTileFormatVersion}, {"key", tile_key(t)}, {"tile", {t[0], t[1]}},
                  {"tiles", {tiles[0], tiles[1]}}, {"texels", {tr.x0, tr.y0, tr.x1, tr.y1}}, {"grid", grid_json(grid)},
-                 {"outputs", json::array()}};
+                 {"outputs", json::array()}, {"whole_outputs", json::array()}};
+    for (const GraphOutput* o : whole_outputs) frag["whole_outputs"].push_back({o->node, o->port});
     const Box2d tb = rect_bounds(grid, tr);
-    for (const GraphOutput* o : plan.outputs) {
+    for (const GraphOutput* o : tiled_outputs) {
         const Held& h = held.at({o->node, o->port});
         const Value v = crop(h.v, h.rect, tr, grid, budget);
         io::OutputMetrics metrics;
@@ -609,8 +641,8 @@ json TiledCook::write_tile(Vec2i t, const TileRect& tr, const HeldValues& held) 
 void TiledCook::write_index() {
     json index = {{"atlas_tile_index", kTileFormatVersion}, {"graph", topt.graph_name}, {"tiles", {tiles[0], tiles[1]}},
                   {"grid", grid_json(grid)}, {"outputs", json::array()}};
-    for (size_t k = 0; k < plan.outputs.size(); ++k) {
-        const GraphOutput* o = plan.outputs[k];
+    for (size_t k = 0; k < tiled_outputs.size(); ++k) {
+        const GraphOutput* o = tiled_outputs[k];
         json entry = {{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format}, {"options", o->options}, {"tiles", json::array()}};
         for (int j = 0; j < tiles[1]; ++j)
             for (int i = 0; i < tiles[0]; ++i) {
@@ -621,6 +653,22 @@ void TiledCook::write_index() {
             }
         index["outputs"].push_back(entry);
     }
+    // Outputs not on the tiled grid, written whole as an untiled cook writes them.
+    Staging staging;
+    for (const GraphOutput* o : whole_outputs) {
+        const Value v = session.get(o->node, o->port, opt);
+        const auto [out_root, rel] = detail::output_place(root, *o, opt.allow_outside_out);
+        StagedOutputs& st = staged_in(staging, out_root);
+        json files = json::array();
+        try {
+            for (const auto& f : io::write_value(v, st.stage(rel), o->format, o->options, nullptr)) files.push_back(file_entry(root, st.final_path(f), f));
+        } catch (const std::exception& e) {
+            throw Error(detail::output_error(*o, e.what()));
+        }
+        index["outputs"].push_back({{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format}, {"options", o->options},
+                                    {"whole", true}, {"files", files}});
+    }
+    commit_all(staging);
     const fs::path p = root / "tiles" / "index.json";
     const std::string text = index.dump(2) + "\n";
     write_file_atomic(p, [&](const fs::path& tmp) { write_file_checked(tmp, text.data(), text.size()); });
@@ -628,11 +676,27 @@ void TiledCook::write_index() {
     result.written.push_back(p);
 }
 
+// The staging of the folder an output lands in (an output may be placed outside --out).
+StagedOutputs& TiledCook::staged_in(Staging& staging, const fs::path& out_root) const {
+    auto& st = staging[out_root];
+    if (!st) {
+        st = std::make_unique<StagedOutputs>(out_root);
+        if (!g.file.empty()) st->protect({{g.file, "the graph file"}});
+    }
+    return *st;
+}
+
+void TiledCook::commit_all(Staging& staging) {
+    for (auto& [r, st] : staging) st->prepare(); // every root checked before any file moves
+    for (auto& [r, st] : staging)
+        for (const auto& p : st->commit()) result.written.push_back(p);
+}
+
 // The untiled outputs, from the tiles' exact values.
 void TiledCook::assemble() {
-    std::map<fs::path, std::unique_ptr<StagedOutputs>> staging;
-    for (size_t k = 0; k < plan.outputs.size(); ++k) {
-        const GraphOutput* o = plan.outputs[k];
+    Staging staging;
+    for (size_t k = 0; k < tiled_outputs.size(); ++k) {
+        const GraphOutput* o = tiled_outputs[k];
         if (opt.progress.on_progress) opt.progress.on_progress({"assembling " + o->file, 1.0, int(selection.size()), int(selection.size())});
         try {
             std::shared_ptr<Field2D> full2;
@@ -680,23 +744,17 @@ void TiledCook::assemble() {
                     }
                 }
             const auto [out_root, rel] = detail::output_place(root, *o, opt.allow_outside_out);
-            auto& st = staging[out_root];
-            if (!st) {
-                st = std::make_unique<StagedOutputs>(out_root);
-                if (!g.file.empty()) st->protect({{g.file, "the graph file"}});
-            }
+            StagedOutputs& st = staged_in(staging, out_root);
             const Value full = full2 ? Value(Field2DPtr(full2)) : Value(Field3DPtr(full3));
-            for (const auto& f : io::write_value(full, st->stage(rel), o->format, o->options, nullptr))
-                result.assembled.push_back(st->final_path(f));
+            for (const auto& f : io::write_value(full, st.stage(rel), o->format, o->options, nullptr))
+                result.assembled.push_back(st.final_path(f));
         } catch (const CancelledError&) {
             throw;
         } catch (const std::exception& e) {
             throw Error(o->where.str() + ": assembling output '" + o->file + "': " + e.what());
         }
     }
-    for (auto& [r, st] : staging) st->prepare(); // every root checked before any file moves
-    for (auto& [r, st] : staging)
-        for (const auto& p : st->commit()) result.written.push_back(p);
+    commit_all(staging);
 }
 
 } // namespace

@@ -75,11 +75,13 @@ struct TileWindow {
 };
 
 struct TileRule {
-    enum class Kind { None, Pointwise, Halo };
+    // Whole: the node needs its whole input (a distance map, a map-wide stencil): it and
+    // what feeds it are cooked whole once per process and cropped to each tile.
+    enum class Kind { None, Pointwise, Halo, Whole };
     Kind kind = Kind::None;
     std::function<int(const NodeParams&)> halo;           // Halo: texels/voxels in x and y
     std::function<std::string(const NodeParams&)> refuse; // optional: why these parameters cannot tile ("" = they can)
-    std::string why_not;                                  // None: why the node does not tile
+    std::string why_not;                                  // None: why the node does not tile; Whole: why it is cooked whole
     // Optional, for generators: the grid the node makes with these
     // parameters when its cook honours CookContext::window() for them
     // (nullopt: it is cooked whole and cropped). Only such generators keep a
@@ -131,6 +133,12 @@ struct TileRule {
     TileRule& whole_input(std::string port) {
         whole_inputs.insert(std::move(port));
         return *this;
+    }
+    static TileRule whole(std::string why) {
+        TileRule r;
+        r.kind = Kind::Whole;
+        r.why_not = std::move(why);
+        return r;
     }
     static TileRule none(std::string why) {
         TileRule r;
