@@ -2,7 +2,9 @@
 #include "cook_steps.h"
 #include "graph_walk.h"
 
+#include "atlas/core/hash.h"
 #include "atlas/core/parallel.h"
+#include "atlas/io/writers.h"
 #include "atlas/core/progress.h"
 
 #include <chrono>
@@ -73,6 +75,22 @@ OutputPlace output_place(const std::filesystem::path& out_dir, const GraphOutput
         p.rel = final_path.filename();
     }
     return p;
+}
+
+// Bump when the output records' meaning changes (every output is written again on
+// the next cook); one writer's byte changes bump that writer's version instead.
+constexpr int kOutputFormatVersion = 1;
+
+OutputSpec output_spec(const GraphOutput& o, const std::string& name, const Hash128& node_hash) {
+    // The format's own writer version (io::OutputFormat::version; the DDS encoder's
+    // compress::kEncoderVersion), so a changed writer rewrites its outputs by itself.
+    int writer_version = 0;
+    for (const io::OutputFormat& f : io::output_formats())
+        if (f.name == o.format) writer_version = f.version;
+    Hasher spec;
+    spec.add("atlas-output").add(int64_t(kOutputFormatVersion)).add(int64_t(writer_version)).add(o.port).add(o.format).add(name);
+    for (const auto& [k, v] : o.options) spec.add(k).add(v);
+    return {spec.finish().hex(), Hasher(spec).add(node_hash).finish()};
 }
 
 std::string output_error(const GraphOutput& o, const std::string& message) {

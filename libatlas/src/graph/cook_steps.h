@@ -7,6 +7,7 @@
 #include "atlas/graph/graph.h"
 #include "atlas/graph/node.h"
 #include "atlas/core/files.h"
+#include "atlas/core/hash.h"
 
 #include <filesystem>
 #include <map>
@@ -44,6 +45,16 @@ struct OutputPlace {
 };
 OutputPlace output_place(const std::filesystem::path& out_dir, const GraphOutput& o, bool allow_outside,
                          const std::vector<ProtectedFile>& protect = {});
+
+// Write: an output's spec (format and writer versions, port, format, its path `name` as
+// placed, options; hex) and its key (the spec and the source node's content hash), by
+// which the output records (output_records.h) know its files on disk. The tiled cook's
+// assembled outputs use the same key: their bytes are the untiled cook's.
+struct OutputSpec {
+    std::string spec;
+    Hash128 key;
+};
+OutputSpec output_spec(const GraphOutput& o, const std::string& name, const Hash128& node_hash);
 
 // Write: the message of an output that failed to write: its place in the graph file,
 // then the writer's message, naming the output once (writers usually name it already).

@@ -52,17 +52,6 @@ namespace {
     }
 }
 
-// Bump when the output records' meaning changes (every output is written again on
-// the next cook); one writer's byte changes bump that writer's version instead.
-constexpr int kOutputFormatVersion = 1;
-// The format's own writer version (io::OutputFormat::version; the DDS encoder's
-// compress::kEncoderVersion), so a changed writer rewrites its outputs by itself.
-int writer_version(const std::string& format) {
-    for (const io::OutputFormat& f : io::output_formats())
-        if (f.name == format) return f.version;
-    return 0;
-}
-
 // Formats whose encoded files the disk cache keeps (costly to encode).
 const std::set<std::string> kCachedOutputFormats = {"dds"};
 
@@ -475,11 +464,9 @@ void CookRun::plan_writes() {
                 throw Error(o->where.str() + ": " + e.what());
             }
             p.name = p.rel.generic_string();
-            Hasher spec;
-            spec.add("atlas-output").add(int64_t(kOutputFormatVersion)).add(int64_t(writer_version(o->format))).add(o->port).add(o->format).add(p.name);
-            for (const auto& [k, v] : o->options) spec.add(k).add(v);
-            p.spec = spec.finish().hex();
-            p.key = Hasher(spec).add(state_.at(o->node).hash).finish();
+            const detail::OutputSpec spec = detail::output_spec(*o, p.name, state_.at(o->node).hash);
+            p.spec = spec.spec;
+            p.key = spec.key;
             auto& rec = records_[p.root];
             if (!rec) {
                 remove_stale_staging(p.root); // what killed cooks left

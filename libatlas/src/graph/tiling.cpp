@@ -9,6 +9,7 @@
 #include "atlas/core/hash.h"
 #include "atlas/core/parallel.h"
 #include "atlas/io/writers.h"
+#include "output_records.h"
 #include "value_cache.h"
 
 #include <nlohmann/json.hpp>
@@ -316,6 +317,19 @@ struct TiledCook {
     void assemble();
 
     using Staging = std::map<fs::path, std::unique_ptr<StagedOutputs>>;
+    struct Untiled {
+        const GraphOutput* out = nullptr;
+        detail::OutputPlace place;
+        std::string name;
+        detail::OutputSpec spec;
+    };
+    Untiled untiled(const GraphOutput& o) const;
+    OutputRecords& records_in(const fs::path& out_root);
+    const OutputRecord* current(const Untiled& u);
+    void record(const Untiled& u, const std::vector<fs::path>& finals);
+    void save_records();
+    std::map<fs::path, std::unique_ptr<OutputRecords>> records; // per output root (output_records.h)
+    std::vector<std::pair<size_t, std::vector<fs::path>>> pending_whole;
     StagedOutputs& staged_in(Staging& staging, const fs::path& out_root) const;
     void commit_all(Staging& staging);
     std::string tile_key(Vec2i t) const;
@@ -653,27 +667,79 @@ void TiledCook::write_index() {
             }
         index["outputs"].push_back(entry);
     }
-    // Outputs not on the tiled grid, written whole as an untiled cook writes them.
+    // Outputs not on the tiled grid, written whole as an untiled cook writes them
+    // (unless their files from an earlier cook are current).
     Staging staging;
+    std::vector<std::pair<Untiled, std::vector<fs::path>>> written;
     for (const GraphOutput* o : whole_outputs) {
-        const Value v = session.get(o->node, o->port, opt);
-        const auto [out_root, rel] = detail::output_place(root, *o, opt.allow_outside_out);
-        StagedOutputs& st = staged_in(staging, out_root);
-        json files = json::array();
-        try {
-            for (const auto& f : io::write_value(v, st.stage(rel), o->format, o->options, nullptr)) files.push_back(file_entry(root, st.final_path(f), f));
-        } catch (const std::exception& e) {
-            throw Error(detail::output_error(*o, e.what()));
+        Untiled u = untiled(*o);
+        std::vector<fs::path> finals;
+        if (const OutputRecord* r = current(u)) {
+            for (const auto& f : r->files) finals.push_back(u.place.root / f.path);
+        } else {
+            const Value v = session.get(o->node, o->port, opt);
+            StagedOutputs& st = staged_in(staging, u.place.root);
+            try {
+                for (const auto& f : io::write_value(v, st.stage(u.place.rel), o->format, o->options, nullptr)) finals.push_back(st.final_path(f));
+            } catch (const std::exception& e) {
+                throw Error(detail::output_error(*o, e.what()));
+            }
+            written.push_back({u, finals});
         }
         index["outputs"].push_back({{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format}, {"options", o->options},
-                                    {"whole", true}, {"files", files}});
+                                    {"whole", true}, {"files", json::array()}});
+        pending_whole.push_back({index["outputs"].size() - 1, finals});
     }
     commit_all(staging);
+    for (auto& [u, finals] : written) record(u, finals);
+    for (const auto& [k, finals] : pending_whole)
+        for (const auto& f : finals) index["outputs"][k]["files"].push_back(file_entry(root, f, f));
+    pending_whole.clear();
+    save_records();
+    // The index: written when it changed (a second identical cook writes nothing).
     const fs::path p = root / "tiles" / "index.json";
     const std::string text = index.dump(2) + "\n";
-    write_file_atomic(p, [&](const fs::path& tmp) { write_file_checked(tmp, text.data(), text.size()); });
     result.index = p;
+    std::error_code ec;
+    if (fs::file_size(p, ec) == text.size() && !ec && read_file_bytes(p) == text) return;
+    write_file_atomic(p, [&](const fs::path& tmp) { write_file_checked(tmp, text.data(), text.size()); });
     result.written.push_back(p);
+}
+
+// An output this cook writes untiled (assembled, or whole): where it lands and its
+// key, as the untiled cook computes them, so either cook finds the other's files current.
+TiledCook::Untiled TiledCook::untiled(const GraphOutput& o) const {
+    Untiled u;
+    u.out = &o;
+    u.place = detail::output_place(root, o, opt.allow_outside_out);
+    u.name = u.place.rel.generic_string();
+    u.spec = detail::output_spec(o, u.name, hashes.at(o.node));
+    return u;
+}
+
+OutputRecords& TiledCook::records_in(const fs::path& out_root) {
+    auto& rec = records[out_root];
+    if (!rec) rec = std::make_unique<OutputRecords>(out_root);
+    return *rec;
+}
+
+const OutputRecord* TiledCook::current(const Untiled& u) {
+    if (!opt.reuse_outputs || opt.checked) return nullptr;
+    return records_in(u.place.root).current(u.name, u.spec.key.hex());
+}
+
+void TiledCook::record(const Untiled& u, const std::vector<fs::path>& finals) {
+    OutputRecord rec;
+    rec.key = u.spec.key.hex();
+    rec.spec = u.spec.spec;
+    for (const auto& f : finals)
+        rec.files.push_back({f.lexically_relative(u.place.root).generic_string(), uint64_t(fs::file_size(f)), file_mtime_ns(f), file_content_hash(f).hex()});
+    records_in(u.place.root).set(u.name, std::move(rec));
+}
+
+void TiledCook::save_records() {
+    for (auto& [r, rec] : records)
+        if (rec->changed()) rec->save();
 }
 
 // The staging of the folder an output lands in (an output may be placed outside --out).
@@ -695,8 +761,11 @@ void TiledCook::commit_all(Staging& staging) {
 // The untiled outputs, from the tiles' exact values.
 void TiledCook::assemble() {
     Staging staging;
+    std::vector<std::pair<Untiled, std::vector<fs::path>>> written;
     for (size_t k = 0; k < tiled_outputs.size(); ++k) {
         const GraphOutput* o = tiled_outputs[k];
+        const Untiled u = untiled(*o);
+        if (current(u)) continue; // its files from an earlier cook (tiled or not) hold these bytes
         if (opt.progress.on_progress) opt.progress.on_progress({"assembling " + o->file, 1.0, int(selection.size()), int(selection.size())});
         try {
             std::shared_ptr<Field2D> full2;
@@ -743,11 +812,12 @@ void TiledCook::assemble() {
                         throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' holds no field");
                     }
                 }
-            const auto [out_root, rel] = detail::output_place(root, *o, opt.allow_outside_out);
-            StagedOutputs& st = staged_in(staging, out_root);
+            StagedOutputs& st = staged_in(staging, u.place.root);
             const Value full = full2 ? Value(Field2DPtr(full2)) : Value(Field3DPtr(full3));
-            for (const auto& f : io::write_value(full, st.stage(rel), o->format, o->options, nullptr))
-                result.assembled.push_back(st.final_path(f));
+            std::vector<fs::path> finals;
+            for (const auto& f : io::write_value(full, st.stage(u.place.rel), o->format, o->options, nullptr)) finals.push_back(st.final_path(f));
+            result.assembled.insert(result.assembled.end(), finals.begin(), finals.end());
+            written.push_back({u, std::move(finals)});
         } catch (const CancelledError&) {
             throw;
         } catch (const std::exception& e) {
@@ -755,6 +825,8 @@ void TiledCook::assemble() {
         }
     }
     commit_all(staging);
+    for (auto& [u, finals] : written) record(u, finals);
+    save_records();
 }
 
 } // namespace
