@@ -319,6 +319,31 @@ TEST(Tiling, TilesCookedSeparatelyAreReusedAndAssembled) {
     for (const auto& f : files_under(single)) EXPECT_TRUE(bytes_of(single / f) == bytes_of(tiled / f)) << f;
 }
 
+// Two tiled cooks into one folder never mix (issue 46 item 5): another tiling is refused before
+// anything is written; a tile whose files another cook replaced is not assembled from.
+TEST(Tiling, AnotherTilingInTheSameFolderIsRefused) {
+    const fs::path out = scratch("two_runs");
+    Session a = load(kWorld);
+    TileOptions t;
+    t.tiles = {{2, 2}};
+    cook_tiled(a, options(out), t);
+    const auto before = files_under(out);
+    Session b = load(kWorld);
+    t.tiles = {{3, 2}};
+    try {
+        cook_tiled(b, options(out), t);
+        FAIL() << "a 3x2 cook into a folder of 2x2 tiles was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("holds the tiles of another tiled cook"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("--tiles 2,2"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(files_under(out), before);
+    // The same tiling into that folder is the cooperating case: accepted (and up to date).
+    Session c = load(kWorld);
+    t.tiles = {{2, 2}};
+    for (const auto& tr : cook_tiled(c, options(out), t).tiles_done) EXPECT_EQ(tr.status, "up to date");
+}
+
 // Every noise kernel fills each tile's window itself (2D and 3D, a
 // non-integer frequency and an offset, tiles of 10 texels): the assembled
 // bytes are the untiled cook's.

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdlib>
 #include <chrono>
 #include <functional>
 #include <set>
@@ -28,6 +29,24 @@ using json = nlohmann::json;
 namespace fs = std::filesystem;
 
 std::string tile_name(Vec2i t) { return std::to_string(t[0]) + "," + std::to_string(t[1]); }
+
+// What made a tile (issue 46 item 5): the build, and the CPU's vector paths as the kernels
+// choose them (ATLAS_SIMD forces the portable ones). Tiles of one world cooked on different
+// machines have the same bytes (tests/cli/portable_simd_test.sh); this says where each came from.
+json made_by() {
+    const char* forced = std::getenv("ATLAS_SIMD");
+    return {{"atlas", ATLAS_VERSION_STRING},
+#if defined(__clang__)
+            {"compiler", "clang " __clang_version__},
+#elif defined(__GNUC__)
+            {"compiler", "gcc " __VERSION__},
+#endif
+#if defined(__x86_64__)
+            {"cpu_avx2", bool(__builtin_cpu_supports("avx2"))},
+            {"cpu_avx512f", bool(__builtin_cpu_supports("avx512f"))},
+#endif
+            {"atlas_simd", forced ? forced : "auto"}};
+}
 
 using detail::source_port;
 using detail::topological_order;
@@ -380,7 +399,25 @@ std::string TiledCook::tile_key(Vec2i t) const {
 }
 
 // The tiles asked for; those on disk and current (e.g. cooked by other workers) are kept.
+// A folder holding another tiling's tiles is refused: their files share names (I_J) and
+// would mix.
 void TiledCook::select_tiles() {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(root / "tiles", ec)) {
+        const std::string name = e.path().filename().string();
+        if (e.path().extension() != ".json" || name == "index.json") continue;
+        try {
+            const json f = json::parse(read_file_bytes(e.path()));
+            const Vec2i other{{f.at("tiles").at(0).get<int>(), f.at("tiles").at(1).get<int>()}};
+            if (other != tiles)
+                throw Error("'" + (root / "tiles").string() + "' holds the tiles of another tiled cook (" + name + ": --tiles " + tile_name(other) +
+                            "); a cook with --tiles " + tile_name(tiles) + " would mix their files: use another --out, or remove that folder");
+        } catch (const Error&) {
+            throw;
+        } catch (const std::exception&) {
+            // Not a fragment (or a damaged one, cooked again): nothing to compare.
+        }
+    }
     if (topt.only) selection.push_back(*topt.only);
     else
         for (int j = 0; j < tiles[1]; ++j)
@@ -618,7 +655,7 @@ json TiledCook::write_tile(Vec2i t, const TileRect& tr, const HeldValues& held) 
     if (!g.file.empty()) st.protect({{g.file, "the graph file"}});
     json frag = {{"atlas_tile", kTileFormatVersion}, {"key", tile_key(t)}, {"tile", {t[0], t[1]}},
                  {"tiles", {tiles[0], tiles[1]}}, {"texels", {tr.x0, tr.y0, tr.x1, tr.y1}}, {"grid", grid_json(grid)},
-                 {"outputs", json::array()}, {"whole_outputs", json::array()}};
+                 {"outputs", json::array()}, {"whole_outputs", json::array()}, {"made_by", made_by()}};
     for (const GraphOutput* o : whole_outputs) frag["whole_outputs"].push_back({o->node, o->port});
     const Box2d tb = rect_bounds(grid, tr);
     for (const GraphOutput* o : tiled_outputs) {
@@ -653,6 +690,14 @@ json TiledCook::write_tile(Vec2i t, const TileRect& tr, const HeldValues& held) 
 
 // Every tile is present: the tile index.
 void TiledCook::write_index() {
+    // Every tile as this cook knows it is still what is on disk: another cook writing into
+    // the folder (another graph, or an edit of this one) would otherwise leave an index that
+    // mixes two runs' tiles.
+    for (int j = 0; j < tiles[1]; ++j)
+        for (int i = 0; i < tiles[0]; ++i)
+            if (!current_fragment(root, {{i, j}}, tile_key({{i, j}})))
+                throw Error("tile " + tile_name({{i, j}}) + " changed on disk after this cook wrote or checked it (another cook writes into '" +
+                            root.string() + "'?): no index written and nothing assembled; cook again, or give each run its own --out");
     json index = {{"atlas_tile_index", kTileFormatVersion}, {"graph", topt.graph_name}, {"tiles", {tiles[0], tiles[1]}},
                   {"grid", grid_json(grid)}, {"outputs", json::array()}};
     for (size_t k = 0; k < tiled_outputs.size(); ++k) {
@@ -663,7 +708,8 @@ void TiledCook::write_index() {
                 const json& f = fragments.at({i, j});
                 const json& fo = f.at("outputs").at(k);
                 entry["tiles"].push_back({{"tile", {i, j}}, {"texels", f.at("texels")}, {"bounds_min", fo.at("bounds_min")},
-                                          {"bounds_max", fo.at("bounds_max")}, {"files", fo.at("files")}, {"raw", fo.at("raw")}});
+                                          {"bounds_max", fo.at("bounds_max")}, {"files", fo.at("files")}, {"raw", fo.at("raw")},
+                                          {"made_by", f.value("made_by", json::object())}});
             }
         index["outputs"].push_back(entry);
     }
@@ -775,7 +821,11 @@ void TiledCook::assemble() {
                     const json& fo = fragments.at({i, j}).at("outputs").at(k);
                     const fs::path raw = root / fo.at("raw").at("path").get<std::string>();
                     std::string why;
-                    auto vals = disk_cache::deserialize(read_file_bytes(raw), &why);
+                    const std::string bytes = read_file_bytes(raw);
+                    if (ContentHasher().add(bytes.data(), bytes.size()).finish().hex() != fo.at("raw").at("hash").get<std::string>())
+                        throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() +
+                                    "' changed after the tile was cooked (another cook writes into this folder?)");
+                    auto vals = disk_cache::deserialize(bytes, &why);
                     if (!vals || !vals->count("value")) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' is unreadable (" + why + ")");
                     const Value& v = vals->at("value");
                     const TileRect r = tile_rect(grid.res, tiles, {{i, j}});
