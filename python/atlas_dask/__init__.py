@@ -46,11 +46,33 @@ def _pair(text: str, what: str, minimum: int) -> tuple[int, int]:
     return a, b
 
 
+def _dies_with_this_process():
+    """A preexec function: the child gets SIGKILL when the process that started it dies (Linux's
+    PR_SET_PDEATHSIG), so a worker killed mid-tile takes its atlas with it instead of leaving it
+    writing while the tile is retried elsewhere. Resolved before the fork: the child only calls."""
+    if not sys.platform.startswith("linux"):
+        return None
+    import ctypes
+    import signal
+
+    try:
+        prctl = ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):
+        return None
+    parent = os.getpid()
+
+    def preexec():
+        prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG
+        if os.getppid() != parent:  # the parent died before the line above
+            os._exit(1)
+    return preexec
+
+
 def _run_atlas(cmd: list[str]) -> tuple[int, str, str, float, int]:
     """Runs atlas; returns (exit code, stdout, stderr, seconds, peak RSS in bytes of that process)."""
     t0 = time.monotonic()
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
+        proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL, preexec_fn=_dies_with_this_process())
         _, status, usage = os.wait4(proc.pid, 0)
         proc.returncode = os.waitstatus_to_exitcode(status)
         out.seek(0)

@@ -130,17 +130,31 @@ if tile == '1,0' and not os.path.exists(os.path.join(marks, 'failed')):
     assert_same_files(single, out)
 
 
+def process_alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return not any(l.startswith("State:") and "Z" in l.split()[1] for l in f)
+    except FileNotFoundError:
+        return False
+
+
 def test_worker_killed_mid_tile(single, tmp_path):
-    # The first attempt at tile 0,1 kills the worker process that runs it.
+    # The first attempt at tile 0,1 kills the worker process that runs it, then goes on as a
+    # long tile would: the atlas child must die with its worker (issue 46 item 5), not keep
+    # writing while the tile is retried elsewhere.
     atlas = wrapper(tmp_path, """
 if tile == '0,1' and not os.path.exists(os.path.join(marks, 'killed')):
-    open(os.path.join(marks, 'killed'), 'w').close()
+    with open(os.path.join(marks, 'killed'), 'w') as f:
+        f.write(str(os.getpid()))
     os.kill(os.getppid(), signal.SIGKILL)
+    import time
+    time.sleep(60)
     sys.exit('worker killed')
 """)
     out = tmp_path / "out"
     atlas_dask.run(str(WORLD), (2, 2), "local", str(out), atlas=atlas, workers=2, retries=1)
-    assert (tmp_path / "marks" / "killed").exists()
+    child = int((tmp_path / "marks" / "killed").read_text())
+    assert not process_alive(child), f"the killed worker's atlas child {child} still runs"
     assert_same_files(single, out)
 
 
