@@ -57,6 +57,7 @@ const std::vector<Command>& commands() {
           {"--tiles", "NX,NY", "cook in NX x NY tiles of the XY grid: tile files and OUT/tiles/index.json (docs/scale.md)"},
           {"--tile", "I,J", "with --tiles: cook only tile I,J (0-based; for a cluster worker)"},
           {"--assemble", "", "with --tiles: also write the untiled outputs from the tiles (the bytes one cook writes)"},
+          {"--no-tile-values", "", "with --tiles: tiles keep only their files, not an exact copy of their values (nothing to --assemble from)"},
           {"--quiet", "", "no progress or summary on stderr (warnings still print)"}},
          run_cook},
         {"validate", "GRAPH [--set NODE.PARAM=VALUE]...", "parse and type-check a graph; cook nothing",

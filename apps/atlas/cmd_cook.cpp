@@ -110,6 +110,7 @@ int run_cook_tiled(const Args& a, CookOptions o) {
     t.tiles = parse_pair(a, "--tiles", 1);
     if (a.has("--tile")) t.only = parse_pair(a, "--tile", 0);
     t.assemble = a.has("--assemble");
+    t.exact_values = !a.has("--no-tile-values");
     if (t.only && t.assemble) throw UsageError{"--assemble needs every tile: it cannot be combined with --tile", "cook"};
     t.graph_name = a.positional[0];
     check_side_file(a, "--report", cook_files(a, {}));
@@ -342,7 +343,7 @@ int run_cook(const Args& a) {
         o.cache_max_bytes = parse_byte_size(a.get("--cache-max-size"));
     }
 
-    if (a.has("--tiles") || a.has("--tile") || a.has("--assemble")) {
+    if (a.has("--tiles") || a.has("--tile") || a.has("--assemble") || a.has("--no-tile-values")) {
         if (a.has("--frames")) throw UsageError{"--frames and --tiles: cook a sequence's frames one at a time", "cook"};
         return run_cook_tiled(a, o);
     }

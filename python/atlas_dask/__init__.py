@@ -205,6 +205,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--atlas", help="the atlas program on the workers (default $ATLAS_BIN or atlas on PATH)")
     p.add_argument("--retries", type=int, default=2, help="retries of a failed tile (default 2)")
     p.add_argument("--no-assemble", action="store_true", help="write the tile index only, not the untiled outputs")
+    p.add_argument("--no-tile-values", action="store_true",
+                   help="tiles keep only their files, not an exact copy of their values (implies --no-assemble)")
     p.add_argument("--set", action="append", default=[], metavar="NODE.PARAM=VALUE", help="parameter override; repeatable")
     p.add_argument("--memory-budget", help="per-tile memory budget (atlas cook --memory-budget)")
     p.add_argument("--jobs", help="threads per tile (atlas cook --jobs)")
@@ -217,8 +219,10 @@ def main(argv: list[str] | None = None) -> int:
         extra += ["--memory-budget", a.memory_budget]
     if a.jobs:
         extra += ["--jobs", a.jobs]
+    if a.no_tile_values:
+        extra += ["--no-tile-values"]
     try:
-        run(a.graph, a.tiles, a.scheduler, a.out, a.cache, a.atlas, a.workers, a.retries, not a.no_assemble,
+        run(a.graph, a.tiles, a.scheduler, a.out, a.cache, a.atlas, a.workers, a.retries, not (a.no_assemble or a.no_tile_values),
             tuple(extra), report=a.report)
     except TileError as e:
         print(f"atlas-dask: error: {e}", file=sys.stderr)

@@ -344,6 +344,31 @@ TEST(Tiling, AnotherTilingInTheSameFolderIsRefused) {
     for (const auto& tr : cook_tiled(c, options(out), t).tiles_done) EXPECT_EQ(tr.status, "up to date");
 }
 
+// Tiles without their exact values (issue 46 item 6): the same tile files, no .atlastile copies,
+// and assembling from them is refused up front.
+TEST(Tiling, TilesWithoutExactValuesWriteTheSameTileFiles) {
+    const fs::path with = scratch("with_values"), without = scratch("without_values");
+    TileOptions t;
+    t.tiles = {{3, 2}};
+    Session a = load(kWorld);
+    cook_tiled(a, options(with), t);
+    t.exact_values = false;
+    Session b = load(kWorld);
+    cook_tiled(b, options(without), t);
+    EXPECT_TRUE(fs::exists(with / "tiles/values"));
+    EXPECT_FALSE(fs::exists(without / "tiles/values"));
+    int compared = 0;
+    for (const auto& f : files_under(without)) {
+        if (f.extension() == ".json") continue; // fragments and the index name their files
+        EXPECT_TRUE(bytes_of(with / f) == bytes_of(without / f)) << f;
+        ++compared;
+    }
+    EXPECT_GT(compared, 20);
+    t.assemble = true;
+    Session c = load(kWorld);
+    EXPECT_THROW(cook_tiled(c, options(without), t), Error);
+}
+
 // Every noise kernel fills each tile's window itself (2D and 3D, a
 // non-integer frequency and an offset, tiles of 10 texels): the assembled
 // bytes are the untiled cook's.

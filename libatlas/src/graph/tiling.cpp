@@ -248,7 +248,7 @@ std::optional<json> current_fragment(const fs::path& root, Vec2i t, const std::s
         if (j.at("key").get<std::string>() != key) return std::nullopt;
         for (const auto& o : j.at("outputs")) {
             if (!files_current(root, o.at("files"))) return std::nullopt;
-            if (!files_current(root, json::array({o.at("raw")}))) return std::nullopt;
+            if (o.contains("raw") && !files_current(root, json::array({o.at("raw")}))) return std::nullopt;
         }
         return j;
     } catch (const std::exception&) {
@@ -303,7 +303,7 @@ TileReport tile_report(Vec2i t, TileRect texels, std::string status, double seco
     for (const auto& o : frag->at("outputs")) {
         for (const auto& f : o.at("files"))
             if (seen.insert(f.at("path").get<std::string>()).second) add(f);
-        if (seen.insert(o.at("raw").at("path").get<std::string>()).second) add(o.at("raw"));
+        if (o.contains("raw") && seen.insert(o.at("raw").at("path").get<std::string>()).second) add(o.at("raw"));
     }
     const fs::path fp = root / fragment_rel(t);
     std::error_code ec;
@@ -320,6 +320,8 @@ void check_tile_counts(const TileOptions& topt) {
         throw Error("--tile " + tile_name(*topt.only) + " is out of range: --tiles " + tile_name(tiles) + " has tiles 0.." +
                     std::to_string(tiles[0] - 1) + ", 0.." + std::to_string(tiles[1] - 1));
     if (topt.only && topt.assemble) throw Error("--assemble needs every tile: it cannot be combined with --tile");
+    if (topt.assemble && !topt.exact_values)
+        throw Error("--assemble reads each tile's exact values, which --no-tile-values leaves out: use one or the other");
 }
 
 // A tiled cook, step by step: select the tiles (those on disk and current are kept),
@@ -389,6 +391,7 @@ TiledCook::TiledCook(Session& s, const CookOptions& o, const TileOptions& to, Ti
 std::string TiledCook::tile_key(Vec2i t) const {
     Hasher h;
     h.add("atlas-tile").add(int64_t(kTileFormatVersion)).add(int64_t(tiles[0])).add(int64_t(tiles[1])).add(int64_t(t[0])).add(int64_t(t[1]));
+    if (!topt.exact_values) h.add("no exact values");
     for (const GraphOutput* o : plan.outputs) {
         h.add(hashes.at(o->node)).add(o->port).add(o->format).add(o->file).add(int64_t(io::output_formats().size()));
         for (const auto& f : io::output_formats())
@@ -670,16 +673,19 @@ json TiledCook::write_tile(Vec2i t, const TileRect& tr, const HeldValues& held) 
         }
         json files = json::array();
         for (const auto& s : staged) files.push_back(file_entry(root, st.final_path(s), s));
-        // The exact values, once per node port (several outputs may write one).
-        const fs::path raw_rel = fs::path("tiles") / "values" / (o->node + "." + o->port + "." + std::to_string(t[0]) + "_" + std::to_string(t[1]) + ".atlastile");
-        const fs::path raw = st.stage(raw_rel);
-        if (!fs::exists(raw)) {
-            const std::string bytes = disk_cache::serialize({{"value", v}});
-            write_file_checked(raw, bytes.data(), bytes.size());
+        json entry = {{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format},
+                      {"bounds_min", {tb.min[0], tb.min[1]}}, {"bounds_max", {tb.max[0], tb.max[1]}}, {"files", files}};
+        if (topt.exact_values) {
+            // The exact values, once per node port (several outputs may write one).
+            const fs::path raw_rel = fs::path("tiles") / "values" / (o->node + "." + o->port + "." + std::to_string(t[0]) + "_" + std::to_string(t[1]) + ".atlastile");
+            const fs::path raw = st.stage(raw_rel);
+            if (!fs::exists(raw)) {
+                const std::string bytes = disk_cache::serialize({{"value", v}});
+                write_file_checked(raw, bytes.data(), bytes.size());
+            }
+            entry["raw"] = file_entry(root, st.final_path(raw), raw);
         }
-        frag["outputs"].push_back({{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format},
-                                   {"bounds_min", {tb.min[0], tb.min[1]}}, {"bounds_max", {tb.max[0], tb.max[1]}},
-                                   {"files", files}, {"raw", file_entry(root, st.final_path(raw), raw)}});
+        frag["outputs"].push_back(std::move(entry));
     }
     const std::string text = frag.dump(2) + "\n";
     // The fragment is the tile's record: it lands after the files it names.
@@ -707,9 +713,10 @@ void TiledCook::write_index() {
             for (int i = 0; i < tiles[0]; ++i) {
                 const json& f = fragments.at({i, j});
                 const json& fo = f.at("outputs").at(k);
-                entry["tiles"].push_back({{"tile", {i, j}}, {"texels", f.at("texels")}, {"bounds_min", fo.at("bounds_min")},
-                                          {"bounds_max", fo.at("bounds_max")}, {"files", fo.at("files")}, {"raw", fo.at("raw")},
-                                          {"made_by", f.value("made_by", json::object())}});
+                json tile = {{"tile", {i, j}}, {"texels", f.at("texels")}, {"bounds_min", fo.at("bounds_min")},
+                             {"bounds_max", fo.at("bounds_max")}, {"files", fo.at("files")}, {"made_by", f.value("made_by", json::object())}};
+                if (fo.contains("raw")) tile["raw"] = fo.at("raw");
+                entry["tiles"].push_back(std::move(tile));
             }
         index["outputs"].push_back(entry);
     }

@@ -42,6 +42,9 @@ struct TileOptions {
     Vec2i tiles{{1, 1}};       // NX, NY
     std::optional<Vec2i> only; // cook this tile only (no index, no assembly)
     bool assemble = false;     // when every tile is present: write the untiled outputs
+    // Each tile also writes an exact copy of its values (.atlastile), which assembling reads.
+    // Without them the tiles are the product: far less to write for a world too big to assemble.
+    bool exact_values = true;
     std::string graph_name;    // recorded in the index
 };
 
