@@ -10,6 +10,7 @@ void declare(NodeDeclaration& d) {
           "surface, 1 at `depth` metres inside and deeper.");
     d.input("sdf", PortType::Field3D, "signed distance, metres, negative inside");
     d.output("out", PortType::Field3D, "channel 'dimensional_profile', 0..1");
+    d.tiling(TileRule::pointwise());
     d.param_float("depth", 64).range(1e-6, 1e9).with_unit("m").describe("depth inside the surface where the profile reaches 1");
     d.param_float("exponent", 1).range(1e-3, 1e3).describe("shape of the ramp (1 = linear)");
 }

@@ -10,6 +10,7 @@ void declare(NodeDeclaration& d) {
           "decodes as R/255*4352 - 256 m); decode: the inverse, 0..1 -> metres.");
     d.input("in", PortType::Field3D, "SDF in metres (encode) or encoded field data (decode)");
     d.output("out", PortType::Field3D, "channel 'field_data' (encode) or 'sdf' (decode)");
+    d.tiling(TileRule::pointwise());
     d.param_enum("mode", {"encode", "decode"}, "encode").describe("direction");
     d.param_float("range_min", -256).with_unit("m").describe("distance mapped to 0");
     d.param_float("range_max", 4096).with_unit("m").describe("distance mapped to 1");

@@ -2,6 +2,8 @@
 #include "atlas/volume/edit.h"
 #include "atlas/graph/node.h"
 
+#include <cmath>
+
 namespace {
 using namespace atlas;
 
@@ -10,6 +12,11 @@ void declare(NodeDeclaration& d) {
           "cube of (2 radius + 1)^3 voxels. All channels.");
     d.input("in", PortType::Field3D, "field");
     d.output("out", PortType::Field3D, "filtered field");
+    // Separable passes reach ceil(3 sigma) (smooth) or radius (dilate, erode) voxels each way; edges clamp
+    // at the grid's own faces only, which a crop grown by that halo shares.
+    d.tiling(TileRule::with_halo([](const NodeParams& p) {
+        return p.get_string("op") == "smooth" ? int(std::ceil(3 * p.get_float("sigma"))) : int(p.get_int("radius"));
+    }));
     d.param_enum("op", {"smooth", "dilate", "erode"}, "smooth").describe("filter");
     d.param_float("sigma", 1).range(0, 1000).with_unit("voxels").describe("Gaussian sigma (smooth)").follows_proxy(ProxyScale::CellLength);
     d.param_int("radius", 1).range(0, 1000).with_unit("voxels").describe("cube half size (dilate, erode)").follows_proxy(ProxyScale::CellLength);

@@ -344,6 +344,50 @@ TEST(Tiling, AnotherTilingInTheSameFolderIsRefused) {
     for (const auto& tr : cook_tiled(c, options(out), t).tiles_done) EXPECT_EQ(tr.status, "up to date");
 }
 
+// The voxel nodes a cloudscape uses, on uneven splits (issue 46 items 1 and 2): metaballs as a
+// windowed generator with its points passed whole, composite of a cloud on a grid of its own,
+// cutout, erosion and paint at the whole grid's positions, a filter's halo (smooth then dilate),
+// the anatomy paint's one-voxel halo and the pointwise NVDF nodes: every assembled byte is the
+// untiled cook's.
+TEST(Tiling, VoxelCloudscapeNodesTileByteIdentically) {
+    const std::string text = R"(atlas: 1
+nodes:
+  pts: { type: volume/billows, params: { spheres: "1000 1000 256 400; 2600 2000 220 500", levels: 1, children: 6, base_height: 100, seed: 2 } }
+  balls:
+    type: volume/metaballs
+    inputs: { points: pts }
+    params: { resolution: [48, 40, 8], bounds_max: [4800, 4000, 512], kernel: sphere, blend: max }
+  cloud: { type: volume/metaballs, params: { resolution: [20, 20, 10], bounds_min: [3000, 2500, 0], bounds_max: [4700, 3900, 512], spheres: "3800 3200 250 500" } }
+  world: { type: volume/world, params: { resolution: [48, 40, 8], bounds_max: [4800, 4000, 512] } }
+  with_balls: { type: volume/composite, inputs: { world: world, cloud: balls } }
+  with_cloud: { type: volume/composite, inputs: { world: with_balls, cloud: cloud }, params: { op: add } }
+  cut: { type: volume/cutout, inputs: { in: with_cloud }, params: { shape: capsule, a: [300, 300, 200], b: [4000, 3000, 300], radius: 150, edge: 60 } }
+  eroded: { type: volume/erode_noise, inputs: { in: cut }, params: { amount: 0.3, frequency: 0.003, octaves: 3 } }
+  soft: { type: volume/filter, inputs: { in: eroded }, params: { op: smooth, sigma: 1.3 } }
+  grown: { type: volume/filter, inputs: { in: soft }, params: { op: dilate, radius: 2 } }
+  sdf: { type: volume/sdf, inputs: { in: grown }, params: { iso: 0.3, max_distance: 400 } }
+  anatomy: { type: volume/cumulus_paint, inputs: { sdf: sdf }, params: { base_height: 100 } }
+  scale: { type: volume/paint, inputs: { like: sdf }, params: { name: density_scale, shape: sphere, a: [2400, 2000, 256], radius: 900, noise_amount: 0.2, noise_frequency: 0.002 } }
+  nvdf: { type: volume/nvdf, inputs: { sdf: sdf, detail_type: anatomy.detail_type, density_scale: scale } }
+outputs:
+  - { node: nvdf, port: vdb_set, file: set.exr }
+  - { node: nvdf, port: field_data, file: field.dds, options: { encoding: bc4, range: "0,1" } }
+)";
+    const fs::path single = scratch("voxel_single");
+    Session a = load_text(text, single);
+    a.cook(options(single));
+    for (const Vec2i tiles : {Vec2i{{3, 2}}, Vec2i{{4, 5}}}) {
+        const fs::path tiled = scratch("voxel_tiled_" + std::to_string(tiles[0]) + std::to_string(tiles[1]));
+        Session b = load_text(text, tiled);
+        TileOptions t;
+        t.tiles = tiles;
+        t.assemble = true;
+        cook_tiled(b, options(tiled), t);
+        for (const char* f : {"set.exr", "field.dds", "field.dds.json"})
+            EXPECT_TRUE(bytes_of(single / f) == bytes_of(tiled / f)) << f << " at " << tiles[0] << "x" << tiles[1];
+    }
+}
+
 // Tiles without their exact values (issue 46 item 6): the same tile files, no .atlastile copies,
 // and assembling from them is refused up front.
 TEST(Tiling, TilesWithoutExactValuesWriteTheSameTileFiles) {
