@@ -65,6 +65,8 @@ struct Plan {
     std::set<std::string> reads_window; // nodes that get their input window (CookContext::window())
     std::map<std::string, TileGrid> windowed; // generators that cook each tile's window themselves
     std::map<std::string, std::string> last_use; // node -> the last node (in order) that reads it
+    // node -> its ports that tiled nodes read through inputs that are not passed whole
+    std::map<std::string, std::set<std::string>> tiled_reads;
     std::set<std::string> output_nodes;
 };
 
@@ -100,8 +102,13 @@ Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::s
             std::all_of(n->inputs.begin(), n->inputs.end(), [&](const auto& in) { return rule.whole_inputs.count(in.first) > 0; }))
             p.sources.insert(n->name);
     }
-    for (const GraphNode* n : p.order)
-        for (const auto& [port, b] : n->inputs) p.last_use[b.node] = n->name;
+    for (const GraphNode* n : p.order) {
+        const TileRule& rule = reg.find(n->type)->decl.tiling();
+        for (const auto& [port, b] : n->inputs) {
+            p.last_use[b.node] = n->name;
+            if (!rule.whole_inputs.count(port)) p.tiled_reads[b.node].insert(source_port(g, reg, b));
+        }
+    }
     for (const GraphOutput* o : p.outputs) p.output_nodes.insert(o->node);
 
     for (const GraphOutput* o : p.outputs) {
@@ -454,12 +461,6 @@ void TiledCook::cook_sources() {
         grid = grid_from_json(f.at("grid"));
         for (const auto& w : f.value("whole_outputs", json::array())) whole.insert({w.at(0).get<std::string>(), w.at(1).get<std::string>()});
     } else {
-        auto read_by_tiled_node = [&](const std::string& name) {
-            for (const GraphNode* m : plan.order)
-                for (const auto& [port, b] : m->inputs)
-                    if (b.node == name && !reg.find(m->type)->decl.tiling().whole_inputs.count(port)) return true;
-            return false;
-        };
         auto off_grid = [&](const GraphNode& n, Vec2i res, Vec2d lo, Vec2d hi, bool only_outputs) {
             if (grid.from.empty()) {
                 grid = {res, lo, hi, n.name};
@@ -473,16 +474,14 @@ void TiledCook::cook_sources() {
         };
         for (const bool feeding : {true, false})
             for (const GraphNode* n : plan.order) {
-                if (!plan.sources.count(n->name) || read_by_tiled_node(n->name) != feeding) continue;
+                if (!plan.sources.count(n->name) || (plan.tiled_reads.count(n->name) > 0) != feeding) continue;
                 if (auto it = plan.windowed.find(n->name); it != plan.windowed.end()) {
                     const TileGrid& tg = it->second;
                     off_grid(*n, tg.res, tg.bounds.min, tg.bounds.max, false);
                     continue; // cooked per tile, on the tile's window
                 }
                 std::set<std::string> ports;
-                for (const GraphNode* m : plan.order)
-                    for (const auto& [port, b] : m->inputs)
-                        if (b.node == n->name && !reg.find(m->type)->decl.tiling().whole_inputs.count(port)) ports.insert(source_port(g, reg, b));
+                if (auto r = plan.tiled_reads.find(n->name); r != plan.tiled_reads.end()) ports = r->second;
                 for (const GraphOutput* o : plan.outputs)
                     if (o->node == n->name) ports.insert(o->port);
                 for (const std::string& port : ports) {
