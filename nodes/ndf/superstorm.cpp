@@ -20,9 +20,12 @@ void declare(NodeDeclaration& d) {
     // Every numeric option from the library's schema (one default, range, unit, doc); anvil
     // belongs to ndf/superstorm_anvil.
     declare_options(d, ndf::superstorm_options(), {"radius", "core", "coverage", "blend", "storm_type", "bottom_type", "min_height",
-                                                    "max_height", "distortion", "height_core", "edge_noise", "noise_scale", "stretch", "wind_direction"});
+                                                    "max_height", "distortion", "height_core", "edge_noise", "noise_scale", "stretch", "wind_direction", "top_core", "wall_noise", "base_relief"});
     d.param_enum("heights", {"radial", "sheet"}, "radial")
         .describe("radial: blend the map's heights toward the storm's (a tower); sheet: a flat-topped anvil sheet over the footprint");
+    d.param_bool("own_coverage", false)
+        .describe("where the storm's heights take a column, its coverage is the stencil's radial coverage (a tower wall the noise billows), "
+                  "not the map's raised one");
     d.param_int("seed", 0).range(0, 4294967295.0).describe("noise seed");
 }
 
@@ -30,8 +33,9 @@ void cook(CookContext& ctx) {
     ndf::SuperstormStencil s;
     s.center = ctx.get_float2("center");
     read_options(ctx, ndf::superstorm_options(), s, {"radius", "core", "coverage", "blend", "storm_type", "bottom_type", "min_height",
-                                                     "max_height", "distortion", "height_core", "edge_noise", "noise_scale", "stretch", "wind_direction"});
+                                                     "max_height", "distortion", "height_core", "edge_noise", "noise_scale", "stretch", "wind_direction", "top_core", "wall_noise", "base_relief"});
     s.sheet = ctx.get_string("heights") == "sheet";
+    s.own_coverage = ctx.get_bool("own_coverage");
     s.seed = uint32_t(ctx.get_int("seed"));
     if (s.min_height > s.max_height) ctx.fail("'min_height' must not be above 'max_height'");
     auto in = ctx.input_field2d("in");

@@ -166,6 +166,105 @@ TEST(Superstorm, HeightCoreWidensTheFlatBaseAndEdgeNoiseZeroIsRound) {
             }
 }
 
+TEST(Superstorm, TowerWallTopAndBaseOptions) {
+    // A tower chained after a sheet of coverage 1 (the shipped superstorm's order).
+    const Box2d box{{{0, 0}}, {{20000, 20000}}};
+    Field2D set = random_set({{201, 201}}, box);
+    SuperstormStencil sheet;
+    sheet.center = set.texel_center(100, 100);
+    sheet.radius = 9000;
+    sheet.core = 0.8;
+    sheet.distortion = 0;
+    sheet.sheet = true;
+    sheet.min_height = 8500;
+    sheet.max_height = 11000;
+    const Field2D under = apply_superstorm(set, sheet, nullptr);
+    SuperstormStencil s;
+    s.center = sheet.center;
+    s.radius = 6000;
+    s.core = 0.4;
+    s.height_core = 0.75;
+    s.min_height = 800;
+    s.max_height = 12300;
+    const Field2D plain = apply_superstorm(under, s, nullptr);
+    // Every new option at its default: the same bytes as before them.
+    s.top_core = -1, s.wall_noise = 0, s.base_relief = 0, s.own_coverage = false;
+    ASSERT_TRUE(apply_superstorm(under, s, nullptr) == plain);
+    s.top_core = s.height_core; // the same core for the top: the same bytes
+    EXPECT_TRUE(apply_superstorm(under, s, nullptr) == plain);
+    const Vec2d texel = set.voxel_size();
+    auto at = [&](const Field2D& f, int c, double r, double angle) {
+        const Vec2d p = s.center + Vec2d{{r * std::cos(angle), r * std::sin(angle)}};
+        return double(f.at(c, int(p[0] / texel[0]), int(p[1] / texel[1])));
+    };
+    // Without own coverage the tower's wall keeps the sheet's solid coverage; with it, the tower's own.
+    const double wall = 0.7 * s.radius;
+    EXPECT_GT(at(plain, Coverage, wall, 0.3), 0.99);
+    s.top_core = -1;
+    s.own_coverage = true;
+    const Field2D own = apply_superstorm(under, s, nullptr);
+    EXPECT_LT(at(own, Coverage, wall, 0.3), 0.9);
+    EXPECT_EQ(at(own, Coverage, 0, 0), 1.0); // the core is still full
+    for (int y = 0; y < 201; ++y)
+        for (int x = 0; x < 201; ++x)
+            if (length(set.texel_center(x, y) - s.center) >= s.radius) {
+                ASSERT_EQ(own.at(Coverage, x, y), under.at(Coverage, x, y)); // unchanged beyond the radius
+            }
+    // top_core: a dome, the top lower half-way out than with the flat top, the same at the centre.
+    s.own_coverage = false;
+    s.top_core = 0.2;
+    const Field2D dome = apply_superstorm(under, s, nullptr);
+    EXPECT_EQ(at(dome, MaxHeight, 0, 0), 12300.0);
+    EXPECT_LT(at(dome, MaxHeight, 0.6 * s.radius, 1.0), at(plain, MaxHeight, 0.6 * s.radius, 1.0) - 100);
+    EXPECT_EQ(at(dome, MinHeight, 0.6 * s.radius, 1.0), at(plain, MinHeight, 0.6 * s.radius, 1.0)); // the base keeps height_core
+    // wall_noise: where the base leaves 800 m, swept round the tower, varies with the direction.
+    auto edge_spread = [&](const Field2D& f) {
+        std::vector<double> edge;
+        for (int a = 0; a < 64; ++a) {
+            const double t = 6.283185307179586 * a / 64;
+            double r = 0;
+            while (r < s.radius && at(f, MinHeight, r, t) < 4000) r += texel[0] * 0.5;
+            edge.push_back(r);
+        }
+        double mean = 0, var = 0;
+        for (double e : edge) mean += e / double(edge.size());
+        for (double e : edge) var += (e - mean) * (e - mean) / double(edge.size());
+        return std::sqrt(var);
+    };
+    s.top_core = -1;
+    s.distortion = 0;
+    s.edge_noise = 0;
+    const Field2D round = apply_superstorm(under, s, nullptr);
+    s.wall_noise = 0.8;
+    const Field2D lumpy = apply_superstorm(under, s, nullptr);
+    EXPECT_LT(edge_spread(round), texel[0]);
+    EXPECT_GT(edge_spread(lumpy), 2 * texel[0]);
+    // base_relief: the base rises in patches by at most the relief, never above the top.
+    s.wall_noise = 0;
+    s.base_relief = 600;
+    const Field2D relief = apply_superstorm(under, s, nullptr);
+    double lo = 1e9, hi = -1e9;
+    for (int a = 0; a < 360; ++a)
+        for (double r = 0; r < 0.7 * s.radius; r += 200) {
+            const double b = at(relief, MinHeight, r, a * 0.0174533);
+            lo = std::min(lo, b), hi = std::max(hi, b);
+        }
+    EXPECT_EQ(lo, 800.0);
+    EXPECT_GT(hi, 800.0 + 300);
+    EXPECT_LE(hi, 800.0 + 600 + 1e-3);
+    // Out of range: refused by name.
+    s.wall_noise = 1.0;
+    try {
+        validate(s);
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("wall_noise"), std::string::npos) << e.what();
+    }
+    s.wall_noise = 0;
+    s.base_relief = -1;
+    EXPECT_THROW(validate(s), Error);
+}
+
 TEST(Superstorm, BadInput) {
     const Box2d box{{{0, 0}}, {{1000, 1000}}};
     Field2D set = make_ndf_set({{8, 8}}, box, 0, 1, nullptr);

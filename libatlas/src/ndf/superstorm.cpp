@@ -6,6 +6,7 @@
 #include "atlas/noise/value_noise.h"
 #include "atlas/core/parallel.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -32,6 +33,9 @@ std::span<const NumberOption<SuperstormStencil>> superstorm_options() {
         {"edge_noise", &S::edge_noise, 0, 0.999, "", "wobble of the footprint's edge (coverage and types); 0 = round"},
         {"stretch", &S::stretch, 1, 100, "", "downwind radius over radius: 1 a disc, > 1 a plume spreading downwind"},
         {"wind_direction", &S::wind_direction, -360, 360, "deg", "direction the plume spreads toward (0: +x, 90: +y)"},
+        {"top_core", &S::top_core, -1, 0.999, "", "fraction of the radius where the top is max_height (a dome narrower than the base); -1 = height_core"},
+        {"wall_noise", &S::wall_noise, 0, 0.999, "", "lumpy wall: fine wobble of the heights' radius, a fraction of the height band; 0 = smooth"},
+        {"base_relief", &S::base_relief, 0, 20000, "m", "the base rises by up to this much in noise patches (underside definition); 0 = flat"},
     };
     return options;
 }
@@ -94,7 +98,20 @@ Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const M
             const double g = 1.0 - smoothstep(s.core * s.radius, s.radius, rc);
             const double w = s.blend * g;
             const double hc = s.height_core >= 0 ? s.height_core : s.core;
-            const double wh = s.blend * (1.0 - smoothstep(hc * s.radius, s.radius, rd));
+            double rw = rd;
+            if (s.wall_noise > 0) {
+                // Billowed wall: finer octaves that do not vanish in the band, only in its outer quarter.
+                double f = 0, amp = 0.5;
+                for (int o = 1; o <= 3; ++o, amp *= 0.5) {
+                    const double ko = k * double(1 << o);
+                    f += amp * (2.0 * noise::value_noise(d[0] * ko + 1024.0 * o, d[1] * ko + 2048.0 * o, 0.0, period, s.seed + 7 + uint32_t(o)) - 1.0);
+                }
+                const double band = (1.0 - hc) * s.radius;
+                rw = rd + s.wall_noise * band * (f / 0.875) * std::min(1.0, 4.0 * (1.0 - r / s.radius));
+            }
+            const double wh = s.blend * (1.0 - smoothstep(hc * s.radius, s.radius, rw));
+            const double tc = s.top_core >= 0 ? s.top_core : hc;
+            const double wt = tc == hc ? wh : s.blend * (1.0 - smoothstep(tc * s.radius, s.radius, rw));
             if (s.sheet) {
                 // The anvil sheet: flat top, underside rising to the ragged rim.
                 if (!(wh > 0)) continue;
@@ -109,12 +126,19 @@ Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const M
             }
             const double cov = set.channel(Coverage)[i];
             mix(Coverage, std::max(cov, s.coverage), w);
+            if (s.own_coverage) out.channel(Coverage)[i] = float(lerp(double(out.channel(Coverage)[i]), s.coverage * g, wh));
             mix(Type, s.storm_type, w);
             mix(TopType, s.storm_type, w);
             mix(BottomType, std::max(double(set.channel(BottomType)[i]), s.bottom_type), w);
             out.channel(SuperstormCoverage)[i] = float(std::max(double(set.channel(SuperstormCoverage)[i]), w));
-            mix(MinHeight, s.min_height, wh);
-            mix(MaxHeight, s.max_height, wh);
+            double base = s.min_height;
+            if (s.base_relief > 0) {
+                const double n1 = noise::value_noise(d[0] * 2 * k + 512.0, d[1] * 2 * k + 512.0, 0.0, period, s.seed + 11);
+                const double n2 = noise::value_noise(d[0] * 4 * k + 640.0, d[1] * 4 * k + 640.0, 0.0, period, s.seed + 12);
+                base = std::min(s.max_height, base + s.base_relief * std::clamp(1.6 * (0.65 * n1 + 0.35 * n2) - 0.6, 0.0, 1.0));
+            }
+            mix(MinHeight, base, wh);
+            mix(MaxHeight, s.max_height, wt);
         }
     });
     return out;

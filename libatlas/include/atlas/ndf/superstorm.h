@@ -73,6 +73,27 @@ struct SuperstormStencil {
     // Plume: downwind radius = stretch * radius (>= 1; 1 = disc).
     double stretch = 1.0;
     double wind_direction = 0; // degrees from +x toward +y
+    // Fraction of the radius inside which the top is the storm's max_height
+    // (the top's own height core: a dome over the updraft narrower than the
+    // flat base); < 0 = height_core.
+    double top_core = -1;
+    // Billowed wall ([0, 1)): a three-octave value-noise wobble of the
+    // heights' radius at 2, 4 and 8 times noise_scale, as a fraction of the
+    // height band's width (radius - height core), so the wall between the
+    // storm's columns and the map's is lumpy at every scale instead of a smooth
+    // cylinder. It fades out over the outer quarter of the band. 0 = none.
+    double wall_noise = 0;
+    // Base relief (metres, >= 0): the storm's base rises by up to this much
+    // following a two-octave noise at 2 and 4 times noise_scale, so the
+    // underside has the "definition" of 000's height adjustment (lowered and
+    // raised patches). 0 = a flat base.
+    double base_relief = 0;
+    // Own coverage: where the stencil's heights take a column (the height
+    // blend w_h), its coverage is the stencil's own radial coverage
+    // (coverage * g(r_c)), not the map's raised one: a tower chained after an
+    // anvil sheet gets a wall the noise can billow instead of the sheet's
+    // solid coverage. false = raise only (never lowers the map's).
+    bool own_coverage = false;
     // Sheet heights (an anvil) instead of the radial height blend.
     bool sheet = false;
 };
