@@ -20,7 +20,7 @@ void declare(NodeDeclaration& d) {
     // Every numeric option from the library's schema (one default, range, unit, doc); anvil
     // belongs to ndf/superstorm_anvil.
     declare_options(d, ndf::superstorm_options(), {"radius", "core", "coverage", "blend", "storm_type", "bottom_type", "min_height",
-                                                    "max_height", "distortion", "height_core", "edge_noise", "noise_scale", "stretch", "wind_direction", "top_core", "wall_noise", "base_relief"});
+                                                    "max_height", "distortion", "height_core", "edge_noise", "noise_scale", "stretch", "wind_direction", "wall_noise", "base_relief"});
     d.param_enum("heights", {"radial", "sheet"}, "radial")
         .describe("radial: blend the map's heights toward the storm's (a tower); sheet: a flat-topped anvil sheet over the footprint");
     d.param_bool("own_coverage", false)
@@ -33,7 +33,7 @@ void cook(CookContext& ctx) {
     ndf::SuperstormStencil s;
     s.center = ctx.get_float2("center");
     read_options(ctx, ndf::superstorm_options(), s, {"radius", "core", "coverage", "blend", "storm_type", "bottom_type", "min_height",
-                                                     "max_height", "distortion", "height_core", "edge_noise", "noise_scale", "stretch", "wind_direction", "top_core", "wall_noise", "base_relief"});
+                                                     "max_height", "distortion", "height_core", "edge_noise", "noise_scale", "stretch", "wind_direction", "wall_noise", "base_relief"});
     s.sheet = ctx.get_string("heights") == "sheet";
     s.own_coverage = ctx.get_bool("own_coverage");
     s.seed = uint32_t(ctx.get_int("seed"));
@@ -46,5 +46,5 @@ void cook(CookContext& ctx) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "ndf/superstorm", .version = 1, .declare = declare, .cook = cook});
+    registry.add({.name = "ndf/superstorm", .version = 2, .declare = declare, .cook = cook});
 }

@@ -188,10 +188,8 @@ TEST(Superstorm, TowerWallTopAndBaseOptions) {
     s.max_height = 12300;
     const Field2D plain = apply_superstorm(under, s, nullptr);
     // Every new option at its default: the same bytes as before them.
-    s.top_core = -1, s.wall_noise = 0, s.base_relief = 0, s.own_coverage = false;
+    s.wall_noise = 0, s.base_relief = 0, s.own_coverage = false;
     ASSERT_TRUE(apply_superstorm(under, s, nullptr) == plain);
-    s.top_core = s.height_core; // the same core for the top: the same bytes
-    EXPECT_TRUE(apply_superstorm(under, s, nullptr) == plain);
     const Vec2d texel = set.voxel_size();
     auto at = [&](const Field2D& f, int c, double r, double angle) {
         const Vec2d p = s.center + Vec2d{{r * std::cos(angle), r * std::sin(angle)}};
@@ -200,7 +198,6 @@ TEST(Superstorm, TowerWallTopAndBaseOptions) {
     // Without own coverage the tower's wall keeps the sheet's solid coverage; with it, the tower's own.
     const double wall = 0.7 * s.radius;
     EXPECT_GT(at(plain, Coverage, wall, 0.3), 0.99);
-    s.top_core = -1;
     s.own_coverage = true;
     const Field2D own = apply_superstorm(under, s, nullptr);
     EXPECT_LT(at(own, Coverage, wall, 0.3), 0.9);
@@ -210,13 +207,6 @@ TEST(Superstorm, TowerWallTopAndBaseOptions) {
             if (length(set.texel_center(x, y) - s.center) >= s.radius) {
                 ASSERT_EQ(own.at(Coverage, x, y), under.at(Coverage, x, y)); // unchanged beyond the radius
             }
-    // top_core: a dome, the top lower half-way out than with the flat top, the same at the centre.
-    s.own_coverage = false;
-    s.top_core = 0.2;
-    const Field2D dome = apply_superstorm(under, s, nullptr);
-    EXPECT_EQ(at(dome, MaxHeight, 0, 0), 12300.0);
-    EXPECT_LT(at(dome, MaxHeight, 0.6 * s.radius, 1.0), at(plain, MaxHeight, 0.6 * s.radius, 1.0) - 100);
-    EXPECT_EQ(at(dome, MinHeight, 0.6 * s.radius, 1.0), at(plain, MinHeight, 0.6 * s.radius, 1.0)); // the base keeps height_core
     // wall_noise: where the base leaves 800 m, swept round the tower, varies with the direction.
     auto edge_spread = [&](const Field2D& f) {
         std::vector<double> edge;
@@ -231,7 +221,7 @@ TEST(Superstorm, TowerWallTopAndBaseOptions) {
         for (double e : edge) var += (e - mean) * (e - mean) / double(edge.size());
         return std::sqrt(var);
     };
-    s.top_core = -1;
+    s.own_coverage = false;
     s.distortion = 0;
     s.edge_noise = 0;
     const Field2D round = apply_superstorm(under, s, nullptr);

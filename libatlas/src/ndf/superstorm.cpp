@@ -33,7 +33,6 @@ std::span<const NumberOption<SuperstormStencil>> superstorm_options() {
         {"edge_noise", &S::edge_noise, 0, 0.999, "", "wobble of the footprint's edge (coverage and types); 0 = round"},
         {"stretch", &S::stretch, 1, 100, "", "downwind radius over radius: 1 a disc, > 1 a plume spreading downwind"},
         {"wind_direction", &S::wind_direction, -360, 360, "deg", "direction the plume spreads toward (0: +x, 90: +y)"},
-        {"top_core", &S::top_core, -1, 0.999, "", "fraction of the radius where the top is max_height (a dome narrower than the base); -1 = height_core"},
         {"wall_noise", &S::wall_noise, 0, 0.999, "", "lumpy wall: fine wobble of the heights' radius, a fraction of the height band; 0 = smooth"},
         {"base_relief", &S::base_relief, 0, 20000, "m", "the base rises by up to this much in noise patches (underside definition); 0 = flat"},
     };
@@ -109,9 +108,10 @@ Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const M
                 const double band = (1.0 - hc) * s.radius;
                 rw = rd + s.wall_noise * band * (f / 0.875) * std::min(1.0, 4.0 * (1.0 - r / s.radius));
             }
-            const double wh = s.blend * (1.0 - smoothstep(hc * s.radius, s.radius, rw));
-            const double tc = s.top_core >= 0 ? s.top_core : hc;
-            const double wt = tc == hc ? wh : s.blend * (1.0 - smoothstep(tc * s.radius, s.radius, rw));
+            // With its own coverage a column is the storm's only as far as the storm covers it:
+            // tall columns of thin coverage render as walls a few metres thick, a shape no cloud has.
+            const double take = s.own_coverage ? std::min(1.0, s.coverage * g / 0.25) : 1.0;
+            const double wh = take * s.blend * (1.0 - smoothstep(hc * s.radius, s.radius, rw));
             if (s.sheet) {
                 // The anvil sheet: flat top, underside rising to the ragged rim.
                 if (!(wh > 0)) continue;
@@ -138,7 +138,7 @@ Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const M
                 base = std::min(s.max_height, base + s.base_relief * std::clamp(1.6 * (0.65 * n1 + 0.35 * n2) - 0.6, 0.0, 1.0));
             }
             mix(MinHeight, base, wh);
-            mix(MaxHeight, s.max_height, wt);
+            mix(MaxHeight, s.max_height, wh);
         }
     });
     return out;

@@ -73,10 +73,6 @@ struct SuperstormStencil {
     // Plume: downwind radius = stretch * radius (>= 1; 1 = disc).
     double stretch = 1.0;
     double wind_direction = 0; // degrees from +x toward +y
-    // Fraction of the radius inside which the top is the storm's max_height
-    // (the top's own height core: a dome over the updraft narrower than the
-    // flat base); < 0 = height_core.
-    double top_core = -1;
     // Billowed wall ([0, 1)): a three-octave value-noise wobble of the
     // heights' radius at 2, 4 and 8 times noise_scale, as a fraction of the
     // height band's width (radius - height core), so the wall between the
