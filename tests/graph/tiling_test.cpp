@@ -5,6 +5,7 @@
 // partial output left.
 #include "atlas/graph/tiling.h"
 
+#include "atlas/io/dds_file.h"
 #include "atlas/io/readers.h"
 #include "atlas/ndf/operators.h"
 
@@ -394,10 +395,32 @@ TEST(Tiling, TilesWithoutExactValuesWriteTheSameTileFiles) {
     const fs::path with = scratch("with_values"), without = scratch("without_values");
     TileOptions t;
     t.tiles = {{3, 2}};
-    Session a = load(kWorld);
+    // The world's DDS outputs map by their own range: without exact values their tiles could
+    // not be given the world's, so that is refused, naming the output, before any tile cooks.
+    t.exact_values = false;
+    {
+        Session s = load(kWorld);
+        try {
+            cook_tiled(s, options(without), t);
+            ADD_FAILURE() << "a DDS without 'range' tiled without exact values was accepted";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("cover_bc4.dds"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("'range"), std::string::npos) << e.what();
+        }
+        EXPECT_FALSE(fs::exists(without / "tiles"));
+    }
+    // With a stated range they tile.
+    std::string text = read_file_bytes(kWorld);
+    for (const char* enc : {"encoding: bc4 }", "encoding: bc1 }"}) {
+        const size_t at = text.find(enc);
+        ASSERT_NE(at, std::string::npos) << enc;
+        text.insert(at + std::string(enc).size() - 2, ", range: '0,1'");
+    }
+    t.exact_values = true;
+    Session a = load_text(text, with);
     cook_tiled(a, options(with), t);
     t.exact_values = false;
-    Session b = load(kWorld);
+    Session b = load_text(text, without);
     cook_tiled(b, options(without), t);
     EXPECT_TRUE(fs::exists(with / "tiles/values"));
     EXPECT_FALSE(fs::exists(without / "tiles/values"));
@@ -409,8 +432,61 @@ TEST(Tiling, TilesWithoutExactValuesWriteTheSameTileFiles) {
     }
     EXPECT_GT(compared, 20);
     t.assemble = true;
-    Session c = load(kWorld);
+    Session c = load_text(text, without);
     EXPECT_THROW(cook_tiled(c, options(without), t), Error);
+}
+
+// A DDS without 'range' maps its values by their own min and max. Each tile's texture
+// quantises as the whole world's does (its blocks are the untiled texture's blocks, byte for
+// byte), the index states the world's range, and a second cook rewrites nothing.
+TEST(Tiling, TileTexturesQuantiseAsTheWorldDoes) {
+    const fs::path single = scratch("single"), tiled = scratch("tiled");
+    Session a = load(kWorld);
+    a.cook(options(single));
+    TileOptions t;
+    t.tiles = {{3, 2}};
+    Session b = load(kWorld);
+    cook_tiled(b, options(tiled), t);
+    const auto index = nlohmann::json::parse(read_file_bytes(tiled / "tiles/index.json"));
+    int blocks = 0;
+    for (const char* name : {"cover_bc4", "rgb_bc1"}) {
+        const compress::DdsTexture whole = io::read_dds_file(single / "maps" / (std::string(name) + ".dds"));
+        const auto manifest = io::read_dds_manifest(single / "maps" / (std::string(name) + ".dds"));
+        ASSERT_TRUE(manifest);
+        bool listed = false;
+        for (const auto& o : index["outputs"])
+            if (o["file"] == std::string("maps/") + name + ".dds") {
+                listed = true;
+                EXPECT_EQ(o["range"], nlohmann::json::array({manifest->range_lo, manifest->range_hi})) << name;
+            }
+        EXPECT_TRUE(listed) << name;
+        const int bpb = int(compress::level_bytes(whole.format, 4, 4, 1)); // bytes per 4x4 block
+        const int wide = whole.width / 4;
+        for (int j = 0; j < 2; ++j)
+            for (int i = 0; i < 3; ++i) {
+                const TileRect r = tile_rect({{48, 32}}, {{3, 2}}, {{i, j}});
+                const fs::path p = tiled / "tiles/maps" / (std::string(name) + "." + std::to_string(i) + "_" + std::to_string(j) + ".dds");
+                const compress::DdsTexture tile = io::read_dds_file(p);
+                ASSERT_EQ(tile.format, whole.format);
+                ASSERT_EQ(tile.width, r.width());
+                // DDS rows run top-down: the tile's block row 0 holds field rows [y1 - 4, y1).
+                for (int by = 0; by < r.height() / 4; ++by)
+                    for (int bx = 0; bx < r.width() / 4; ++bx) {
+                        const size_t wb = size_t((32 - r.y1) / 4 + by) * size_t(wide) + size_t(r.x0 / 4 + bx);
+                        const size_t tb = size_t(by) * size_t(r.width() / 4) + size_t(bx);
+                        ASSERT_TRUE(std::equal(tile.data.begin() + long(tb) * bpb, tile.data.begin() + long(tb + 1) * bpb,
+                                               whole.data.begin() + long(wb) * bpb))
+                            << p << " block " << bx << "," << by;
+                        ++blocks;
+                    }
+            }
+    }
+    EXPECT_EQ(blocks, 2 * 12 * 8);
+    // A second cook finds every tile on the world's range: nothing is written.
+    Session c = load(kWorld);
+    TiledCookResult again;
+    cook_tiled(c, options(tiled), t, again);
+    EXPECT_TRUE(again.written.empty()) << again.written.size() << " files, the first " << again.written.front();
 }
 
 // Every noise kernel fills each tile's window itself (2D and 3D, a

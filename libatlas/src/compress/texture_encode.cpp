@@ -183,6 +183,27 @@ std::vector<int> stored_channels(const Field3D& field, const CompressOptions& o,
 }
 } // namespace
 
+bool maps_by_own_range(const CompressOptions& o) {
+    return !o.value_range && detail::map_kind(dxgi_format(o.format)) != MapKind::Float;
+}
+
+std::optional<std::pair<float, float>> own_value_range(const Field3D& field, const CompressOptions& o) {
+    if (!maps_by_own_range(o)) return std::nullopt;
+    const std::vector<int> chans = stored_channels(field, o, stored_channel_count(o.format));
+    float lo = INFINITY, hi = -INFINITY;
+    for (int c : chans) {
+        if (c < 0 || c >= field.channels()) continue; // encode_texture refuses it
+        // gpu_pro_7 stores min(1, 1.5 t) for the type channels: monotonic, so the range maps too.
+        const bool type = o.type_encoding == TypeEncoding::GpuPro7 && is_type_channel(field.channel_name(c));
+        for (float v : field.channel(c)) {
+            if (type) v = std::min(1.0f, 1.5f * v);
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+        }
+    }
+    return std::make_pair(lo, hi);
+}
+
 EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, const ProgressSink* progress) {
     if (o.type_encoding == TypeEncoding::GpuPro7) {
         // The type channels re-encoded (t' = min(1, 1.5 t)) in a copy; the bound then holds for

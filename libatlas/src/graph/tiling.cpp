@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <chrono>
 #include <functional>
@@ -244,6 +245,23 @@ json file_entry(const fs::path& root, const fs::path& final_path, const fs::path
             {"sha256", sha256_hex(read_file_bytes(on_disk))}};
 }
 
+// A range in a fragment: {+inf, -inf} (no stored channel) as null, which JSON has no number for.
+json range_json(std::pair<float, float> r) {
+    if (!(r.second >= r.first)) return nullptr;
+    return {r.first, r.second};
+}
+std::optional<std::pair<float, float>> range_of(const json& j) {
+    if (!j.is_array()) return std::nullopt;
+    return std::make_pair(j.at(0).get<float>(), j.at(1).get<float>());
+}
+// The range a texture of data in `own` maps from (compress::encode_texture's rule: the
+// data's min and max, 0..1 without data, hi = lo + 1 for constant data).
+std::pair<float, float> mapped_range(std::pair<float, float> own) {
+    if (!(own.second >= own.first)) return {0.0f, 1.0f};
+    if (!(own.second > own.first)) return {own.first, own.first + 1.0f};
+    return own;
+}
+
 // A fragment's files are all present with the recorded sizes and hashes.
 bool files_current(const fs::path& root, const json& files) {
     for (const auto& f : files) {
@@ -350,6 +368,7 @@ struct TiledCook {
     void check_grid();
     void cook_tiles();
     void write_index();
+    void share_ranges();
     void assemble();
 
     using Staging = std::map<fs::path, std::unique_ptr<StagedOutputs>>;
@@ -371,6 +390,7 @@ struct TiledCook {
     std::string tile_key(Vec2i t) const;
     HeldValues cook_tile(const TileRect& tr, ThreadLimit& arena, uint64_t& value_peak);
     json write_tile(Vec2i t, const TileRect& tr, const HeldValues& held);
+    Value read_raw(const json& fo, Vec2i t) const;
 
     const std::chrono::steady_clock::time_point t_start = std::chrono::steady_clock::now();
     Session& session;
@@ -529,10 +549,16 @@ void TiledCook::check_grid() {
         if (h < 0) throw Error(node_label(n) + ": internal: negative tiling halo");
         plan.halo[name] = h;
     }
-    for (const GraphOutput* o : tiled_outputs)
+    for (const GraphOutput* o : tiled_outputs) {
         if (o->format == "dds" && (tile_size[0] % 4 || tile_size[1] % 4))
             throw Error(o->where.str() + ": --tiles " + tile_name(tiles) + ": output '" + o->file +
                         "' is BC-compressed in 4x4 blocks, and tiles of " + xy_text(tile_size) + " texels are not block-aligned");
+        // Its tiles share the world's range from their exact values at the index step (share_ranges).
+        if (!topt.exact_values && io::output_maps_by_own_range(o->format, o->options))
+            throw Error(o->where.str() + ": output '" + o->file + "' maps its values by their own range (a DDS without option 'range'), so each tile " +
+                        "must be re-encoded with the world's range once every tile is cooked, from the tile's exact values; " +
+                        "--no-tile-values leaves none: set 'range: LO,HI' on the output, or keep the tile values");
+    }
 }
 
 void TiledCook::cook_tiles() {
@@ -682,6 +708,11 @@ json TiledCook::write_tile(Vec2i t, const TileRect& tr, const HeldValues& held) 
         for (const auto& s : staged) files.push_back(file_entry(root, st.final_path(s), s));
         json entry = {{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format},
                       {"bounds_min", {tb.min[0], tb.min[1]}}, {"bounds_max", {tb.max[0], tb.max[1]}}, {"files", files}};
+        // Quantised by its own range: recorded, so that the index step can give every tile the world's.
+        if (const auto own = io::output_own_range(v, o->format, o->options)) {
+            entry["own_range"] = range_json(*own);
+            entry["range"] = range_json(mapped_range(*own));
+        }
         if (topt.exact_values) {
             // The exact values, once per node port (several outputs may write one).
             const fs::path raw_rel = fs::path("tiles") / "values" / (o->node + "." + o->port + "." + std::to_string(t[0]) + "_" + std::to_string(t[1]) + ".atlastile");
@@ -701,6 +732,65 @@ json TiledCook::write_tile(Vec2i t, const TileRect& tr, const HeldValues& held) 
     return frag;
 }
 
+// A tile's exact values of one output (its fragment entry `fo`), checked against the hash
+// the tile recorded.
+Value TiledCook::read_raw(const json& fo, Vec2i t) const {
+    const fs::path raw = root / fo.at("raw").at("path").get<std::string>();
+    std::string why;
+    const std::string bytes = read_file_bytes(raw);
+    if (ContentHasher().add(bytes.data(), bytes.size()).finish().hex() != fo.at("raw").at("hash").get<std::string>())
+        throw Error("tile " + tile_name(t) + ": '" + raw.string() + "' changed after the tile was cooked (another cook writes into this folder?)");
+    auto vals = disk_cache::deserialize(bytes, &why);
+    if (!vals || !vals->count("value")) throw Error("tile " + tile_name(t) + ": '" + raw.string() + "' is unreadable (" + why + ")");
+    return vals->at("value");
+}
+
+// Outputs quantised by their own range (a DDS without 'range'): each tile was encoded with
+// its own, so neighbours quantise differently at their border. With every tile cooked, the
+// world's range is the union of theirs (the range the untiled texture maps from); each tile
+// encoded with another is encoded again from its exact values with the world's, and its
+// fragment rewritten. A second cook finds every tile on the world's range: nothing to do.
+void TiledCook::share_ranges() {
+    for (size_t k = 0; k < tiled_outputs.size(); ++k) {
+        const GraphOutput* o = tiled_outputs[k];
+        std::optional<std::pair<float, float>> own;
+        for (const auto& [t, f] : fragments) {
+            const auto r = range_of(f.at("outputs").at(k).value("own_range", json()));
+            if (!r) continue;
+            own = own ? std::make_pair(std::min(own->first, r->first), std::max(own->second, r->second)) : *r;
+        }
+        if (!own && !std::any_of(fragments.begin(), fragments.end(), [&](const auto& f) { return f.second.at("outputs").at(k).contains("range"); }))
+            continue; // not quantised by its own range
+        const std::pair<float, float> world = mapped_range(own.value_or(std::make_pair(INFINITY, -INFINITY)));
+        const io::OutputOptions options = io::with_range(o->options, world);
+        for (auto& [t, f] : fragments) {
+            json& fo = f.at("outputs").at(k);
+            if (range_of(fo.at("range")) == std::optional(world)) continue;
+            opt.progress.poll();
+            const Vec2i tile{{t.first, t.second}};
+            StagedOutputs st(root);
+            if (!g.file.empty()) st.protect({{g.file, "the graph file"}});
+            json files = json::array();
+            try {
+                for (const auto& p : io::write_value(read_raw(fo, tile), st.stage(tile_rel(*o, tile)), o->format, options, nullptr))
+                    files.push_back(file_entry(root, st.final_path(p), p));
+            } catch (const CancelledError&) {
+                throw;
+            } catch (const std::exception& e) {
+                throw Error("tile " + tile_name(tile) + ": " + detail::output_error(*o, std::string("with the world's range: ") + e.what()));
+            }
+            fo["files"] = files;
+            fo["range"] = range_json(world);
+            const std::string text = f.dump(2) + "\n";
+            write_file_checked(st.stage_last(fragment_rel(tile)), text.data(), text.size());
+            for (const auto& p : st.commit()) result.written.push_back(p);
+            // The report lists the tile's files as they now are.
+            for (TileReport& r : result.tiles_done)
+                if (r.tile == tile) r.files = tile_report(tile, r.texels, r.status, 0, 0, 0, &f, root).files;
+        }
+    }
+}
+
 // Every tile is present: the tile index.
 void TiledCook::write_index() {
     // Every tile as this cook knows it is still what is on disk: another cook writing into
@@ -711,11 +801,13 @@ void TiledCook::write_index() {
             if (!current_fragment(root, {{i, j}}, tile_key({{i, j}})))
                 throw Error("tile " + tile_name({{i, j}}) + " changed on disk after this cook wrote or checked it (another cook writes into '" +
                             root.string() + "'?): no index written and nothing assembled; cook again, or give each run its own --out");
+    share_ranges();
     json index = {{"atlas_tile_index", kTileFormatVersion}, {"graph", topt.graph_name}, {"tiles", {tiles[0], tiles[1]}},
                   {"grid", grid_json(grid)}, {"outputs", json::array()}};
     for (size_t k = 0; k < tiled_outputs.size(); ++k) {
         const GraphOutput* o = tiled_outputs[k];
         json entry = {{"file", o->file}, {"node", o->node}, {"port", o->port}, {"format", o->format}, {"options", o->options}, {"tiles", json::array()}};
+        if (const json& r = fragments.begin()->second.at("outputs").at(k); r.contains("range")) entry["range"] = r.at("range"); // every tile's
         for (int j = 0; j < tiles[1]; ++j)
             for (int i = 0; i < tiles[0]; ++i) {
                 const json& f = fragments.at({i, j});
@@ -834,14 +926,7 @@ void TiledCook::assemble() {
                 for (int i = 0; i < tiles[0]; ++i) {
                     const json& fo = fragments.at({i, j}).at("outputs").at(k);
                     const fs::path raw = root / fo.at("raw").at("path").get<std::string>();
-                    std::string why;
-                    const std::string bytes = read_file_bytes(raw);
-                    if (ContentHasher().add(bytes.data(), bytes.size()).finish().hex() != fo.at("raw").at("hash").get<std::string>())
-                        throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() +
-                                    "' changed after the tile was cooked (another cook writes into this folder?)");
-                    auto vals = disk_cache::deserialize(bytes, &why);
-                    if (!vals || !vals->count("value")) throw Error("tile " + tile_name({{i, j}}) + ": '" + raw.string() + "' is unreadable (" + why + ")");
-                    const Value& v = vals->at("value");
+                    const Value v = read_raw(fo, {{i, j}});
                     const TileRect r = tile_rect(grid.res, tiles, {{i, j}});
                     const Box2d gb = rect_bounds(grid, {0, 0, grid.res[0], grid.res[1]});
                     if (auto t2 = std::get_if<Field2DPtr>(&v)) {

@@ -8,6 +8,8 @@
 #include "atlas/io/readers.h"
 #include "format_table.h"
 
+#include <cstdio>
+
 namespace atlas::io::detail {
 
 namespace {
@@ -47,3 +49,27 @@ std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path,
 }
 
 } // namespace atlas::io::detail
+
+namespace atlas::io {
+
+bool output_maps_by_own_range(const std::string& format, const OutputOptions& options) {
+    return format == "dds" && compress::maps_by_own_range(detail::dds_options(OptionReader(options, "output")));
+}
+
+std::optional<std::pair<float, float>> output_own_range(const Value& value, const std::string& format, const OutputOptions& options) {
+    if (!output_maps_by_own_range(format, options)) return std::nullopt;
+    compress::CompressOptions c = detail::dds_options(OptionReader(options, "output"));
+    const Field3DPtr field = as_field3d(value);
+    compress::resolve_channel_names(c, *field);
+    return compress::own_value_range(*field, c);
+}
+
+OutputOptions with_range(OutputOptions options, std::pair<float, float> range) {
+    // %.9g round-trips a float exactly, so the tile maps by the very range given.
+    char text[64];
+    std::snprintf(text, sizeof text, "%.9g,%.9g", double(range.first), double(range.second));
+    options["range"] = text;
+    return options;
+}
+
+} // namespace atlas::io

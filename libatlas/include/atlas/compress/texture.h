@@ -194,6 +194,15 @@ struct EncodedTexture {
 };
 EncodedTexture encode_texture(const Field3D& field, const CompressOptions& options, const ProgressSink* progress = nullptr);
 
+// Whether `options` map values into the format's 0..1 by the data's own min and max: a
+// normalised format (unorm or snorm; not the float formats) without value_range.
+bool maps_by_own_range(const CompressOptions& options);
+// The min and max encode_texture would map from when maps_by_own_range(options): over the
+// stored channels (after a gpu_pro_7 type re-encoding); {+inf, -inf} when none is stored.
+// nullopt otherwise. A tiled cook gives its tiles the union of theirs as value_range, so
+// every tile quantises as the whole world does (docs/scale.md).
+std::optional<std::pair<float, float>> own_value_range(const Field3D& field, const CompressOptions& options);
+
 // Decodes level 0 of every slice / array element to float in source units (the
 // manifest's mapping when there is one, else the normalized values; a bc1-scalar
 // texture without manifest decodes as RGB). Arrays stack along z. From a file:

@@ -24,7 +24,7 @@
 
 namespace atlas {
 
-constexpr int kTileFormatVersion = 1;
+constexpr int kTileFormatVersion = 2; // 2: outputs quantised by their own range share the world's ("own_range", "range")
 
 // A texel rectangle [x0, x1) x [y0, y1) of the tiled XY grid.
 struct TileRect {

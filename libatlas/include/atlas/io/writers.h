@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -55,5 +56,14 @@ void check_output_options(const std::string& format, const fs::path& path, const
 
 std::vector<fs::path> write_value(const Value& value, const fs::path& path, const std::string& format, const OutputOptions& options,
                                   OutputMetrics* metrics = nullptr);
+
+// Outputs that quantise a value by its own range (a "dds" in a normalised format without
+// option 'range', compress::maps_by_own_range): a tile of such an output would be
+// quantised differently from its neighbours. A tiled cook records each tile's
+// output_own_range and rewrites the tiles with their union as 'range'
+// (with_range) so that they quantise as the whole world does (docs/scale.md).
+bool output_maps_by_own_range(const std::string& format, const OutputOptions& options);
+std::optional<std::pair<float, float>> output_own_range(const Value& value, const std::string& format, const OutputOptions& options);
+OutputOptions with_range(OutputOptions options, std::pair<float, float> range); // 'range' set exactly ("%.9g,%.9g")
 
 } // namespace atlas::io
