@@ -26,7 +26,24 @@ add_test(NAME shipped_tiles_cloudscape COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/
 add_test(NAME shipped_tiles_towering_cumulus COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
          ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/towering_cumulus graphs/towering_cumulus.yaml
          --set "density.resolution=[96,96,72]")
-set_tests_properties(shipped_tiles_cloudscape shipped_tiles_towering_cumulus PROPERTIES LABELS graph TIMEOUT 600)
+# The grown cloudscape reads the quick tower the cook_shipped fixture grows; the solver sequence
+# at its quick size (the solver is cooked whole, once per process, and cropped).
+add_test(NAME shipped_tiles_cumulus_cloudscape COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
+         ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/cumulus_cloudscape graphs/cumulus_cloudscape.yaml
+         --set "tower.file=${PROJECT_BINARY_DIR}/cook_shipped/cumulus_cloudscape/graphs/cumulus_out/cumulus_final.vdb"
+         --set "world.resolution=[64,64,56]" --set "tower_a.resolution=[64,64,56]" --set "tower_b.resolution=[64,64,56]"
+         --set "clouds.resolution=[64,64,56]")
+add_test(NAME shipped_tiles_cumulus_side_view COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
+         ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/cumulus_side_view graphs/cumulus_side_view.yaml
+         --set "frame.file=${PROJECT_BINARY_DIR}/cook_shipped/cumulus_cloudscape/graphs/cumulus_out/cumulus/cloud.0006.vdb")
+set_tests_properties(shipped_tiles_cumulus_cloudscape shipped_tiles_cumulus_side_view PROPERTIES FIXTURES_REQUIRED shipped_cumulus_cloudscape)
+add_test(NAME shipped_tiles_cumulus_sequence COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
+         ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/cumulus_sequence graphs/cumulus_sequence.yaml
+         --set "cloud.resolution=[32,32,32]" --set cloud.dx=125)
+set_tests_properties(shipped_tiles_cloudscape shipped_tiles_towering_cumulus shipped_tiles_cumulus_cloudscape shipped_tiles_cumulus_sequence
+                     shipped_tiles_cumulus_side_view PROPERTIES LABELS graph TIMEOUT 600)
+set_tests_properties(shipped_tiles_cumulus_cloudscape shipped_tiles_cumulus_sequence PROPERTIES ENVIRONMENT "TILES=1,1 2,2 4,2")
+set_tests_properties(shipped_tiles_cumulus_side_view PROPERTIES ENVIRONMENT "TILES=1,1 2,2 4,2;MIN_FILES=1")
 # The 2D graphs at full size (a second each): map-wide nodes cooked whole and cropped, outputs on
 # grids of their own (LUTs, the baked volume, the cirrus textures, the ring table) written whole.
 foreach(name superstorm superstorm_lifecycle envelope_mountain hzd_weather fc6_forecast)

@@ -6,6 +6,7 @@ namespace {
 using namespace atlas;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("an exact transform and an inside vote over the whole grid"));
     d.doc("Signed distance (metres, negative inside) to a mesh over the whole grid, inside decided by the six-ray winding "
           "vote with (fast) generalized winding numbers where the rays disagree (survives holes and self-intersections; "
           "metric winding_fallback_voxels). Distances go to the surface of the union of overlapping parts (buried faces "

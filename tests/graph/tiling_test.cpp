@@ -346,7 +346,8 @@ TEST(Tiling, AnotherTilingInTheSameFolderIsRefused) {
 }
 
 // The voxel nodes a cloudscape uses, on uneven splits (issue 46 items 1 and 2): metaballs as a
-// windowed generator with its points passed whole, composite of a cloud on a grid of its own,
+// windowed generator with its points passed whole, composite of a cloud on a grid of its own and
+// of a mesh's SDF (volume/mesh_to_sdf, cooked whole and cropped),
 // cutout, erosion and paint at the whole grid's positions, a filter's halo (smooth then dilate),
 // the anatomy paint's one-voxel halo and the pointwise NVDF nodes: every assembled byte is the
 // untiled cook's.
@@ -362,7 +363,10 @@ nodes:
   world: { type: volume/world, params: { resolution: [48, 40, 8], bounds_max: [4800, 4000, 512] } }
   with_balls: { type: volume/composite, inputs: { world: world, cloud: balls } }
   with_cloud: { type: volume/composite, inputs: { world: with_balls, cloud: cloud }, params: { op: add } }
-  cut: { type: volume/cutout, inputs: { in: with_cloud }, params: { shape: capsule, a: [300, 300, 200], b: [4000, 3000, 300], radius: 150, edge: 60 } }
+  ring: { type: volume/mesh_primitive, params: { shape: torus, center: [1500, 2800, 250], radius: 700, minor_radius: 150 } }
+  ring_sdf: { type: volume/mesh_to_sdf, inputs: { mesh: ring }, params: { resolution: [48, 40, 8], bounds_max: [4800, 4000, 512] } }
+  with_ring: { type: volume/composite, inputs: { world: with_cloud, cloud: ring_sdf.density } }
+  cut: { type: volume/cutout, inputs: { in: with_ring }, params: { shape: capsule, a: [300, 300, 200], b: [4000, 3000, 300], radius: 150, edge: 60 } }
   eroded: { type: volume/erode_noise, inputs: { in: cut }, params: { amount: 0.3, frequency: 0.003, octaves: 3 } }
   soft: { type: volume/filter, inputs: { in: eroded }, params: { op: smooth, sigma: 1.3 } }
   grown: { type: volume/filter, inputs: { in: soft }, params: { op: dilate, radius: 2 } }
