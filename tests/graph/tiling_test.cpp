@@ -553,6 +553,21 @@ outputs:
                 for (int y = 0; y < 32; ++y)
                     for (int x = 0; x < 32; ++x) ASSERT_EQ(f->at(0, x, y, z), ref->at(0, 32 * i + x, 32 * j + y, z)) << p;
         }
+    // Assembling the whole field under that budget is refused before it is allocated; the
+    // message says the tiles and their index are the product, and they stay as they were.
+    const std::string index_before = read_file_bytes(tiled / "tiles/index.json");
+    t.assemble = true;
+    Session c = load_text(text, tiled);
+    try {
+        cook_tiled(c, o, t);
+        ADD_FAILURE() << "assembling past the memory budget was accepted";
+    } catch (const MemoryBudgetError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("assembling output 'd.exr'"), std::string::npos) << what;
+        EXPECT_NE(what.find("index.json' are written and complete"), std::string::npos) << what;
+    }
+    EXPECT_FALSE(fs::exists(tiled / "d.exr"));
+    EXPECT_EQ(read_file_bytes(tiled / "tiles/index.json"), index_before);
 }
 
 // ------------------------------------------------------------ clipped SDFs

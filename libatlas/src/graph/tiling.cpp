@@ -969,6 +969,11 @@ void TiledCook::assemble() {
             written.push_back({u, std::move(finals)});
         } catch (const CancelledError&) {
             throw;
+        } catch (const MemoryBudgetError& e) {
+            // Past the budget the tiles are the product: they and the index are already written.
+            throw MemoryBudgetError(o->where.str() + ": assembling output '" + o->file + "': " + e.what() + "; its tiles and '" +
+                                    (root / "tiles" / "index.json").string() + "' are written and complete: stream the tiles (docs/scale.md), " +
+                                    "and assemble only worlds that fit");
         } catch (const std::exception& e) {
             throw Error(o->where.str() + ": assembling output '" + o->file + "': " + e.what());
         }
