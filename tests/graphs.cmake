@@ -26,6 +26,11 @@ add_test(NAME shipped_tiles_cloudscape COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/
 add_test(NAME shipped_tiles_towering_cumulus COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
          ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/towering_cumulus graphs/towering_cumulus.yaml
          --set "density.resolution=[96,96,72]")
+# The quickstart: its cumulus (288 x 288) tiles, its coverage chain (128 x 128, a grid of its own that
+# the cumulus never reads as a field) is cooked whole and written whole.
+add_test(NAME shipped_tiles_quickstart COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
+         ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/quickstart examples/quickstart.yaml)
+set_tests_properties(shipped_tiles_quickstart PROPERTIES LABELS graph TIMEOUT 600)
 # The grown cloudscape reads the quick tower the cook_shipped fixture grows; the solver sequence
 # at its quick size (the solver is cooked whole, once per process, and cropped).
 add_test(NAME shipped_tiles_cumulus_cloudscape COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>

@@ -440,6 +440,49 @@ TEST(Tiling, TilesWithoutExactValuesWriteTheSameTileFiles) {
     EXPECT_THROW(cook_tiled(c, options(without), t), Error);
 }
 
+// Two chains on two grids: the one of the most texels tiles, the other (a chain of its own)
+// is cooked whole and written whole, every byte the untiled cook's; a node that reads both
+// grids is refused, naming both, before any tile cooks.
+TEST(Tiling, AChainOnAGridOfItsOwnIsCookedWhole) {
+    const std::string head = R"(atlas: 1
+nodes:
+  map: { type: ndf/noise, params: { resolution: [16, 16], bounds_max: [4800, 4000], period: [4, 4], seed: 1 } }
+  soft: { type: ndf/blur, inputs: { in: map }, params: { sigma: 1.0, tileable: false } }
+  vol: { type: noise/perlin_worley, params: { resolution: [48, 40, 4], bounds_max: [4800, 4000, 400], seed: 5 } }
+  dens: { type: math/remap, inputs: { in: vol }, params: { in_min: 0.2, in_max: 0.9, clamp: true } }
+)";
+    const std::string outs = "outputs:\n  - { node: soft, file: soft.exr }\n  - { node: dens, file: dens.exr }\n";
+    const fs::path single = scratch("single"), tiled = scratch("tiled");
+    Session a = load_text(head + outs, single);
+    a.cook(options(single));
+    Session b = load_text(head + outs, tiled);
+    TileOptions t;
+    t.tiles = {{3, 2}};
+    t.assemble = true;
+    cook_tiled(b, options(tiled), t);
+    for (const char* f : {"soft.exr", "dens.exr"}) EXPECT_TRUE(bytes_of(single / f) == bytes_of(tiled / f)) << f;
+    const auto index = nlohmann::json::parse(read_file_bytes(tiled / "tiles/index.json"));
+    EXPECT_EQ(index["grid"]["resolution"], nlohmann::json::array({48, 40}));
+    for (const auto& o : index["outputs"]) EXPECT_EQ(o.value("whole", false), o["file"] == "soft.exr") << o["file"];
+    EXPECT_FALSE(fs::exists(tiled / "tiles/soft.0_0.exr"));
+    // A node reading both grids.
+    const std::string mixed = head + "  both: { type: math/binary, inputs: { a: dens, b: other }, params: { op: mul } }\n"
+                                     "  other: { type: noise/perlin_worley, params: { resolution: [24, 20, 4], bounds_max: [4800, 4000, 400] } }\n"
+                                     "outputs:\n  - { node: both, file: both.exr }\n";
+    const fs::path refused = scratch("refused");
+    Session c = load_text(mixed, refused);
+    try {
+        cook_tiled(c, options(refused), t);
+        ADD_FAILURE() << "a node reading two grids was tiled";
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("node 'both'"), std::string::npos) << what;
+        EXPECT_NE(what.find("24 x 20"), std::string::npos) << what;
+        EXPECT_NE(what.find("48 x 40"), std::string::npos) << what;
+    }
+    EXPECT_FALSE(fs::exists(refused / "tiles"));
+}
+
 // A DDS without 'range' maps its values by their own min and max. Each tile's texture
 // quantises as the whole world's does (its blocks are the untiled texture's blocks, byte for
 // byte), the index states the world's range, and a second cook rewrites nothing.

@@ -481,24 +481,24 @@ void TiledCook::cook_sources() {
         grid = grid_from_json(f.at("grid"));
         for (const auto& w : f.value("whole_outputs", json::array())) whole.insert({w.at(0).get<std::string>(), w.at(1).get<std::string>()});
     } else {
-        auto off_grid = [&](const GraphNode& n, Vec2i res, Vec2d lo, Vec2d hi, bool only_outputs) {
-            if (grid.from.empty()) {
-                grid = {res, lo, hi, n.name};
-                return false;
-            }
-            if (res == grid.res && lo == grid.lo && hi == grid.hi) return false;
-            if (only_outputs) return true;
-            throw Error(node_label(n) + ": tiling needs one XY grid for the whole graph, but its " + xy_text(res) +
-                        " grid over its bounds differs from the " + xy_text(grid.res) + " grid of node '" + grid.from +
-                        "' (cook the outputs of each grid in tiles separately: --output NAME)");
+        // The grids of the sources: a feeding source (one a tiled node reads) of the most texels
+        // sets the tiled grid; chains that start on other grids and never meet it are cooked
+        // whole (as outputs on a grid of their own are), a node that reads two grids is refused.
+        struct Found {
+            const GraphNode* n;
+            std::string port; // empty for a windowed generator (cooked per tile)
+            Value v;
+            Grid at;
+            bool feeding;
         };
+        std::vector<Found> found;
         for (const bool feeding : {true, false})
             for (const GraphNode* n : plan.order) {
                 if (!plan.sources.count(n->name) || (plan.tiled_reads.count(n->name) > 0) != feeding) continue;
                 if (auto it = plan.windowed.find(n->name); it != plan.windowed.end()) {
                     const TileGrid& tg = it->second;
-                    off_grid(*n, tg.res, tg.bounds.min, tg.bounds.max, false);
-                    continue; // cooked per tile, on the tile's window
+                    found.push_back({n, "", {}, {tg.res, tg.bounds.min, tg.bounds.max, n->name}, feeding});
+                    continue;
                 }
                 std::set<std::string> ports;
                 if (auto r = plan.tiled_reads.find(n->name); r != plan.tiled_reads.end()) ports = r->second;
@@ -514,16 +514,51 @@ void TiledCook::cook_sources() {
                         throw Error(node_label(*n) + ": output '" + port + "' is a " + std::string(port_type_name(value_type(v))) +
                                     ", which does not tile (only fields do)");
                     }
-                    Vec2i res;
-                    Vec2d lo, hi;
-                    field_xy(v, res, lo, hi);
-                    if (off_grid(*n, res, lo, hi, !feeding)) {
-                        whole.insert({n->name, port});
-                        continue;
-                    }
-                    sources[{n->name, port}] = {v, {0, 0, res[0], res[1]}, false};
+                    Grid at;
+                    at.from = n->name;
+                    field_xy(v, at.res, at.lo, at.hi);
+                    found.push_back({n, port, std::move(v), at, feeding});
                 }
             }
+        auto same = [](const Grid& x, const Grid& y) { return x.res == y.res && x.lo == y.lo && x.hi == y.hi; };
+        auto texels = [](const Grid& x) { return int64_t(x.res[0]) * int64_t(x.res[1]); };
+        // Without feeding sources (outputs read the sources directly) the first one's grid.
+        const bool any_feeding = std::any_of(found.begin(), found.end(), [](const Found& f) { return f.feeding; });
+        for (const Found& f : found)
+            if (any_feeding ? f.feeding && (grid.from.empty() || texels(f.at) > texels(grid)) : grid.from.empty()) grid = f.at;
+        std::map<std::string, Grid> off; // nodes of chains on another grid: cooked whole
+        for (Found& f : found) {
+            if (same(f.at, grid)) {
+                if (!f.port.empty()) sources[{f.n->name, f.port}] = {std::move(f.v), {0, 0, f.at.res[0], f.at.res[1]}, false};
+                continue;
+            }
+            if (f.feeding) off.emplace(f.n->name, f.at);
+            else whole.insert({f.n->name, f.port});
+        }
+        std::vector<const GraphNode*> on;
+        for (const GraphNode* n : plan.order) {
+            if (off.count(n->name)) continue;
+            const auto& whole_in = reg.find(n->type)->decl.tiling().whole_inputs;
+            const Grid* other = nullptr;
+            const GraphNode* from_on = nullptr;
+            for (const auto& [port, b] : n->inputs) {
+                if (whole_in.count(port)) continue;
+                if (auto it = off.find(b.node); it != off.end()) other = &it->second;
+                else from_on = g.find(b.node);
+            }
+            if (other && from_on)
+                throw Error(node_label(*n) + ": it reads values on two XY grids, the " + xy_text(other->res) + " grid of node '" + other->from +
+                            "' and the tiled " + xy_text(grid.res) + " grid of node '" + grid.from +
+                            "' (tiling needs one grid per chain: cook the outputs of each grid in tiles separately, --output NAME)");
+            if (other) off.emplace(n->name, *other);
+            else on.push_back(n);
+        }
+        if (!off.empty()) {
+            for (const GraphOutput* o : plan.outputs)
+                if (off.count(o->node)) whole.insert({o->node, o->port});
+            plan.order = std::move(on);
+            for (const auto& [name, at] : off) plan.sources.erase(name), plan.windowed.erase(name);
+        }
         if (grid.from.empty()) throw Error("tiling: no output of the graph is a field on a grid to tile");
         for (const auto& [node, port] : plan.aside) aside[{node, port}] = {session.get(node, port, opt), {}, true};
     }
