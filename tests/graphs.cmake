@@ -49,9 +49,9 @@ set_tests_properties(shipped_tiles_cloudscape shipped_tiles_towering_cumulus shi
                      shipped_tiles_cumulus_side_view PROPERTIES LABELS graph TIMEOUT 600)
 set_tests_properties(shipped_tiles_cumulus_cloudscape shipped_tiles_cumulus_sequence PROPERTIES ENVIRONMENT "TILES=1,1 2,2 4,2")
 set_tests_properties(shipped_tiles_cumulus_side_view PROPERTIES ENVIRONMENT "TILES=1,1 2,2 4,2;MIN_FILES=1")
-# The 2D graphs at full size (a second each): map-wide nodes cooked whole and cropped, outputs on
+# The 2D graphs and the noise sets at full size (a second each; the noise sets some 15 s): map-wide nodes cooked whole and cropped, outputs on
 # grids of their own (LUTs, the baked volume, the cirrus textures, the ring table) written whole.
-foreach(name superstorm superstorm_lifecycle envelope_mountain hzd_weather fc6_forecast)
+foreach(name superstorm superstorm_lifecycle envelope_mountain hzd_weather fc6_forecast nubis_noise hzd_noise sky_layer)
   add_test(NAME shipped_tiles_${name} COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
            ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/${name} graphs/${name}.yaml)
   set_tests_properties(shipped_tiles_${name} PROPERTIES LABELS graph TIMEOUT 600 ENVIRONMENT "TILES=1,1 2,2 4,2")
