@@ -17,6 +17,8 @@ namespace {
 using namespace atlas;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::none("a picture of the whole scene, every ray crossing many columns: a reduction, not a field on the world grid "
+                            "(preview the assembled outputs, or the tiles one by one)"));
     d.doc("Renders the NVDF set (voxel mode) and/or the NDF set (2.5D mode, the cloud layer over a curved Earth) with the "
           "preview ray-marchers (docs/render.md), as `atlas preview` does: `image` is linear radiance r, g, b plus view "
           "transmittance (write it as EXR), `preview` the tone-mapped sRGB picture (write it as PNG). Give `nvdf` "

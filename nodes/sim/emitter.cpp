@@ -11,6 +11,7 @@ namespace {
 using namespace atlas;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a solver forcing on a grid of its own, read whole by sim/cloud_growth"));
     d.doc("Heat (K/s) and vapour (kg/kg/s) source rates for sim/cloud_growth's 'emitter' input. 'ground_patch': a disc of "
           "'radius' at 'center' on the grid floor, strength cos^2(pi r / 2R) (1 - h / depth) with h the height above "
           "bounds_min z; 'mask': the input field's channel (negative values count as 0) times the rates, on the mask's grid. "

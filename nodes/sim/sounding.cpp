@@ -12,6 +12,7 @@ namespace {
 using namespace atlas;
 
 void declare(NodeDeclaration& d) {
+    d.tiling(TileRule::whole("a parameter record and a vertical profile, not maps of the world"));
     d.doc("Ambient sounding for sim/cloud_growth: potential temperature with a lapse rate, a capping inversion (height, "
           "jump, depth) and a relative-humidity profile; or, with total_water > 0, a saturated moist-neutral atmosphere. "
           "'out' is the parameter record (1 x 1, one channel per member, see docs/solver.md); 'profile' is the hydrostatic "

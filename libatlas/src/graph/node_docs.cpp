@@ -1,11 +1,23 @@
 #include "atlas/graph/node_docs.h"
 
+#include <algorithm>
+
 #include "atlas/compress/compress_options.h"
 #include "atlas/io/writers.h"
 
 #include <sstream>
 
 namespace atlas {
+
+std::string tiling_refusal(const NodeDeclaration& decl) {
+    const TileRule& r = decl.tiling();
+    if (!r.why_not.empty()) return r.why_not;
+    const auto& outs = decl.outputs();
+    if (!outs.empty() && std::all_of(outs.begin(), outs.end(), [](const PortDecl& o) { return o.type == PortType::Points || o.type == PortType::Mesh; }))
+        return "it makes no field (points or a mesh); a node that reads it whole tiles (volume/metaballs' points, "
+               "volume/composite's cloud, volume/cutout's cutter: docs/scale.md)";
+    return "its type declares no tiling rule (docs/scale.md lists the nodes that tile)";
+}
 
 namespace {
 std::string first_sentence(const std::string& doc) {
@@ -41,7 +53,7 @@ std::string tiling_text(const NodeType& t) {
     case TileRule::Kind::Whole: return "cooked whole once per process and cropped" + (r.why_not.empty() ? std::string() : ": " + r.why_not);
     case TileRule::Kind::None: break;
     }
-    return "not tileable" + (r.why_not.empty() ? std::string() : ": " + r.why_not);
+    return "not tileable: " + tiling_refusal(t.decl);
 }
 
 std::string port_line(const PortDecl& p) {

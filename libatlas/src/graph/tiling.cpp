@@ -2,6 +2,7 @@
 // crops, tile files, fragments, the tile index and assembly.
 #include "atlas/core/progress.h"
 #include "atlas/graph/tiling.h"
+#include "atlas/graph/node_docs.h"
 #include "cook_steps.h"
 #include "graph_walk.h"
 
@@ -122,17 +123,7 @@ Plan make_plan(const Graph& g, const NodeRegistry& reg, const std::vector<std::s
     for (const GraphNode* n : p.order) {
         const NodeType* t = reg.find(n->type);
         const TileRule& rule = t->decl.tiling();
-        if (rule.kind == TileRule::Kind::None) {
-            std::string why = rule.why_not;
-            const auto& outs = t->decl.outputs();
-            if (why.empty() && !outs.empty() && std::all_of(outs.begin(), outs.end(), [](const PortDecl& o) {
-                    return o.type == PortType::Points || o.type == PortType::Mesh;
-                }))
-                why = "it makes no field (points or a mesh); a node that reads it whole tiles (volume/metaballs' points, "
-                      "volume/composite's cloud, volume/cutout's cutter: docs/scale.md)";
-            if (why.empty()) why = "its type declares no tiling rule (docs/scale.md lists the nodes that tile)";
-            throw Error(node_label(*n) + " cannot be cooked in tiles: " + why);
-        }
+        if (rule.kind == TileRule::Kind::None) throw Error(node_label(*n) + " cannot be cooked in tiles: " + tiling_refusal(t->decl));
         NodeParams params(&t->decl, resolved_params(*n, *t), g.base_dir);
         if (rule.refuse)
             if (std::string why = rule.refuse(params); !why.empty()) throw Error(node_label(*n) + " cannot be cooked in tiles: " + why);

@@ -9,6 +9,11 @@
 
 namespace atlas {
 
+// Why a node type without a tiling rule (TileRule::Kind::None) is not cooked in tiles: its
+// rule's own reason, else, for a node that makes only points or a mesh, that the nodes reading
+// it take it whole (so it needs no rule). What `atlas nodes` shows and a tiled cook refuses with.
+std::string tiling_refusal(const NodeDeclaration& decl);
+
 // One line per node type: "name  summary".
 std::string node_list_text(const NodeRegistry& registry);
 // Ports and parameters of one node type, as plain text for a terminal.
