@@ -133,6 +133,7 @@ int run_cook_tiled(const Args& a, CookOptions o) {
         throw;
     }
     bar.finish();
+    for (const auto& w : r.warnings) std::cerr << "warning: " << w << "\n";
     if (a.has("--report")) write_text_atomic(a.get("--report"), tiled_report_json(r, a.positional[0], "ok", ""), "the report", tiled_files(a, r));
     size_t cooked = 0;
     for (const auto& tr : r.tiles_done) cooked += tr.status == "cooked";

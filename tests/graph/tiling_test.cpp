@@ -483,6 +483,38 @@ nodes:
     EXPECT_FALSE(fs::exists(refused / "tiles"));
 }
 
+// A halo wider than a tile is exact but costly: the cook says so, naming the node, and the
+// report carries it; a halo within a tile says nothing.
+TEST(Tiling, AHaloWiderThanATileIsSaid) {
+    auto text = [](int max_distance) {
+        return std::string(R"(atlas: 1
+nodes:
+  vol: { type: noise/perlin_worley, params: { resolution: [48, 40, 4], bounds_max: [4800, 4000, 400], seed: 5 } }
+  sdf: { type: volume/sdf, inputs: { in: vol }, params: { iso: 0.6, max_distance: )") + std::to_string(max_distance) + R"( } }
+outputs:
+  - { node: sdf, file: sdf.exr }
+)";
+    };
+    TileOptions t;
+    t.tiles = {{3, 2}}; // tiles of 16 x 20 voxels of 100 m
+    for (const int d : {500, 3000}) {
+        const fs::path out = scratch("halo" + std::to_string(d));
+        Session s = load_text(text(d), out);
+        TiledCookResult r;
+        cook_tiled(s, options(out), t, r);
+        const auto doc = nlohmann::json::parse(tiled_report_json(r, "inline.yaml", "ok", ""));
+        if (d == 500) {
+            EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
+            EXPECT_FALSE(doc.contains("warnings"));
+        } else {
+            ASSERT_EQ(r.warnings.size(), 1u);
+            EXPECT_NE(r.warnings[0].find("node 'sdf' (volume/sdf): its tiling halo of 31 texels is wider than a tile (16 x 20)"), std::string::npos)
+                << r.warnings[0];
+            EXPECT_EQ(doc["warnings"][0], r.warnings[0]);
+        }
+    }
+}
+
 // A DDS without 'range' maps its values by their own min and max. Each tile's texture
 // quantises as the whole world's does (its blocks are the untiled texture's blocks, byte for
 // byte), the index states the world's range, and a second cook rewrites nothing.

@@ -575,6 +575,14 @@ void TiledCook::check_grid() {
         if (h < 0) throw Error(node_label(n) + ": internal: negative tiling halo");
         plan.halo[name] = h;
     }
+    // A halo wider than a tile is exact but not cheaper per tile: said, not refused (the shipped
+    // graphs clip their SDFs where the untiled bytes stay the same, which is often wider).
+    for (const GraphNode* n : plan.order)
+        if (const int h = plan.halo.at(n->name); h > std::min(tile_size[0], tile_size[1]))
+            result.warnings.push_back(node_label(*n) + ": its tiling halo of " + std::to_string(h) + " texels is wider than a tile (" +
+                                      xy_text(tile_size) + "): each tile cooks it over up to " + std::to_string(2 * h) +
+                                      " texels more per axis, exact but not cheaper per tile" +
+                                      (n->type == "volume/sdf" ? " (a nearer max_distance clips the halo)" : ""));
     for (const GraphOutput* o : tiled_outputs) {
         if (o->format == "dds" && (tile_size[0] % 4 || tile_size[1] % 4))
             throw Error(o->where.str() + ": --tiles " + tile_name(tiles) + ": output '" + o->file +
@@ -1025,6 +1033,7 @@ std::string tiled_report_json(const TiledCookResult& r, const std::string& graph
     doc["seconds"] = r.seconds;
     doc["jobs"] = r.jobs;
     doc["tiled"] = {{"tiles", {r.tiles[0], r.tiles[1]}}, {"grid", {r.grid[0], r.grid[1]}}};
+    if (!r.warnings.empty()) doc["warnings"] = r.warnings;
     std::vector<const TileReport*> order;
     for (const auto& t : r.tiles_done) order.push_back(&t);
     std::stable_sort(order.begin(), order.end(), [](const TileReport* a, const TileReport* b) {

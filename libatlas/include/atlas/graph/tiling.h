@@ -78,6 +78,9 @@ struct TiledCookResult {
     std::vector<std::filesystem::path> assembled; // the untiled outputs written by assembling
     int jobs = 0;
     double seconds = 0;
+    // What the cook did that works but costs: a node whose halo is wider than a tile (each
+    // tile then cooks it over most of the grid), named with its place.
+    std::vector<std::string> warnings;
 };
 
 // Throws atlas::Error (naming file:line:col, the node and its type) for the
