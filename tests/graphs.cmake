@@ -26,6 +26,17 @@ add_test(NAME shipped_tiles_cloudscape COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/
 add_test(NAME shipped_tiles_towering_cumulus COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
          ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/towering_cumulus graphs/towering_cumulus.yaml
          --set "density.resolution=[96,96,72]")
+# The solver graphs at their quick size (the solver cooked whole once per process and cropped);
+# the Straka density current is one cell thick in y.
+foreach(name cumulus_growth periodic_cumulus_field)
+  add_test(NAME shipped_tiles_${name} COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
+           ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/${name} graphs/${name}.yaml
+           --set "cloud.resolution=[32,32,32]" --set cloud.dx=125)
+  set_tests_properties(shipped_tiles_${name} PROPERTIES LABELS graph TIMEOUT 600 ENVIRONMENT "TILES=1,1 2,2 4,2")
+endforeach()
+add_test(NAME shipped_tiles_straka_density_current COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
+         ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/shipped_tiles/straka_density_current graphs/straka_density_current.yaml)
+set_tests_properties(shipped_tiles_straka_density_current PROPERTIES LABELS graph TIMEOUT 600 ENVIRONMENT "TILES=1,1 2,1 4,1;MIN_FILES=2")
 # The quickstart: its cumulus (288 x 288) tiles, its coverage chain (128 x 128, a grid of its own that
 # the cumulus never reads as a field) is cooked whole and written whole.
 add_test(NAME shipped_tiles_quickstart COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/shipped_tiles_test.sh $<TARGET_FILE:atlas>
