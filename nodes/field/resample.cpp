@@ -14,13 +14,13 @@ void declare(NodeDeclaration& d) {
           "input's XY resolution and bounds (z only; keep_bounds, wrap: clamp).");
     d.input("in", PortType::Field, "field to resample");
     // Tiles when it keeps the XY grid (resampling z only): halo 1 texel for the
-    // bilinear tap + 1 for rounding; any other XY resolution changes the grid.
-    d.tiling(TileRule::with_halo([](const NodeParams&) { return 2; },
-                                 [](const NodeParams& p) -> std::string {
-                                     if (!p.get_bool("keep_bounds")) return "keep_bounds: false changes the grid (tiles are regions of one grid)";
-                                     if (p.get_string("wrap") == "wrap") return "wrap: wrap reads around the field, which no local halo covers";
-                                     return "";
-                                 })
+    // bilinear tap + 1 for rounding, or the whole grid with wrap: wrap (its taps read
+    // around the world, not the tile); any other XY resolution changes the grid.
+    d.tiling(TileRule::with_grid_halo([](const NodeParams& p, const TileGrid& g) { return p.get_string("wrap") == "wrap" ? std::max(g.res[0], g.res[1]) : 2; },
+                                      [](const NodeParams& p) -> std::string {
+                                          if (!p.get_bool("keep_bounds")) return "keep_bounds: false changes the grid (tiles are regions of one grid)";
+                                          return "";
+                                      })
                  .with_window());
     d.output("out", PortType::Field, "resampled field, same dimensionality");
     d.param_int3("resolution", {{64, 64, 16}}).range(1, 65536).with_unit("voxels").describe("new resolution (z ignored for 2D)").follows_proxy(ProxyScale::Cells);

@@ -10,8 +10,11 @@ using namespace atlas;
 using namespace atlas::ndf_nodes;
 
 // A tiled cook's halo: the largest offset |amount| in texels, + 1 for the
-// bilinear tap, + 1 for rounding.
+// bilinear tap, + 1 for rounding. Tileable, the lookups wrap around the whole map:
+// the halo is the whole grid, so each tile warps the whole map (exact, as a wrap
+// across the world must be; the cook says the halo is wider than a tile).
 int warp_halo(const NodeParams& p, const TileGrid& g) {
+    if (p.get_bool("tileable")) return std::max(g.res[0], g.res[1]);
     const double sx = g.bounds.size()[0] / g.res[0], sy = g.bounds.size()[1] / g.res[1];
     const double texels = std::ceil(std::abs(p.get_float("amount")) / std::min(sx, sy)) + 2;
     return int(std::min(texels, double(std::max(g.res[0], g.res[1]))));
@@ -19,13 +22,12 @@ int warp_halo(const NodeParams& p, const TileGrid& g) {
 
 void declare(NodeDeclaration& d) {
     d.doc("Domain warp: out(p) = in(p + amount * (2 * warp(p) - 1)), bilinear; warp channel 0 moves x, channel 1 (or 0) moves y. "
-          "Tiles (tileable: false) with a halo of |amount| in texels + 2; a tiled cook then requires every warp value in [0, 1].");
+          "Tiles with a halo of |amount| in texels + 2 (tileable: false; a tiled cook then requires every warp value in [0, 1]), or of the whole map "
+          "(tileable: true: the lookups wrap around the world, not the tile).");
     d.input("in", PortType::Field2D, "map to warp");
     d.input("warp", PortType::Field2D, "offsets in [0, 1] (0.5 = none), the resolution of `in`");
     d.tiling(TileRule::with_grid_halo(warp_halo,
                                       [](const NodeParams& p) -> std::string {
-                                          if (p.get_bool("tileable"))
-                                              return "tileable: true wraps lookups around the map, which no local halo covers";
                                           if (!std::isfinite(p.get_float("amount"))) return "'amount' is not finite";
                                           return "";
                                       })

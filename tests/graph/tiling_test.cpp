@@ -208,10 +208,8 @@ TEST(Tiling, NodesThatCannotTileAreRefusedByName) {
     };
     const std::vector<Case> cases = {
         {"  x: { type: test/untiled, inputs: { in: base } }\n", "node 'x' (test/untiled) cannot be cooked in tiles: its type declares no tiling rule"},
-        {"  w: { type: ndf/constant, params: { resolution: [32, 32], bounds_max: [3200, 3200], value: 0.5 } }\n"
-         "  x: { type: ndf/warp, inputs: { in: base, warp: w } }\n",
-         "node 'x' (ndf/warp) cannot be cooked in tiles"},
-        {"  x: { type: ndf/blur, inputs: { in: base } }\n", "node 'x' (ndf/blur) cannot be cooked in tiles: tileable: true wraps"},
+        {"  x: { type: field/resample, inputs: { in: base }, params: { keep_bounds: false, bounds_max: [3200, 3200, 1] } }\n",
+         "node 'x' (field/resample) cannot be cooked in tiles: keep_bounds: false changes the grid"},
     };
     for (const auto& c : cases) {
         Session s = load_text(std::string(kMapHead) + c.nodes + "outputs:\n  - { node: x, file: x.exr }\n", out);
@@ -883,6 +881,41 @@ TEST(Tiling, ReportListsEveryTileAndTheFailedOne) {
     EXPECT_FALSE(doc.contains("index"));
 }
 
+// Tileable blur and warp wrap around the world, not the tile: their halo is the whole map, so
+// every tile computes them over the whole map (exact; the cook says the halo is wider than a
+// tile), and the assembled bytes are the untiled cook's.
+TEST(Tiling, TileableBlurAndWarpWrapAcrossTheWorld) {
+    const std::string text = R"(atlas: 1
+nodes:
+  base: { type: ndf/noise, params: { resolution: [48, 32], bounds_min: [0, 0], bounds_max: [4800, 3200], period: [4, 4], octaves: 3, seed: 1 } }
+  push: { type: ndf/noise, params: { resolution: [48, 32], bounds_min: [0, 0], bounds_max: [4800, 3200], period: [3, 3], octaves: 2, seed: 4 } }
+  soft: { type: ndf/blur, inputs: { in: base }, params: { sigma: 2.5 } }
+  bent: { type: ndf/warp, inputs: { in: soft, warp: push }, params: { amount: 600 } }
+outputs:
+  - { node: soft, file: soft.exr }
+  - { node: bent, file: bent.exr }
+)";
+    const fs::path single = scratch("single");
+    Session a = load_text(text, single);
+    a.cook(options(single));
+    // Wrapped: the left column's blur reads the right edge (it differs from the clamped blur there).
+    const Field2DPtr soft = std::get<Field2DPtr>(a.get("soft", "out"));
+    const Field2D clamped = ndf::blur(*std::get<Field2DPtr>(a.get("base", "out")), 2.5, WrapMode::Clamp, nullptr);
+    EXPECT_NE(soft->at(0, 0, 10), clamped.at(0, 0, 10));
+    for (auto [nx, ny] : {std::pair{2, 2}, std::pair{3, 2}}) {
+        const fs::path tiled = scratch("tiled" + std::to_string(nx) + std::to_string(ny));
+        Session b = load_text(text, tiled);
+        TileOptions t;
+        t.tiles = {{nx, ny}};
+        t.assemble = true;
+        TiledCookResult r;
+        cook_tiled(b, options(tiled), t, r);
+        for (const char* f : {"soft.exr", "bent.exr"}) EXPECT_TRUE(bytes_of(single / f) == bytes_of(tiled / f)) << f << " " << nx << "x" << ny;
+        ASSERT_EQ(r.warnings.size(), 2u);
+        EXPECT_NE(r.warnings[0].find("node 'soft' (ndf/blur): its tiling halo of 48 texels is wider than a tile"), std::string::npos) << r.warnings[0];
+    }
+}
+
 // ndf/warp (tileable: false) tiles with a halo of its largest offset: the
 // assembled EXR and BC4 DDS are the untiled bytes, for an offset below and
 // above the tile size; a warp value outside [0, 1] (an offset beyond the
@@ -944,8 +977,8 @@ outputs:
     EXPECT_TRUE(files_under(bad).empty());
 }
 
-// field/resample tiles when it keeps the XY grid (z only, and a 2D identity):
-// the assembled bytes are the untiled cook's; a new XY resolution fails the
+// field/resample tiles when it keeps the XY grid (z only, and a 2D identity; with wrap: wrap
+// its halo is the whole grid): the assembled bytes are the untiled cook's; a new XY resolution fails the
 // tile naming the node, and keep_bounds: false is refused.
 TEST(Tiling, ResampleOfZOnlyTiles) {
     const std::string head = R"(atlas: 1
@@ -955,10 +988,12 @@ nodes:
 )";
     const std::string text = head + R"(  fine: { type: field/resample, inputs: { in: vol }, params: { resolution: [48, 32, 13] } }
   flat: { type: field/resample, inputs: { in: base }, params: { resolution: [48, 32, 1] } }
+  wrapped: { type: field/resample, inputs: { in: vol }, params: { resolution: [48, 32, 5], wrap: wrap } }
 outputs:
   - { node: fine, file: fine.vdb }
   - { node: fine, file: fine.exr }
   - { node: flat, file: flat.exr }
+  - { node: wrapped, file: wrapped.exr }
 )";
     const fs::path single = scratch("single");
     Session a = load_text(text, single);
@@ -972,7 +1007,7 @@ outputs:
         t.assemble = true;
         cook_tiled(b, options(tiled), t);
         const auto files = files_under(single);
-        ASSERT_EQ(files.size(), size_t(3));
+        ASSERT_EQ(files.size(), size_t(4));
         for (const auto& f : files) EXPECT_TRUE(bytes_of(single / f) == bytes_of(tiled / f)) << f << " " << nx << "x" << ny;
     }
     const fs::path bad = scratch("bad");
