@@ -241,6 +241,21 @@ def test_cli_tile_errors(tmp_path, args, message):
 
 
 def test_cli_refuses_untileable_graph(tmp_path):
+    g = tmp_path / "resample.yaml"
+    g.write_text("""atlas: 1
+nodes:
+  a: { type: ndf/noise, params: { resolution: [32, 32] } }
+  r: { type: field/resample, inputs: { in: a }, params: { keep_bounds: false, bounds_max: [100, 100, 1] } }
+outputs:
+  - { node: r, file: r.exr }
+""")
+    r = subprocess.run([ATLAS, "cook", str(g), "--tiles", "2,2", "--out", str(tmp_path / "o"), "--quiet"], capture_output=True, text=True)
+    assert r.returncode != 0
+    assert "node 'r' (field/resample) cannot be cooked in tiles: keep_bounds: false" in r.stderr, r.stderr
+
+
+def test_cli_warns_of_a_halo_wider_than_a_tile(tmp_path):
+    # A tileable warp wraps around the world: its halo is the whole map; the cook tiles, and says so.
     g = tmp_path / "warp.yaml"
     g.write_text("""atlas: 1
 nodes:
@@ -250,8 +265,8 @@ outputs:
   - { node: w, file: w.exr }
 """)
     r = subprocess.run([ATLAS, "cook", str(g), "--tiles", "2,2", "--out", str(tmp_path / "o"), "--quiet"], capture_output=True, text=True)
-    assert r.returncode != 0
-    assert "node 'w' (ndf/warp) cannot be cooked in tiles" in r.stderr, r.stderr
+    assert r.returncode == 0, r.stderr
+    assert "warning: " in r.stderr and "node 'w' (ndf/warp): its tiling halo of 32 texels is wider than a tile (16 x 16)" in r.stderr, r.stderr
 
 
 @pytest.mark.parametrize("entry", [["python/atlas_dask/atlas-dask"], ["-m", "atlas_dask"]])
