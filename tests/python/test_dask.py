@@ -137,6 +137,11 @@ SHIPPED = [
     ("graphs/envelope_mountain.yaml", (2, 2), ()),
     ("graphs/fc6_forecast.yaml", (2, 2), ()),
     ("graphs/sky_layer.yaml", (2, 2), ()),
+    ("graphs/nubis_noise.yaml", (2, 2), ()),
+    ("graphs/hzd_noise.yaml", (2, 2), ()),
+    ("graphs/cumulus_growth.yaml", (2, 2), ("cloud.resolution=[32,32,32]", "cloud.dx=125")),
+    ("graphs/periodic_cumulus_field.yaml", (2, 2), ("cloud.resolution=[32,32,32]", "cloud.dx=125")),
+    ("graphs/straka_density_current.yaml", (2, 1), ()),
 ]
 
 

@@ -523,7 +523,9 @@ void TiledCook::cook_sources() {
                 if (!f.port.empty()) sources[{f.n->name, f.port}] = {std::move(f.v), {0, 0, f.at.res[0], f.at.res[1]}, false};
                 continue;
             }
-            if (f.feeding) off.emplace(f.n->name, f.at);
+            // Off the grid: cooked whole, not per tile. A port only outputs read is written whole
+            // (a source's other ports may be on the grid); a windowed generator is off as a whole.
+            if (f.feeding || f.port.empty()) off.emplace(f.n->name, f.at);
             else whole.insert({f.n->name, f.port});
         }
         std::vector<const GraphNode*> on;
