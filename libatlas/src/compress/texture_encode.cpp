@@ -11,6 +11,7 @@
 #include "texture_internal.h"
 
 #include <chrono>
+#include <tuple>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -170,6 +171,8 @@ TypeEncoding parse_type_encoding(const std::string& name) {
 
 namespace {
 bool is_type_channel(const std::string& name) { return name == "type" || name == "top_type" || name == "bottom_type"; }
+// gpu_pro_7's type re-encoding (docs/compression.md): monotonic, so a range maps through it.
+float gpu_pro_7_type(float t) { return std::min(1.0f, 1.5f * t); }
 
 // How many channels the format stores (bc1-scalar: one, spread over RGB).
 int stored_channel_count(Format f) { return f == Format::Bc1Scalar ? 1 : format_channels(dxgi_format(f)); }
@@ -189,19 +192,21 @@ bool maps_by_own_range(const CompressOptions& o) {
 
 std::optional<std::pair<float, float>> own_value_range(const Field3D& field, const CompressOptions& o) {
     if (!maps_by_own_range(o)) return std::nullopt;
-    const std::vector<int> chans = stored_channels(field, o, stored_channel_count(o.format));
     float lo = INFINITY, hi = -INFINITY;
-    for (int c : chans) {
+    for (int c : stored_channels(field, o, stored_channel_count(o.format))) {
         if (c < 0 || c >= field.channels()) continue; // encode_texture refuses it
-        // gpu_pro_7 stores min(1, 1.5 t) for the type channels: monotonic, so the range maps too.
-        const bool type = o.type_encoding == TypeEncoding::GpuPro7 && is_type_channel(field.channel_name(c));
-        for (float v : field.channel(c)) {
-            if (type) v = std::min(1.0f, 1.5f * v);
-            lo = std::min(lo, v);
-            hi = std::max(hi, v);
-        }
+        auto [clo, chi] = data_range(field, {c});
+        if (o.type_encoding == TypeEncoding::GpuPro7 && is_type_channel(field.channel_name(c))) clo = gpu_pro_7_type(clo), chi = gpu_pro_7_type(chi);
+        lo = std::min(lo, clo);
+        hi = std::max(hi, chi);
     }
     return std::make_pair(lo, hi);
+}
+
+std::pair<float, float> mapped_value_range(std::pair<float, float> data) {
+    if (!(data.second >= data.first)) return {0.0f, 1.0f};
+    if (!(data.second > data.first)) return {data.first, data.first + 1.0f};
+    return data;
 }
 
 EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, const ProgressSink* progress) {
@@ -213,7 +218,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
         int found = 0;
         for (int c : chans)
             if (c >= 0 && c < field.channels() && is_type_channel(field.channel_name(c))) {
-                for (float& t : converted.channel(c)) t = std::min(1.0f, 1.5f * t);
+                for (float& t : converted.channel(c)) t = gpu_pro_7_type(t);
                 ++found;
             }
         if (!found) {
@@ -268,11 +273,7 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
             if (!(map.hi > map.lo) || !std::isfinite(map.lo) || !std::isfinite(map.hi))
                 throw Error("compress: value_range must be finite with lo < hi");
         } else {
-            auto [lo, hi] = data_range(field, chans);
-            if (chans.empty()) { lo = 0; hi = 1; }
-            if (!(hi > lo)) hi = lo + 1.0f;
-            map.lo = lo;
-            map.hi = hi;
+            std::tie(map.lo, map.hi) = mapped_value_range(data_range(field, chans));
         }
     } else if (dx == DxgiFormat::R16_FLOAT || dx == DxgiFormat::R16G16B16A16_FLOAT || bc6h) {
         for (int c : chans)

@@ -6,6 +6,7 @@
 #include "cook_steps.h"
 #include "graph_walk.h"
 
+#include "atlas/compress/texture.h"
 #include "atlas/core/files.h"
 #include "atlas/core/hash.h"
 #include "atlas/core/parallel.h"
@@ -244,13 +245,6 @@ json range_json(std::pair<float, float> r) {
 std::optional<std::pair<float, float>> range_of(const json& j) {
     if (!j.is_array()) return std::nullopt;
     return std::make_pair(j.at(0).get<float>(), j.at(1).get<float>());
-}
-// The range a texture of data in `own` maps from (compress::encode_texture's rule: the
-// data's min and max, 0..1 without data, hi = lo + 1 for constant data).
-std::pair<float, float> mapped_range(std::pair<float, float> own) {
-    if (!(own.second >= own.first)) return {0.0f, 1.0f};
-    if (!(own.second > own.first)) return {own.first, own.first + 1.0f};
-    return own;
 }
 
 // A fragment's files are all present with the recorded sizes and hashes.
@@ -747,7 +741,7 @@ json TiledCook::write_tile(Vec2i t, const TileRect& tr, const HeldValues& held) 
         // Quantised by its own range: recorded, so that the index step can give every tile the world's.
         if (const auto own = io::output_own_range(v, o->format, o->options)) {
             entry["own_range"] = range_json(*own);
-            entry["range"] = range_json(mapped_range(*own));
+            entry["range"] = range_json(compress::mapped_value_range(*own));
         }
         if (topt.exact_values) {
             // The exact values, once per node port (several outputs may write one).
@@ -797,7 +791,7 @@ void TiledCook::share_ranges() {
         }
         if (!own && !std::any_of(fragments.begin(), fragments.end(), [&](const auto& f) { return f.second.at("outputs").at(k).contains("range"); }))
             continue; // not quantised by its own range
-        const std::pair<float, float> world = mapped_range(own.value_or(std::make_pair(INFINITY, -INFINITY)));
+        const std::pair<float, float> world = compress::mapped_value_range(own.value_or(std::make_pair(INFINITY, -INFINITY)));
         const io::OutputOptions options = io::with_range(o->options, world);
         for (auto& [t, f] : fragments) {
             json& fo = f.at("outputs").at(k);

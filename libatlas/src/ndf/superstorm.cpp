@@ -100,13 +100,14 @@ Field2D apply_superstorm(const Field2D& set, const SuperstormStencil& s, const M
             double rw = rd;
             if (s.wall_noise > 0) {
                 // Billowed wall: finer octaves that do not vanish in the band, only in its outer quarter.
-                double f = 0, amp = 0.5;
+                double f = 0, amp = 0.5, amps = 0;
                 for (int o = 1; o <= 3; ++o, amp *= 0.5) {
                     const double ko = k * double(1 << o);
                     f += amp * (2.0 * noise::value_noise(d[0] * ko + 1024.0 * o, d[1] * ko + 2048.0 * o, 0.0, period, s.seed + 7 + uint32_t(o)) - 1.0);
+                    amps += amp;
                 }
                 const double band = (1.0 - hc) * s.radius;
-                rw = rd + s.wall_noise * band * (f / 0.875) * std::min(1.0, 4.0 * (1.0 - r / s.radius));
+                rw = rd + s.wall_noise * band * (f / amps) * std::min(1.0, 4.0 * (1.0 - r / s.radius));
             }
             // With its own coverage a column is the storm's only as far as the storm covers it:
             // tall columns of thin coverage render as walls a few metres thick, a shape no cloud has.

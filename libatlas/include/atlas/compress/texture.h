@@ -197,11 +197,14 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& optio
 // Whether `options` map values into the format's 0..1 by the data's own min and max: a
 // normalised format (unorm or snorm; not the float formats) without value_range.
 bool maps_by_own_range(const CompressOptions& options);
-// The min and max encode_texture would map from when maps_by_own_range(options): over the
-// stored channels (after a gpu_pro_7 type re-encoding); {+inf, -inf} when none is stored.
-// nullopt otherwise. A tiled cook gives its tiles the union of theirs as value_range, so
-// every tile quantises as the whole world does (docs/scale.md).
+// The data's min and max over the stored channels (after a gpu_pro_7 type re-encoding) when
+// maps_by_own_range(options); {+inf, -inf} when none is stored; nullopt otherwise. A tiled
+// cook gives its tiles the union of theirs as value_range, so every tile quantises as the
+// whole world does (docs/scale.md).
 std::optional<std::pair<float, float>> own_value_range(const Field3D& field, const CompressOptions& options);
+// The range encode_texture maps such data from: the data's min and max; 0..1 without data
+// ({+inf, -inf}); lo..lo + 1 for constant data.
+std::pair<float, float> mapped_value_range(std::pair<float, float> data);
 
 // Decodes level 0 of every slice / array element to float in source units (the
 // manifest's mapping when there is one, else the normalized values; a bc1-scalar
