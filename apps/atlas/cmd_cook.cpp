@@ -349,6 +349,7 @@ int run_cook(const Args& a) {
         return run_cook_tiled(a, o);
     }
     if (a.has("--frames")) return run_cook_frames(a, o);
+    o.keep_values = false; // one cook per session: a value is freed once what reads it is done
     if (a.has("--report") && a.has("--depfile") && std::filesystem::path(a.get("--report")).lexically_normal() == std::filesystem::path(a.get("--depfile")).lexically_normal())
         throw UsageError{"--report and --depfile name one file", "cook"};
     const std::vector<ProtectedFile> graphs = cook_files(a, {});

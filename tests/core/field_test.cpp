@@ -9,6 +9,8 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <memory>
+#include <utility>
 
 using namespace atlas;
 
@@ -35,6 +37,45 @@ TEST(Field3D, LayoutAndGeometry) {
     EXPECT_EQ(f.voxel_center(0, 0, 0), (Vec3d{{-9.5, 1, 101}}));
     EXPECT_EQ(f.channel_names(), (std::vector<std::string>{"r"}));
     EXPECT_EQ(f.byte_size(), 24u * 4u);
+}
+
+TEST(Field3D, SharedChannelsAreTheSourcesUntilWritten) {
+    auto a = std::make_shared<const Field3D>(ramp3d({{5, 4, 3}}));
+    Field3D b0({{5, 4, 3}}, 1, a->bounds(), {"b"});
+    b0.at(0, 2, 1, 1) = 7;
+    auto b = std::make_shared<const Field3D>(std::move(b0));
+    Field3D s = Field3D::sharing({{a, 1}, {b, 0}, {a, 0}}, {"x", "y", "z"});
+    // No copy: the very samples of the sources, counted as the sources' bytes.
+    EXPECT_EQ(std::as_const(s).channel(0).data(), a->channel(1).data());
+    EXPECT_EQ(std::as_const(s).channel(1).data(), b->channel(0).data());
+    EXPECT_EQ(s.owned_byte_size(), 0u);
+    EXPECT_EQ(s.byte_size(), 3u * 60u * 4u);
+    // Equal and hashed the same as a field holding copies of those channels.
+    Field3D copy({{5, 4, 3}}, 3, a->bounds(), {"x", "y", "z"});
+    std::copy(a->channel(1).begin(), a->channel(1).end(), copy.channel(0).begin());
+    std::copy(b->channel(0).begin(), b->channel(0).end(), copy.channel(1).begin());
+    std::copy(a->channel(0).begin(), a->channel(0).end(), copy.channel(2).begin());
+    EXPECT_TRUE(s == copy);
+    Hasher hs, hc;
+    s.hash_into(hs);
+    copy.hash_into(hc);
+    EXPECT_EQ(hs.finish(), hc.finish());
+    // A copy of a sharing field owns its channels.
+    Field3D c = s;
+    EXPECT_EQ(c.owned_byte_size(), c.byte_size());
+    EXPECT_NE(std::as_const(c).channel(0).data(), a->channel(1).data());
+    // Writing copies first: the sources never change.
+    const float before = a->at(1, 3, 2, 1);
+    s.at(0, 3, 2, 1) = 1000;
+    EXPECT_EQ(a->at(1, 3, 2, 1), before);
+    EXPECT_EQ(s.at(0, 3, 2, 1), 1000);
+    EXPECT_EQ(s.at(1, 2, 1, 1), 7);
+    EXPECT_EQ(s.owned_byte_size(), s.byte_size());
+    // Grids must agree, channels exist.
+    auto other = std::make_shared<const Field3D>(Field3D({{5, 4, 2}}, 1, Box3d{{{0, 0, 0}}, {{5, 4, 2}}}));
+    EXPECT_THROW(Field3D::sharing({{a, 0}, {other, 0}}, {"p", "q"}), Error);
+    EXPECT_THROW(Field3D::sharing({{a, 2}}, {"p"}), Error);
+    EXPECT_THROW(Field3D::sharing({{a, 0}}, {"p", "q"}), Error);
 }
 
 TEST(Field3D, TrilinearSamplingIsExactOnLinearData) {

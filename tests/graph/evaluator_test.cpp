@@ -517,6 +517,40 @@ TEST_F(Fixture, ReportJsonHasTheDocumentedKeys) {
     EXPECT_LE(j["memory"]["peak_counted"].get<uint64_t>(), MemoryBudget::kDefaultLimit);
 }
 
+// `atlas cook`'s one-shot cook (keep_values false) frees each value once the nodes
+// reading it are done; an editor's session (the default) keeps them all for the next edit.
+TEST_F(Fixture, AOneShotCookFreesValuesOnceRead) {
+    const char* chain = R"(atlas: 1
+nodes:
+  a: {type: test/source, params: {value: 2}}
+  s1: {type: test/add, inputs: {a: a, b: a}}
+  s2: {type: test/add, inputs: {a: s1, b: s1}}
+  s3: {type: test/add, inputs: {a: s2, b: s2}}
+outputs:
+  - {node: s3, file: s3.exr}
+)";
+    const uint64_t field = 8 * 8 * 4 * sizeof(float);
+    auto peak = [&](bool keep, CookResult* second) {
+        Session s = session(chain);
+        CookOptions o = writing_options();
+        o.keep_values = keep;
+        o.jobs = 1;
+        const CookResult r = s.cook(o);
+        if (second) *second = s.cook(o);
+        return nlohmann::json::parse(r.to_json("chain.yaml"))["memory"]["peak_counted"].get<uint64_t>();
+    };
+    CookResult kept, freed;
+    const uint64_t keep_peak = peak(true, &kept), free_peak = peak(false, &freed);
+    // Kept: all four values at the end, and the writer's copy of s3.
+    EXPECT_GE(keep_peak, 5 * field);
+    // Freed: at most a node's inputs, its result and the writer's copy.
+    EXPECT_LE(free_peak, 3 * field);
+    // The kept session's next cook takes s3 from memory; the one-shot's cooks it again.
+    EXPECT_EQ(kept.nodes.at("s3").status, "cached");
+    EXPECT_EQ(freed.with_status("cooked"), (std::vector<std::string>{"a", "s1", "s2", "s3"}));
+    EXPECT_EQ(slurp(dir / "out" / "s3.exr").size() > 0, true);
+}
+
 TEST_F(Fixture, GetReturnsAValueWithoutWriting) {
     Session s = session();
     Value v = s.get("sum", "out");

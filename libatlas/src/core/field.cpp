@@ -7,7 +7,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <new>
+#include <sys/mman.h>
 
 namespace atlas {
 
@@ -31,12 +34,68 @@ ChannelData zeroed_channel(size_t count) {
 }
 } // namespace
 
-FieldStorage::FieldStorage(const FieldStorage& o) : count_(o.count_), names_(o.names_) {
-    data_.reserve(o.data_.size());
-    for (const ChannelData& src : o.data_) {
-        ChannelData& d = data_.emplace_back(src.size());
-        parallel_blocks(src.size(), kFillBlock, [&](size_t i0, size_t i1) { std::memcpy(d.data() + i0, src.data() + i0, (i1 - i0) * sizeof(float)); });
+void* allocate_channel_bytes(size_t bytes) {
+    // Transparent huge pages for channels of 8 MiB and more, aligned so whole
+    // 2 MiB pages back them; the kernel decides (THP "never" ignores the advice).
+    constexpr size_t kHuge = size_t(2) << 20;
+    if (bytes < 4 * kHuge) {
+        if (void* p = std::malloc(bytes ? bytes : 1)) return p;
+        throw std::bad_alloc();
     }
+    const size_t rounded = (bytes + kHuge - 1) / kHuge * kHuge;
+    void* p = std::aligned_alloc(kHuge, rounded);
+    if (!p) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+    madvise(p, rounded, MADV_HUGEPAGE);
+#endif
+    return p;
+}
+
+void free_channel_bytes(void* p, size_t) noexcept { std::free(p); }
+
+FieldStorage::FieldStorage(const FieldStorage& o) : count_(o.count_), names_(o.names_) {
+    data_.reserve(o.ptr_.size());
+    for (const float* src : o.ptr_) {
+        ChannelData& d = data_.emplace_back(o.count_);
+        parallel_blocks(o.count_, kFillBlock, [&](size_t i0, size_t i1) { std::memcpy(d.data() + i0, src + i0, (i1 - i0) * sizeof(float)); });
+        ptr_.push_back(d.data());
+    }
+}
+
+FieldStorage::FieldStorage(size_t count, std::vector<const float*> channels, std::vector<std::shared_ptr<const void>> owners,
+                           std::vector<std::string> names)
+    : count_(count), data_(channels.size()), owners_(std::move(owners)), shared_(true), names_(std::move(names)) {
+    if (channels.empty() || channels.size() > 64) throw Error("field: channel count " + std::to_string(channels.size()) + " out of range (expected 1..64)");
+    if (names_.size() != channels.size())
+        throw Error("field: " + std::to_string(names_.size()) + " channel names given for " + std::to_string(channels.size()) + " channels");
+    // Never written through: a write copies them first (own_channels).
+    for (const float* c : channels) ptr_.push_back(const_cast<float*>(c));
+}
+
+void FieldStorage::own_channels() {
+    for (size_t c = 0; c < ptr_.size(); ++c) {
+        if (!data_[c].empty() || count_ == 0) continue;
+        ChannelData d(count_);
+        const float* src = ptr_[c];
+        parallel_blocks(count_, kFillBlock, [&](size_t i0, size_t i1) { std::memcpy(d.data() + i0, src + i0, (i1 - i0) * sizeof(float)); });
+        data_[c] = std::move(d);
+        ptr_[c] = data_[c].data();
+    }
+    owners_.clear();
+    shared_ = false;
+}
+
+uint64_t FieldStorage::owned_byte_size() const {
+    uint64_t n = 0;
+    for (const ChannelData& d : data_) n += d.size() * sizeof(float);
+    return n;
+}
+
+bool FieldStorage::same_storage(const FieldStorage& o) const {
+    if (names_ != o.names_ || count_ != o.count_) return false;
+    for (size_t c = 0; c < ptr_.size(); ++c)
+        if (!std::equal(ptr_[c], ptr_[c] + count_, o.ptr_[c])) return false;
+    return true;
 }
 
 FieldStorage& FieldStorage::operator=(const FieldStorage& o) {
@@ -51,7 +110,10 @@ FieldStorage::FieldStorage(size_t count, int channels, std::vector<std::string> 
         throw Error("field: " + std::to_string(names.size()) + " channel names given for " + std::to_string(channels) + " channels");
     names_ = std::move(names);
     data_.reserve(size_t(channels));
-    for (int c = 0; c < channels; ++c) data_.push_back(zeroed_channel(count));
+    for (int c = 0; c < channels; ++c) {
+        data_.push_back(zeroed_channel(count));
+        ptr_.push_back(data_.back().data());
+    }
 }
 
 int FieldStorage::find_channel(const std::string& name) const {
@@ -61,15 +123,15 @@ int FieldStorage::find_channel(const std::string& name) const {
 }
 
 void FieldStorage::set_channel_names(std::vector<std::string> names) {
-    if (names.size() != data_.size()) throw Error("field: channel name count does not match channel count");
+    if (names.size() != ptr_.size()) throw Error("field: channel name count does not match channel count");
     names_ = std::move(names);
 }
 
 void FieldStorage::hash_storage(Hasher& h) const {
-    h.add(uint64_t(data_.size()));
-    for (size_t c = 0; c < data_.size(); ++c) {
+    h.add(uint64_t(ptr_.size()));
+    for (size_t c = 0; c < ptr_.size(); ++c) {
         h.add(names_[c]);
-        h.add_floats(data_[c]);
+        h.add_floats(std::span<const float>(ptr_[c], count_));
     }
 }
 
@@ -155,6 +217,28 @@ Field3D::Field3D(Vec3i resolution, int channels, Box3d bounds, std::vector<std::
     : FieldStorage((check_shape(resolution, bounds, "Field3D"), checked_count(resolution, channels, budget, "3D field")), channels,
                    std::move(channel_names)),
       res_(resolution), bounds_(bounds) {}
+
+Field3D::Field3D(Vec3i resolution, Box3d bounds, std::vector<const float*> channels, std::vector<std::shared_ptr<const void>> owners,
+                 std::vector<std::string> names)
+    : FieldStorage(size_t(resolution[0]) * size_t(resolution[1]) * size_t(resolution[2]), std::move(channels), std::move(owners), std::move(names)),
+      res_(resolution), bounds_(bounds) {}
+
+Field3D Field3D::sharing(const std::vector<std::pair<std::shared_ptr<const Field3D>, int>>& channels, std::vector<std::string> channel_names) {
+    if (channels.empty()) throw Error("Field3D::sharing: no channels given");
+    const Field3D& first = *channels.front().first;
+    std::vector<const float*> ptrs;
+    std::vector<std::shared_ptr<const void>> owners;
+    for (const auto& [f, c] : channels) {
+        if (!f) throw Error("Field3D::sharing: a null field");
+        if (f->resolution() != first.resolution() || !(f->bounds() == first.bounds()))
+            throw Error("Field3D::sharing: the fields' grids differ (every channel must have the same resolution and bounds)");
+        if (c < 0 || c >= f->channels())
+            throw Error("Field3D::sharing: channel " + std::to_string(c) + " out of range (the field has " + std::to_string(f->channels()) + ")");
+        ptrs.push_back(f->channel(c).data());
+        if (std::find(owners.begin(), owners.end(), f) == owners.end()) owners.push_back(f);
+    }
+    return Field3D(first.resolution(), first.bounds(), std::move(ptrs), std::move(owners), std::move(channel_names));
+}
 
 Vec3d Field3D::voxel_size() const {
     Vec3d s = bounds_.size();

@@ -55,4 +55,13 @@ uint64_t value_bytes(const Value& v) {
     }, v);
 }
 
+uint64_t value_storage_bytes(const Value& v) {
+    return std::visit([](const auto& p) -> uint64_t {
+        using P = std::decay_t<decltype(p)>;
+        if constexpr (std::is_same_v<P, std::monostate>) return 0;
+        else if constexpr (std::is_same_v<P, Field2DPtr> || std::is_same_v<P, Field3DPtr>) return p->owned_byte_size();
+        else return p->byte_size();
+    }, v);
+}
+
 } // namespace atlas

@@ -542,7 +542,7 @@ void CookRun::fetch() {
             if (loaded) {
                 s.cached = held_outputs(std::move(*loaded), ledger_);
                 s.cache_source = "disk cache";
-                cache_.put(s.hash, s.cached);
+                if (opt_.keep_values) cache_.put(s.hash, s.cached);
             } else {
                 // A damaged entry is never used: remove it and cook again.
                 const auto path = disk_cache::entry_path(*opt_.cache_dir, s.hash);
@@ -662,7 +662,7 @@ void CookRun::cook() {
                 }
             }
             values_[n.name] = produced[i];
-            cache_.put(s.hash, produced[i]);
+            if (opt_.keep_values) cache_.put(s.hash, produced[i]);
             if (cache_writable_) {
                 try {
                     disk_cache::store(*opt_.cache_dir, s.hash, *produced[i]);
@@ -684,6 +684,8 @@ void CookRun::cook() {
                 if (--pending[b.node] == 0 && !target_nodes.count(b.node) && values_.count(b.node)) {
                     for (const auto& [p, v] : *values_.at(b.node)) released_bytes_[b.node] += value_bytes(v);
                     values_.erase(b.node);
+                    // A one-shot cook keeps no other reference (checked mode compares with it).
+                    if (!opt_.keep_values && !opt_.checked) state_.at(b.node).cached.reset();
                 }
     }
 }

@@ -37,7 +37,7 @@ std::shared_ptr<const NodeOutputs> held_outputs(NodeOutputs outputs, const detai
             if constexpr (std::is_same_v<std::decay_t<decltype(p)>, std::monostate>) return nullptr;
             else return p.get();
         }, v);
-        if (auto t = ledger.hold(key, value_bytes(v))) tokens.push_back(std::move(t));
+        if (auto t = ledger.hold(key, value_storage_bytes(v))) tokens.push_back(std::move(t));
     }
     auto* raw = new NodeOutputs(std::move(outputs));
     return std::shared_ptr<const NodeOutputs>(raw, [tokens = std::move(tokens)](const NodeOutputs* p) mutable {

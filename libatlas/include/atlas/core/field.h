@@ -29,9 +29,14 @@ enum class WrapMode {
 };
 
 namespace detail {
+void* allocate_channel_bytes(size_t bytes);
+void free_channel_bytes(void* p, size_t bytes) noexcept;
 // Allocator that leaves floats uninitialised on resize, so FieldStorage can
 // zero and copy channels in parallel (first touch of hundreds of MB is the
-// dominant cost of a large field on a VM; see docs/DECISIONS.md).
+// dominant cost of a large field on a VM; see docs/DECISIONS.md). Large
+// channels are asked for transparent huge pages: a 512x512x64 channel touched
+// in 4 KiB pages took ~16k page faults, the cook's largest system-time cost
+// (issue 49); small ones come from the heap as before.
 template <typename T>
 struct UninitialisedAllocator : std::allocator<T> {
     template <typename U>
@@ -49,36 +54,54 @@ struct UninitialisedAllocator : std::allocator<T> {
     void construct(U* p, Args&&... args) {
         ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
     }
+    T* allocate(size_t n) { return static_cast<T*>(allocate_channel_bytes(n * sizeof(T))); }
+    void deallocate(T* p, size_t n) noexcept { free_channel_bytes(p, n * sizeof(T)); }
 };
 using ChannelData = std::vector<float, UninitialisedAllocator<float>>;
 
 // Shared by Field2D and Field3D: channels, names, storage.
 class FieldStorage {
 public:
-    int channels() const { return static_cast<int>(data_.size()); }
+    int channels() const { return static_cast<int>(ptr_.size()); }
     const std::vector<std::string>& channel_names() const { return names_; }
     const std::string& channel_name(int c) const { return names_[static_cast<size_t>(c)]; }
     // Index of a named channel, or -1.
     int find_channel(const std::string& name) const;
-    std::span<float> channel(int c) { return data_[static_cast<size_t>(c)]; }
-    std::span<const float> channel(int c) const { return data_[static_cast<size_t>(c)]; }
+    // Writing to a field that shares channels copies them first (own_channels).
+    std::span<float> channel(int c) {
+        if (shared_) [[unlikely]]
+            own_channels();
+        return {ptr_[static_cast<size_t>(c)], count_};
+    }
+    std::span<const float> channel(int c) const { return {ptr_[static_cast<size_t>(c)], count_}; }
     size_t voxel_count() const { return count_; }
-    uint64_t byte_size() const { return uint64_t(count_) * data_.size() * sizeof(float); }
+    // Bytes of the field's channels as a value (shared channels counted too).
+    uint64_t byte_size() const { return uint64_t(count_) * ptr_.size() * sizeof(float); }
+    // Bytes this field allocated itself (shared channels belong to their owners).
+    uint64_t owned_byte_size() const;
     void set_channel_names(std::vector<std::string> names);
 
 protected:
     FieldStorage(size_t count, int channels, std::vector<std::string> names);
-    // Copies fill the new channels in parallel (same bytes as a serial copy).
+    // Channels of other fields, shared without a copy: `owners` keep them alive.
+    FieldStorage(size_t count, std::vector<const float*> channels, std::vector<std::shared_ptr<const void>> owners,
+                 std::vector<std::string> names);
+    // Copies fill the new channels in parallel (same bytes as a serial copy); a copy owns its channels.
     FieldStorage(const FieldStorage& o);
     FieldStorage& operator=(const FieldStorage& o);
+    // Moving keeps every channel's address (the vectors' buffers move with them).
     FieldStorage(FieldStorage&&) noexcept = default;
     FieldStorage& operator=(FieldStorage&&) noexcept = default;
     ~FieldStorage() = default;
     void hash_storage(Hasher& h) const;
-    bool same_storage(const FieldStorage& o) const { return names_ == o.names_ && data_ == o.data_; }
+    bool same_storage(const FieldStorage& o) const;
+    void own_channels();
 
     size_t count_ = 0;
-    std::vector<ChannelData> data_;
+    std::vector<ChannelData> data_;  // the channels this field owns (empty where shared)
+    std::vector<float*> ptr_;        // every channel's samples
+    std::vector<std::shared_ptr<const void>> owners_; // keep shared channels alive
+    bool shared_ = false;
     std::vector<std::string> names_;
 };
 } // namespace detail
@@ -121,6 +144,11 @@ class Field3D : public detail::FieldStorage {
 public:
     Field3D(Vec3i resolution, int channels, Box3d bounds, std::vector<std::string> channel_names = {},
             const MemoryBudget* budget = nullptr);
+    // A field made of other fields' channels (field, channel index), shared
+    // without a copy: the NVDF node's VDB set is its modeling channels and the
+    // SDF. Every source must have the same resolution and bounds; a write to the
+    // result copies its channels first, so the sources never change.
+    static Field3D sharing(const std::vector<std::pair<std::shared_ptr<const Field3D>, int>>& channels, std::vector<std::string> channel_names);
 
     Vec3i resolution() const { return res_; }
     int nx() const { return res_[0]; }
@@ -143,6 +171,8 @@ public:
     bool operator==(const Field3D& o) const { return res_ == o.res_ && bounds_ == o.bounds_ && same_storage(o); }
 
 private:
+    Field3D(Vec3i resolution, Box3d bounds, std::vector<const float*> channels, std::vector<std::shared_ptr<const void>> owners,
+            std::vector<std::string> names);
     Vec3i res_;
     Box3d bounds_;
 };

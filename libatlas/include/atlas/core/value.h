@@ -24,5 +24,7 @@ PortType value_type(const Value& v);
 void hash_value(Hasher& h, const Value& v);
 bool values_equal(const Value& a, const Value& b);
 uint64_t value_bytes(const Value& v);
+// The bytes the value allocated itself: a field's shared channels belong to their owners (memory budgets).
+uint64_t value_storage_bytes(const Value& v);
 
 } // namespace atlas

@@ -53,6 +53,11 @@ struct CookOptions {
     // so cache, apart from full ones; it never writes outputs (write_outputs must be
     // false). 1: full resolution.
     int proxy = 1;
+    // false: a one-shot cook (`atlas cook`): the session's in-memory cache keeps
+    // none of this cook's values, so each is freed once the nodes reading it and
+    // the outputs it feeds are done (the cloudscape's peak 2.1 -> GB; issue 49).
+    // true: an editor's session keeps every value for the next edit.
+    bool keep_values = true;
     ProgressSink progress;
 };
 
