@@ -14,12 +14,14 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <unistd.h>
@@ -793,6 +795,49 @@ TEST(Bc6hTexture, InvalidInputIsAClearError) {
     f.at(1, 2, 2, 0) = 0.0f;
     o.one_sided_below = true;
     expect_error("one-sided");
+}
+
+// A repeated flat block is answered from the thread's memo: the same bytes and result
+// as a fresh encode on a new thread, for every signedness and option set in turn
+// (dropping the signedness or options from the memo's key fails here).
+TEST(Bc6h, FlatBlockMemoEqualsAFreshEncode) {
+    using test::unit;
+    std::vector<std::array<float, 48>> blocks;
+    auto flat = [&](float r, float g, float b) {
+        std::array<float, 48> a;
+        for (int t = 0; t < 16; ++t) { a[size_t(3 * t)] = r; a[size_t(3 * t + 1)] = g; a[size_t(3 * t + 2)] = b; }
+        blocks.push_back(a);
+    };
+    for (int k = 0; k < 30; ++k) {
+        const float r = float(8 * unit(uint64_t(k), 1)), g = float(unit(uint64_t(k), 2)), b = float(0.01 * unit(uint64_t(k), 3));
+        flat(r, g, b);
+        flat(r, g, b);
+        if (k % 3 == 0) { // a non-flat block between two flat ones of the same colour
+            std::array<float, 48> a;
+            for (int i = 0; i < 48; ++i) a[size_t(i)] = float(4 * unit(uint64_t(k), 10 + uint64_t(i)));
+            blocks.push_back(a);
+            flat(r, g, b);
+        }
+        if (k % 5 == 0) flat(r, g, std::nextafter(b, 2.0f)); // one ulp off: a different colour
+    }
+    std::vector<BlockOptions> opts(3);
+    opts[0].quality = Quality::Fast;
+    opts[2].max_error = 1e-4f;
+    // Each block under each (options, signedness) twice in a row (the second from the
+    // memo), in an order where consecutive encodes differ in one of the two only.
+    const std::pair<int, bool> combos[] = {{0, false}, {0, true}, {1, true}, {1, false}, {2, false}, {2, true}};
+    for (size_t i = 0; i < blocks.size(); ++i)
+        for (const auto& [oi, sg] : combos)
+            for (int rep = 0; rep < 2; ++rep) {
+                const BlockOptions& o = opts[size_t(oi)];
+                uint8_t a[16], b[16];
+                const BlockResult ra = encode_bc6h_block(blocks[i].data(), sg, o, a);
+                BlockResult rb;
+                std::thread([&, sg = sg] { rb = encode_bc6h_block(blocks[i].data(), sg, o, b); }).join();
+                ASSERT_EQ(std::memcmp(a, b, 16), 0) << "block " << i << " options " << oi << " signed " << sg << " repeat " << rep;
+                ASSERT_EQ(std::memcmp(&ra.max_error, &rb.max_error, 4), 0) << "block " << i;
+                ASSERT_EQ(std::memcmp(&ra.sum_sq, &rb.sum_sq, 8), 0) << "block " << i;
+            }
 }
 
 } // namespace

@@ -5,6 +5,8 @@
 #include "volume_test_util.h"
 
 #include <gtest/gtest.h>
+
+#include <bit>
 #include <tbb/global_control.h>
 
 #include <cmath>
@@ -198,6 +200,35 @@ TEST(Erosion, NubisRemapProperties) {
     o.amount = 0.5;
     o.frequency = 0;
     EXPECT_THROW(erode_by_noise(f, o), Error);
+}
+
+// Empty voxels are skipped (the noise is evaluated over each row's occupied span):
+// a voxel of a sparse field erodes exactly as in the full field, empty ones stay +0.
+TEST(Erosion, SparseRowsErodeAsInTheFullField) {
+    const Field3D full = density_from_sdf(shape_sdf(sphere({{32, 32, 32}}, 20), {{64, 64, 64}}, box(64)));
+    ErosionOptions o;
+    o.frequency = 1.0 / 8;
+    o.amount = 0.6;
+    o.octaves = 3;
+    const Field3D ref = erode_by_noise(full, o);
+    Field3D sparse = full;
+    for (size_t i = 0; i < sparse.voxel_count(); ++i)
+        if ((i * 2654435761u) % 7 != 0) sparse.channel(0)[i] = 0.0f; // a seventh kept, in scattered runs
+    sparse.at(0, 5, 40, 31) = -0.0f;                                // a negative zero alone in its row
+    const Field3D e = erode_by_noise(sparse, o);
+    size_t kept = 0;
+    for (size_t i = 0; i < e.voxel_count(); ++i) {
+        const float in = sparse.channel(0)[i], out = e.channel(0)[i];
+        if (std::bit_cast<uint32_t>(in) == 0u) {
+            ASSERT_EQ(std::bit_cast<uint32_t>(out), 0u) << i;
+        } else if (in == 0.0f) {
+            ASSERT_EQ(out, 0.0f) << i;
+        } else {
+            ASSERT_EQ(std::bit_cast<uint32_t>(out), std::bit_cast<uint32_t>(ref.channel(0)[i])) << i;
+            ++kept;
+        }
+    }
+    EXPECT_GT(kept, 1000u);
 }
 
 TEST(Filters, SmoothDilateErode) {

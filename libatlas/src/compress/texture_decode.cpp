@@ -52,13 +52,18 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
         const int bw = std::max(1, (L.w + 3) / 4), bh = std::max(1, (L.h + 3) / 4);
         const int unit = format_unit_bytes(f);
         const uint8_t* base = level + size_t(z0) * size_t(bh) * size_t(bw) * size_t(unit);
+        // A block with the bytes of the one before decodes the same (empty space is
+        // runs of one block): its texels are reused (lo and hi outlive the iteration).
+        const uint8_t* prev = nullptr;
+        float lo[48], hi[48];
+        const int ch = L.channels;
         for (int z = 0; z < L.d; ++z)
             for (int by = 0; by < bh; ++by)
                 for (int bx = 0; bx < bw; ++bx) {
                     const uint8_t* blk = base + ((size_t(z) * size_t(bh) + size_t(by)) * size_t(bw) + size_t(bx)) * size_t(unit);
-                    float lo[48], hi[48];
-                    int ch = L.channels;
-                    if (f == DxgiFormat::BC6H_UF16 || f == DxgiFormat::BC6H_SF16) {
+                    if (prev && std::memcmp(prev, blk, size_t(unit)) == 0) {
+                        // same lo and hi as the block before
+                    } else if (f == DxgiFormat::BC6H_UF16 || f == DxgiFormat::BC6H_SF16) {
                         decode_bc6h_block(blk, f == DxgiFormat::BC6H_SF16, lo); // exact: no decoder tolerance
                         std::copy(lo, lo + 48, hi);
                     } else if (f == DxgiFormat::BC4_UNORM || f == DxgiFormat::BC4_SNORM) {
@@ -103,6 +108,7 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
                                 }
                         }
                     }
+                    prev = blk;
                     for (int t = 0; t < 16; ++t) {
                         const int x = bx * 4 + t % 4, y = by * 4 + t / 4;
                         if (x >= L.w || y >= L.h) continue;

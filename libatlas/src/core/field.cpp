@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <new>
 #include <sys/mman.h>
 
@@ -34,15 +35,47 @@ ChannelData zeroed_channel(size_t count) {
 }
 } // namespace
 
+namespace {
+constexpr size_t kHuge = size_t(2) << 20;
+// Freed large channels, kept for the next channel of the same size: a cook frees and
+// makes channels of one size over and over (every 512x512x64 channel is 64 MiB), and
+// a fresh one costs its page faults and the kernel's zeroing again. A miss gives every
+// kept block back first, so the process never holds more than it held live at a time.
+struct FreeBlocks {
+    std::mutex mutex;
+    std::vector<std::pair<void*, size_t>> blocks; // pointer, rounded size
+    void release_all() {
+        for (auto& [p, n] : blocks) std::free(p);
+        blocks.clear();
+    }
+};
+FreeBlocks& free_blocks() {
+    // Never destroyed: a field may be freed after static destructors ran.
+    static FreeBlocks* f = new FreeBlocks;
+    return *f;
+}
+size_t rounded_size(size_t bytes) { return (bytes + kHuge - 1) / kHuge * kHuge; }
+} // namespace
+
 void* allocate_channel_bytes(size_t bytes) {
-    // Transparent huge pages for channels of 8 MiB and more, aligned so whole
-    // 2 MiB pages back them; the kernel decides (THP "never" ignores the advice).
-    constexpr size_t kHuge = size_t(2) << 20;
+    // Channels of 8 MiB and more: transparent huge pages, aligned so whole 2 MiB pages
+    // back them (the kernel decides; THP "never" ignores the advice).
     if (bytes < 4 * kHuge) {
         if (void* p = std::malloc(bytes ? bytes : 1)) return p;
         throw std::bad_alloc();
     }
-    const size_t rounded = (bytes + kHuge - 1) / kHuge * kHuge;
+    const size_t rounded = rounded_size(bytes);
+    {
+        FreeBlocks& f = free_blocks();
+        std::lock_guard<std::mutex> lock(f.mutex);
+        for (size_t i = 0; i < f.blocks.size(); ++i)
+            if (f.blocks[i].second == rounded) {
+                void* p = f.blocks[i].first;
+                f.blocks.erase(f.blocks.begin() + std::ptrdiff_t(i));
+                return p;
+            }
+        f.release_all();
+    }
     void* p = std::aligned_alloc(kHuge, rounded);
     if (!p) throw std::bad_alloc();
 #ifdef MADV_HUGEPAGE
@@ -51,7 +84,17 @@ void* allocate_channel_bytes(size_t bytes) {
     return p;
 }
 
-void free_channel_bytes(void* p, size_t) noexcept { std::free(p); }
+void free_channel_bytes(void* p, size_t bytes) noexcept {
+    if (!p) return;
+    if (bytes < 4 * kHuge) return std::free(p);
+    FreeBlocks& f = free_blocks();
+    std::lock_guard<std::mutex> lock(f.mutex);
+    try {
+        f.blocks.emplace_back(p, rounded_size(bytes));
+    } catch (...) {
+        std::free(p);
+    }
+}
 
 FieldStorage::FieldStorage(const FieldStorage& o) : count_(o.count_), names_(o.names_) {
     data_.reserve(o.ptr_.size());

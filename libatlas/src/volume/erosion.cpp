@@ -7,6 +7,7 @@
 #include "atlas/core/parallel.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <vector>
 
@@ -29,10 +30,21 @@ Field3D erode_by_noise(const Field3D& density, const ErosionOptions& o, const Me
     // Gain 0.5 (octave weights 2^-k / sum); octave k at frequency 2^k.
     const noise::ValueFbm fbm{.octaves = o.octaves, .gain = 0.5, .seed = o.seed, .seed_step = 0x9E3779B9u};
     const std::vector<float> weights = noise::fbm_weights(fbm);
+    // A voxel whose density is +0 stays +0 whatever the noise ((0 - e) / (1 - e) clamps to
+    // +0), and most of a cloudscape is empty: the noise is evaluated only over each row's
+    // span from its first to its last other voxel (a window of the same row: same values).
+    const std::span<const float> in = density.channel(o.channel);
+    auto is_pos_zero = [](float v) { return std::bit_cast<uint32_t>(v) == 0u; };
     parallel_for_index(density.nz(), [&](int z) {
         std::vector<float> acc(size_t(density.nx())), scratch;
         for (int y = 0; y < density.ny(); ++y) {
-            noise::value_fbm_row(acc, fbm, weights, [&](int k) {
+            const float* row = in.data() + density.index(0, y, z);
+            int x_lo = 0, x_hi = density.nx();
+            while (x_lo < x_hi && is_pos_zero(row[x_lo])) ++x_lo;
+            while (x_hi > x_lo && is_pos_zero(row[x_hi - 1])) --x_hi;
+            if (x_lo == x_hi) continue; // the copy holds the row already
+            const std::span<float> span(acc.data(), size_t(x_hi - x_lo));
+            noise::value_fbm_row(span, fbm, weights, [&](int k) {
                 const double f = o.frequency * std::ldexp(1.0, k);
                 // Period in cells: the extent, so the noise tiles on the bounds
                 // when frequency * extent is an integer.
@@ -41,13 +53,13 @@ Field3D erode_by_noise(const Field3D& density, const ErosionOptions& o, const Me
                              std::max(1, int(std::lround(ext[2] * f)))}};
                 r.x0 = 0.5 * h[0] * f;
                 r.dx = h[0] * f;
-                r.first = fr.offset[0];
+                r.first = fr.offset[0] + x_lo;
                 r.y = ((y + fr.offset[1]) + 0.5) * h[1] * f;
                 r.z = ((z + fr.offset[2]) + 0.5) * h[2] * f;
                 return r;
             }, scratch);
-            for (int x = 0; x < density.nx(); ++x) {
-                const double e = o.amount * std::clamp(double(acc[size_t(x)]), 0.0, 1.0);
+            for (int x = x_lo; x < x_hi; ++x) {
+                const double e = o.amount * std::clamp(double(acc[size_t(x - x_lo)]), 0.0, 1.0);
                 float& d = out.at(o.channel, x, y, z);
                 d = e >= 1 ? 0.0f : float(std::clamp((double(d) - e) / (1 - e), 0.0, 1.0));
             }
