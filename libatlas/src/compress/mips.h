@@ -1,15 +1,19 @@
 // Internal: mip reduction of normalized planes (box average, or min for one-sided).
 #pragma once
 
+#include "atlas/core/field.h"
+
 #include <algorithm>
 #include <vector>
 
 namespace atlas::compress::detail {
 
-// One level: planes[layer][channel], x fastest, then y, then z.
+// One level: planes[layer][channel], x fastest, then y, then z. Planes are field
+// channels' storage (not zero-filled, large ones reused): every texel is written.
+using Plane = atlas::detail::ChannelData;
 struct LevelData {
     int w = 1, h = 1, d = 1;
-    std::vector<std::vector<std::vector<float>>> planes;
+    std::vector<std::vector<Plane>> planes;
 };
 
 // The next level: size max(1, n/2) per axis (z only for volumes). Output texel i
@@ -31,7 +35,7 @@ inline LevelData reduce_level(const LevelData& in, bool volume, bool use_min) {
         for (size_t c = 0; c < in.planes[l].size(); ++c) {
             const auto& src = in.planes[l][c];
             auto& dst = out.planes[l][c];
-            dst.assign(size_t(out.w) * size_t(out.h) * size_t(out.d), 0.0f);
+            dst.resize(size_t(out.w) * size_t(out.h) * size_t(out.d)); // every texel written below
             for (int z = 0; z < out.d; ++z) {
                 int z0, z1;
                 span(z, out.d, in.d, z0, z1);

@@ -302,11 +302,12 @@ EncodedTexture encode_texture(const Field3D& field, const CompressOptions& o, co
     const size_t slice = size_t(L0.w) * size_t(L0.h) * size_t(L0.d);
     // Each plane allocated in place: assign() with a prototype would hold the
     // prototype and its copy at once (twice the planes, 256 MiB more on a
-    // 512x512x64 RGBA volume, seen with heaptrack).
+    // 512x512x64 RGBA volume, seen with heaptrack). Not zero-filled: every texel
+    // is written below.
     L0.planes.resize(size_t(layers));
     for (auto& layer_planes : L0.planes) {
         layer_planes.resize(size_t(stored));
-        for (auto& plane : layer_planes) plane.assign(slice, 0.0f);
+        for (auto& plane : layer_planes) plane.resize(slice);
     }
     for (int l = 0; l < layers; ++l)
         for (int c = 0; c < stored; ++c) {
