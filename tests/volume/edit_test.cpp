@@ -10,6 +10,7 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <numbers>
 #include <limits>
 
 using namespace atlas;
@@ -169,6 +170,48 @@ TEST(Transform, RotateScaleSquash) {
     CloudTransform bad;
     bad.scale = {{1, 0, 1}};
     EXPECT_THROW(transform_field(f, bad, res, box(40)), Error);
+}
+
+// Empty space is not sampled: every voxel equals sample_or at its inverse-mapped point,
+// inside the cloud, at its edge and far from it (a small cloud in a large grid).
+TEST(Transform, SkippedEmptySpaceEqualsSamplingEveryVoxel) {
+    Field3D f({{48, 40, 24}}, 2, box(48));
+    for (int z = 10; z < 16; ++z)
+        for (int y = 12; y < 20; ++y)
+            for (int x = 20; x < 27; ++x) {
+                f.at(0, x, y, z) = 0.1f * float(x - 19);
+                f.at(1, x, y, z) = 1.0f / float(1 + y - 11 + z);
+            }
+    f.at(1, 3, 5, 2) = -0.0f; // a lone negative zero counts as occupied
+    CloudTransform t;
+    t.pivot = {{23, 16, 13}};
+    t.rotate_deg = {{10, -20, 35}};
+    t.squash = 0.7;
+    t.translate = {{2.5, -1.25, 0.5}};
+    const Field3D g = transform_field(f, t, f.resolution(), f.bounds());
+    // The same mapping, written out (transform.cpp's inverse: p = pivot + S^-1 R^T (p' - pivot - translate)).
+    const double d2r = std::numbers::pi / 180;
+    const double cx = std::cos(10 * d2r), sx = std::sin(10 * d2r), cy = std::cos(-20 * d2r), sy = std::sin(-20 * d2r),
+                 cz = std::cos(35 * d2r), sz = std::sin(35 * d2r);
+    const double R[3][3] = {{cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx},
+                            {sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx},
+                            {-sy, cy * sx, cy * cx}};
+    const double sq = 1 / std::sqrt(0.7);
+    const Vec3d S{{sq, sq, 0.7}};
+    size_t nonzero = 0;
+    for (int z = 0; z < 24; ++z)
+        for (int y = 0; y < 40; ++y)
+            for (int x = 0; x < 48; ++x) {
+                const Vec3d q = g.voxel_center(x, y, z) - t.pivot - t.translate;
+                Vec3d p;
+                for (int i = 0; i < 3; ++i) p[i] = (R[0][i] * q[0] + R[1][i] * q[1] + R[2][i] * q[2]) / S[i] + t.pivot[i];
+                for (int c = 0; c < 2; ++c) {
+                    const float want = sample_or(f, c, p);
+                    ASSERT_EQ(std::bit_cast<uint32_t>(g.at(c, x, y, z)), std::bit_cast<uint32_t>(want)) << x << " " << y << " " << z << " " << c;
+                    nonzero += want != 0;
+                }
+            }
+    EXPECT_GT(nonzero, 300u);
 }
 
 TEST(Erosion, NubisRemapProperties) {

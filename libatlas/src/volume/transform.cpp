@@ -5,7 +5,10 @@
 
 #include "atlas/core/parallel.h"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 
 namespace atlas::volume {
@@ -36,12 +39,42 @@ Field3D transform_field(const Field3D& src, const CloudTransform& t, Vec3i res, 
     const double sq_xy = 1 / std::sqrt(t.squash);
     const Vec3d S{{t.scale[0] * sq_xy, t.scale[1] * sq_xy, t.scale[2] * t.squash}};
     Field3D out(res, src.channels(), bounds, src.channel_names(), budget);
+    // A cloud fills a small part of its grid: a point whose trilinear taps all lie
+    // outside the source's occupied voxels (any bits but +0) samples +0, which `out`
+    // holds already, so it is not sampled (the same bytes).
+    const Vec3i n = src.resolution();
+    Vec3i lo = n, hi{{-1, -1, -1}};
+    for (int c = 0; c < src.channels(); ++c) {
+        const auto ch = src.channel(c);
+        for (int z = 0; z < n[2]; ++z)
+            for (int y = 0; y < n[1]; ++y) {
+                const float* row = ch.data() + src.index(0, y, z);
+                int x0 = 0, x1 = n[0];
+                while (x0 < x1 && std::bit_cast<uint32_t>(row[x0]) == 0u) ++x0;
+                if (x0 == x1) continue;
+                while (std::bit_cast<uint32_t>(row[x1 - 1]) == 0u) --x1;
+                lo = {{std::min(lo[0], x0), std::min(lo[1], y), std::min(lo[2], z)}};
+                hi = {{std::max(hi[0], x1 - 1), std::max(hi[1], y), std::max(hi[2], z)}};
+            }
+    }
+    if (hi[0] < 0) return out; // nothing but +0
+    const Vec3d h = src.voxel_size();
+    // Voxel coordinate u (centres at i + 0.5) has taps floor(u - 0.5) and one more:
+    // both outside [lo, hi] when u < lo - 0.5 or u >= hi + 2 (a voxel's margin kept).
+    auto occupied = [&](const Vec3d& p) {
+        for (int a = 0; a < 3; ++a) {
+            const double u = (p[a] - src.bounds().min[a]) / h[a];
+            if (!(u >= lo[a] - 1.0 && u < hi[a] + 2.0)) return false;
+        }
+        return true;
+    };
     parallel_for_index(res[2], [&](int z) {
         for (int y = 0; y < res[1]; ++y)
             for (int x = 0; x < res[0]; ++x) {
                 const Vec3d q = out.voxel_center(x, y, z) - t.pivot - t.translate;
                 Vec3d p;
                 for (int i = 0; i < 3; ++i) p[i] = (R[0][i] * q[0] + R[1][i] * q[1] + R[2][i] * q[2]) / S[i] + t.pivot[i];
+                if (!occupied(p)) continue;
                 for (int c = 0; c < src.channels(); ++c) out.at(c, x, y, z) = sample_or(src, c, p);
             }
     });
