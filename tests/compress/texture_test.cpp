@@ -327,7 +327,7 @@ TEST(Texture, ReportJsonHasTheDocumentedKeys) {
     o.max_error = 1e-6f;
     o.allow_over_bound = true;
     const std::string j = encode_texture(sdf_field(8, 8, 1, 0), o).report.to_json();
-    for (const char* key : {"\"max_error\"", "\"rmse\"", "\"psnr\"", "\"blocks_over_bound\"", "\"encode_seconds\"",
+    for (const char* key : {"\"max_error\"", "\"rmse\"", "\"psnr\"", "\"blocks_over_bound\"", "\"encode_seconds\"", "\"verify_seconds\"",
                             "\"texels_per_second\"", "\"one_sided_violations\"", "\"decoder\": \"conformant\""})
         EXPECT_NE(j.find(key), std::string::npos) << key;
 }

@@ -45,6 +45,7 @@ std::vector<fs::path> write_dds_output(const Value& value, const fs::path& path,
     metrics["bound_max_error"] = r.bound_max_error;
     metrics["blocks_over_bound"] = double(r.blocks_over_bound.size());
     metrics["encode_seconds"] = r.encode_seconds;
+    metrics["verify_seconds"] = r.verify_seconds;
     return {path, fs::path(path.string() + ".json")};
 }
 

@@ -136,6 +136,7 @@ struct CompressReport {
     std::vector<BlockMiss> blocks_over_bound;
     std::vector<DecoderStats> per_decoder;
     double encode_seconds = 0;
+    double verify_seconds = 0; // decoding the written blocks and measuring the errors above
     double texels_per_second = 0;
     uint64_t texels = 0;
     uint64_t bytes = 0;
