@@ -483,11 +483,7 @@ TEST(Bc1Scalar, ConstantBlockReachesEndpointPrecision) {
 // give what each block gives alone on a fresh thread (an empty memo).
 TEST(Bc1, FlatBlockMemoEqualsAFreshSearch) {
     std::vector<std::array<float, 48>> blocks;
-    auto flat = [&](float r, float g, float b) {
-        std::array<float, 48> a;
-        for (int t = 0; t < 16; ++t) { a[size_t(3 * t)] = r; a[size_t(3 * t + 1)] = g; a[size_t(3 * t + 2)] = b; }
-        blocks.push_back(a);
-    };
+    auto flat = [&](float r, float g, float b) { blocks.push_back(test::flat_rgb_block(r, g, b)); };
     for (int k = 0; k < 40; ++k) {
         const float r = float(unit(uint64_t(k), 1)), g = float(unit(uint64_t(k), 2)), b = float(unit(uint64_t(k), 3));
         flat(r, g, b);

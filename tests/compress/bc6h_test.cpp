@@ -799,15 +799,11 @@ TEST(Bc6hTexture, InvalidInputIsAClearError) {
 
 // A repeated flat block is answered from the thread's memo: the same bytes and result
 // as a fresh encode on a new thread, for every signedness and option set in turn
-// (dropping the signedness or options from the memo's key fails here).
+// (leaving the signedness out of the memo's key fails here).
 TEST(Bc6h, FlatBlockMemoEqualsAFreshEncode) {
     using test::unit;
     std::vector<std::array<float, 48>> blocks;
-    auto flat = [&](float r, float g, float b) {
-        std::array<float, 48> a;
-        for (int t = 0; t < 16; ++t) { a[size_t(3 * t)] = r; a[size_t(3 * t + 1)] = g; a[size_t(3 * t + 2)] = b; }
-        blocks.push_back(a);
-    };
+    auto flat = [&](float r, float g, float b) { blocks.push_back(test::flat_rgb_block(r, g, b)); };
     for (int k = 0; k < 30; ++k) {
         const float r = float(8 * unit(uint64_t(k), 1)), g = float(unit(uint64_t(k), 2)), b = float(0.01 * unit(uint64_t(k), 3));
         flat(r, g, b);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 
 #include <cmath>
 #include <cstdint>
@@ -24,6 +25,17 @@ inline double unit(uint64_t seed, uint64_t i) {
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     z ^= z >> 31;
     return double(z >> 11) * (1.0 / 9007199254740992.0);
+}
+
+// A flat RGB block: 16 texels of one colour (the encoders' flat-block memos).
+inline std::array<float, 48> flat_rgb_block(float r, float g, float b) {
+    std::array<float, 48> a;
+    for (size_t t = 0; t < 16; ++t) {
+        a[3 * t] = r;
+        a[3 * t + 1] = g;
+        a[3 * t + 2] = b;
+    }
+    return a;
 }
 
 // Block `k` of a mixed stream: noise, gradients, two-level, steps, constants, extremes.
