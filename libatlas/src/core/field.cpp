@@ -40,13 +40,18 @@ constexpr size_t kHuge = size_t(2) << 20;
 // Freed large channels, kept for the next channel of the same size: a cook frees and
 // makes channels of one size over and over (every 512x512x64 channel is 64 MiB), and
 // a fresh one costs its page faults and the kernel's zeroing again. A miss gives every
-// kept block back first, so the process never holds more than it held live at a time.
+// kept block back first, so the process never holds more than it held live at a time,
+// and at most kKeptBytes are kept (a host that cooked a large graph once does not hold
+// its memory for good).
+constexpr size_t kKeptBytes = size_t(512) << 20;
 struct FreeBlocks {
     std::mutex mutex;
     std::vector<std::pair<void*, size_t>> blocks; // pointer, rounded size
+    size_t bytes = 0;
     void release_all() {
         for (auto& [p, n] : blocks) std::free(p);
         blocks.clear();
+        bytes = 0;
     }
 };
 FreeBlocks& free_blocks() {
@@ -71,6 +76,7 @@ void* allocate_channel_bytes(size_t bytes) {
         for (size_t i = 0; i < f.blocks.size(); ++i)
             if (f.blocks[i].second == rounded) {
                 void* p = f.blocks[i].first;
+                f.bytes -= rounded;
                 f.blocks.erase(f.blocks.begin() + std::ptrdiff_t(i));
                 return p;
             }
@@ -87,10 +93,13 @@ void* allocate_channel_bytes(size_t bytes) {
 void free_channel_bytes(void* p, size_t bytes) noexcept {
     if (!p) return;
     if (bytes < 4 * kHuge) return std::free(p);
+    const size_t rounded = rounded_size(bytes);
     FreeBlocks& f = free_blocks();
     std::lock_guard<std::mutex> lock(f.mutex);
+    if (f.bytes + rounded > kKeptBytes) return std::free(p);
     try {
-        f.blocks.emplace_back(p, rounded_size(bytes));
+        f.blocks.emplace_back(p, rounded);
+        f.bytes += rounded;
     } catch (...) {
         std::free(p);
     }
