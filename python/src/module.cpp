@@ -285,12 +285,13 @@ per Session (cook releases the GIL, so other Python threads run meanwhile).)doc"
              "Overrides NODE.PARAM from text as the CLI's --set spells it ('0.5', '[1, 2, 3]', 'name').")
         .def("cook", [](PySession& ps, const py::object& outputs, int jobs, bool write_outputs, const py::object& out_dir,
                         const py::object& cache_dir, bool checked, const py::object& memory_budget, const py::object& progress,
-                        const py::object& cancel, bool keep_going, int proxy) {
+                        const py::object& cancel, bool keep_going, int proxy, bool keep_values) {
                  BusyGuard guard(ps);
                  Session& s = ps.session;
                  CookOptions o = make_options(outputs, jobs, write_outputs, out_dir, cache_dir, checked, memory_budget, progress, cancel);
                  o.keep_going = keep_going;
                  o.proxy = proxy;
+                 o.keep_values = keep_values;
                  CookResult r;
                  {
                      py::gil_scoped_release nogil;
@@ -301,6 +302,7 @@ per Session (cook releases the GIL, so other Python threads run meanwhile).)doc"
              py::arg("outputs") = py::none(), py::arg("jobs") = 0, py::arg("write_outputs") = false, py::arg("out_dir") = py::none(),
              py::arg("cache_dir") = py::none(), py::arg("checked") = false, py::arg("memory_budget") = py::none(),
              py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("keep_going") = false, py::arg("proxy") = 1,
+             py::arg("keep_values") = true,
              R"doc(Cooks the graph's outputs (or those named) and returns the report as a dict:
 {"nodes": {name: {"status": "cooked"|"cached"|"skipped", "type", "reason", "hash", "seconds", "bytes", "metrics", "warnings"}}, "outputs": [...], ...}.
 write_outputs=True also writes the output files into out_dir (atomically). The GIL is released while
@@ -308,7 +310,9 @@ cooking; progress(fraction, task, done, total) and cancel() -> bool are called f
 with the GIL taken. Raises atlas.CancelledError when cancel() returns true. keep_going=True: an output
 whose writer fails is reported with "status": "failed" and its "error" (and a warning), and the other
 outputs are written (an editor's edit); otherwise the cook raises and writes nothing. proxy=P: every world
-grid at 1/P of its cells per axis (values only: a proxy cook never writes outputs).)doc")
+grid at 1/P of its cells per axis (values only: a proxy cook never writes outputs). keep_values=False: a
+one-shot cook (a build step, as `atlas cook`): each value is freed once the nodes reading it are done and
+the outputs it feeds are written, and the session keeps none for the next cook.)doc")
         .def("preview", [](PySession& ps, const py::object& options, int proxy, int jobs, const py::object& cache_dir, const std::string& mode,
                            const std::string& noise, bool tone_mapped, const py::object& progress, const py::object& cancel) {
                  BusyGuard guard(ps);

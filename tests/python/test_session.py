@@ -191,6 +191,19 @@ def test_progress_and_cancel(small_graph):
         s.cook(jobs=1, progress=broken_progress)
 
 
+def test_a_one_shot_cook_keeps_no_values(small_graph, tmp_path):
+    s = atlas.Session()
+    s.load_text(small_graph, "small.yaml")
+    r1 = s.cook(jobs=1, keep_values=False, write_outputs=True, out_dir=str(tmp_path))
+    assert r1["nodes"]["coverage"]["status"] == "cooked"
+    # Nothing kept: the next cook cooks every node again; a session that keeps its values does not.
+    r2 = s.cook(jobs=1, keep_values=False)
+    assert {r2["nodes"][n]["status"] for n in ("base", "coverage")} == {"cooked"}
+    r3 = s.cook(jobs=1)
+    assert r3["nodes"]["coverage"]["status"] == "cooked"
+    assert s.cook(jobs=1)["nodes"]["coverage"]["status"] == "cached"
+
+
 def test_cook_releases_the_gil(quickstart):
     s = atlas.Session()
     s.load(quickstart)
