@@ -5,9 +5,9 @@
 #include "atlas/volume/edit.h"
 
 #include "atlas/core/parallel.h"
+#include "occupied_span.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <vector>
 
@@ -34,14 +34,11 @@ Field3D erode_by_noise(const Field3D& density, const ErosionOptions& o, const Me
     // +0), and most of a cloudscape is empty: the noise is evaluated only over each row's
     // span from its first to its last other voxel (a window of the same row: same values).
     const std::span<const float> in = density.channel(o.channel);
-    auto is_pos_zero = [](float v) { return std::bit_cast<uint32_t>(v) == 0u; };
     parallel_for_index(density.nz(), [&](int z) {
         std::vector<float> acc(size_t(density.nx())), scratch;
         for (int y = 0; y < density.ny(); ++y) {
             const float* row = in.data() + density.index(0, y, z);
-            int x_lo = 0, x_hi = density.nx();
-            while (x_lo < x_hi && is_pos_zero(row[x_lo])) ++x_lo;
-            while (x_hi > x_lo && is_pos_zero(row[x_hi - 1])) --x_hi;
+            const auto [x_lo, x_hi] = detail::occupied_span(row, density.nx());
             if (x_lo == x_hi) continue; // the copy holds the row already
             const std::span<float> span(acc.data(), size_t(x_hi - x_lo));
             noise::value_fbm_row(span, fbm, weights, [&](int k) {

@@ -4,11 +4,10 @@
 #include "atlas/volume/edit.h"
 
 #include "atlas/core/parallel.h"
+#include "occupied_span.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
-#include <cstdint>
 #include <numbers>
 
 namespace atlas::volume {
@@ -49,10 +48,8 @@ Field3D transform_field(const Field3D& src, const CloudTransform& t, Vec3i res, 
         for (int z = 0; z < n[2]; ++z)
             for (int y = 0; y < n[1]; ++y) {
                 const float* row = ch.data() + src.index(0, y, z);
-                int x0 = 0, x1 = n[0];
-                while (x0 < x1 && std::bit_cast<uint32_t>(row[x0]) == 0u) ++x0;
+                const auto [x0, x1] = detail::occupied_span(row, n[0]);
                 if (x0 == x1) continue;
-                while (std::bit_cast<uint32_t>(row[x1 - 1]) == 0u) --x1;
                 lo = {{std::min(lo[0], x0), std::min(lo[1], y), std::min(lo[2], z)}};
                 hi = {{std::max(hi[0], x1 - 1), std::max(hi[1], y), std::max(hi[2], z)}};
             }
@@ -60,7 +57,8 @@ Field3D transform_field(const Field3D& src, const CloudTransform& t, Vec3i res, 
     if (hi[0] < 0) return out; // nothing but +0
     const Vec3d h = src.voxel_size();
     // Voxel coordinate u (centres at i + 0.5) has taps floor(u - 0.5) and one more:
-    // both outside [lo, hi] when u < lo - 0.5 or u >= hi + 2 (a voxel's margin kept).
+    // both below lo when u < lo - 0.5 and both above hi when u >= hi + 1.5; the test keeps
+    // half a voxel more margin on each side.
     auto occupied = [&](const Vec3d& p) {
         for (int a = 0; a < 3; ++a) {
             const double u = (p[a] - src.bounds().min[a]) / h[a];
