@@ -38,7 +38,9 @@ Field3D erode_by_noise(const Field3D& density, const ErosionOptions& o, const Me
         std::vector<float> acc(size_t(density.nx())), scratch;
         for (int y = 0; y < density.ny(); ++y) {
             const float* row = in.data() + density.index(0, y, z);
-            const auto [x_lo, x_hi] = detail::occupied_span(row, density.nx());
+            // Not a structured binding: clang 14 cannot capture one in the lambda below.
+            const std::pair<int, int> occ = detail::occupied_span(row, density.nx());
+            const int x_lo = occ.first, x_hi = occ.second;
             if (x_lo == x_hi) continue; // the copy holds the row already
             const std::span<float> span(acc.data(), size_t(x_hi - x_lo));
             noise::value_fbm_row(span, fbm, weights, [&](int k) {
