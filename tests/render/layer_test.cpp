@@ -414,14 +414,16 @@ TEST(LayerLights, FlashesBrightenTheLayerNeverItsTransmittance) {
     EXPECT_THROW(layer_flash_probability(prob, 0, 5, 5), Error);
 }
 
-TEST(LayerVortex, RingsTurnTheStormAndAFullTurnIsTheStart) {
+TEST(LayerVortex, RingsTurnTheNoiseNotTheMapAndAFullTurnIsTheStart) {
     // One ring over the whole map turning at w rad/s, no wind: at time t the
-    // layer is the t = 0 layer turned by w t about the centre, so w t = 2 pi
-    // gives the t = 0 picture (to float rounding of the rotation) and pi does not.
+    // noise is read turned by w t about the centre, so w t = 2 pi gives the
+    // t = 0 picture (to float rounding of the rotation) and pi does not. The map
+    // does not turn (000 turns the noise's sample positions): the clear east
+    // half (coverage 0) stays clear at every turn.
     LayerScene s = scene_with(0.0);
     Field2D set = *s.ndf;
     for (int y = 0; y < 16; ++y)
-        for (int x = 0; x < 16; ++x) set.at(ndf::Coverage, x, y) = x < 8 ? 0.9f : 0.1f; // not rotation-symmetric
+        for (int x = 0; x < 16; ++x) set.at(ndf::Coverage, x, y) = x < 8 ? 0.9f : 0.0f; // not rotation-symmetric
     s.ndf = std::make_shared<const Field2D>(std::move(set));
     s.wind = {{0, 0}};
     s.cloud_top_offset = 0;
@@ -450,6 +452,48 @@ TEST(LayerVortex, RingsTurnTheStormAndAFullTurnIsTheStart) {
     EXPECT_GT(d_half, 0.2);
     const auto f = full.report.active_features();
     EXPECT_NE(std::find(f.begin(), f.end(), "vortex_rings"), f.end());
+    // Half a turn: cloud where the west half has it (the noise turned), none over the
+    // east half, which a turned map would have covered with the west's clouds.
+    std::vector<Vec3d> west, east;
+    for (int i = 0; i < 30; ++i)
+        for (int k = 0; k < 10; ++k) {
+            const double y = 1000 + 600.0 * i, h = 1700 + 200.0 * k;
+            west.push_back({{3000, y, h}});
+            east.push_back({{17000, y, h}});
+        }
+    const std::vector<double> dw = layer_density(s, west), de = layer_density(s, east);
+    EXPECT_GT(*std::max_element(dw.begin(), dw.end()), 0.05);
+    EXPECT_EQ(*std::max_element(de.begin(), de.end()), 0.0);
+}
+
+TEST(LayerVortex, TheTurnsCentreMovesWithTheMapsWindScroll) {
+    // With wind the map scrolls by wind * time, and the storm's centre with it:
+    // on the vertical through the scrolled centre the noise turns about itself (the
+    // layer is the unturned one, exactly); through the table's own centre it does not.
+    LayerScene s = scene_with(0.7);
+    s.wind = {{4, 0}};
+    s.time = 500; // 2 km downwind
+    s.cloud_top_offset = 0;
+    s.earth_radius = 1e12; // a flat shell: the points' altitude is their z
+    const LayerScene plain = s;
+    Field2D table({{1, 1}}, 5, Box2d{{{0, 0}}, {{20000, 20000}}}, {"inner", "outer", "speed", "skew", "overlap_end"});
+    table.at(0, 0, 0) = 0;
+    table.at(1, 0, 0) = 5e5;
+    table.at(2, 0, 0) = 0.003f; // 1.5 rad at time 500
+    table.at(4, 0, 0) = 6e5;
+    s.vortex_table = std::make_shared<const Field2D>(std::move(table));
+    std::vector<Vec3d> moved, fixed;
+    for (int k = 0; k < 60; ++k) {
+        moved.push_back({{12000, 10000, 1550.0 + 40 * k}});
+        for (double dy : {-900.0, 900.0}) fixed.push_back({{10000, 10000 + dy, 1550.0 + 40 * k}});
+    }
+    const std::vector<double> m = layer_density(s, moved), m0 = layer_density(plain, moved);
+    for (size_t i = 0; i < m.size(); ++i) EXPECT_EQ(m[i], m0[i]) << i;
+    EXPECT_GT(*std::max_element(m.begin(), m.end()), 0.0);
+    const std::vector<double> f = layer_density(s, fixed), f0 = layer_density(plain, fixed);
+    double moved_most = 0;
+    for (size_t i = 0; i < f.size(); ++i) moved_most = std::max(moved_most, std::fabs(f[i] - f0[i]));
+    EXPECT_GT(moved_most, 0.05) << "off the scrolled centre the noise turns";
 }
 
 TEST(LayerAnvil, TheAnvilRisesAboveMaxHeightOnlyWhereTheBiasIsPositiveAndAtMostItsLift) {
@@ -512,14 +556,14 @@ TEST(LayerAnvil, TheAnvilRisesAboveMaxHeightOnlyWhereTheBiasIsPositiveAndAtMostI
 }
 
 TEST(LayerVortex, SkewTurnsTheRingPatternByItsAngleTimesTheHeightFraction) {
-    // At time 0 one ring with skew k over the whole map: the layer at
-    // altitude h equals the layer without rings turned by k * phi about the
-    // ring centre, phi = (h - 1500) / (4000 - 1500). Checked at points by
-    // rotating them by hand.
+    // At time 0 one ring with skew k over the whole map: over a uniform map the
+    // layer at altitude h equals the layer without rings with its noise turned by
+    // k * phi about the ring centre, phi = (h - 1500) / (4000 - 1500). Checked at
+    // points by rotating them by hand.
     LayerScene s = scene_with(0.0);
     Field2D set = *s.ndf;
     for (int y = 0; y < 16; ++y)
-        for (int x = 0; x < 16; ++x) set.at(ndf::Coverage, x, y) = x < 8 ? 0.9f : 0.15f;
+        for (int x = 0; x < 16; ++x) set.at(ndf::Coverage, x, y) = 0.7f; // the map is the same turned: the noise shows the turn
     s.ndf = std::make_shared<const Field2D>(std::move(set));
     s.wind = {{0, 0}};
     s.cloud_top_offset = 0;

@@ -246,36 +246,72 @@ public:
     bool has_anvil() const { return anvil_ != nullptr; }
     bool has_vortex() const { return !rings_.empty(); }
 
-    // Vortex rings: the angle (radians) the map turns by at radius r and
-    // height fraction phi of the set's shell (skew tilts the tendrils).
-    double vortex_angle(double r, double phi) const {
+    // Vortex rings (000, "MDR Vortex Field"): the noise's sample positions turn about the
+    // storm's centre, each ring at its own speed; the map itself (coverage, heights) does
+    // not turn, so the storm keeps its shape and its billows swirl. Where two rings overlap
+    // the noise is sampled at both turns and the samples interpolated, as 000 does:
+    // interpolating the angle instead winds the noise into a tighter spiral every second.
+    struct Turns {
+        double angle[2] = {0, 0};
+        double w = 0; // weight of angle[1]; 0: one sample
+    };
+    Turns vortex_turns(double r, double phi) const {
+        Turns t;
         const size_t n = rings_.size();
         for (size_t i = 0; i < n; ++i) {
             const Ring& g = rings_[i];
             if (r < g.inner) break;
             const double a = g.speed * s_.time + g.skew * phi;
             if (r < g.outer) {
+                t.angle[0] = a;
                 // Inside ring i: the previous ring's overlap band reaches in.
                 if (i > 0 && r < rings_[i - 1].overlap_end) {
                     const Ring& pr = rings_[i - 1];
-                    const double w = (r - pr.outer) / std::max(1e-9, pr.overlap_end - pr.outer);
-                    const double ap = pr.speed * s_.time + pr.skew * phi;
-                    return ap + (a - ap) * w;
+                    t.angle[0] = pr.speed * s_.time + pr.skew * phi;
+                    t.angle[1] = a;
+                    t.w = (r - pr.outer) / std::max(1e-9, pr.overlap_end - pr.outer);
                 }
-                return a;
+                return t;
             }
-            if (i + 1 == n && r < g.overlap_end) return a * (1 - (r - g.outer) / std::max(1e-9, g.overlap_end - g.outer));
+            if (i + 1 == n && r < g.overlap_end) { // the outermost ring fades into the still sky
+                t.angle[0] = a;
+                t.w = (r - g.outer) / std::max(1e-9, g.overlap_end - g.outer);
+                return t;
+            }
         }
-        return 0;
+        return t;
     }
-    // p (altitude h) with its x, y turned about the vortex centre by -angle(r, phi).
-    Vec3d unrotate(const Vec3d& p, double h) const {
-        const double dx = p[0] - vortex_centre_[0], dy = p[1] - vortex_centre_[1];
+    // The noise's (x, y) for p at altitude h: up to two turned positions and the weight of
+    // the second. The storm's centre moves with the map (the wind scrolls both).
+    struct NoiseXY {
+        double x[2], y[2];
+        double w = 0;
+    };
+    NoiseXY noise_xy(const Vec3d& p, double h) const {
+        NoiseXY q{{p[0], p[0]}, {p[1], p[1]}, 0};
+        if (rings_.empty()) return q;
+        const double cx = vortex_centre_[0] + map_shift_[0], cy = vortex_centre_[1] + map_shift_[1];
+        const double dx = p[0] - cx, dy = p[1] - cy;
         const double phi = set_top_ > bottom_ ? detail::saturate((h - bottom_) / (set_top_ - bottom_)) : 0.0;
-        const double a = -vortex_angle(std::hypot(dx, dy), phi);
-        if (a == 0) return p;
-        const double c = std::cos(a), sn = std::sin(a);
-        return {{vortex_centre_[0] + c * dx - sn * dy, vortex_centre_[1] + sn * dx + c * dy, p[2]}};
+        const Turns t = vortex_turns(std::hypot(dx, dy), phi);
+        for (int k = 0; k < 2; ++k) {
+            const double a = -t.angle[k];
+            if (a == 0) continue;
+            const double c = std::cos(a), sn = std::sin(a);
+            q.x[k] = cx + c * dx - sn * dy;
+            q.y[k] = cy + sn * dx + c * dy;
+        }
+        q.w = t.w;
+        return q;
+    }
+    // A noise texture's four channels at the (one or two) positions xy(k) gives, blended.
+    template <class Sample>
+    static void blended(const NoiseXY& q, Sample&& sample, float n[4]) {
+        sample(0, n);
+        if (q.w == 0) return;
+        float m[4];
+        sample(1, m);
+        for (int c = 0; c < 4; ++c) n[c] = float(n[c] + (m[c] - n[c]) * q.w);
     }
 
     const Vec3d& centre() const { return centre_; }
@@ -359,7 +395,7 @@ public:
     // (HZD's "cheap" sample). shape_out: the base shape with coverage (the
     // sample's profile for ambient and multiple scattering).
     double density(const Vec3d& p_in, double h, bool full, Column* col_out = nullptr, double* shape_out = nullptr) const {
-        const Vec3d p = rings_.empty() ? p_in : unrotate(p_in, h);
+        const Vec3d& p = p_in;
         Column c;
         if (!column(p[0], p[1], c)) return 0;
         if (h <= c.min_h) return 0;
@@ -383,17 +419,18 @@ public:
         // Wind: tops pushed downwind, the noise scrolled (detail faster, a
         // little upward: clouds seem to grow).
         const double skew = f * s_.cloud_top_offset;
-        const double qx = p[0] + wind_dir_[0] * skew - s_.wind[0] * s_.time;
-        const double qy = p[1] + wind_dir_[1] * skew - s_.wind[1] * s_.time;
-        const double qz = h - rise_;
         const double thr = coverage_threshold(c.coverage);
         // The base is at most the texture's largest value: skip the lookup
         // where even that stays under the coverage threshold.
         if (profile * base_max_ <= thr) return 0;
+        const NoiseXY xy = noise_xy(p, h);
+        auto qx = [&](int k) { return xy.x[k] + wind_dir_[0] * skew - s_.wind[0] * s_.time; };
+        auto qy = [&](int k) { return xy.y[k] + wind_dir_[1] * skew - s_.wind[1] * s_.time; };
+        const double qz = h - rise_;
         double base = 1;
         if (base_.ok()) {
             float n[4];
-            base_.sample(qx, qy, qz, n);
+            blended(xy, [&](int k, float* out) { base_.sample(qx(k), qy(k), qz, out); }, n);
             base = ndf::dilated_base(n[0], n[1], n[2], n[3]);
         }
         base *= profile;
@@ -405,18 +442,21 @@ public:
         if (col_out) *col_out = c;
         if (shape_out) *shape_out = shaped;
         if (!full || !detail_.ok()) return shaped * s_.density_scale;
-        double dx = qx * 1.3, dy = qy * 1.3, dz = qz * 1.3; // detail moves faster than the base (detail_texel)
-        if (curl_) {
-            // Turbulence at the cloud base: curl-distorted detail coordinates.
-            Bilinear b;
-            wrap_axis(dx / s_.curl_tile * curl_->width(), curl_->width(), curl_mask_[0], b.x0, b.x1, b.tx);
-            wrap_axis(dy / s_.curl_tile * curl_->height(), curl_->height(), curl_mask_[1], b.y0, b.y1, b.ty);
-            const double k = s_.curl_amount * (1.0 - f);
-            dx += (2.0 * lerp2(curl_r_, curl_->width(), b) - 1.0) * k;
-            dy += (2.0 * lerp2(curl_g_, curl_->width(), b) - 1.0) * k;
-        }
+        const double dz = qz * 1.3;
         float n[4];
-        detail_.sample(dx, dy, dz, n);
+        blended(xy, [&](int k, float* out) {
+            double dx = qx(k) * 1.3, dy = qy(k) * 1.3; // detail moves faster than the base (detail_texel)
+            if (curl_) {
+                // Turbulence at the cloud base: curl-distorted detail coordinates.
+                Bilinear b;
+                wrap_axis(dx / s_.curl_tile * curl_->width(), curl_->width(), curl_mask_[0], b.x0, b.x1, b.tx);
+                wrap_axis(dy / s_.curl_tile * curl_->height(), curl_->height(), curl_mask_[1], b.y0, b.y1, b.ty);
+                const double amount = s_.curl_amount * (1.0 - f);
+                dx += (2.0 * lerp2(curl_r_, curl_->width(), b) - 1.0) * amount;
+                dy += (2.0 * lerp2(curl_g_, curl_->width(), b) - 1.0) * amount;
+            }
+            detail_.sample(dx, dy, dz, out);
+        }, n);
         const double high_fbm = ndf::worley_fbm(n[0], n[1], n[2]);
         // Wispy (FBM) at the base to billowy (inverted) above 10 % height.
         const double mod = high_fbm + ((1.0 - high_fbm) - high_fbm) * detail::saturate(f * 10.0);

@@ -121,13 +121,17 @@ struct LayerScene {
     Field2DPtr anvil;
     // Optional vortex rings (ndf/vortex_rings' `table`: N x 1 texels with
     // channels inner, outer (m), speed (rad/s), overlap_end (m), optional skew
-    // (rad); bounds = centre +- radius). At `time` and altitude h the map and
-    // the noise are read rotated by -(speed_i * time + skew_i * phi) about the
-    // centre inside ring i, phi = saturate((h - bottom) / (top - bottom)) over
-    // the shell of the set (anvil lift not counted): the ring's tendrils tilt,
-    // its pattern turning by skew_i from the layer's base to its top. In ring
-    // i's overlap band [outer_i, overlap_end_i] the angle blends linearly to
-    // ring i+1's (past the last ring, to 0), so the storm turns, faster inside.
+    // (rad); bounds = centre +- radius; the centre moves with the map's wind
+    // scroll). 000's vortex: at `time` and altitude h the noises (base, detail,
+    // curl) are read at positions turned by -(speed_i * time + skew_i * phi)
+    // about the centre inside ring i, phi = saturate((h - bottom) / (top -
+    // bottom)) over the shell of the set (anvil lift not counted): the ring's
+    // tendrils tilt, its pattern turning by skew_i from the layer's base to its
+    // top. The map (coverage, heights, types) does not turn: the storm keeps its
+    // shape while its billows swirl. In ring i's overlap band [outer_i,
+    // overlap_end_i] the noise is read at ring i's and ring i+1's turns (past
+    // the last ring, at its turn and unturned) and the samples interpolated
+    // linearly across the band, so the storm turns faster inside without seams.
     Field2DPtr vortex_table;
 };
 
