@@ -52,62 +52,59 @@ DecodedLevel decode_level(const DdsTexture& tex, int layer, int mip, Decoder dec
         const int bw = std::max(1, (L.w + 3) / 4), bh = std::max(1, (L.h + 3) / 4);
         const int unit = format_unit_bytes(f);
         const uint8_t* base = level + size_t(z0) * size_t(bh) * size_t(bw) * size_t(unit);
+        float lo[48], hi[48];
+        const int ch = L.channels;
+        // One block's texels into lo and hi (equal where the decode is exact).
+        auto decode_block = [&](const uint8_t* blk) {
+            if (f == DxgiFormat::BC6H_UF16 || f == DxgiFormat::BC6H_SF16) {
+                decode_bc6h_block(blk, f == DxgiFormat::BC6H_SF16, lo); // exact: no decoder tolerance
+                std::copy(lo, lo + 48, hi);
+            } else if (f == DxgiFormat::BC4_UNORM || f == DxgiFormat::BC4_SNORM) {
+                const bool sn = f == DxgiFormat::BC4_SNORM;
+                if (decoder == Decoder::Conformant)
+                    decode_bc4_interval(blk, sn, decoder_bit(decoder), lo, hi);
+                else {
+                    decode_bc4_block(blk, sn, decoder, lo);
+                    std::copy(lo, lo + 16, hi);
+                }
+            } else { // BC1
+                float rgb[48];
+                decode_bc1_block(blk, decoder, rgb);
+                float tol[4][3] = {};
+                if (decoder == Decoder::Conformant) {
+                    const uint16_t c0 = uint16_t(blk[0] | (blk[1] << 8)), c1 = uint16_t(blk[2] | (blk[3] << 8));
+                    float ref[4][3];
+                    bc1_palette(c0, c1, Decoder::Reference, ref);
+                    for (int i = 0; i < 4; ++i)
+                        for (int c = 0; c < 3; ++c) tol[i][c] = (c0 <= c1 && i == 3) ? 0.0f : bc1_conformant_tolerance(ref[0][c], ref[1][c]);
+                }
+                const uint32_t bits = uint32_t(blk[4]) | (uint32_t(blk[5]) << 8) | (uint32_t(blk[6]) << 16) | (uint32_t(blk[7]) << 24);
+                for (int t = 0; t < 16; ++t) {
+                    const int i = int((bits >> (2 * t)) & 3);
+                    if (bc1_scalar) {
+                        float tv = 0;
+                        for (int c = 0; c < 3; ++c) tv += tol[i][c] * unpack.weights[size_t(c)];
+                        // same summation order as decode_bc1_scalar_block
+                        const float v = rgb[3 * t] * unpack.weights[0] + rgb[3 * t + 1] * unpack.weights[1] + rgb[3 * t + 2] * unpack.weights[2];
+                        lo[t] = v - tv;
+                        hi[t] = v + tv;
+                    } else
+                        for (int c = 0; c < 3; ++c) {
+                            lo[3 * t + c] = rgb[3 * t + c] - tol[i][c];
+                            hi[3 * t + c] = rgb[3 * t + c] + tol[i][c];
+                        }
+                }
+            }
+        };
         // A block with the bytes of the one before decodes the same (empty space is
         // runs of one block): its texels are reused (lo and hi outlive the iteration).
         const uint8_t* prev = nullptr;
-        float lo[48], hi[48];
-        const int ch = L.channels;
         for (int z = 0; z < L.d; ++z)
             for (int by = 0; by < bh; ++by)
                 for (int bx = 0; bx < bw; ++bx) {
                     const uint8_t* blk = base + ((size_t(z) * size_t(bh) + size_t(by)) * size_t(bw) + size_t(bx)) * size_t(unit);
-                    if (prev && std::memcmp(prev, blk, size_t(unit)) == 0) {
-                        // same lo and hi as the block before
-                    } else if (f == DxgiFormat::BC6H_UF16 || f == DxgiFormat::BC6H_SF16) {
-                        decode_bc6h_block(blk, f == DxgiFormat::BC6H_SF16, lo); // exact: no decoder tolerance
-                        std::copy(lo, lo + 48, hi);
-                    } else if (f == DxgiFormat::BC4_UNORM || f == DxgiFormat::BC4_SNORM) {
-                        const bool sn = f == DxgiFormat::BC4_SNORM;
-                        if (decoder == Decoder::Conformant)
-                            decode_bc4_interval(blk, sn, decoder_bit(decoder), lo, hi);
-                        else {
-                            decode_bc4_block(blk, sn, decoder, lo);
-                            std::copy(lo, lo + 16, hi);
-                        }
-                    } else { // BC1
-                        float rgb[48];
-                        decode_bc1_block(blk, decoder, rgb);
-                        float tol[4][3] = {};
-                        if (decoder == Decoder::Conformant) {
-                            const uint16_t c0 = uint16_t(blk[0] | (blk[1] << 8)), c1 = uint16_t(blk[2] | (blk[3] << 8));
-                            float ref[4][3];
-                            bc1_palette(c0, c1, Decoder::Reference, ref);
-                            for (int i = 0; i < 4; ++i)
-                                for (int c = 0; c < 3; ++c)
-                                    tol[i][c] = (c0 <= c1 && i == 3) ? 0.0f : bc1_conformant_tolerance(ref[0][c], ref[1][c]);
-                        }
-                        const uint32_t bits =
-                            uint32_t(blk[4]) | (uint32_t(blk[5]) << 8) | (uint32_t(blk[6]) << 16) | (uint32_t(blk[7]) << 24);
-                        for (int t = 0; t < 16; ++t) {
-                            const int i = int((bits >> (2 * t)) & 3);
-                            if (bc1_scalar) {
-                                float v = 0, tv = 0;
-                                for (int c = 0; c < 3; ++c) {
-                                    v += rgb[3 * t + c] * unpack.weights[size_t(c)];
-                                    tv += tol[i][c] * unpack.weights[size_t(c)];
-                                }
-                                // same summation order as decode_bc1_scalar_block
-                                v = rgb[3 * t] * unpack.weights[0] + rgb[3 * t + 1] * unpack.weights[1] +
-                                    rgb[3 * t + 2] * unpack.weights[2];
-                                lo[t] = v - tv;
-                                hi[t] = v + tv;
-                            } else
-                                for (int c = 0; c < 3; ++c) {
-                                    lo[3 * t + c] = rgb[3 * t + c] - tol[i][c];
-                                    hi[3 * t + c] = rgb[3 * t + c] + tol[i][c];
-                                }
-                        }
-                    }
+                    const bool repeat = prev && std::memcmp(prev, blk, size_t(unit)) == 0;
+                    if (!repeat) decode_block(blk);
                     prev = blk;
                     for (int t = 0; t < 16; ++t) {
                         const int x = bx * 4 + t % 4, y = by * 4 + t / 4;

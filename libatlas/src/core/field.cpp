@@ -33,6 +33,12 @@ ChannelData zeroed_channel(size_t count) {
     parallel_blocks(count, kFillBlock, [&](size_t i0, size_t i1) { std::memset(d.data() + i0, 0, (i1 - i0) * sizeof(float)); });
     return d;
 }
+
+ChannelData copied_channel(const float* src, size_t count) {
+    ChannelData d(count);
+    parallel_blocks(count, kFillBlock, [&](size_t i0, size_t i1) { std::memcpy(d.data() + i0, src + i0, (i1 - i0) * sizeof(float)); });
+    return d;
+}
 } // namespace
 
 namespace {
@@ -107,11 +113,7 @@ void free_channel_bytes(void* p, size_t bytes) noexcept {
 
 FieldStorage::FieldStorage(const FieldStorage& o) : count_(o.count_), names_(o.names_) {
     data_.reserve(o.ptr_.size());
-    for (const float* src : o.ptr_) {
-        ChannelData& d = data_.emplace_back(o.count_);
-        parallel_blocks(o.count_, kFillBlock, [&](size_t i0, size_t i1) { std::memcpy(d.data() + i0, src + i0, (i1 - i0) * sizeof(float)); });
-        ptr_.push_back(d.data());
-    }
+    for (const float* src : o.ptr_) ptr_.push_back(data_.emplace_back(copied_channel(src, o.count_)).data());
 }
 
 FieldStorage::FieldStorage(size_t count, std::vector<const float*> channels, std::vector<std::shared_ptr<const void>> owners,
@@ -127,10 +129,7 @@ FieldStorage::FieldStorage(size_t count, std::vector<const float*> channels, std
 void FieldStorage::own_channels() {
     for (size_t c = 0; c < ptr_.size(); ++c) {
         if (!data_[c].empty() || count_ == 0) continue;
-        ChannelData d(count_);
-        const float* src = ptr_[c];
-        parallel_blocks(count_, kFillBlock, [&](size_t i0, size_t i1) { std::memcpy(d.data() + i0, src + i0, (i1 - i0) * sizeof(float)); });
-        data_[c] = std::move(d);
+        data_[c] = copied_channel(ptr_[c], count_);
         ptr_[c] = data_[c].data();
     }
     owners_.clear();
