@@ -649,8 +649,8 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
     report.precipitation = model.precipitation() && scene.rain_absorption > 0;
     report.anvil = model.has_anvil();
     report.vortex = model.has_vortex();
-    report.cone_skipping = model.has_cone() && !model.has_vortex();
-    report.distance_skipping = model.has_distance() && !model.has_vortex();
+    report.cone_skipping = model.has_cone();
+    report.distance_skipping = model.has_distance();
     report.sky_layers = int(scene.sky_layers.size());
     report.sky_gradient = settings.sky_horizon.has_value();
 
@@ -708,8 +708,8 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
                        scene.earth_radius,
                        scene.earth_radius + model.bottom(),
                        scene.earth_radius + model.top(),
-                       // The envelope describes the unturned map: no skipping while rings turn it.
-                       (model.has_cone() || model.has_distance()) && !model.has_vortex(),
+                       // The envelope describes the map; vortex rings turn only the noise inside it.
+                       model.has_cone() || model.has_distance(),
                        sky,
                        settings.sky_horizon.value_or(settings.sky_colour),
                        {},

@@ -132,6 +132,7 @@ struct LayerScene {
     // overlap_end_i] the noise is read at ring i's and ring i+1's turns (past
     // the last ring, at its turn and unturned) and the samples interpolated
     // linearly across the band, so the storm turns faster inside without seams.
+    // The envelope stays valid: it bounds the map, which does not turn.
     Field2DPtr vortex_table;
 };
 
