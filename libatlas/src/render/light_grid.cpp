@@ -188,40 +188,64 @@ SunDepthMap::SunDepthMap(const Box3d& bounds, Vec3d voxel, Vec3d sun_dir, const 
             col.first = std::max(0, static_cast<int>(std::floor(lo / da - 0.5)));
             col.count = std::min(n_[0] - 1, static_cast<int>(std::ceil(hi / da - 0.5))) - col.first + 1;
         }
-    size_t total = 0;
-    for (Column& col : cols_) {
-        col.offset = total;
-        total += size_t(std::max(0, col.count));
-    }
-    depth_.assign(total, 0.0f);
     // Path length per sample: the ray advances da along a in da / |sun_a| metres.
     const double ds = da / std::abs(sa);
+    // A column keeps only the samples from its first to its last cloud sample: on the sun's
+    // side of them the depth is exactly 0, beyond them exactly the column's total, which is
+    // what at() answers outside the kept range (a cloudscape's table is mostly such runs).
+    std::vector<std::vector<float>> slabs(static_cast<size_t>(n_[2]));
     parallel_for_index(n_[2], [&](int k) {
         const double v = v0_ + (k + 0.5) * voxel_[c_];
+        std::vector<float> d;
+        std::vector<float>& kept = slabs[size_t(k)];
         for (int j = 0; j < n_[1]; ++j) {
             Column& col = cols_[size_t(k) * size_t(n_[1]) + size_t(j)];
             if (col.count <= 0) continue;
             const double u = u0_ + (j + 0.5) * voxel_[b_];
-            float* d = depth_.data() + col.offset;
+            d.resize(size_t(col.count));
+            int lo = col.count, hi = -1; // the first and last samples with density
             for (int m = 0; m < col.count; ++m) {
                 const double t = (col.first + m + 0.5) * da;
                 Vec3d p;
                 p[a_] = a0_ + t;
                 p[b_] = u + sb_ * t;
                 p[c_] = v + sc_ * t;
-                d[m] = density(p[0], p[1], p[2]);
+                d[size_t(m)] = density(p[0], p[1], p[2]);
+                if (d[size_t(m)] != 0.0f) {
+                    lo = std::min(lo, m);
+                    hi = m;
+                }
             }
             // Midpoint rule toward the sun: half the own sample, all beyond it.
             double acc = 0;
             for (int s = 0; s < col.count; ++s) {
                 const int m = toward_plus_ ? col.count - 1 - s : s;
-                const double dm = d[m];
-                d[m] = static_cast<float>(acc + 0.5 * dm * ds);
+                const double dm = d[size_t(m)];
+                d[size_t(m)] = static_cast<float>(acc + 0.5 * dm * ds);
                 acc += dm * ds;
             }
             col.total = static_cast<float>(acc);
+            if (hi < 0) {
+                col.count = 0; // no cloud on this ray: 0 toward the sun and (total =) 0 away
+                continue;
+            }
+            col.offset = kept.size();
+            kept.insert(kept.end(), d.begin() + lo, d.begin() + hi + 1);
+            col.first += lo;
+            col.count = hi - lo + 1;
         }
     });
+    // One array, slab after slab (offsets were per slab).
+    size_t total = 0;
+    for (int k = 0; k < n_[2]; ++k) {
+        for (int j = 0; j < n_[1]; ++j) cols_[size_t(k) * size_t(n_[1]) + size_t(j)].offset += total;
+        total += slabs[size_t(k)].size();
+    }
+    depth_.reserve(total);
+    for (auto& slab : slabs) {
+        depth_.insert(depth_.end(), slab.begin(), slab.end());
+        std::vector<float>().swap(slab);
+    }
 }
 
 float SunDepthMap::at(int i, int j, int k) const {

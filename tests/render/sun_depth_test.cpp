@@ -1,0 +1,55 @@
+// The sun depth map (render/light_grid.h, the march's light lookups) keeps only the
+// samples of a column from its first to its last cloud sample. At every voxel centre of
+// a sun straight overhead (columns are the voxel columns, no shear, no interpolation)
+// its depth must equal the midpoint sum of the same density samples, computed here in
+// the map's order: 0 above the cloud, the column's total below it, the running sum
+// between, and 0 in columns without cloud.
+#include "../../libatlas/src/render/light_grid.h" // internal
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace atlas::render::detail {
+namespace {
+
+TEST(SunDepthMap, KeptRangeAnswersEveryVoxelAsTheFullColumnSum) {
+    const Box3d bounds{{{0, 0, 0}}, {{160, 120, 200}}};
+    const Vec3d voxel{{10, 10, 10}};
+    // Two blobs stacked in some columns (a gap of empty samples between them), one
+    // elsewhere, most columns empty.
+    auto blob = [](double x, double y, double z, double cx, double cy, double cz, double r) {
+        const double d = std::sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz));
+        return d < r ? 1.0 - d / r : 0.0;
+    };
+    const LightGrid::DensityFn density = [&](double x, double y, double z) {
+        return static_cast<float>(blob(x, y, z, 45, 55, 40, 28) + blob(x, y, z, 45, 55, 150, 22) + 0.5 * blob(x, y, z, 125, 85, 95, 18));
+    };
+    const SunDepthMap map(bounds, voxel, Vec3d{{0, 0, 1}}, density);
+    const int nx = 16, ny = 12, nz = 20;
+    size_t cloud_columns = 0;
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            const double x = 5 + 10 * i, y = 5 + 10 * j;
+            std::vector<float> want(static_cast<size_t>(nz));
+            double acc = 0;
+            bool any = false;
+            for (int k = nz - 1; k >= 0; --k) { // from the sun's side, as the map sums
+                const double dm = density(x, y, 5 + 10 * k);
+                any = any || dm != 0;
+                want[size_t(k)] = static_cast<float>(acc + 0.5 * dm * 10.0);
+                acc += dm * 10.0;
+            }
+            cloud_columns += any;
+            for (int k = 0; k < nz; ++k) EXPECT_EQ(map.sun(x, y, 5 + 10 * k), want[size_t(k)]) << i << " " << j << " " << k;
+        }
+    EXPECT_GT(cloud_columns, 10u);
+    // Only the cloud's stretch of each column is stored: far fewer than the table's samples.
+    EXPECT_EQ(map.columns(), size_t(nx) * size_t(ny));
+    EXPECT_LT(map.cells(), size_t(nx) * size_t(ny) * size_t(nz) / 4);
+    EXPECT_GT(map.cells(), 0u);
+}
+
+} // namespace
+} // namespace atlas::render::detail
