@@ -259,7 +259,8 @@ TEST(Render, ReportListsOnlyWhatRan) {
 // through scene_from_fields: the sampled density is density_scene's (itself checked
 // against the grid above), and the empty-space SDF never claims more room
 // than there is: at random points its interpolated value stays under the
-// brute-force distance to the nearest non-zero voxel's cell.
+// brute-force distance to the nearest non-zero voxel's cell. Its SDF is kept
+// per 2^3 block and renders the bytes of the SDF broadcast to every voxel.
 #include "atlas/io/readers.h"
 #include "atlas/io/vdb.h"
 
@@ -292,10 +293,33 @@ TEST(RenderLoadScene, DensityGridGetsTheSameDensityAndASafeSdf) {
     EXPECT_EQ(*s.uniform_density_scale, ref.modeling->channel(2)[0]);
     const Field3D a = sample_density(s, res), b = sample_density(ref, res);
     for (size_t i = 0; i < a.voxel_count(); ++i) ASSERT_NEAR(a.channel(0)[i], b.channel(0)[i], 1e-6f) << i;
-    // SDF bound, brute force over the non-zero voxels.
-    const Field3D& sdf = *s.sdf;
-    const int c = sdf.find_channel("sdf");
-    ASSERT_GE(c, 0);
+    // SDF bound, brute force over the non-zero voxels. The SDF is stored once per 2^3
+    // block (CloudScene::sdf_block); the renderer reads every voxel as its block's value.
+    ASSERT_EQ(s.sdf_block, 2);
+    ASSERT_EQ(s.sdf->resolution(), (Vec3i{{24, 20, 12}}));
+    Field3D sdf(res, 1, d.bounds(), {"sdf"});
+    for (int z = 0; z < res[2]; ++z)
+        for (int y = 0; y < res[1]; ++y)
+            for (int x = 0; x < res[0]; ++x) sdf.at(0, x, y, z) = s.sdf->at(0, x / 2, y / 2, z / 2);
+    const int c = 0;
+    {
+        // The same scene with that broadcast SDF renders the same bytes; a block SDF of
+        // the wrong size is refused.
+        CloudScene broadcast = s;
+        broadcast.sdf = std::make_shared<const Field3D>(sdf);
+        broadcast.sdf_block = 1;
+        RenderSettings st = preview_settings(d.bounds(), 40, 30);
+        st.light_grid = {{12, 12, 12}};
+        const auto blocks = render_clouds(s, st), voxels = render_clouds(broadcast, st);
+        for (int ch = 0; ch < 4; ++ch)
+            for (size_t i = 0; i < blocks.image.channel(ch).size(); ++i)
+                ASSERT_EQ(blocks.image.channel(ch)[i], voxels.image.channel(ch)[i]) << ch << " " << i;
+        CloudScene wrong = broadcast;
+        wrong.sdf_block = 2;
+        EXPECT_THROW(validate_scene(wrong), Error);
+        wrong.sdf_block = 0;
+        EXPECT_THROW(validate_scene(wrong), Error);
+    }
     const Vec3d vox = d.voxel_size();
     const double diag = std::sqrt(vox[0] * vox[0] + vox[1] * vox[1] + vox[2] * vox[2]);
     std::vector<Vec3d> occupied;

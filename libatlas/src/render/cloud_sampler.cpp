@@ -39,13 +39,16 @@ CloudSampler::CloudSampler(const CloudScene& scene) {
     // not interpolated.
     if (scene.uniform_detail_type) grid_.value[1] = *scene.uniform_detail_type;
     if (scene.uniform_density_scale) grid_.value[2] = *scene.uniform_density_scale;
+    sdf_block_ = scene.sdf_block;
+    sdf_nx_ = s.nx();
+    sdf_ny_ = s.ny();
     for (size_t c = 0; c < 4; ++c) {
         const float* p = grid_.ch[c];
         if (!p) {
             grid_.uniform[c] = true;
             continue;
         }
-        const size_t n = m.voxel_count();
+        const size_t n = c == 3 ? s.voxel_count() : m.voxel_count();
         const float v0 = p[0];
         grid_.uniform[c] = std::isfinite(v0) && std::all_of(p, p + n, [v0](float v) { return v == v0; });
         grid_.value[c] = v0;
@@ -80,6 +83,12 @@ CloudSampler::Cell CloudSampler::cell(double x, double y, double z) const {
     k.dx = size_t(x1 - x0);
     k.dy = size_t(y1 - y0) * sy;
     k.dz = size_t(z1 - z0) * sz;
+    k.x0 = x0;
+    k.x1 = x1;
+    k.y0 = y0;
+    k.y1 = y1;
+    k.z0 = z0;
+    k.z1 = z1;
     return k;
 }
 
@@ -97,14 +106,31 @@ float CloudSampler::channel(int c, const Cell& k) const {
     return ab + (cd - ab) * tz;
 }
 
+float CloudSampler::sdf_of(const Cell& k) const {
+    if (sdf_block_ == 1 || grid_.uniform[3]) return channel(3, k);
+    // The taps' voxels read their blocks' values: the same eight values, in the same
+    // order, as the SDF broadcast to every voxel of its block.
+    const float* p = grid_.ch[3];
+    const int b = sdf_block_;
+    auto at = [&](int x, int y, int z) { return p[(size_t(z / b) * size_t(sdf_ny_) + size_t(y / b)) * size_t(sdf_nx_) + size_t(x / b)]; };
+    const float tx = k.tx, ty = k.ty, tz = k.tz;
+    float a = at(k.x0, k.y0, k.z0) + (at(k.x1, k.y0, k.z0) - at(k.x0, k.y0, k.z0)) * tx;
+    float bb = at(k.x0, k.y1, k.z0) + (at(k.x1, k.y1, k.z0) - at(k.x0, k.y1, k.z0)) * tx;
+    float cc = at(k.x0, k.y0, k.z1) + (at(k.x1, k.y0, k.z1) - at(k.x0, k.y0, k.z1)) * tx;
+    float d = at(k.x0, k.y1, k.z1) + (at(k.x1, k.y1, k.z1) - at(k.x0, k.y1, k.z1)) * tx;
+    float ab = a + (bb - a) * ty;
+    float cd = cc + (d - cc) * ty;
+    return ab + (cd - ab) * tz;
+}
+
 VoxelSample CloudSampler::voxel(double x, double y, double z) const {
     const Cell k = cell(x, y, z);
-    const float sdf = channel(3, k);
+    const float sdf = sdf_of(k);
     if (!(sdf < 0)) return {0, 0, 0, sdf};
     return {channel(0, k), channel(1, k), channel(2, k), sdf};
 }
 
-float CloudSampler::sdf(double x, double y, double z) const { return channel(3, cell(x, y, z)); }
+float CloudSampler::sdf(double x, double y, double z) const { return sdf_of(cell(x, y, z)); }
 
 std::array<float, 4> CloudSampler::noise(double x, double y, double z) const {
     int x0, x1, y0, y1, z0, z1;

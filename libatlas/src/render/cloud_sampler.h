@@ -60,15 +60,18 @@ private:
     struct Cell {
         size_t i000, dx, dy, dz;
         float tx, ty, tz;
+        int x0, x1, y0, y1, z0, z1; // the taps' voxels (a block SDF's lookups)
     };
     Cell cell(double x, double y, double z) const;
     float channel(int c, const Cell& k) const;
+    float sdf_of(const Cell& k) const; // channel 3, from its blocks when sdf_block_ > 1
     std::array<float, 4> noise(double x, double y, double z) const;
     Grid4 grid_;
     NoiseGrid noise_;
     Box3d bounds_;
     Vec3d voxel_;
     bool billowy_ = false;
+    int sdf_block_ = 1, sdf_nx_ = 0, sdf_ny_ = 0; // CloudScene::sdf_block and the block grid
 };
 
 // NaN maps to 0 so that bad voxels read as empty rather than poisoning a ray.

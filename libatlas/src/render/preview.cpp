@@ -199,26 +199,27 @@ CloudExtent scan_clouds(const CloudScene& scene, bool want_column) {
     // inside its SDF; a density grid's SDF is a conservative bound several
     // voxels wider, which made its clouds look small in the frame).
     const Field3D& sdf = *scene.sdf;
-    const bool profile = scene.modeling && scene.modeling->resolution() == sdf.resolution() && scene.modeling->channels() > 0;
+    const bool profile = scene.modeling && (scene.modeling->resolution() == sdf.resolution() || scene.sdf_block > 1) &&
+                         scene.modeling->channels() > 0;
     const Field3D& f = profile ? *scene.modeling : sdf;
     const int c = profile ? std::max(0, f.find_channel("dimensional_profile")) : std::max(0, sdf.find_channel("sdf")); // as the sampler picks them
     auto inside = [&](int x, int y, int z) { return profile ? f.at(c, x, y, z) > 0 : f.at(c, x, y, z) < 0; };
-    std::vector<int> count(want_column && profile ? size_t(sdf.nx()) * sdf.ny() : 0, 0);
-    Vec3i lo{{sdf.nx(), sdf.ny(), sdf.nz()}}, hi{{-1, -1, -1}};
-    for (int z = 0; z < sdf.nz(); ++z)
-        for (int y = 0; y < sdf.ny(); ++y)
-            for (int x = 0; x < sdf.nx(); ++x)
+    std::vector<int> count(want_column && profile ? size_t(f.nx()) * f.ny() : 0, 0);
+    Vec3i lo{{f.nx(), f.ny(), f.nz()}}, hi{{-1, -1, -1}};
+    for (int z = 0; z < f.nz(); ++z)
+        for (int y = 0; y < f.ny(); ++y)
+            for (int x = 0; x < f.nx(); ++x)
                 if (inside(x, y, z)) {
                     lo = {{std::min(lo[0], x), std::min(lo[1], y), std::min(lo[2], z)}};
                     hi = {{std::max(hi[0], x), std::max(hi[1], y), std::max(hi[2], z)}};
-                    if (!count.empty()) ++count[size_t(y) * sdf.nx() + x];
+                    if (!count.empty()) ++count[size_t(y) * f.nx() + x];
                 }
     CloudExtent e;
-    const Box3d b = sdf.bounds();
+    const Box3d b = f.bounds();
     if (hi[0] < 0) {
         e.bounds = b;
     } else {
-        const Vec3d v = sdf.voxel_size();
+        const Vec3d v = f.voxel_size();
         for (int a = 0; a < 3; ++a) {
             e.bounds.min[a] = b.min[a] + lo[a] * v[a];
             e.bounds.max[a] = b.min[a] + (hi[a] + 1) * v[a];

@@ -45,8 +45,12 @@ void validate_scene(const CloudScene& s) {
                     " channels, expected 3 (dimensional_profile, detail_type, density_scale)");
     if (s.uniform_detail_type && !std::isfinite(*s.uniform_detail_type)) throw Error("render: uniform_detail_type must be finite");
     if (s.uniform_density_scale && !std::isfinite(*s.uniform_density_scale)) throw Error("render: uniform_density_scale must be finite");
-    if (s.sdf->resolution() != s.modeling->resolution() || !(s.sdf->bounds() == s.modeling->bounds()))
-        throw Error("render: scene.sdf must have the modeling NVDF's resolution and bounds");
+    if (!(s.sdf_block >= 1 && s.sdf_block <= 64)) throw Error("render: sdf_block must be 1..64, got " + std::to_string(s.sdf_block));
+    Vec3i want = s.modeling->resolution();
+    for (int a = 0; a < 3; ++a) want[a] = (want[a] + s.sdf_block - 1) / s.sdf_block;
+    if (s.sdf->resolution() != want || !(s.sdf->bounds() == s.modeling->bounds()))
+        throw Error(s.sdf_block == 1 ? "render: scene.sdf must have the modeling NVDF's resolution and bounds"
+                                     : "render: scene.sdf must have the modeling NVDF's bounds and its resolution / sdf_block (rounded up)");
     if (s.noise && !(std::isfinite(s.noise_tile) && s.noise_tile > 0))
         throw Error("render: noise_tile must be a finite number of metres > 0, got " + std::to_string(s.noise_tile));
 }

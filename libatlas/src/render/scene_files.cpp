@@ -77,18 +77,21 @@ void edt_line(const double* f, int n, double w, double* out, int* v, double* z) 
 // non-zero corner is inside at every corner (so wherever the density is
 // non-zero the picture is density_scene's), and the interpolated SDF
 // elsewhere stays under the distance to the nearest cell with a non-zero
-// corner. Peak memory: the grid plus one SDF channel (was the grid plus a
-// 4-channel set, 4.9 times the grid).
+// corner. Peak memory: the grid plus the SDF's blocks (1/8 of the grid; it
+// was the grid plus a 4-channel set, 4.9 times the grid, then the SDF
+// broadcast to every voxel).
 CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
     Field3D& density = *grid;
     const Vec3i r = density.resolution();
-    auto sdf = std::make_shared<Field3D>(r, 1, density.bounds(), std::vector<std::string>{"sdf"});
     const Vec3d vox = density.voxel_size();
     const double vmin = std::min({vox[0], vox[1], vox[2]}), vmax = std::max({vox[0], vox[1], vox[2]});
-    auto p = density.channel(0), sd = sdf->channel(0);
+    auto p = density.channel(0);
     const size_t nx = size_t(r[0]), ny = size_t(r[1]), nz = size_t(r[2]), sxy = nx * ny;
     constexpr int B = 2;
     const Vec3i cr{{(r[0] + B - 1) / B, (r[1] + B - 1) / B, (r[2] + B - 1) / B}};
+    // The SDF is one value per block: stored so (CloudScene::sdf_block), not broadcast.
+    auto sdf = std::make_shared<Field3D>(cr, 1, density.bounds(), std::vector<std::string>{"sdf"});
+    auto block = sdf->channel(0);
     const size_t cx = size_t(cr[0]), cy = size_t(cr[1]), cz = size_t(cr[2]), cxy = cx * cy;
     std::vector<double> cd(cx * cy * cz, std::numeric_limits<double>::infinity());
     // 1. Check, maximum, block occupancy (a coarse z row belongs to one task).
@@ -151,8 +154,7 @@ CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
     for (int a = 0; a < 3; ++a) pass(a);
     const float inside = -static_cast<float>(vmin);
     const double margin = B * std::sqrt(vox[0] * vox[0] + vox[1] * vox[1] + vox[2] * vox[2]) + 4.0 * vmax;
-    // One value per block, then broadcast to its voxels.
-    std::vector<float> block(cd.size());
+    // One value per block.
     parallel_for_index(int(cz), [&](int bzi) {
         const size_t bz = size_t(bzi);
         for (size_t i = bz * cxy; i < (bz + 1) * cxy; ++i) {
@@ -163,17 +165,10 @@ CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
         }
     });
     std::vector<double>().swap(cd);
-    parallel_for_index(int(nz), [&](int zi) {
-        const size_t z = size_t(zi);
-        for (size_t y = 0; y < ny; ++y) {
-            const float* row = &block[(z / B) * cxy + (y / B) * cx];
-            float* out = &sd[z * sxy + y * nx];
-            for (size_t x = 0; x < nx; ++x) out[x] = row[x / B];
-        }
-    });
     CloudScene s;
     s.modeling = std::move(grid);
     s.sdf = std::move(sdf);
+    s.sdf_block = B;
     s.uniform_detail_type = 0.0f;
     s.uniform_density_scale = static_cast<float>(S);
     s.density_grid_max = dmax;

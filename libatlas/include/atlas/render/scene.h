@@ -41,6 +41,12 @@ struct CloudScene {
     // default: it has its own detail, and erosion made foam of it) and its
     // units are read (PreviewOptions::density_units).
     std::optional<float> density_grid_max;
+    // The SDF stored once per sdf_block^3 voxels of the modeling grid (>= 1):
+    // resolution ceil(n / sdf_block) per axis over the modeling's bounds, voxel
+    // (x, y, z) reading block (x / b, y / b, z / b). A density grid's SDF is
+    // constant over its blocks (render::load_scene): stored so, it takes 1/8 of
+    // the memory and samples to the same values as broadcast to every voxel.
+    int sdf_block = 1;
 };
 
 // A scene from one 4-channel "vdb_set" field (volume/nvdf's output, or
