@@ -319,6 +319,8 @@ TEST(RenderLoadScene, DensityGridGetsTheSameDensityAndASafeSdf) {
         EXPECT_THROW(validate_scene(wrong), Error);
         wrong.sdf_block = 0;
         EXPECT_THROW(validate_scene(wrong), Error);
+        wrong.sdf_block = 3; // not a power of two
+        EXPECT_THROW(validate_scene(wrong), Error);
     }
     const Vec3d vox = d.voxel_size();
     const double diag = std::sqrt(vox[0] * vox[0] + vox[1] * vox[1] + vox[2] * vox[2]);

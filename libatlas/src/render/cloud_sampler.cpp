@@ -4,6 +4,7 @@
 #include "atlas/core/error.h"
 
 #include <algorithm>
+#include <bit>
 
 namespace atlas::render::detail {
 
@@ -39,7 +40,7 @@ CloudSampler::CloudSampler(const CloudScene& scene) {
     // not interpolated.
     if (scene.uniform_detail_type) grid_.value[1] = *scene.uniform_detail_type;
     if (scene.uniform_density_scale) grid_.value[2] = *scene.uniform_density_scale;
-    sdf_block_ = scene.sdf_block;
+    sdf_shift_ = std::countr_zero(unsigned(scene.sdf_block)); // a power of two (validate_scene)
     sdf_nx_ = s.nx();
     sdf_ny_ = s.ny();
     for (size_t c = 0; c < 4; ++c) {
@@ -107,17 +108,19 @@ float CloudSampler::channel(int c, const Cell& k) const {
 }
 
 float CloudSampler::sdf_of(const Cell& k) const {
-    if (sdf_block_ == 1 || grid_.uniform[3]) return channel(3, k);
+    if (sdf_shift_ == 0 || grid_.uniform[3]) return channel(3, k);
     // The taps' voxels read their blocks' values: the same eight values, in the same
     // order, as the SDF broadcast to every voxel of its block.
     const float* p = grid_.ch[3];
-    const int b = sdf_block_;
-    auto at = [&](int x, int y, int z) { return p[(size_t(z / b) * size_t(sdf_ny_) + size_t(y / b)) * size_t(sdf_nx_) + size_t(x / b)]; };
+    const int b = sdf_shift_;
+    const size_t sy = size_t(sdf_nx_), sz = sy * size_t(sdf_ny_);
+    const size_t x0 = size_t(k.x0 >> b), x1 = size_t(k.x1 >> b), y0 = size_t(k.y0 >> b) * sy, y1 = size_t(k.y1 >> b) * sy,
+                 z0 = size_t(k.z0 >> b) * sz, z1 = size_t(k.z1 >> b) * sz;
     const float tx = k.tx, ty = k.ty, tz = k.tz;
-    float a = at(k.x0, k.y0, k.z0) + (at(k.x1, k.y0, k.z0) - at(k.x0, k.y0, k.z0)) * tx;
-    float bb = at(k.x0, k.y1, k.z0) + (at(k.x1, k.y1, k.z0) - at(k.x0, k.y1, k.z0)) * tx;
-    float cc = at(k.x0, k.y0, k.z1) + (at(k.x1, k.y0, k.z1) - at(k.x0, k.y0, k.z1)) * tx;
-    float d = at(k.x0, k.y1, k.z1) + (at(k.x1, k.y1, k.z1) - at(k.x0, k.y1, k.z1)) * tx;
+    float a = p[z0 + y0 + x0] + (p[z0 + y0 + x1] - p[z0 + y0 + x0]) * tx;
+    float bb = p[z0 + y1 + x0] + (p[z0 + y1 + x1] - p[z0 + y1 + x0]) * tx;
+    float cc = p[z1 + y0 + x0] + (p[z1 + y0 + x1] - p[z1 + y0 + x0]) * tx;
+    float d = p[z1 + y1 + x0] + (p[z1 + y1 + x1] - p[z1 + y1 + x0]) * tx;
     float ab = a + (bb - a) * ty;
     float cd = cc + (d - cc) * ty;
     return ab + (cd - ab) * tz;

@@ -64,14 +64,14 @@ private:
     };
     Cell cell(double x, double y, double z) const;
     float channel(int c, const Cell& k) const;
-    float sdf_of(const Cell& k) const; // channel 3, from its blocks when sdf_block_ > 1
+    float sdf_of(const Cell& k) const; // channel 3, from its blocks when the scene's sdf_block > 1
     std::array<float, 4> noise(double x, double y, double z) const;
     Grid4 grid_;
     NoiseGrid noise_;
     Box3d bounds_;
     Vec3d voxel_;
     bool billowy_ = false;
-    int sdf_block_ = 1, sdf_nx_ = 0, sdf_ny_ = 0; // CloudScene::sdf_block and the block grid
+    int sdf_shift_ = 0, sdf_nx_ = 0, sdf_ny_ = 0; // log2 CloudScene::sdf_block and the block grid
 };
 
 // NaN maps to 0 so that bad voxels read as empty rather than poisoning a ray.

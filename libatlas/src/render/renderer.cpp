@@ -286,8 +286,9 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
     std::unique_ptr<detail::SunDepthMap> sun_map, sky_map;
     with_thread_limit(settings.threads, [&] {
         if (lookup) {
-            // The SDF alone first: most of a table lies outside the cloud.
-            const auto density = [&cloud](double x, double y, double z) { return cloud.sdf(x, y, z) < 0 ? cloud.density_at(x, y, z, 1e30) : 0.0f; };
+            // density_at reads the SDF alone first (most of a table lies outside the cloud)
+            // and the other channels only inside.
+            const auto density = [&cloud](double x, double y, double z) { return cloud.density_at(x, y, z, 1e30); };
             // Columns at most 8 m apart (the pack's voxels: the up-rez's
             // detail casts shadows that fine) within a sample budget. The
             // 16 m quickstart at its own spacing stayed 6/255 from marched

@@ -45,7 +45,8 @@ void validate_scene(const CloudScene& s) {
                     " channels, expected 3 (dimensional_profile, detail_type, density_scale)");
     if (s.uniform_detail_type && !std::isfinite(*s.uniform_detail_type)) throw Error("render: uniform_detail_type must be finite");
     if (s.uniform_density_scale && !std::isfinite(*s.uniform_density_scale)) throw Error("render: uniform_density_scale must be finite");
-    if (!(s.sdf_block >= 1 && s.sdf_block <= 64)) throw Error("render: sdf_block must be 1..64, got " + std::to_string(s.sdf_block));
+    if (!(s.sdf_block >= 1 && s.sdf_block <= 64 && (s.sdf_block & (s.sdf_block - 1)) == 0))
+        throw Error("render: sdf_block must be a power of two from 1 to 64, got " + std::to_string(s.sdf_block));
     Vec3i want = s.modeling->resolution();
     for (int a = 0; a < 3; ++a) want[a] = (want[a] + s.sdf_block - 1) / s.sdf_block;
     if (s.sdf->resolution() != want || !(s.sdf->bounds() == s.modeling->bounds()))

@@ -41,7 +41,7 @@ struct CloudScene {
     // default: it has its own detail, and erosion made foam of it) and its
     // units are read (PreviewOptions::density_units).
     std::optional<float> density_grid_max;
-    // The SDF stored once per sdf_block^3 voxels of the modeling grid (>= 1):
+    // The SDF stored once per sdf_block^3 voxels of the modeling grid (a power of two, 1..64):
     // resolution ceil(n / sdf_block) per axis over the modeling's bounds, voxel
     // (x, y, z) reading block (x / b, y / b, z / b). A density grid's SDF is
     // constant over its blocks (render::load_scene): stored so, it takes 1/8 of
