@@ -314,6 +314,17 @@ TEST(RenderLoadScene, DensityGridGetsTheSameDensityAndASafeSdf) {
         for (int ch = 0; ch < 4; ++ch)
             for (size_t i = 0; i < blocks.image.channel(ch).size(); ++i)
                 ASSERT_EQ(blocks.image.channel(ch)[i], voxels.image.channel(ch)[i]) << ch << " " << i;
+        // Its SDF bounds the density from below (checked at random points below), so the
+        // light tables skip by it: the picture is the one without any skipping.
+        EXPECT_TRUE(s.sdf_is_lower_bound);
+        RenderSettings plain = st;
+        plain.skip_empty_space = false;
+        const auto unskipped = render_clouds(s, plain);
+        EXPECT_TRUE(blocks.report.sdf_skipping);
+        EXPECT_FALSE(unskipped.report.sdf_skipping);
+        for (int ch = 0; ch < 4; ++ch)
+            for (size_t i = 0; i < blocks.image.channel(ch).size(); ++i)
+                ASSERT_EQ(blocks.image.channel(ch)[i], unskipped.image.channel(ch)[i]) << ch << " " << i;
         CloudScene wrong = broadcast;
         wrong.sdf_block = 2;
         EXPECT_THROW(validate_scene(wrong), Error);

@@ -3,11 +3,13 @@
 // a sun straight overhead (columns are the voxel columns, no shear, no interpolation)
 // its depth must equal the midpoint sum of the same density samples, computed here in
 // the map's order: 0 above the cloud, the column's total below it, the running sum
-// between, and 0 in columns without cloud.
+// between, and 0 in columns without cloud. Given a distance that bounds the cloud from
+// below, it skips the samples within it unread and keeps every depth.
 #include "../../libatlas/src/render/light_grid.h" // internal
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -49,6 +51,28 @@ TEST(SunDepthMap, KeptRangeAnswersEveryVoxelAsTheFullColumnSum) {
     EXPECT_EQ(map.columns(), size_t(nx) * size_t(ny));
     EXPECT_LT(map.cells(), size_t(nx) * size_t(ny) * size_t(nz) / 4);
     EXPECT_GT(map.cells(), 0u);
+
+    // With a distance that bounds the cloud from below (here the exact distance to the
+    // blobs' supports), the samples inside its balls are not read, and every depth is the same.
+    auto dist = [](double x, double y, double z, double cx, double cy, double cz, double r) {
+        return std::sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz)) - r;
+    };
+    const LightGrid::DensityFn distance = [&](double x, double y, double z) {
+        return static_cast<float>(std::min({dist(x, y, z, 45, 55, 40, 28), dist(x, y, z, 45, 55, 150, 22), dist(x, y, z, 125, 85, 95, 18)}));
+    };
+    size_t reads = 0, reads_skipping = 0;
+    const LightGrid::DensityFn counted = [&](double x, double y, double z) { ++reads; return density(x, y, z); };
+    const LightGrid::DensityFn counted_skipping = [&](double x, double y, double z) { ++reads_skipping; return density(x, y, z); };
+    const SunDepthMap full(bounds, voxel, Vec3d{{0, 0, 1}}, counted, 1.0, nullptr);
+    const SunDepthMap skipping(bounds, voxel, Vec3d{{0, 0, 1}}, counted_skipping, 1.0, &distance);
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                const double x = 5 + 10 * i, y = 5 + 10 * j, z = 5 + 10 * k;
+                EXPECT_EQ(skipping.sun(x, y, z), full.sun(x, y, z)) << i << " " << j << " " << k;
+            }
+    EXPECT_EQ(reads, size_t(nx) * size_t(ny) * size_t(nz));
+    EXPECT_LT(reads_skipping, reads / 2);
 }
 
 } // namespace

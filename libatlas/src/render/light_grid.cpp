@@ -125,7 +125,8 @@ LightGrid::LightGrid(const Box3d& bounds, Vec3i res, Vec3d sun_dir, const Densit
     });
 }
 
-SunDepthMap::SunDepthMap(const Box3d& bounds, Vec3d voxel, Vec3d sun_dir, const LightGrid::DensityFn& density, double across) {
+SunDepthMap::SunDepthMap(const Box3d& bounds, Vec3d voxel, Vec3d sun_dir, const LightGrid::DensityFn& density, double across,
+                         const LightGrid::DensityFn* distance) {
     // The march axis: any the sun is not parallel to works; the one with the
     // fewest columns keeps the table small (a flat cloudscape under a low sun
     // marches along z: along y its sheared columns would span 5x its height).
@@ -210,6 +211,16 @@ SunDepthMap::SunDepthMap(const Box3d& bounds, Vec3d voxel, Vec3d sun_dir, const 
                 p[a_] = a0_ + t;
                 p[b_] = u + sb_ * t;
                 p[c_] = v + sc_ * t;
+                if (distance) {
+                    const double r = (*distance)(p[0], p[1], p[2]);
+                    if (r > 0) { // this sample and the next ones closer than r hold no cloud
+                        const int ahead = static_cast<int>(std::min(double(col.count), std::ceil(r / ds))); // r may be 1e30
+                        const int last = std::min(col.count - 1, m + ahead - 1);
+                        std::fill(d.begin() + m, d.begin() + last + 1, 0.0f);
+                        m = last;
+                        continue;
+                    }
+                }
                 d[size_t(m)] = density(p[0], p[1], p[2]);
                 if (d[size_t(m)] != 0.0f) {
                     lo = std::min(lo, m);

@@ -53,7 +53,11 @@ class SunDepthMap {
 public:
     // `voxel`: the sample spacing per world axis (the volume's voxels);
     // across the rays it is divided by `across`.
-    SunDepthMap(const Box3d& bounds, Vec3d voxel, Vec3d sun_dir, const LightGrid::DensityFn& density, double across = 1.0);
+    // `distance` (optional): the SDF, a ball of that radius about a point holding no
+    // cloud; the samples of a column inside it are 0 without a density lookup (as the
+    // view march's sphere tracing crosses them).
+    SunDepthMap(const Box3d& bounds, Vec3d voxel, Vec3d sun_dir, const LightGrid::DensityFn& density, double across = 1.0,
+                const LightGrid::DensityFn* distance = nullptr);
     // Summed density from p to the bounds toward the sun (trilinear).
     float sun(double x, double y, double z) const;
     // The smallest sample spacing (the march's near samples are half of it).

@@ -300,8 +300,12 @@ RenderResult render_clouds(const CloudScene& scene, const RenderSettings& settin
             const auto across = [&](double budget) {
                 return std::max(1.0, std::min({std::max({vox[0], vox[1], vox[2]}) / 8.0, 4.0, std::sqrt(budget / voxels)}));
             };
-            sun_map = std::make_unique<detail::SunDepthMap>(cloud.bounds(), vox, sun, density, across(double(1 << 25)));
-            sky_map = std::make_unique<detail::SunDepthMap>(cloud.bounds(), vox, Vec3d{{0, 0, 1}}, density, across(double(1 << 24)));
+            // Where the SDF is a lower bound of the distance to any density, its balls are
+            // skipped unread (exact); with the view march's switch.
+            const detail::LightGrid::DensityFn distance = [&cloud](double x, double y, double z) { return cloud.sdf(x, y, z); };
+            const detail::LightGrid::DensityFn* skip = settings.skip_empty_space && scene.sdf_is_lower_bound ? &distance : nullptr;
+            sun_map = std::make_unique<detail::SunDepthMap>(cloud.bounds(), vox, sun, density, across(double(1 << 25)), skip);
+            sky_map = std::make_unique<detail::SunDepthMap>(cloud.bounds(), vox, Vec3d{{0, 0, 1}}, density, across(double(1 << 24)), skip);
         }
         if (detail::diffusion_wanted(settings)) {
             Vec3i grid_res = settings.light_grid;

@@ -169,6 +169,7 @@ CloudScene density_grid_scene(std::shared_ptr<Field3D> grid) {
     s.modeling = std::move(grid);
     s.sdf = std::move(sdf);
     s.sdf_block = B;
+    s.sdf_is_lower_bound = true; // see above: L - 4 max voxel, clamped below
     s.uniform_detail_type = 0.0f;
     s.uniform_density_scale = static_cast<float>(S);
     s.density_grid_max = dmax;

@@ -47,6 +47,12 @@ struct CloudScene {
     // constant over its blocks (render::load_scene): stored so, it takes 1/8 of
     // the memory and samples to the same values as broadcast to every voxel.
     int sdf_block = 1;
+    // The SDF's interpolated value at any point is at most the distance to the
+    // nearest non-zero density (a density grid's SDF is built so): the light
+    // tables then skip the samples within that distance unread. An NVDF's SDF,
+    // interpolated from distances at voxel centres (or 8-bit field data), need
+    // not be, and its tables read every sample.
+    bool sdf_is_lower_bound = false;
 };
 
 // A scene from one 4-channel "vdb_set" field (volume/nvdf's output, or
