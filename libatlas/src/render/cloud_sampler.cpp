@@ -74,30 +74,21 @@ CloudSampler::CloudSampler(const CloudScene& scene) {
 }
 
 CloudSampler::Cell CloudSampler::cell(double x, double y, double z) const {
-    int x0, x1, y0, y1, z0, z1;
     Cell k;
-    detail::axis_clamp((x - grid_.min[0]) * grid_.inv_voxel[0], grid_.nx, x0, x1, k.tx);
-    detail::axis_clamp((y - grid_.min[1]) * grid_.inv_voxel[1], grid_.ny, y0, y1, k.ty);
-    detail::axis_clamp((z - grid_.min[2]) * grid_.inv_voxel[2], grid_.nz, z0, z1, k.tz);
-    const size_t sx = 1, sy = size_t(grid_.nx), sz = size_t(grid_.nx) * size_t(grid_.ny);
-    k.i000 = size_t(z0) * sz + size_t(y0) * sy + size_t(x0) * sx;
-    k.dx = size_t(x1 - x0);
-    k.dy = size_t(y1 - y0) * sy;
-    k.dz = size_t(z1 - z0) * sz;
-    k.x0 = x0;
-    k.x1 = x1;
-    k.y0 = y0;
-    k.y1 = y1;
-    k.z0 = z0;
-    k.z1 = z1;
+    detail::axis_clamp((x - grid_.min[0]) * grid_.inv_voxel[0], grid_.nx, k.x0, k.x1, k.tx);
+    detail::axis_clamp((y - grid_.min[1]) * grid_.inv_voxel[1], grid_.ny, k.y0, k.y1, k.ty);
+    detail::axis_clamp((z - grid_.min[2]) * grid_.inv_voxel[2], grid_.nz, k.z0, k.z1, k.tz);
+    const size_t sy = size_t(grid_.nx), sz = size_t(grid_.nx) * size_t(grid_.ny);
+    k.i000 = size_t(k.z0) * sz + size_t(k.y0) * sy + size_t(k.x0);
+    k.dx = size_t(k.x1 - k.x0);
+    k.dy = size_t(k.y1 - k.y0) * sy;
+    k.dz = size_t(k.z1 - k.z0) * sz;
     return k;
 }
 
-float CloudSampler::channel(int c, const Cell& k) const {
-    if (grid_.uniform[size_t(c)]) return grid_.value[size_t(c)];
-    const float* p = grid_.ch[size_t(c)];
-    const size_t i000 = k.i000, dx = k.dx, dy = k.dy, dz = k.dz;
-    const float tx = k.tx, ty = k.ty, tz = k.tz;
+namespace {
+// Trilinear blend of the eight values at i000 + {0, dx} + {0, dy} + {0, dz}.
+inline float blend8(const float* p, size_t i000, size_t dx, size_t dy, size_t dz, float tx, float ty, float tz) {
     float a = p[i000] + (p[i000 + dx] - p[i000]) * tx;
     float b = p[i000 + dy] + (p[i000 + dy + dx] - p[i000 + dy]) * tx;
     float cc = p[i000 + dz] + (p[i000 + dz + dx] - p[i000 + dz]) * tx;
@@ -106,24 +97,22 @@ float CloudSampler::channel(int c, const Cell& k) const {
     float cd = cc + (d - cc) * ty;
     return ab + (cd - ab) * tz;
 }
+} // namespace
+
+float CloudSampler::channel(int c, const Cell& k) const {
+    if (grid_.uniform[size_t(c)]) return grid_.value[size_t(c)];
+    return blend8(grid_.ch[size_t(c)], k.i000, k.dx, k.dy, k.dz, k.tx, k.ty, k.tz);
+}
 
 float CloudSampler::sdf_of(const Cell& k) const {
     if (sdf_shift_ == 0 || grid_.uniform[3]) return channel(3, k);
-    // The taps' voxels read their blocks' values: the same eight values, in the same
-    // order, as the SDF broadcast to every voxel of its block.
-    const float* p = grid_.ch[3];
+    // The same cell over the block grid: its taps read their blocks' values, the same
+    // eight values, blended in the same order, as the SDF broadcast to every voxel.
     const int b = sdf_shift_;
     const size_t sy = size_t(sdf_nx_), sz = sy * size_t(sdf_ny_);
-    const size_t x0 = size_t(k.x0 >> b), x1 = size_t(k.x1 >> b), y0 = size_t(k.y0 >> b) * sy, y1 = size_t(k.y1 >> b) * sy,
-                 z0 = size_t(k.z0 >> b) * sz, z1 = size_t(k.z1 >> b) * sz;
-    const float tx = k.tx, ty = k.ty, tz = k.tz;
-    float a = p[z0 + y0 + x0] + (p[z0 + y0 + x1] - p[z0 + y0 + x0]) * tx;
-    float bb = p[z0 + y1 + x0] + (p[z0 + y1 + x1] - p[z0 + y1 + x0]) * tx;
-    float cc = p[z1 + y0 + x0] + (p[z1 + y0 + x1] - p[z1 + y0 + x0]) * tx;
-    float d = p[z1 + y1 + x0] + (p[z1 + y1 + x1] - p[z1 + y1 + x0]) * tx;
-    float ab = a + (bb - a) * ty;
-    float cd = cc + (d - cc) * ty;
-    return ab + (cd - ab) * tz;
+    const size_t x0 = size_t(k.x0 >> b), y0 = size_t(k.y0 >> b), z0 = size_t(k.z0 >> b);
+    return blend8(grid_.ch[3], z0 * sz + y0 * sy + x0, size_t(k.x1 >> b) - x0, (size_t(k.y1 >> b) - y0) * sy, (size_t(k.z1 >> b) - z0) * sz,
+                  k.tx, k.ty, k.tz);
 }
 
 VoxelSample CloudSampler::voxel(double x, double y, double z) const {

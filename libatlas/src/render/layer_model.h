@@ -394,8 +394,7 @@ public:
     // Density at p (altitude h). full = false: the cheap base shape only
     // (HZD's "cheap" sample). shape_out: the base shape with coverage (the
     // sample's profile for ambient and multiple scattering).
-    double density(const Vec3d& p_in, double h, bool full, Column* col_out = nullptr, double* shape_out = nullptr) const {
-        const Vec3d& p = p_in;
+    double density(const Vec3d& p, double h, bool full, Column* col_out = nullptr, double* shape_out = nullptr) const {
         Column c;
         if (!column(p[0], p[1], c)) return 0;
         if (h <= c.min_h) return 0;
