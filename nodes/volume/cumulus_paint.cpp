@@ -20,12 +20,12 @@ void declare(NodeDeclaration& d) {
     d.tiling(TileRule::with_halo([](const NodeParams&) { return 1; }).with_window());
     d.output("density_scale", PortType::Field3D, "channel 'density_scale'");
     d.param_float("base_height", 0).range(-1e9, 1e9).with_unit("m").describe("condensation height (the flat base)");
-    d.param_float("billow_depth", 60).range(1e-3, 1e9).with_unit("m").describe("depth below an up-facing surface where detail type reaches 0");
+    d.param_float("billow_depth", 200).range(1e-3, 1e9).with_unit("m").describe("depth below an up-facing surface where detail type reaches 0");
     d.param_float("facing_low", -0.9).range(-1, 1).describe("upward normal component where detail type starts (undersides below it stay wispy)");
     d.param_float("facing_high", 0.2).range(-1, 1).describe("upward normal component where detail type is full");
     d.param_float("skirt", 40).range(0, 1e9).with_unit("m").describe("height above the base kept wispy");
-    d.param_float("scale_floor", 0.6).range(0, 1).describe("density scale at the base (a denser base is a darker base)");
-    d.param_float("scale_ramp", 120).range(0, 1e9).with_unit("m").describe("height over which density scale rises to 1");
+    d.param_float("scale_floor", 0.2).range(0, 1).describe("density scale at the base (the pack's clouds are thin at the base: low scale draws them white)");
+    d.param_float("scale_ramp", 500).range(0, 1e9).with_unit("m").describe("height over which density scale rises to 1");
 }
 
 void cook(CookContext& ctx) {
@@ -61,5 +61,5 @@ void cook(CookContext& ctx) {
 } // namespace
 
 ATLAS_REGISTER_NODE(registry) {
-    registry.add({.name = "volume/cumulus_paint", .version = 1, .declare = declare, .cook = cook});
+    registry.add({.name = "volume/cumulus_paint", .version = 2, .declare = declare, .cook = cook});
 }

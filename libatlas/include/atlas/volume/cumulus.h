@@ -65,16 +65,17 @@ Points spheres_from_sdf(const Field3D& sdf, const SphereFillSpec& spec);
 
 struct CumulusPaintSpec {
     double base_height = 0;     // metres: the condensation height (flat base)
-    double billow_depth = 60;   // metres below an up-facing surface where detail type reaches 0
-    // The pack's own values are about -0.2 / 0.7 (sides 0.3), a floor near 0
-    // and a 180 m ramp (docs/look.md); under Atlas's preview up-rez (256 m
-    // noise tiles) those sides and that thin base shred, so the defaults keep
-    // more of the surface billowy and the base denser (a darker flat base).
+    double billow_depth = 200;  // metres below an up-facing surface where detail type reaches 0
+    // The pack's density scale is low (median 0.24-0.31 over its clouds,
+    // rising with height); its facing values, about -0.2 / 0.7 (sides 0.3),
+    // shred the sides under Atlas's preview up-rez (256 m noise tiles), so the
+    // sides stay billowy. Billows reach 200 m in: a wispy core under a soft
+    // profile ramp is eroded away (docs/look.md).
     double facing_low = -0.9;   // upward component of the surface normal where detail type starts
     double facing_high = 0.2;   // ... and where it is full
     double skirt = 40;          // metres above the base kept wispy (detail type 0)
-    double scale_floor = 0.6;   // density scale at the base
-    double scale_ramp = 120;    // metres over which density scale rises to 1
+    double scale_floor = 0.2;   // density scale at the base
+    double scale_ramp = 500;    // metres over which density scale rises to 1
 };
 
 struct CumulusChannels {
