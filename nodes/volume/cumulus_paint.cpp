@@ -12,7 +12,7 @@ void declare(NodeDeclaration& d) {
     d.doc("Paints a cumulus's detail type and density scale from its SDF, as Guerrilla's voxel pack has them "
           "(docs/look.md): detail type 1 (billowy) on up-facing surfaces, fading to 0 (wispy) `billow_depth` below them, "
           "0 on undersides and in the skirt above the base; density scale from `scale_floor` at the condensation height "
-          "to 1 over `scale_ramp`. Defined outside the cloud too, so filtering at its edge reads its values. Connect the "
+          "to 1 over `scale_ramp`. Defined `outside_voxels` past the cloud's surface too, so filtering at its edge reads its values; 0 beyond. Connect the "
           "outputs to volume/nvdf's detail_type and density_scale.");
     d.input("sdf", PortType::Field3D, "the cloud's signed distance (m, negative inside)");
     d.output("detail_type", PortType::Field3D, "channel 'detail_type' (0 wispy .. 1 billowy)");
@@ -26,6 +26,8 @@ void declare(NodeDeclaration& d) {
     d.param_float("skirt", 40).range(0, 1e9).with_unit("m").describe("height above the base kept wispy");
     d.param_float("scale_floor", 0.2).range(0, 1).describe("density scale at the base (the pack's clouds are thin at the base: low scale draws them white)");
     d.param_float("scale_ramp", 500).range(0, 1e9).with_unit("m").describe("height over which density scale rises to 1");
+    d.param_float("outside_voxels", 3).range(0, 1e9).describe("voxels outside the cloud still painted; beyond, both channels are 0 "
+                                                          "(nothing samples there; flat texture blocks, sparse VDB grids)");
 }
 
 void cook(CookContext& ctx) {
@@ -40,6 +42,7 @@ void cook(CookContext& ctx) {
     s.skirt = ctx.get_float("skirt");
     s.scale_floor = ctx.get_float("scale_floor");
     s.scale_ramp = ctx.get_float("scale_ramp");
+    s.outside_voxels = ctx.get_float("outside_voxels");
     // A condensation height at or above the cloud's top leaves no cloud above its base. A tile holds
     // part of a cloud, so a tiled cook leaves the check to the untiled one (a tile of a cloud's skirt
     // would be refused for the tile's own top).

@@ -92,7 +92,7 @@ TEST(Billows, BadSettingsAndShapesAreNamed) {
 }
 
 // A sphere's SDF: detail type 1 on top, 0 underneath and deep inside; density
-// scale from the floor at the base to 1 past the ramp.
+// scale from the floor at the base to 1 past the ramp; 0 in both beyond outside_voxels.
 TEST(CumulusPaint, UpFacingTopsBillowyUndersidesWispyDensityRisesFromTheBase) {
     const Vec3i res{{40, 40, 40}};
     Field3D sdf(res, 1, Box3d{{{-200, -200, 0}}, {{200, 200, 400}}}, {"sdf"});
@@ -116,9 +116,25 @@ TEST(CumulusPaint, UpFacingTopsBillowyUndersidesWispyDensityRisesFromTheBase) {
     EXPECT_GT(at(c.detail_type, 0, 0, 345), 0.9);  // just under the top
     EXPECT_LT(at(c.detail_type, 0, 0, 55), 0.05);  // the underside
     EXPECT_LT(at(c.detail_type, 0, 0, 200), 0.05); // deep inside
-    EXPECT_GT(at(c.detail_type, 0, 0, 395), 0.9);  // outside above the top: spread outward
+    EXPECT_GT(at(c.detail_type, 0, 0, 375), 0.9);  // outside above the top (2.5 voxels out): spread outward
     EXPECT_NEAR(at(c.density_scale, 0, 0, 45), 0.1, 1e-6);
-    EXPECT_NEAR(at(c.density_scale, 0, 0, 395), 1.0, 1e-6);
+    EXPECT_NEAR(at(c.density_scale, 0, 0, 375), 1.0, 1e-6);
+    // Past outside_voxels (3) both channels are 0: 4.5 voxels above the top, and a corner.
+    EXPECT_EQ(at(c.detail_type, 0, 0, 395), 0.0f);
+    EXPECT_EQ(at(c.density_scale, 0, 0, 395), 0.0f);
+    EXPECT_EQ(c.density_scale.at(0, 0, 0, 39), 0.0f);
+    s.outside_voxels = 1e9; // paint everywhere
+    const auto everywhere = volume::cumulus_channels(sdf, s);
+    EXPECT_NEAR(at(everywhere.density_scale, 0, 0, 395), 1.0, 1e-6);
+    EXPECT_NEAR(everywhere.density_scale.at(0, 0, 0, 39), 1.0, 1e-6);
+    for (size_t i = 0; i < sdf.voxel_count(); ++i) // the same values wherever both paint
+        if (sdf.channel(0)[i] <= 30.0f) {
+            ASSERT_EQ(everywhere.density_scale.channel(0)[i], c.density_scale.channel(0)[i]);
+            ASSERT_EQ(everywhere.detail_type.channel(0)[i], c.detail_type.channel(0)[i]);
+        }
+    s.outside_voxels = -1;
+    EXPECT_THROW(volume::cumulus_channels(sdf, s), Error);
+    s.outside_voxels = 3;
     const float mid = at(c.density_scale, 0, 0, 155);
     EXPECT_GT(mid, 0.2);
     EXPECT_LT(mid, 0.9);

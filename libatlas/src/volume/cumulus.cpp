@@ -180,22 +180,29 @@ Points spheres_from_sdf(const Field3D& sdf, const SphereFillSpec& s) {
 }
 
 CumulusChannels cumulus_channels(const Field3D& sdf, const CumulusPaintSpec& s, const MemoryBudget* budget, const GridFrame* frame) {
-    for (double v : {s.base_height, s.billow_depth, s.facing_low, s.facing_high, s.skirt, s.scale_floor, s.scale_ramp})
+    for (double v : {s.base_height, s.billow_depth, s.facing_low, s.facing_high, s.skirt, s.scale_floor, s.scale_ramp, s.outside_voxels})
         if (!std::isfinite(v)) throw Error("cumulus_channels: every setting must be finite");
     if (!(s.billow_depth > 0)) throw Error("cumulus_channels: 'billow_depth' must be > 0");
     if (!(s.facing_high > s.facing_low)) throw Error("cumulus_channels: 'facing_high' must be above 'facing_low'");
     if (s.skirt < 0 || s.scale_ramp < 0) throw Error("cumulus_channels: 'skirt' and 'scale_ramp' must be >= 0");
     if (s.scale_floor < 0 || s.scale_floor > 1) throw Error("cumulus_channels: 'scale_floor' must be in [0, 1]");
+    if (s.outside_voxels < 0) throw Error("cumulus_channels: 'outside_voxels' must be >= 0");
     if (sdf.channels() < 1) throw Error("cumulus_channels: the SDF has no channel");
     const Vec3i r = sdf.resolution();
     CumulusChannels out{Field3D(r, 1, sdf.bounds(), {"detail_type"}, budget), Field3D(r, 1, sdf.bounds(), {"density_scale"}, budget)};
     // Differences one-sided at the grid's own faces; a tiled cook's crop (grown by a voxel) has the rest as neighbours.
     const GridFrame fr = frame ? *frame : sdf.frame();
     const Vec3d h = fr.voxel_size();
+    const double reach = s.outside_voxels * std::max({h[0], h[1], h[2]});
     parallel_for_index(r[2], [&](int z) {
         for (int y = 0; y < r[1]; ++y)
             for (int x = 0; x < r[0]; ++x) {
                 const double d = sdf.at(0, x, y, z);
+                if (d > reach) {
+                    out.detail_type.at(0, x, y, z) = 0.0f;
+                    out.density_scale.at(0, x, y, z) = 0.0f;
+                    continue;
+                }
                 // Outward normal: the SDF's gradient (central differences, one-sided at the grid's faces).
                 auto diff = [&](int a) {
                     int lo[3] = {x, y, z}, hi[3] = {x, y, z};

@@ -76,6 +76,11 @@ struct CumulusPaintSpec {
     double skirt = 40;          // metres above the base kept wispy (detail type 0)
     double scale_floor = 0.2;   // density scale at the base
     double scale_ramp = 500;    // metres over which density scale rises to 1
+    // Voxels whose SDF is more than this many voxels (the largest voxel side) outside the
+    // cloud get 0 in both channels: no sample reads them (a sample inside the cloud
+    // blends taps at most a voxel diagonal away), and constant space compresses to flat
+    // texture blocks and sparse VDB grids. A huge value paints everywhere.
+    double outside_voxels = 3;
 };
 
 struct CumulusChannels {
