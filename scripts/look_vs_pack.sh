@@ -43,4 +43,24 @@ for view in ground orbit; do
   pics+=("$OUT/pack_parkouring_$view.png" "$OUT/pack_stormbird_$view.png")
   oiiotool "${pics[@]}" --mosaic 5x1 -o "$OUT/compare_$view.png"
 done
+# At a glance, in numbers: how bright each cloud is and how dark its shadows go (8-bit
+# luminance over the cloud's pixels: those differing from their row's median sky by
+# more than 6/255), read back with OpenImageIO.
+/usr/bin/python3 - "$OUT" <<'EOF'
+import glob, os, sys
+import numpy as np
+import OpenImageIO as oiio
+print(f"{'picture':34s} {'cloud %':>8s} {'mean':>6s} {'p10':>6s} {'p90':>6s}")
+for path in sorted(glob.glob(os.path.join(sys.argv[1], "*_*.png"))):
+    if os.path.basename(path).startswith("compare_"):
+        continue
+    px = np.round(oiio.ImageBuf(path).get_pixels(oiio.FLOAT)[..., :3] * 255.0)
+    cloud = np.abs(px - np.median(px, axis=1, keepdims=True)).max(axis=2) > 6
+    lum = (px @ np.array([0.2126, 0.7152, 0.0722]))[cloud]
+    if lum.size == 0:
+        print(f"{os.path.basename(path):34s} {0:8.1f}      -      -      -")
+        continue
+    p10, p90 = np.percentile(lum, [10, 90])
+    print(f"{os.path.basename(path):34s} {100 * cloud.mean():8.1f} {lum.mean():6.0f} {p10:6.0f} {p90:6.0f}")
+EOF
 ls -l "$OUT"/compare_*.png
