@@ -51,24 +51,33 @@ double hg(double c, double g) { return (1 - g * g) / std::pow(1 + g * g - 2 * g 
 TEST(RenderGolden, AmbientOnlySlabMatchesClosedForm) {
     // Sun off: radiance = amb * sky * (1 - e^{-sigma L}) + sky * e^{-sigma L}
     // with density d = 0.75^0.6 (sharpening power at scale 1), sigma = ext d,
-    // amb = sqrt(1 - 0.75) * e^{-ext d (200 - z)} (summed density to the top).
+    // amb = sqrt(1 - 0.75) * e^{-k ext d (200 - z)} (summed density to the top,
+    // k = sky_occlusion: 1 the library's default, 0.1 the preview's, 0 none).
     // Stated tolerance: 1e-3 relative.
     const double d = std::pow(kProfile, 0.6);
-    for (double z : {60.0, 100.0, 150.0})
-        for (RenderMode mode : {RenderMode::Fast, RenderMode::Reference}) {
-            RenderSettings s = centre_ray(z);
-            s.mode = mode;
-            s.sun_colour = {{0, 0, 0}};
-            auto r = render_clouds(constant_box(), s);
-            const double sigma = s.extinction * d, L = 200;
-            const double amb = std::sqrt(1 - kProfile) * std::exp(-s.extinction * d * (200 - z));
-            for (int c = 0; c < 3; ++c) {
-                const double sky = s.sky_colour[c];
-                const double expect = amb * sky * (1 - std::exp(-sigma * L)) + sky * std::exp(-sigma * L);
-                EXPECT_NEAR(r.image.at(c, 2, 2), expect, 1e-3 * expect) << "z " << z << " mode " << int(mode);
+    for (double k : {1.0, kPreviewSkyOcclusion, 0.0}) {
+        for (double z : {60.0, 100.0, 150.0})
+            for (RenderMode mode : {RenderMode::Fast, RenderMode::Reference}) {
+                RenderSettings s = centre_ray(z);
+                s.mode = mode;
+                s.sun_colour = {{0, 0, 0}};
+                s.sky_occlusion = k;
+                auto r = render_clouds(constant_box(), s);
+                const double sigma = s.extinction * d, L = 200;
+                const double amb = std::sqrt(1 - kProfile) * std::exp(-k * s.extinction * d * (200 - z));
+                for (int c = 0; c < 3; ++c) {
+                    const double sky = s.sky_colour[c];
+                    const double expect = amb * sky * (1 - std::exp(-sigma * L)) + sky * std::exp(-sigma * L);
+                    EXPECT_NEAR(r.image.at(c, 2, 2), expect, 1e-3 * expect) << "k " << k << " z " << z << " mode " << int(mode);
+                }
+                EXPECT_NEAR(r.image.at(3, 2, 2), std::exp(-sigma * L), 1e-5);
             }
-            EXPECT_NEAR(r.image.at(3, 2, 2), std::exp(-sigma * L), 1e-5);
-        }
+    }
+    RenderSettings bad = centre_ray(100);
+    for (double k : {-0.1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+        bad.sky_occlusion = k;
+        EXPECT_THROW(render_clouds(constant_box(), bad), Error) << k;
+    }
 }
 
 TEST(RenderGolden, OverheadSunSlabMatchesClosedForm) {

@@ -136,7 +136,7 @@ inline void shade(const RenderSettings& s, const SunTerms& st, double tau, doubl
     const double direct = beer * (powder + (1 - powder) * st.powder_mix) * st.sun_phase;
     // tau is infinite where the Earth hides the sun: no light, not inf x 0.
     const double ms = std::isinf(tau) ? 0.0 : dp * std::exp(-tau * remap(st.ms_sun, 0.0, 0.9, 0.25, ms_relax));
-    const double amb = std::sqrt(1 - dp) * std::exp(-sky_tau);
+    const double amb = std::sqrt(1 - dp) * std::exp(-sky_tau * s.sky_occlusion);
     sun_w = direct + s.multiple_scattering * ms;
     sky_w = s.ambient_strength * amb;
 }

@@ -58,6 +58,7 @@ void check_settings(const RenderSettings& s) {
     if (!(std::fabs(s.hg_forward) < 1) || !(std::fabs(s.hg_back) < 1)) bad("hg_forward and hg_back must be in (-1, 1)");
     if (!(s.hg_forward_weight >= 0 && s.hg_forward_weight <= 1)) bad("hg_forward_weight must be in [0, 1]");
     if (!(s.ambient_strength >= 0) || !std::isfinite(s.ambient_strength)) bad("ambient_strength must be finite and >= 0");
+    if (!(s.sky_occlusion >= 0) || !std::isfinite(s.sky_occlusion)) bad("sky_occlusion must be finite and >= 0");
     if (!(s.multiple_scattering >= 0) || !std::isfinite(s.multiple_scattering)) bad("multiple_scattering must be finite and >= 0");
     if (!(s.reference_step >= 0) || !std::isfinite(s.reference_step)) bad("reference_step must be finite and >= 0 (0 = automatic)");
     if (!(s.min_transmittance >= 0 && s.min_transmittance < 1)) bad("min_transmittance must be in [0, 1)");
@@ -361,6 +362,7 @@ RenderSettings preview_settings(const Box3d& bounds, int width, int height) {
     s.height = height;
     s.camera = framing_camera(bounds, double(width) / double(height));
     s.sun_direction = sun_direction(kPreviewSunAzimuthDeg, kPreviewSunElevationDeg); // the preview's sun (renderer.h)
+    s.sky_occlusion = kPreviewSkyOcclusion;
     return s;
 }
 

@@ -66,6 +66,13 @@ struct RenderSettings {
     // Dual-lobe HG: w * HG(g_forward) + (1 - w) * HG(g_back).
     double hg_forward = 0.6, hg_back = -0.3, hg_forward_weight = 0.7;
     double ambient_strength = 1.0;  // >= 0
+    // Artistic lighting: the ambient's occlusion by the density above a
+    // sample, exp(-sky_occlusion x tau_up). 1 is Beer along the vertical; sky
+    // light arrives from the whole hemisphere and scatters on into the cloud,
+    // so the preview's look relaxes it (0.1: lobes under an overhang stay
+    // blue-grey, where 1 drew them black). >= 0; 0 = the talk's
+    // sqrt(1 - profile) alone.
+    double sky_occlusion = 1.0;
     double multiple_scattering = 0.5; // strength of the profile-based term, >= 0
     // Voxel light grid resolution (fast mode; the talk's is 256x256x32). Its
     // z is raised so cells are no taller than wide, and each axis capped at
@@ -183,10 +190,14 @@ namespace atlas::render {
 // 2026-12-02). RenderSettings' own default direction is unchanged.
 inline constexpr double kPreviewSunAzimuthDeg = 230;
 inline constexpr double kPreviewSunElevationDeg = 25;
+// The preview's ambient occlusion by the density above (RenderSettings::
+// sky_occlusion): relaxed as the sun's multiple scattering is (2026-12-07).
+inline constexpr double kPreviewSkyOcclusion = 0.1;
 
 // Settings for a w x h preview of a volume with these bounds: the default
 // framing camera (framing_camera with its defaults), the preview sun
-// (kPreviewSun*), the default sky, fast mode. Throws atlas::Error on a
+// (kPreviewSun*), the preview's sky occlusion (kPreviewSkyOcclusion), the
+// default sky, fast mode. Throws atlas::Error on a
 // non-positive size.
 RenderSettings preview_settings(const Box3d& bounds, int width, int height);
 
