@@ -55,6 +55,25 @@ TEST(Exr, Field3DRoundTripIsBitExact) {
         for (size_t i = 0; i < f.voxel_count(); ++i) ASSERT_TRUE(same_bits(f.channel(c)[i], g.channel(c)[i]));
 }
 
+// compression: none (the SDF's option) writes an uncompressed file, checked with
+// OpenEXR's own header, that reads back bit for bit, as ZIP (the default) does.
+TEST(Exr, UncompressedRoundTripIsBitExactAndSaysSo) {
+    TempDir dir;
+    const Box3d b{{{0.0, 0.0, 0.0}}, {{64.0, 48.0, 40.0}}};
+    Field3D f = make_field3d({{8, 6, 5}}, b, {"sdf"}, [](int x, int y, int z, int c) { return awkward_float(3, x, y, z, c); });
+    ExrOptions o;
+    o.compress = false;
+    write_exr(f, dir / "raw.exr", o);
+    write_exr(f, dir / "zip.exr");
+    for (const char* name : {"raw.exr", "zip.exr"}) {
+        Imf::InputFile in((dir / name).string().c_str());
+        EXPECT_EQ(in.header().compression(), std::string(name) == "raw.exr" ? Imf::NO_COMPRESSION : Imf::ZIP_COMPRESSION) << name;
+        const Value v = read_exr(dir / name);
+        const Field3D& g = *std::get<Field3DPtr>(v);
+        for (size_t i = 0; i < f.voxel_count(); ++i) ASSERT_TRUE(same_bits(f.channel(0)[i], g.channel(0)[i])) << name << " index " << i;
+    }
+}
+
 // The documented layout, checked with OpenEXR directly: nx wide, ny*nz tall,
 // slice z in rows [z*ny, (z+1)*ny), each slice's top row (y = ny-1) first,
 // and the header attributes.

@@ -61,9 +61,9 @@ void check_half_range(const atlas::detail::FieldStorage& f, const fs::path& path
         }
 }
 
-Imf::Header base_header(int width, int height, const std::vector<std::string>& names, const std::string& meaning) {
+Imf::Header base_header(int width, int height, const std::vector<std::string>& names, const std::string& meaning, bool compress) {
     Imf::Header h(width, height);
-    h.compression() = Imf::ZIP_COMPRESSION;
+    h.compression() = compress ? Imf::ZIP_COMPRESSION : Imf::NO_COMPRESSION;
     h.insert("atlas:version", Imf::IntAttribute(kExrLayoutVersion));
     h.insert("atlas:channel_meaning", Imf::StringAttribute(meaning));
     // EXR lists channels alphabetically; this keeps the field's order.
@@ -291,7 +291,7 @@ void write_exr(const Field2D& f, const fs::path& path, const ExrOptions& o) {
     check_channel_names(f.channel_names(), path);
     if (o.half) check_half_range(f, path);
     const int width = f.width(), height = f.height();
-    Imf::Header hd = base_header(width, height, f.channel_names(), o.channel_meaning);
+    Imf::Header hd = base_header(width, height, f.channel_names(), o.channel_meaning, o.compress);
     const auto& b = f.bounds();
     const Vec2d v = f.voxel_size();
     hd.insert("atlas:bounds_min", Imf::V2dAttribute(Imath::V2d(b.min[0], b.min[1])));
@@ -310,7 +310,7 @@ void write_exr(const Field3D& f, const fs::path& path, const ExrOptions& o) {
     if (int64_t(ny) * nz > (int64_t(1) << 30))
         throw Error(path.string() + ": cannot write EXR: " + std::to_string(ny) + "x" + std::to_string(nz) + " rows are too many for one image");
     // Slices stacked top to bottom (z = 0 first), each with its rows flipped.
-    Imf::Header hd = base_header(nx, ny * nz, f.channel_names(), o.channel_meaning);
+    Imf::Header hd = base_header(nx, ny * nz, f.channel_names(), o.channel_meaning, o.compress);
     const auto& b = f.bounds();
     const Vec3d v = f.voxel_size();
     hd.insert("atlas:bounds_min", Imf::V3dAttribute(Imath::V3d(b.min[0], b.min[1], b.min[2])));

@@ -98,6 +98,7 @@ const std::vector<FormatEntry>& format_table() {
           "OpenEXR, 32-bit float (bit-exact) or half; a 3D field is nx x (ny*nz) stacked slices with atlas:* header attributes",
           {{"half", "true: store 16-bit half floats (values beyond +-65504 are an error)"},
            {"meaning", "free text stored in the atlas:channel_meaning attribute"},
+           {"compression", "zip (default) or none: data that does not compress (an SDF's float mantissas) writes faster uncompressed"},
            kChannels}},
          write_exr_output,
          check_exr_options},

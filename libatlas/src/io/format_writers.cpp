@@ -92,6 +92,12 @@ ExrOptions exr_options(const OptionReader& o) {
     ExrOptions eo;
     eo.half = o.flag("half");
     if (o.has("meaning")) eo.channel_meaning = o.text("meaning");
+    if (o.has("compression")) {
+        const std::string& c = o.text("compression");
+        if (c == "zip") eo.compress = true;
+        else if (c == "none") eo.compress = false;
+        else o.bad("compression", "zip or none");
+    }
     o.list("channels");
     return eo;
 }

@@ -30,6 +30,10 @@ struct ExrOptions {
     // rather than a silent infinity.
     bool half = false;
     std::string channel_meaning; // free text stored in atlas:channel_meaning
+    // ZIP (the default) or none: float data that does not compress (a signed
+    // distance field's mantissas) is written in a fraction of the time and
+    // barely larger uncompressed.
+    bool compress = true;
 };
 
 // Writes straight to `path` (atomicity is the caller's: core/files.h).
