@@ -200,6 +200,31 @@ TEST(GraphPreview, PixelSizeMarchesFewerRaysForTheSamePicture) {
     EXPECT_THROW(preview::set_preview_options(po, {{"pixel_size", "9"}}), Error);
 }
 
+// Issue 41: the preview's sky_occlusion (default 0.1) only dims the ambient under cloud:
+// the same transmittance, and no pixel brighter with more occlusion (1 = Beer straight up).
+TEST(GraphPreview, SkyOcclusionDimsTheAmbientUnderCloudOnly) {
+    preview::GraphPreviewOptions how;
+    how.noise = "none";
+    Session s = cloud_session();
+    render::PreviewOptions po;
+    preview::set_preview_options(po, {{"size", "64,36"}, {"view", "orbit"}});
+    EXPECT_EQ(po.sky_occlusion, render::kPreviewSkyOcclusion);
+    const render::PreviewFrame relaxed = preview::preview_session(s, po, how);
+    preview::set_preview_options(po, {{"sky_occlusion", "1"}});
+    const render::PreviewFrame beer = preview::preview_session(s, po, how);
+    double darker = 0;
+    for (int y = 0; y < 36; ++y)
+        for (int x = 0; x < 64; ++x) {
+            ASSERT_EQ(relaxed.image.at(3, x, y), beer.image.at(3, x, y)) << x << "," << y;
+            for (int c = 0; c < 3; ++c) {
+                ASSERT_LE(beer.image.at(c, x, y), relaxed.image.at(c, x, y) + 1e-6f) << x << "," << y;
+                darker += relaxed.image.at(c, x, y) - beer.image.at(c, x, y);
+            }
+        }
+    EXPECT_GT(darker, 0.0) << "cloud with cloud above it is dimmer with full occlusion";
+    EXPECT_THROW(preview::set_preview_options(po, {{"sky_occlusion", "-1"}}), Error);
+}
+
 // Issue 43: a graph's lightning schedule (ndf/lightning's table) is drawn: the window's
 // longest strike sequence becomes point lights at its flashes, with their intensities;
 // flash_schedule false leaves them out, and a window without flashes adds none.

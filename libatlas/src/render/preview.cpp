@@ -463,6 +463,7 @@ PreviewJob prepare_preview(std::optional<CloudScene> voxel, std::optional<LayerS
     s.skip_empty_space = o.sdf_skipping;
     s.use_light_grid = o.light_lookup_grid;
     s.extinction = o.extinction;
+    s.sky_occlusion = o.sky_occlusion;
     s.mode = o.mode;
     if (o.sky_colour) s.sky_colour = *o.sky_colour;
     if (o.sky_horizon) s.sky_horizon = *o.sky_horizon;

@@ -24,6 +24,7 @@ bool PreviewOptions::operator==(const PreviewOptions& o) const {
            same_lights(lights, o.lights) && lightning == o.lightning && flash_schedule == o.flash_schedule && flash_seed == o.flash_seed && flash_index == o.flash_index &&
            flash_count == o.flash_count && flash_colour == o.flash_colour && flash_intensity == o.flash_intensity && flash_radius == o.flash_radius &&
            mode == o.mode && quality == o.quality && extinction == o.extinction && noise_tile == o.noise_tile && artistic == o.artistic &&
+           sky_occlusion == o.sky_occlusion &&
            ms_octaves == o.ms_octaves && ms_diffusion == o.ms_diffusion && ms_diffusion_sweeps == o.ms_diffusion_sweeps && light_grid == o.light_grid &&
            time == o.time && wind == o.wind && earth_radius == o.earth_radius &&
            edge == o.edge && envelope == o.envelope && density_units == o.density_units && sdf_skipping == o.sdf_skipping &&
@@ -200,6 +201,11 @@ std::vector<TextOption<P>> make_preview_options() {
             [](P& p, const V& v) { p.exposure = v.number; }),
         opt({"noise_tile", "--noise-tile", "M", K::Number, "voxel up-rez: metres per noise period", 1e-3, 1e9}, "256", "m",
             [](P& p, const V& v) { p.noise_tile = v.number; }),
+        opt({"sky_occlusion", "--sky-occlusion", "K", K::Number,
+             "artistic lighting: the ambient is occluded by exp(-K x the optical depth above); 1 = Beer straight up, 0 = sqrt(1 - profile) alone "
+             "(docs/render.md \"Ambient\")",
+             0, 1e3},
+            "0.1", "", [](P& p, const V& v) { p.sky_occlusion = v.number; }),
         opt({"artistic", "--artistic", "on|off", K::Choice,
              "off: the physical lighting a path tracer computes (no powder, octave and diffusion multiple scattering; docs/render.md \"Reference: "
              "Cycles\")",

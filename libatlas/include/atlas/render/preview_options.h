@@ -54,6 +54,7 @@ struct PreviewOptions {
     double flash_intensity = 1e5, flash_radius = 0;
     RenderMode mode = RenderMode::Fast;
     double quality = 1, extinction = 0.04, noise_tile = 256;
+    double sky_occlusion = kPreviewSkyOcclusion; // artistic ambient: share of the optical depth above (RenderSettings)
     // The physical model (docs/render.md, "Reference: Cycles"): artistic false turns
     // it on, with kPhysicalMsOctaves octaves and the diffusion term unless given.
     bool artistic = true;
