@@ -57,6 +57,14 @@ CookOptions values(int proxy, int jobs = 0) {
     return o;
 }
 
+// A 64 x 36 orbit view of kCloud, drawn without the up-rez noise.
+render::PreviewOptions orbit_picture(preview::GraphPreviewOptions& how) {
+    how.noise = "none";
+    render::PreviewOptions po;
+    preview::set_preview_options(po, {{"size", "64,36"}, {"view", "orbit"}});
+    return po;
+}
+
 render::PreviewOptions small_picture() {
     render::PreviewOptions po;
     preview::set_preview_options(po, {{"size", "48,27"}});
@@ -177,10 +185,8 @@ TEST(GraphPreview, BadOptionsNameTheOptionAndWhatItTakes) {
 
 TEST(GraphPreview, PixelSizeMarchesFewerRaysForTheSamePicture) {
     preview::GraphPreviewOptions how;
-    how.noise = "none";
+    render::PreviewOptions po = orbit_picture(how);
     Session s = cloud_session();
-    render::PreviewOptions po;
-    preview::set_preview_options(po, {{"size", "64,36"}, {"view", "orbit"}});
     const render::PreviewFrame full = preview::preview_session(s, po, how);
     preview::set_preview_options(po, {{"pixel_size", "2"}});
     const render::PreviewFrame coarse = preview::preview_session(s, po, how);
@@ -204,10 +210,8 @@ TEST(GraphPreview, PixelSizeMarchesFewerRaysForTheSamePicture) {
 // the same transmittance, and no pixel brighter with more occlusion (1 = Beer straight up).
 TEST(GraphPreview, SkyOcclusionDimsTheAmbientUnderCloudOnly) {
     preview::GraphPreviewOptions how;
-    how.noise = "none";
+    render::PreviewOptions po = orbit_picture(how);
     Session s = cloud_session();
-    render::PreviewOptions po;
-    preview::set_preview_options(po, {{"size", "64,36"}, {"view", "orbit"}});
     EXPECT_EQ(po.sky_occlusion, render::kPreviewSkyOcclusion);
     const render::PreviewFrame relaxed = preview::preview_session(s, po, how);
     preview::set_preview_options(po, {{"sky_occlusion", "1"}});
