@@ -262,21 +262,37 @@ CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* mani
                 const size_t first = (size_t(layer) * size_t(depth0) + size_t(z0)) * slice;
                 for (int c = 0; c < r.channels; ++c) {
                     const int sc = src_channel(c);
-                    for (size_t i = 0; i < L.lo[size_t(c)].size(); ++i) {
-                        // The decoded slab is in DDS row order (top-down); the source is y-up.
-                        const float s = sc >= 0 ? source.channel(sc)[first + detail::dds_row_flip(i, L.w, L.h)]
-                                                : map.to_src(c == 3 ? 1.0f : 0.0f); // missing: stored constants
-                        // In double, as an engine may reconstruct: the float mapping can round
-                        // an ulp below and hide a texel just above its source.
-                        const double lo = map.to_src_exact(L.lo[size_t(c)][i]), hi = map.to_src_exact(L.hi[size_t(c)][i]);
-                        st.max_error[size_t(c)] = std::max(st.max_error[size_t(c)], std::max(hi - s, s - lo));
-                        st.max_over = std::max(st.max_over, hi - s);
-                        if (hi > s) ++st.one_sided_violations;
-                        const double mid = map.to_src_exact(0.5 * (double(L.lo[size_t(c)][i]) + double(L.hi[size_t(c)][i])));
-                        under += s - mid;
-                        sq[size_t(c)] += (mid - s) * (mid - s);
-                        ++count;
+                    const float missing = map.to_src(c == 3 ? 1.0f : 0.0f); // a missing channel: stored constants
+                    const float* src = sc >= 0 ? source.channel(sc).data() + first : nullptr;
+                    const float* dlo = L.lo[size_t(c)].data();
+                    const float* dhi = L.hi[size_t(c)].data();
+                    const size_t W = size_t(L.w), H = size_t(L.h), rows = L.lo[size_t(c)].size() / W;
+                    double max_error = st.max_error[size_t(c)], max_over = st.max_over, sum_sq = sq[size_t(c)];
+                    uint64_t violations = st.one_sided_violations;
+                    // Row by row, in the decoded slab's order (so the sums add in the same
+                    // order as texel by texel): DDS rows run top-down, the source is y-up.
+                    for (size_t row = 0; row < rows; ++row) {
+                        const size_t z = row / H, y = row % H;
+                        const float* srow = src ? src + (z * H + (H - 1 - y)) * W : nullptr;
+                        const size_t i0 = row * W;
+                        for (size_t x = 0; x < W; ++x) {
+                            const float s = srow ? srow[x] : missing;
+                            // In double, as an engine may reconstruct: the float mapping can round
+                            // an ulp below and hide a texel just above its source.
+                            const double lo = map.to_src_exact(dlo[i0 + x]), hi = map.to_src_exact(dhi[i0 + x]);
+                            max_error = std::max(max_error, std::max(hi - s, s - lo));
+                            max_over = std::max(max_over, hi - s);
+                            violations += hi > s ? 1 : 0;
+                            const double mid = map.to_src_exact(0.5 * (double(dlo[i0 + x]) + double(dhi[i0 + x])));
+                            under += s - mid;
+                            sum_sq += (mid - s) * (mid - s);
+                        }
                     }
+                    st.max_error[size_t(c)] = max_error;
+                    st.max_over = max_over;
+                    st.one_sided_violations = violations;
+                    sq[size_t(c)] = sum_sq;
+                    count += rows * W;
                 }
             }
         }
