@@ -610,3 +610,50 @@ TEST(LayerVortex, SkewTurnsTheRingPatternByItsAngleTimesTheHeightFraction) {
     EXPECT_TRUE(r.report.vortex);
     EXPECT_FALSE(same_bytes(r.image, render_layer(plain, st, nullptr).image));
 }
+
+TEST(LayerSky, HorizonStripWrapsAroundTheCameraFromTheHorizonUpAtItsTexelSize) {
+    // Far Cry 6's cirrus horizon strip on a cylinder around the camera: x the azimuth
+    // from +x toward +y, row 0 the horizon, rows up at the width's texel size
+    // (tan(elevation) x W / 2 pi rows). A 64 x 8 strip, 1 only at azimuths 45-135
+    // degrees (x 8..23) in rows 0-3: rows 0-3 reach tan(e) = 4 x 2 pi / 64, e = 21.4
+    // degrees, the strip's top (row 8) 38.1 degrees.
+    Field2D strip({{64, 8}}, 1, Box2d{{{0, 0}}, {{1, 1}}}, {"cirrus_horizon"});
+    for (int y = 0; y < 4; ++y)
+        for (int x = 8; x < 24; ++x) strip.at(0, x, y) = 1.0f;
+    LayerScene clear = scene_with(0.0, false);
+    clear.haze_distance = 0;
+    LayerScene with = clear;
+    SkyLayer l;
+    l.mapping = SkyMapping::Cylinder;
+    l.texture = std::make_shared<const Field2D>(std::move(strip));
+    l.opacity = 0.8;
+    with.sky_layers.push_back(l);
+    // One pixel looking along (azimuth, elevation) from the ground.
+    auto pixel = [&](const LayerScene& sc, double az_deg, double el_deg) {
+        RenderSettings st = small_settings(1, 1);
+        st.camera.fov_deg = 1;
+        const double a = az_deg * std::numbers::pi / 180, e = el_deg * std::numbers::pi / 180;
+        st.camera.position = {{10000, 10000, 2}};
+        st.camera.look_at = {{10000 + 1000 * std::cos(e) * std::cos(a), 10000 + 1000 * std::cos(e) * std::sin(a), 2 + 1000 * std::sin(e)}};
+        const LayerResult r = render_layer(sc, st, nullptr);
+        return Vec3d{{r.image.at(0, 0, 0), r.image.at(1, 0, 0), r.image.at(2, 0, 0)}};
+    };
+    auto differs = [](const Vec3d& a, const Vec3d& b) { return std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]); };
+    // Toward +y (azimuth 90) low: the strip's cloud, whiter than the blue sky.
+    const Vec3d lit = pixel(with, 90, 8), sky = pixel(clear, 90, 8);
+    EXPECT_GT(differs(lit, sky), 0.05);
+    EXPECT_GT(lit[0] - lit[2], sky[0] - sky[2]) << "cloud is less blue than the sky";
+    // Elsewhere around, above row 4 and above the strip: the sky alone, exactly.
+    for (const auto& [az, el] : std::vector<std::pair<double, double>>{{270, 8}, {0, 8}, {180, 8}, {90, 30}, {90, 45}}) {
+        const Vec3d a = pixel(with, az, el), b = pixel(clear, az, el);
+        EXPECT_EQ(a[0], b[0]) << az << ", " << el;
+        EXPECT_EQ(a[1], b[1]) << az << ", " << el;
+        EXPECT_EQ(a[2], b[2]) << az << ", " << el;
+    }
+    // Just inside and outside the cloud's rows at azimuth 90: row 4 is at 21.4 degrees.
+    EXPECT_GT(differs(pixel(with, 90, 18), pixel(clear, 90, 18)), 0.05);
+    EXPECT_LT(differs(pixel(with, 90, 24), pixel(clear, 90, 24)), 1e-6);
+    // Below the horizon: nothing of it.
+    const Vec3d g = pixel(with, 90, -5), g0 = pixel(clear, 90, -5);
+    EXPECT_EQ(g[0], g0[0]);
+}

@@ -32,7 +32,7 @@ namespace {
 //   otherwise the last 1-channel 2D field               -> a sky layer at 6 km (Quilez)
 struct GraphContent {
     Field3DPtr nvdf;
-    Field2DPtr ndf, lut, cone, cirrus, sky2d, anvil, vortex;
+    Field2DPtr ndf, lut, cone, cirrus, sky2d, horizon, anvil, vortex;
     Field2DPtr flashes; // ndf/lightning's table: x = flash
     Field3DPtr distance;
     Field3DPtr forecast; // ndf/forecast maps: z = time slice, channels coverage, precipitation, type, ...
@@ -93,7 +93,7 @@ GraphContent cook_graph(Session& session, const std::string& file, const GraphPr
         for (const auto& w : wants)
             if (w.generic == (pass == 1)) now.push_back(&w);
         if (now.empty()) continue;
-        if (pass == 1 && (g.nvdf || g.ndf || g.cirrus || g.sky2d)) break;
+        if (pass == 1 && (g.nvdf || g.ndf || g.cirrus || g.sky2d || g.horizon)) break;
         CookOptions o = value_cook(how);
         for (const Want* w : now) o.outputs.push_back(w->file);
         const CookResult r = session.cook(o);
@@ -131,6 +131,11 @@ GraphContent cook_graph(Session& session, const std::string& file, const GraphPr
                 if (!g.lut) g.lut = *f2;
             } else if (has_channels(f, {"apex_height", "cone_ratio"})) {
                 if (!g.cone) g.cone = *f2;
+            } else if (has_channels(f, {"cirrus_horizon"})) {
+                // Far Cry 6's horizon strip goes around the camera; drawn as a sky
+                // plane it stretched into bars across the sky.
+                render::check_finite(f, what);
+                if (!g.horizon) g.horizon = *f2;
             } else if (has_channels(f, {"cirrus"})) {
                 render::check_finite(f, what);
                 if (!g.cirrus) g.cirrus = *f2;
@@ -291,7 +296,7 @@ GraphPreview prepare_graph_preview(Session& session, const render::PreviewOption
                         std::to_string(g.forecast->nz() - 1) + ")");
         g.ndf = std::make_shared<const Field2D>(forecast_slice(*g.forecast, out.slice));
     }
-    const bool layerish = g.ndf || g.cirrus || g.sky2d;
+    const bool layerish = g.ndf || g.cirrus || g.sky2d || g.horizon;
     if (!g.nvdf && !layerish) {
         std::string list;
         for (const auto& x : g.written) list += "\n  " + x;
@@ -320,6 +325,7 @@ GraphPreview prepare_graph_preview(Session& session, const render::PreviewOption
         li.distance_map = g.distance;
         li.cirrus = g.cirrus;
         li.sky_texture = g.sky2d;
+        li.horizon_strip = g.horizon;
         layer = render::layer_preview_scene(li);
     }
     render::PreviewOptions lit = options;

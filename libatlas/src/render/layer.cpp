@@ -616,17 +616,30 @@ struct LayerIntegrator {
         const double up_t = detail::saturate(dot(dir, cam_up));
         for (int c = 0; c < 3; ++c) out[c] = sky.at(c, up_t);
         for (const SkyLayer& l : sc.sky_layers) {
-            const double t = ray_sphere_exit_or_hit(o, dir, m.centre(), sc.earth_radius + l.altitude);
-            if (!(t > 0)) continue;
-            const Vec3d p = o + dir * t;
             const Field2D& tex = *l.texture;
             Bilinear b;
-            axis_wrap((p[0] - l.wind[0] * sc.time) / l.tile * tex.width(), tex.width(), b.x0, b.x1, b.tx);
-            axis_wrap((p[1] - l.wind[1] * sc.time) / l.tile * tex.height(), tex.height(), b.y0, b.y1, b.ty);
+            double fade = 1;
+            if (l.mapping == SkyMapping::Cylinder) {
+                const double up = dot(dir, cam_up);
+                if (!(up > 0)) continue;
+                const double pi2 = 2 * std::acos(-1.0);
+                const double rows = up / std::sqrt(std::max(1e-12, 1 - up * up)) * tex.width() / pi2;
+                if (!(rows < tex.height())) continue; // above the strip
+                double az = std::atan2(dir[1], dir[0]) / pi2;
+                if (az < 0) az += 1;
+                axis_wrap(az * tex.width(), tex.width(), b.x0, b.x1, b.tx);
+                axis_clamp(rows, tex.height(), b.y0, b.y1, b.ty);
+            } else {
+                const double t = ray_sphere_exit_or_hit(o, dir, m.centre(), sc.earth_radius + l.altitude);
+                if (!(t > 0)) continue;
+                const Vec3d p = o + dir * t;
+                axis_wrap((p[0] - l.wind[0] * sc.time) / l.tile * tex.width(), tex.width(), b.x0, b.x1, b.tx);
+                axis_wrap((p[1] - l.wind[1] * sc.time) / l.tile * tex.height(), tex.height(), b.y0, b.y1, b.ty);
+                // Fade toward the horizon where the layer's texels alias.
+                fade = detail::saturate(dot(dir, cam_up) * 8.0);
+            }
             const double v = lerp2(tex.channel(l.channel).data(), tex.width(), b);
-            double a = l.opacity * detail::saturate((v - l.value_min) / (l.value_max - l.value_min));
-            // Fade toward the horizon where the layer's texels alias.
-            a *= detail::saturate(dot(dir, cam_up) * 8.0);
+            double a = l.opacity * detail::saturate((v - l.value_min) / (l.value_max - l.value_min)) * fade;
             if (!(a > 0)) continue;
             const double ph = 0.55 + 0.45 * std::min(4.0, detail::hg(dot(dir, sun), 0.5));
             for (int c = 0; c < 3; ++c) {

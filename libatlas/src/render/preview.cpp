@@ -85,6 +85,14 @@ LayerScene layer_preview_scene(const LayerPreviewInputs& in) {
         layer.sky_layers.push_back(sky_layer_from(in.cirrus, c >= 0 ? c : 0, 8000, tile_of(*in.cirrus), 0.8));
     }
     if (in.sky_texture) layer.sky_layers.push_back(sky_layer_from(in.sky_texture, 0, 6000, tile_of(*in.sky_texture), 0.9));
+    if (in.horizon_strip) {
+        // Its values are coverage already (0 to 1, fading to 0 at the top): no window.
+        SkyLayer l;
+        l.mapping = SkyMapping::Cylinder;
+        l.texture = in.horizon_strip;
+        l.opacity = 0.8;
+        layer.sky_layers.push_back(l);
+    }
     // A storm is one feature: no copies of it beyond the map. Weather maps tile.
     // Every NDF set carries a storm channel (all zero in a weather map, so
     // its presence says nothing); a storm's graph also gives an anvil map or

@@ -44,7 +44,13 @@ enum class MapEdge {
 // volumetric clouds. Opacity = opacity * saturate((v - value_min) /
 // (value_max - value_min)), v = channel `channel` at the hit's map position
 // (texture tiled every `tile` metres, scrolled by wind * time).
+// Cylinder: Far Cry 6's cirrus horizon strip, mapped on a cylinder around the
+// camera instead: x is the azimuth (from +x toward +y, the texture's width once
+// around), row 0 the horizon, rows up at the width's texel size (v = tan(elevation)
+// x width / 2 pi), nothing above the strip; altitude, tile and wind unused.
+enum class SkyMapping { Sphere, Cylinder };
 struct SkyLayer {
+    SkyMapping mapping = SkyMapping::Sphere;
     Field2DPtr texture;
     int channel = 0;
     double altitude = 8000;  // metres above the ground, > 0

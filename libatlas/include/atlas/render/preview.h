@@ -38,6 +38,7 @@ struct LayerPreviewInputs {
     Field3DPtr distance_map;           // ndf/distance_map
     Field2DPtr cirrus;                 // a field with a 'cirrus' channel: a sky layer at 8 km, opacity 0.8
     Field2DPtr sky_texture;            // a 1-channel texture: a sky layer at 6 km, opacity 0.9 (channel 0)
+    Field2DPtr horizon_strip;          // ndf/cirrus_horizon: on a cylinder around the camera (SkyMapping::Cylinder), opacity 0.8
 };
 
 // The field's role in a 2.5D preview, by its channels.
