@@ -266,15 +266,14 @@ CompressReport verify_texture(const DdsTexture& tex, const TextureManifest* mani
                     const float* src = sc >= 0 ? source.channel(sc).data() + first : nullptr;
                     const float* dlo = L.lo[size_t(c)].data();
                     const float* dhi = L.hi[size_t(c)].data();
-                    const size_t W = size_t(L.w), H = size_t(L.h), rows = L.lo[size_t(c)].size() / W;
+                    const size_t W = size_t(L.w), rows = L.lo[size_t(c)].size() / W;
                     double max_error = st.max_error[size_t(c)], max_over = st.max_over, sum_sq = sq[size_t(c)];
                     uint64_t violations = st.one_sided_violations;
                     // Row by row, in the decoded slab's order (so the sums add in the same
                     // order as texel by texel): DDS rows run top-down, the source is y-up.
                     for (size_t row = 0; row < rows; ++row) {
-                        const size_t z = row / H, y = row % H;
-                        const float* srow = src ? src + (z * H + (H - 1 - y)) * W : nullptr;
                         const size_t i0 = row * W;
+                        const float* srow = src ? src + detail::dds_row_flip(i0, L.w, L.h) : nullptr;
                         for (size_t x = 0; x < W; ++x) {
                             const float s = srow ? srow[x] : missing;
                             // In double, as an engine may reconstruct: the float mapping can round

@@ -622,7 +622,7 @@ struct LayerIntegrator {
             if (l.mapping == SkyMapping::Cylinder) {
                 const double up = dot(dir, cam_up);
                 if (!(up > 0)) continue;
-                const double pi2 = 2 * std::acos(-1.0);
+                const double pi2 = 2 * std::numbers::pi;
                 const double rows = up / std::sqrt(std::max(1e-12, 1 - up * up)) * tex.width() / pi2;
                 if (!(rows < tex.height())) continue; // above the strip
                 double az = std::atan2(dir[1], dir[0]) / pi2;
