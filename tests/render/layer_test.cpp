@@ -61,6 +61,19 @@ RenderSettings small_settings(int w = 64, int h = 36) {
 
 using atlas::render::testing::same_bytes;
 
+// Points given as (x, y, altitude) over scene_with's 20 km map: |p - C| - R
+// = z at the map centre only, so place them on the sphere, radial from the
+// Earth's centre.
+void place_at_altitude(std::vector<Vec3d>& pts) {
+    const Vec3d C{{10000, 10000, -kR}};
+    for (Vec3d& p : pts) {
+        const double h = p[2];
+        Vec3d d{{p[0] - C[0], p[1] - C[1], 0 - C[2]}};
+        const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int a = 0; a < 3; ++a) p[a] = C[a] + d[a] / n * (kR + h);
+    }
+}
+
 } // namespace
 
 TEST(LayerGeometry, HorizontalRayFromTheGroundMeetsTheShellWhereTheClosedFormSays) {
@@ -520,15 +533,7 @@ TEST(LayerAnvil, TheAnvilRisesAboveMaxHeightOnlyWhereTheBiasIsPositiveAndAtMostI
     std::vector<Vec3d> pts;
     for (int i = 0; i < 40; ++i)
         for (int k = 0; k < 40; ++k) pts.push_back({{250.0 + 500.0 * i, 10000.0, 4000.0 + 50.0 * k}});
-    // Points given at altitude: |p - C| - R = z at the map centre only, so
-    // place them on the sphere: radial from the Earth's centre.
-    const Vec3d C{{10000, 10000, -kR}};
-    for (Vec3d& p : pts) {
-        const double h = p[2];
-        Vec3d d{{p[0] - C[0], p[1] - C[1], 0 - C[2]}};
-        const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        for (int a = 0; a < 3; ++a) p[a] = C[a] + d[a] / n * (kR + h);
-    }
+    place_at_altitude(pts);
     const std::vector<double> d = layer_density(s, pts), d0 = layer_density(plain, pts);
     int west_cloudy = 0;
     for (size_t j = 0; j < pts.size(); ++j) {
@@ -656,4 +661,49 @@ TEST(LayerSky, HorizonStripWrapsAroundTheCameraFromTheHorizonUpAtItsTexelSize) {
     // Below the horizon: nothing of it.
     const Vec3d g = pixel(with, 90, -5), g0 = pixel(clear, 90, -5);
     EXPECT_EQ(g[0], g0[0]);
+}
+
+TEST(LayerMap, AClearTexelsHeightsDrawNoSheetToItsCloudyNeighbour) {
+    // West half 1500..4000 m at coverage 0.8, no noise; east half 9000..11000 m.
+    // Clear (coverage 0) in the east, the east's heights mean nothing: between
+    // the two texel centres there is cloud only under 4000 m, fading out with
+    // the coverage. (Lerping the heights drew a sheet rising from 4 to 9 km
+    // across the texel, a few metres thick where a ray crossed it: the
+    // superstorm's veils that the march hit at random.) Cloudy in the east
+    // too, the heights interpolate as before: the midpoint's column is
+    // 5250..7500 m.
+    for (const double east_coverage : {0.0, 0.8}) {
+        LayerScene s = scene_with(0.8, false, 1.0);
+        s.wind = {{0, 0}};
+        s.cloud_top_offset = 0;
+        Field2D set = *s.ndf;
+        for (int y = 0; y < 16; ++y)
+            for (int x = 8; x < 16; ++x) {
+                set.at(ndf::Coverage, x, y) = float(east_coverage);
+                set.at(ndf::MinHeight, x, y) = 9000.0f;
+                set.at(ndf::MaxHeight, x, y) = 11000.0f;
+            }
+        s.ndf = std::make_shared<const Field2D>(std::move(set));
+        // Texel centres 7 and 8 are at x = 9375 and 10625 m (1250 m texels).
+        std::vector<Vec3d> pts;
+        for (int i = 0; i <= 20; ++i)
+            for (int k = 0; k < 200; ++k) pts.push_back({{9375.0 + 62.5 * i, 10000.0, 1500.0 + 50.0 * k}});
+        place_at_altitude(pts);
+        const std::vector<double> d = layer_density(s, pts);
+        int low = 0, high = 0, mid_band = 0;
+        for (size_t j = 0; j < pts.size(); ++j) {
+            const int i = int(j / 200);
+            const double h = 1500.0 + 50.0 * double(j % 200);
+            ASSERT_TRUE(std::isfinite(d[j]));
+            if (d[j] > 0) (h < 4000 ? low : high)++;
+            if (i == 10 && h > 5400 && h < 7400 && d[j] > 0) ++mid_band;
+        }
+        if (east_coverage == 0) {
+            EXPECT_EQ(high, 0) << "cloud above the cloudy texel's top between it and a clear texel";
+            EXPECT_GT(low, 20 * 20) << "the west cloud fades out across the texel at its own heights";
+            EXPECT_EQ(mid_band, 0);
+        } else {
+            EXPECT_GT(mid_band, 20) << "two cloudy texels: the heights interpolate";
+        }
+    }
 }
