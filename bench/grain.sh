@@ -23,18 +23,7 @@ render() { # render OUT GRAPH [options...]: prints the render's own seconds
     "$atlas" preview "$src/$graph" -o "$out" --size "$size" --cache "$work/cache" "$@" 2>&1 |
         sed -n 's/.*rendered [0-9x]* ([^)]*) in \([0-9.]*\) s.*/\1/p'
 }
-grain() {
-    "$py" - "$1" "$2" <<'EOF'
-import sys, numpy as np, OpenImageIO as oiio
-a, b = (oiio.ImageBuf(p).get_pixels(oiio.FLOAT)[..., :3] * 255.0 for p in sys.argv[1:3])
-a, b = np.round(a), np.round(b)
-def cloud(x):
-    return np.abs(x - np.median(x, axis=1, keepdims=True)).max(axis=2) > 6
-m = cloud(a) | cloud(b)
-d = (a - b)[m]
-print(f"{np.sqrt((d ** 2).mean()) if d.size else 0.0:.2f} {100 * m.mean():.1f}")
-EOF
-}
+grain() { "$py" "$src/scripts/grain_rms.py" "$1" "$2"; }
 printf "%-34s %8s %10s %8s\n" view "RMS/255" "region %" "seconds"
 view() { # view NAME GRAPH [options...]
     local name=$1 graph=$2
