@@ -2,16 +2,13 @@
 // serve from cache, cook the rest level by level in parallel, write outputs
 // atomically.
 #include "atlas/graph/evaluator.h"
+#include "cook_run.h"
 #include "cook_steps.h"
 #include "graph_walk.h"
 
-#include "atlas/core/files.h"
-#include "atlas/core/option_schema.h"
-#include "atlas/core/parallel.h"
-#include "atlas/io/writers.h"
 #include "atlas/core/file_limits.h"
-#include "output_records.h"
-#include "value_cache.h"
+#include "atlas/core/files.h"
+#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <atomic>
@@ -21,7 +18,6 @@
 #include <functional>
 #include <mutex>
 #include <set>
-#include <sstream>
 
 namespace atlas {
 
@@ -51,21 +47,6 @@ namespace {
         throw Error(located(e.what(), false));
     }
 }
-
-// Formats whose encoded files the disk cache keeps (costly to encode).
-const std::set<std::string> kCachedOutputFormats = {"dds"};
-
-struct NodeState {
-    const GraphNode* node = nullptr;
-    const NodeType* type = nullptr;
-    Hash128 hash;
-    bool needed = false;   // some requested output depends on it
-    bool required = false; // its value must be present in this cook
-    bool cook = false;     // it will be cooked
-    std::shared_ptr<const NodeOutputs> cached; // value found in a cache
-    std::string cache_source;
-    int level = 0;
-};
 
 } // namespace
 
@@ -260,130 +241,7 @@ std::vector<Value> Session::get(const std::vector<std::pair<std::string, std::st
     return values;
 }
 
-namespace {
-
-using Wanted = std::vector<std::pair<std::string, std::string>>;
-
-// An output to write, as planned before anything cooks.
-struct OutputPlan {
-    const GraphOutput* out = nullptr;
-    std::filesystem::path root, rel;
-    std::string name; // the record's name: rel, generic form
-    std::string spec; // hash of everything in the key but the source
-    Hash128 key;
-    // The files on disk were written with this spec from a value that may
-    // be the same as the one cooked now (an upstream change that did not
-    // change this port): compare value hashes before writing.
-    const OutputRecord* same_spec = nullptr;
-    enum { write, current, restore, copy } action = write;
-    const OutputRecord* record = nullptr;
-    EarlierOutput* earlier = nullptr; // copy: the same output an earlier cook wrote elsewhere
-    std::optional<disk_cache::CachedFiles> cached;
-};
-
-// One cook, step by step as docs/architecture.md names them: plan, resolve, hash,
-// plan the writes, fetch (from the caches), cook, report, write. Session::run calls
-// the steps in that order; the tiled cook shares plan, resolve, cook and write's
-// placing (cook_steps.h).
-class CookRun {
-public:
-    CookRun(const Graph& g, const NodeRegistry& reg, ValueCache& cache, std::map<std::pair<std::string, int>, Hash128>& last_hashes, EarlierOutputs& earlier,
-            const CookOptions& opt, CookResult& result);
-
-    void plan(const Wanted* want_value); // 1. the targets: graph outputs or node ports
-    void resolve();                      // 2. what they need, in order
-    void hash();                         // 3. every needed node's hash, before anything cooks
-    void plan_writes();                  // 3b. outputs already on disk or in the disk cache
-    void fetch();                        // 4. consumers before producers: cached or to cook
-    void cook();                         // 5-6. level by level, a level's nodes in parallel
-    void report(bool for_values);        // 7. every node of the graph; the memory cache trimmed
-    void values_for(std::vector<Value>& out) const;
-    void write();                        // 8. the outputs, staged and committed together
-    CookResult finish();
-
-private:
-    void progress_step(const std::string& task, const std::string& node, double node_fraction, bool finished);
-    void warn(std::string message) { result_.warnings.push_back(std::move(message)); }
-    struct PendingWrite;
-    void encode(std::vector<PendingWrite>& batch);
-    void finish_write(PendingWrite& w);
-    void fail_output(PendingWrite& w, const std::string& msg);
-    void check_texture_budget();
-    void record_written();
-    const std::string& value_hash(const GraphOutput* o);
-
-    struct EvictorReset {
-        const detail::MemoryLedger& l;
-        CookResult& r;
-        // A failed cook's report (read from last_) says how much was counted when it
-        // stopped; a cook that returns sets the peak itself, as the copy it returns
-        // is made before this runs.
-        ~EvictorReset() {
-            l.set_evictor(nullptr);
-            r.memory_peak = l.peak();
-        }
-    };
-    struct Written {
-        size_t report; // index into result.outputs
-        OutputPlan* plan;
-        StagedOutputs* stage;
-        std::vector<std::filesystem::path> staged;
-    };
-    // An output on its way: staged, then encoded (with others), then finished.
-    struct PendingWrite {
-        OutputPlan* plan;
-        size_t report; // index into result.outputs
-        StagedOutputs* stage;
-        std::filesystem::path target; // the writer's staged path
-        std::vector<std::filesystem::path> staged;
-        std::shared_ptr<void> scratch_held;
-        std::chrono::steady_clock::time_point start;
-        double encode_seconds; // staging and writing (restoring) the files
-        std::exception_ptr error;
-        uint64_t scratch = 0;
-    };
-
-    const std::chrono::steady_clock::time_point t_start_ = std::chrono::steady_clock::now();
-    const Graph& g_;
-    const NodeRegistry& reg_;
-    ValueCache& cache_;
-    std::map<std::pair<std::string, int>, Hash128>& last_hashes_;
-    EarlierOutputs& earlier_;
-    const CookOptions& opt_;
-    CookResult& result_;
-    const int jobs_;
-    // One budget per session: the live total of this cook's fields and values
-    // and of the in-memory cache; before refusing it drops cache entries.
-    const MemoryBudget budget_;
-    const detail::MemoryLedger& ledger_;
-    const detail::MemoryLedger::Attachment attached_;
-    EvictorReset evictor_reset_;
-
-    std::vector<const GraphOutput*> outputs_;
-    Wanted targets_;
-    std::map<std::string, NodeState> state_;
-    std::vector<const GraphNode*> order_;
-    std::vector<OutputPlan> plans_;
-    std::map<std::filesystem::path, std::unique_ptr<OutputRecords>> records_;
-    // What no output may replace: the graph file and every file the cook reads.
-    std::vector<ProtectedFile> protect_;
-    std::set<std::string> feeds_writes_; // nodes some output to write depends on
-    bool cache_writable_ = false;
-    std::map<std::string, std::shared_ptr<const NodeOutputs>> values_;
-    std::map<std::string, uint64_t> released_bytes_;
-    // Progress: one unit per node to cook and per output to write; each running node
-    // adds what it reported of itself (never going back), and the fraction sent never
-    // decreases: one 0..1 run per cook.
-    std::mutex progress_mutex_;
-    int units_ = 0, done_ = 0;
-    std::map<std::string, double> in_flight_;
-    double shown_ = 0;
-    // Staged outputs and what they record.
-    std::map<std::filesystem::path, std::unique_ptr<StagedOutputs>> staging_;
-    std::vector<Written> written_;
-    std::vector<std::pair<OutputPlan*, OutputRecord>> rekeyed_;
-    std::map<std::pair<std::string, std::string>, std::string> value_hashes_;
-};
+namespace detail {
 
 CookRun::CookRun(const Graph& g, const NodeRegistry& reg, ValueCache& cache, std::map<std::pair<std::string, int>, Hash128>& last_hashes, EarlierOutputs& earlier,
                  const CookOptions& opt, CookResult& result)
@@ -440,84 +298,6 @@ void CookRun::hash() {
         for (const auto& r : reads) result_.inputs.push_back({r.path, r.bytes, r.hash.hex(), n->name});
         hashes[n->name] = s.hash;
     }
-}
-
-// An output whose key is unchanged and whose files still match needs no value (nothing
-// cooks or loads for it); one whose encoded files the disk cache holds is copied from there.
-void CookRun::plan_writes() {
-    const bool reuse = opt_.write_outputs && opt_.reuse_outputs && !opt_.checked;
-    cache_writable_ = bool(opt_.cache_dir);
-    if (!g_.file.empty()) protect_.push_back({g_.file, "the graph file"});
-    for (const auto& in : result_.inputs) protect_.push_back({in.path, "an input file of the cook (node '" + in.node + "')"});
-    if (opt_.write_outputs && !outputs_.empty()) {
-        if (opt_.cache_dir) remove_stale_staging(*opt_.cache_dir);
-        for (const GraphOutput* o : outputs_) {
-            OutputPlan p;
-            p.out = o;
-            try {
-                const detail::OutputPlace place = detail::output_place(opt_.out_dir, *o, opt_.allow_outside_out, protect_);
-                p.root = place.root;
-                p.rel = place.rel;
-            } catch (const std::exception& e) {
-                result_.error_output = o->file;
-                result_.error_where = o->where.str();
-                throw Error(o->where.str() + ": " + e.what());
-            }
-            p.name = p.rel.generic_string();
-            const detail::OutputSpec spec = detail::output_spec(*o, p.name, state_.at(o->node).hash);
-            p.spec = spec.spec;
-            p.key = spec.key;
-            auto& rec = records_[p.root];
-            if (!rec) {
-                remove_stale_staging(p.root); // what killed cooks left
-                rec = std::make_unique<OutputRecords>(p.root);
-            }
-            if (reuse) {
-                const auto earlier = earlier_.by_key.find(p.key.hex());
-                if ((p.record = rec->current(p.name, p.key.hex()))) {
-                    p.action = OutputPlan::current;
-                } else if (earlier != earlier_.by_key.end() && earlier->second.root != p.root &&
-                           files_unchanged(earlier->second.root, earlier->second.record.files)) {
-                    p.action = OutputPlan::copy;
-                    p.earlier = &earlier->second;
-                } else if (const OutputRecord* r = rec->on_disk(p.name); r && r->spec == p.spec && !r->value_hash.empty()) {
-                    p.same_spec = r;
-                } else if (opt_.cache_dir && kCachedOutputFormats.count(o->format) &&
-                           std::filesystem::exists(disk_cache::files_entry_path(*opt_.cache_dir, p.key))) {
-                    std::string why;
-                    p.cached = disk_cache::load_files(*opt_.cache_dir, p.key, &why);
-                    // Only the files this output writes: its own name and its sidecars beside it.
-                    if (p.cached)
-                        for (const auto& [name, bytes] : p.cached->files) {
-                            const std::filesystem::path f(name);
-                            if (f.parent_path() != p.rel.parent_path() || f.filename().string().rfind(p.rel.filename().string(), 0) != 0) {
-                                why = "it holds '" + name + "', not a file of this output";
-                                p.cached.reset();
-                                break;
-                            }
-                        }
-                    if (p.cached) {
-                        p.action = OutputPlan::restore;
-                    } else {
-                        std::error_code ec;
-                        std::filesystem::remove(disk_cache::files_entry_path(*opt_.cache_dir, p.key), ec);
-                        warn("disk cache: the encoded files of output '" + o->file + "' (" + disk_cache::files_entry_path(*opt_.cache_dir, p.key).string() +
-                             ") are unusable (" + why + "); discarded, the output is written again");
-                    }
-                }
-            }
-            plans_.push_back(std::move(p));
-        }
-        // Only the outputs to write need values.
-        targets_.clear();
-        for (const auto& p : plans_)
-            if (p.action == OutputPlan::write) targets_.emplace_back(p.out->node, p.out->port);
-    }
-    std::function<void(const std::string&)> mark_writes = [&](const std::string& name) {
-        if (!feeds_writes_.insert(name).second) return;
-        for (const auto& [port, b] : state_.at(name).node->inputs) mark_writes(b.node);
-    };
-    for (const auto& t : targets_) mark_writes(t.first);
 }
 
 void CookRun::fetch() {
@@ -732,277 +512,6 @@ void CookRun::values_for(std::vector<Value>& out) const {
     for (const auto& t : targets_) out.push_back(values_.at(t.first)->at(t.second));
 }
 
-// Outputs are staged in plan order, encoded in parallel (each writer makes its own
-// files from a value nothing changes any more, so the bytes do not depend on what
-// else runs), then finished in plan order: sizes, hashes, the disk cache, the report.
-void CookRun::write() {
-    if (!opt_.write_outputs || outputs_.empty()) {
-        for (const GraphOutput* o : outputs_) result_.outputs.push_back({o->node, o->port, o->file, o->format, {}, {}, {}, {}});
-        return;
-    }
-    std::vector<PendingWrite> batch;
-    batch.reserve(plans_.size());
-    // Writers' copies are held together while they run; one the budget refuses
-    // beside the others waits for them (the same decisions whatever the thread count).
-    auto flush = [&] {
-        encode(batch);
-        for (PendingWrite& w : batch) finish_write(w);
-        batch.clear();
-    };
-    for (OutputPlan& p : plans_) {
-        const GraphOutput* o = p.out;
-        OutputReport orep{o->node, o->port, o->file, o->format, {}, {}, {}, {}, {}, 0.0};
-        if (p.same_spec && p.same_spec->value_hash == value_hash(o)) {
-            // Upstream changed, this port did not: the files already hold it.
-            p.action = OutputPlan::current;
-            p.record = p.same_spec;
-            OutputRecord r = *p.same_spec;
-            r.key = p.key.hex();
-            rekeyed_.emplace_back(&p, std::move(r));
-            progress_step("up to date: " + o->file, "", 0.0, true);
-        }
-        if (p.action == OutputPlan::current) {
-            orep.status = "up to date";
-            orep.metrics = p.record->metrics;
-            for (const auto& f : p.record->files) orep.files.push_back({p.root / f.path, f.bytes, f.hash});
-            result_.outputs.push_back(orep);
-            continue;
-        }
-        PendingWrite w{&p, result_.outputs.size(), nullptr, {}, {}, {}, std::chrono::steady_clock::now(), 0.0, {}};
-        result_.outputs.push_back(orep);
-        const std::string what = "output '" + o->file + "': the writer's copy of the value";
-        if (p.action == OutputPlan::write) {
-            // A writer may copy the value (a slice stack, a half-float frame): room for one copy;
-            // the DDS encoder holds its channels and blocks besides (cloudscape's modeling.dds
-            // peaked 490 MB of RSS over the one copy counted), so two.
-            w.scratch = value_bytes(values_.at(o->node)->at(o->port)) * (o->format == "dds" ? 2 : 1);
-            bool fits = true;
-            try {
-                budget_.check(w.scratch, what);
-            } catch (const MemoryBudgetError&) {
-                fits = false;
-            }
-            if (!fits) flush(); // the writers before it finish first, then it is checked alone
-        }
-        std::optional<std::string> failure;
-        try {
-            opt_.progress.poll();
-            auto& st = staging_[p.root];
-            if (!st) {
-                st = std::make_unique<StagedOutputs>(p.root);
-                st->protect(protect_);
-            }
-            w.stage = st.get();
-            if (p.action == OutputPlan::restore || p.action == OutputPlan::copy) {
-                // Encoded files already exist: the disk cache's bytes, or the files an
-                // earlier cook of the session wrote elsewhere.
-                progress_step("writing " + o->file, "", 0.0, false);
-                OutputReport& r = result_.outputs[w.report];
-                const bool restore = p.action == OutputPlan::restore;
-                r.status = restore ? "restored" : "copied";
-                r.metrics = restore ? p.cached->metrics : p.earlier->record.metrics;
-                if (restore)
-                    for (const auto& [name, bytes] : p.cached->files) {
-                        w.staged.push_back(st->stage(name));
-                        write_file_checked(w.staged.back(), bytes.data(), bytes.size());
-                    }
-                else
-                    for (const auto& f : p.earlier->record.files) {
-                        w.staged.push_back(st->stage(f.path));
-                        std::filesystem::copy_file(p.earlier->root / f.path, w.staged.back(), std::filesystem::copy_options::overwrite_existing);
-                    }
-                p.cached.reset();
-                w.encode_seconds = seconds_since(w.start);
-            } else {
-                budget_.check(w.scratch, what);
-                w.scratch_held = ledger_.hold(&p, w.scratch);
-                w.target = st->stage(p.rel);
-            }
-        } catch (const CancelledError&) {
-            throw;
-        } catch (const std::exception& e) {
-            failure = e.what();
-        }
-        if (failure) {
-            // Flushed first, so that the report lists the outputs in plan order.
-            flush();
-            fail_output(w, *failure);
-            continue;
-        }
-        batch.push_back(std::move(w));
-    }
-    flush();
-    check_texture_budget();
-    // Everything written: move it into place.
-    // Every root's destinations checked and journaled before any file moves.
-    for (auto& [root, st] : staging_) st->prepare();
-    for (auto& [root, st] : staging_) st->commit();
-    record_written();
-}
-
-// The batch's writers, up to the cook's jobs at a time.
-void CookRun::encode(std::vector<PendingWrite>& batch) {
-    std::vector<size_t> todo;
-    for (size_t i = 0; i < batch.size(); ++i)
-        if (batch[i].plan->action == OutputPlan::write) todo.push_back(i);
-    ThreadLimit arena(jobs_);
-    arena.run([&] {
-        parallel_for_each(todo.size(), 1, [&](size_t k) {
-            PendingWrite& w = batch[todo[k]];
-            const GraphOutput* o = w.plan->out;
-            const auto t0 = std::chrono::steady_clock::now();
-            try {
-                opt_.progress.poll();
-                progress_step("writing " + o->file, "", 0.0, false);
-                OutputReport& r = result_.outputs[w.report];
-                r.status = "written";
-                w.staged = io::write_value(values_.at(o->node)->at(o->port), w.target, o->format, o->options, &r.metrics);
-            } catch (...) {
-                w.error = std::current_exception();
-            }
-            w.encode_seconds = seconds_since(t0);
-            w.scratch_held.reset();
-        });
-    });
-}
-
-// One output after its writer: what is on disk is what gets reported and recorded.
-void CookRun::finish_write(PendingWrite& w) {
-    const auto t0 = std::chrono::steady_clock::now();
-    OutputPlan& p = *w.plan;
-    const GraphOutput* o = p.out;
-    OutputReport& orep = result_.outputs[w.report];
-    std::optional<std::string> failure;
-    if (w.error) {
-        try {
-            std::rethrow_exception(w.error);
-        } catch (const CancelledError&) {
-            throw;
-        } catch (const std::exception& e) {
-            failure = e.what();
-        }
-    } else {
-        try {
-            for (const auto& staged : w.staged) {
-                std::error_code ec;
-                const uint64_t bytes = std::filesystem::file_size(staged, ec);
-                if (ec) throw Error("'" + staged.string() + "' was not written: " + ec.message());
-                const auto final_path = w.stage->final_path(staged);
-                orep.written.push_back(final_path);
-                orep.files.push_back({final_path, bytes, file_content_hash(staged).hex()});
-            }
-            if (p.action == OutputPlan::copy)
-                for (size_t k = 0; k < orep.files.size(); ++k)
-                    if (orep.files[k].hash != p.earlier->record.files[k].hash)
-                        throw Error("'" + (p.earlier->root / p.earlier->record.files[k].path).string() + "', copied from an earlier cook, changed while it was read");
-        } catch (const CancelledError&) {
-            throw;
-        } catch (const std::exception& e) {
-            failure = e.what();
-        }
-    }
-    if (failure) {
-        fail_output(w, *failure);
-        return;
-    }
-    if (p.action == OutputPlan::write && cache_writable_ && kCachedOutputFormats.count(o->format)) {
-        std::vector<std::pair<std::string, std::filesystem::path>> files;
-        for (size_t k = 0; k < w.staged.size(); ++k) files.emplace_back(orep.files[k].path.lexically_relative(p.root).generic_string(), w.staged[k]);
-        try {
-            disk_cache::store_files(*opt_.cache_dir, p.key, files, orep.metrics);
-        } catch (const std::exception& e) {
-            cache_writable_ = false;
-            warn("disk cache: cannot store the encoded files of output '" + o->file + "' (" + e.what() + "); cooking on without writing the cache");
-        }
-    }
-    orep.seconds = w.encode_seconds + seconds_since(t0);
-    written_.push_back({w.report, &p, w.stage, std::move(w.staged)});
-    progress_step("wrote " + o->file, "", 0.0, true);
-}
-
-// The output failed, not the node that fed it: the report marks the output. With
-// keep going, the cook goes on without it; else nothing is written and the
-// report ends at this output.
-void CookRun::fail_output(PendingWrite& w, const std::string& msg) {
-    const GraphOutput* o = w.plan->out;
-    OutputReport& orep = result_.outputs[w.report];
-    orep.status = "failed";
-    orep.error = msg;
-    orep.written.clear();
-    orep.files.clear();
-    orep.seconds = w.encode_seconds;
-    if (opt_.keep_going) {
-        if (w.stage) w.stage->discard(w.plan->rel);
-        warn("output '" + o->file + "' (" + o->where.str() + ") was not written (keep going): " + msg);
-        return;
-    }
-    result_.outputs.resize(w.report + 1);
-    result_.error_output = o->file;
-    result_.error_where = o->where.str();
-    throw Error(detail::output_error(*o, msg));
-}
-
-// Content hash of the value an output writes, once per node port.
-const std::string& CookRun::value_hash(const GraphOutput* o) {
-    auto [it, fresh] = value_hashes_.try_emplace({o->node, o->port});
-    if (fresh) it->second = disk_cache::content_hash(values_.at(o->node)->at(o->port)).hex();
-    return it->second;
-}
-
-// The graph's texture budget, on what is staged or already up to date, before anything moves.
-void CookRun::check_texture_budget() {
-    if (!g_.texture_budget_mb) return;
-    const uint64_t texture_total = result_.texture_bytes();
-    const double limit = *g_.texture_budget_mb * 1e6;
-    if (double(texture_total) <= limit) return;
-    std::vector<std::pair<uint64_t, std::string>> textures;
-    for (const OutputReport& o : result_.outputs)
-        if (const uint64_t b = o.texture_bytes()) textures.emplace_back(b, o.file);
-    std::sort(textures.rbegin(), textures.rend());
-    auto mb = [](double bytes) {
-        std::ostringstream os;
-        os.precision(3);
-        os << bytes / 1e6 << " MB";
-        return os.str();
-    };
-    std::string list;
-    for (const auto& [b, file] : textures) list += (list.empty() ? "" : ", ") + file + " " + mb(double(b));
-    result_.error_where = g_.budget_where.str();
-    throw Error(g_.budget_where.str() + ": budget: the textures take " + mb(double(texture_total)) + ", over texture_mb " +
-                detail::number_text(*g_.texture_budget_mb) + " by " + mb(double(texture_total) - limit) + " (largest first: " + list +
-                "); nothing was written");
-}
-
-// Records what is on disk now (renames keep the mtime).
-void CookRun::record_written() {
-    for (auto& [plan, rec] : rekeyed_) records_.at(plan->root)->set(plan->name, std::move(rec));
-    for (const auto& w : written_) {
-        OutputRecord rec;
-        rec.key = w.plan->key.hex();
-        rec.spec = w.plan->spec;
-        if (w.plan->action == OutputPlan::write) rec.value_hash = value_hash(w.plan->out);
-        if (w.plan->action == OutputPlan::copy) rec.value_hash = w.plan->earlier->record.value_hash;
-        const OutputReport& orep = result_.outputs[w.report];
-        rec.metrics = orep.metrics;
-        for (const auto& f : orep.files)
-            rec.files.push_back({f.path.lexically_relative(w.plan->root).generic_string(), f.bytes, file_mtime_ns(f.path), f.hash});
-        records_.at(w.plan->root)->set(w.plan->name, std::move(rec));
-    }
-    // What this cook leaves on disk, for the next cook of the session (issue 43 item 6).
-    EarlierOutputs now;
-    for (const OutputPlan& p : plans_)
-        if (const OutputRecord* r = records_.at(p.root)->find(p.name); r && r->key == p.key.hex() && !r->files.empty())
-            now.by_key[r->key] = {p.root, *r};
-    earlier_ = std::move(now);
-    for (auto& [root, rec] : records_) {
-        try {
-            rec->save();
-        } catch (const std::exception& e) {
-            warn("cannot record the outputs written in '" + root.string() + "' (" + e.what() + "); the next cook writes them again");
-        }
-    }
-}
-
 CookResult CookRun::finish() {
     if (opt_.cache_dir && opt_.cache_max_bytes > 0) disk_cache::prune(*opt_.cache_dir, opt_.cache_max_bytes);
     result_.seconds = seconds_since(t_start_);
@@ -1010,7 +519,7 @@ CookResult CookRun::finish() {
     return result_;
 }
 
-} // namespace
+} // namespace detail
 
 CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std::string, std::string>>* want_value,
                         std::vector<Value>* values_out) {
@@ -1023,7 +532,7 @@ CookResult Session::run(const CookOptions& opt, const std::vector<std::pair<std:
     if (opt.proxy > 1 && opt.write_outputs && !want_value)
         throw Error("a proxy cook (proxy " + std::to_string(opt.proxy) +
                     ") is for interaction: its results are never written as final outputs; cook without proxy to write them");
-    CookRun cook(g, registry_, *cache_, last_hashes_, *earlier_, opt, last_);
+    detail::CookRun cook(g, registry_, *cache_, last_hashes_, *earlier_, opt, last_);
     cook.plan(want_value);
     cook.resolve();
     cook.hash();
