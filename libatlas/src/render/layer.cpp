@@ -310,6 +310,14 @@ Vec2d diffusion_patch_centre(const LayerModel& m, const Camera& cam, double eart
 constexpr double kMaxStepTau = 1.0;
 constexpr double kMinCappedStep = 2.0; // metres
 constexpr int kEntryBisections = 4;
+// While most of the view is still ahead (transmittance above kSurfaceLayer) the
+// in-cloud step is kSurfaceDetailStep of detail_step (0.8 detail texels): the
+// surface layer is what the eye sees, and wisps 50-90 m deep along a ray took
+// one 58 m sample at a random depth (grain against 16x the steps: superstorm
+// ground 3.1 -> 1.9/255, hzd_weather ground 1.45 -> 0.64; +22-32% render time,
+// bench/grain.sh). Deeper samples keep the full detail step.
+constexpr double kSurfaceLayer = 0.7;
+constexpr double kSurfaceDetailStep = 0.4;
 
 struct LayerIntegrator {
     const LayerModel& m;
@@ -532,7 +540,7 @@ struct LayerIntegrator {
                 }
                 // Optically deep (under 10 % of the view left): what lies further
                 // adds at most that much, so it is marched at twice the step.
-                dt = std::min({dt, tau_cap, detail_step, entry_cap});
+                dt = std::min({dt, tau_cap, trans > kSurfaceLayer ? kSurfaceDetailStep * detail_step : detail_step, entry_cap});
                 if (trans < 0.1) dt *= 2;
                 dt = std::min(dt, t_end - t);
                 const double tm = t + 0.5 * dt;
