@@ -315,9 +315,14 @@ constexpr int kEntryBisections = 4;
 // surface layer is what the eye sees, and wisps 50-90 m deep along a ray took
 // one 58 m sample at a random depth (grain against 16x the steps: superstorm
 // ground 3.1 -> 1.9/255, hzd_weather ground 1.45 -> 0.64; +22-32% render time,
-// bench/grain.sh). Deeper samples keep the full detail step.
+// bench/grain.sh). Deeper samples keep the full detail step. The draft keeps
+// its speed: the fraction rises to 1 as the quality falls from 1 to 0.5 (the
+// superstorm's proxy edits at quality 0.5 took 0.9 s instead of 0.6 with it).
 constexpr double kSurfaceLayer = 0.7;
 constexpr double kSurfaceDetailStep = 0.4;
+inline double surface_detail_fraction(double quality) {
+    return kSurfaceDetailStep + (1 - kSurfaceDetailStep) * std::clamp((1 - quality) / 0.5, 0.0, 1.0);
+}
 
 struct LayerIntegrator {
     const LayerModel& m;
@@ -341,6 +346,7 @@ struct LayerIntegrator {
     // (700 m at 35 km) sampled the detail noise's billows at random, a grain
     // of 3-12/255 RMS against 16x the steps (docs/look.md).
     double detail_step = std::numeric_limits<double>::infinity();
+    double surface_detail_step = std::numeric_limits<double>::infinity(); // while trans > kSurfaceLayer
 
     // The ray from p toward the sun meets the ground sphere ahead of p.
     bool earth_hides_sun(const Vec3d& p) const {
@@ -540,7 +546,7 @@ struct LayerIntegrator {
                 }
                 // Optically deep (under 10 % of the view left): what lies further
                 // adds at most that much, so it is marched at twice the step.
-                dt = std::min({dt, tau_cap, trans > kSurfaceLayer ? kSurfaceDetailStep * detail_step : detail_step, entry_cap});
+                dt = std::min({dt, tau_cap, trans > kSurfaceLayer ? surface_detail_step : detail_step, entry_cap});
                 if (trans < 0.1) dt *= 2;
                 dt = std::min(dt, t_end - t);
                 const double tm = t + 0.5 * dt;
@@ -752,6 +758,7 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
                        25.0, // a 5 m core keeps the inverse square finite at the light
                        diffusion.get()};
     in.detail_step = 2.0 * model.detail_texel() / step_quality;
+    in.surface_detail_step = surface_detail_fraction(settings.quality) * in.detail_step;
     // Six fixed directions in [-1, 1]^3 spread the light cone (the talk's noise kernel).
     for (int i = 0; i < 6; ++i)
         for (int a = 0; a < 3; ++a) in.cone_kernel[i][a] = 2.0 * hash_to_unit(hash_coords(0x636f6e65u, i, a)) - 1.0;
