@@ -4,7 +4,6 @@
 // are in tile_parts.h.
 #include "atlas/core/progress.h"
 #include "atlas/graph/tiling.h"
-#include "atlas/graph/node_docs.h"
 #include "cook_steps.h"
 #include "graph_walk.h"
 #include "tile_parts.h"
@@ -20,10 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <cmath>
-#include <cstdlib>
 #include <chrono>
-#include <functional>
 #include <set>
 
 
