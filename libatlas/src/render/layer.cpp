@@ -314,10 +314,11 @@ constexpr int kEntryBisections = 4;
 // in-cloud step is kSurfaceDetailStep of detail_step (0.8 detail texels): the
 // surface layer is what the eye sees, and wisps 50-90 m deep along a ray took
 // one 58 m sample at a random depth (grain against 16x the steps: superstorm
-// ground 3.1 -> 1.9/255, hzd_weather ground 1.45 -> 0.64; +22-32% render time,
+// ground 3.09 -> 1.97/255, hzd_weather ground 1.45 -> 0.66; +22-32% render time,
 // bench/grain.sh). Deeper samples keep the full detail step. The draft keeps
 // its speed: the fraction rises to 1 as the quality falls from 1 to 0.5 (the
-// superstorm's proxy edits at quality 0.5 took 0.9 s instead of 0.6 with it).
+// superstorm's proxy edits at quality 0.5 took 0.89-0.91 s with it, 0.78-0.83
+// without; docs/PERFORMANCE.md).
 constexpr double kSurfaceLayer = 0.7;
 constexpr double kSurfaceDetailStep = 0.4;
 inline double surface_detail_fraction(double quality) {
