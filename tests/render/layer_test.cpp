@@ -707,3 +707,42 @@ TEST(LayerMap, AClearTexelsHeightsDrawNoSheetToItsCloudyNeighbour) {
         }
     }
 }
+
+// The sky occlusion's mean density (LayerModel::mean_density, a table over
+// profile and coverage) against brute force: the cheap density averaged over
+// the base noise's whole tile (a plane of points across its x and y, the
+// wind's time rise stepping the plane through its z), at several heights and
+// coverages. Without base noise it is the density itself.
+TEST(LayerMeanDensity, IsTheCheapDensityAveragedOverTheNoise) {
+    for (double coverage : {0.3, 0.6, 0.9}) {
+        LayerScene s = scene_with(coverage);
+        s.detail_noise = nullptr; // layer_density's full sample is then the cheap one
+        s.curl = nullptr;
+        s.wind = {{10, 0}}; // the noise rises 0.1 x 10 m per second of time
+        for (double h : {1900.0, 2500.0, 3000.0}) {
+            std::vector<Vec3d> plane;
+            const int n = 48; // over one 6 km base tile: 125 m apart, the 32^3 noise's 188 m texels
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i) plane.push_back({{7000 + (i + 0.5) * s.base_tile / n, 7000 + (j + 0.5) * s.base_tile / n, h}});
+            place_at_altitude(plane);
+            double brute = 0;
+            const int slices = 64;
+            for (int k = 0; k < slices; ++k) {
+                s.time = (k + 0.5) * s.base_tile / slices; // a rise of base_tile / slices metres each
+                for (double v : layer_density(s, plane)) brute += v;
+            }
+            brute /= double(plane.size()) * slices;
+            const double mean = layer_mean_density(s, {plane[0]})[0];
+            const double elsewhere = layer_mean_density(s, {plane[plane.size() / 2]})[0];
+            std::printf("coverage %.1f altitude %.0f: mean %.4f, brute force %.4f\n", coverage, h, mean, brute);
+            EXPECT_GT(brute, 0.0) << coverage << " " << h;
+            EXPECT_NEAR(mean, brute, 0.05 * brute + 0.001) << "coverage " << coverage << ", altitude " << h;
+            EXPECT_DOUBLE_EQ(mean, elsewhere) << "the mean is the map's, not the noise's: the same over a uniform map";
+        }
+    }
+    // No base noise: the mean is the density.
+    LayerScene plain = scene_with(0.6, false);
+    std::vector<Vec3d> pts{{{9000, 9000, 2000}}, {{12000, 8000, 3000}}};
+    place_at_altitude(pts);
+    EXPECT_EQ(layer_mean_density(plain, pts), layer_density(plain, pts));
+}

@@ -419,7 +419,9 @@ struct LayerIntegrator {
         return acc;
     }
 
-    // Summed density straight up to the column's top (2 cheap samples).
+    // Summed density straight up to the column's top (2 samples of the
+    // noise's mean, LayerModel::mean_density: the sky's light comes from the
+    // whole hemisphere, not down one line through the billows).
     double sky_depth(const Vec3d& p, double h, const Column& c) const {
         const double len = c.max_h - h;
         if (!(len > 0)) return 0;
@@ -427,7 +429,7 @@ struct LayerIntegrator {
         double acc = 0;
         for (int i = 0; i < 2; ++i) {
             const Vec3d q = p + up * ((i + 0.5) * 0.5 * len);
-            acc += m.density(q, m.altitude(q), false);
+            acc += m.mean_density(q, m.altitude(q));
         }
         return acc * 0.5 * len;
     }
@@ -674,7 +676,7 @@ LayerResult render_layer(const LayerScene& scene, const RenderSettings& settings
     const auto t0 = std::chrono::steady_clock::now();
     detail::check_settings(settings);
     validate_layer_scene(scene);
-    LayerModel model(scene);
+    LayerModel model(scene, true);
     const double cam_alt = model.altitude(settings.camera.position);
     if (cam_alt < 0) {
         char buf[160];
@@ -796,6 +798,14 @@ std::vector<double> layer_density(const LayerScene& scene, const std::vector<Vec
     const LayerModel m(scene);
     std::vector<double> d(points.size(), 0.0);
     for (size_t i = 0; i < points.size(); ++i) d[i] = m.density(points[i], m.altitude(points[i]), true);
+    return d;
+}
+
+std::vector<double> layer_mean_density(const LayerScene& scene, const std::vector<Vec3d>& points) {
+    validate_layer_scene(scene);
+    const LayerModel m(scene, true);
+    std::vector<double> d(points.size(), 0.0);
+    for (size_t i = 0; i < points.size(); ++i) d[i] = m.mean_density(points[i], m.altitude(points[i]));
     return d;
 }
 

@@ -147,6 +147,11 @@ struct LayerScene {
 // rings), for tests and tools. Validates the scene (throws as
 // validate_layer_scene). Thread-safe, deterministic.
 std::vector<double> layer_density(const LayerScene& scene, const std::vector<Vec3d>& points);
+// The cheap shape's density (no detail erosion) at each point averaged over
+// the base noise's values: the smooth part of the weather map the sky light's
+// occlusion reads (docs/render.md, "Ambient"). Without base noise, the cheap
+// density itself. Validates as layer_density.
+std::vector<double> layer_mean_density(const LayerScene& scene, const std::vector<Vec3d>& points);
 // The altitude range [bottom, top] (metres) of the cloud shell render_layer
 // marches: the lowest min_height and highest max_height over texels with
 // coverage > 0 and max > min, the top raised by the anvil map's largest lift.
