@@ -85,7 +85,7 @@ void BM_Peer3D_Atlas(benchmark::State& state) {
     state.SetLabel(std::string("atlas ") + std::string(kernel_name(Kernel(k))) + ", " + simd_path_name(simd_path()));
     set_simd_path(SimdPath::Auto);
 }
-BENCHMARK(BM_Peer3D_Atlas)->ArgsProduct({{int64_t(Kernel::Gradient), int64_t(Kernel::Worley)}, {32, 64, 128}, {1, 2, 3}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Peer3D_Atlas)->ArgsProduct({{int64_t(Kernel::Gradient), int64_t(Kernel::Worley)}, {32, 64, 128}, {1, 2, 3, 4}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Peer3D_Atlas)->Name("BM_Peer3D_Atlas_Smoke")->Args({0, 8, 0})->Args({2, 8, 0});
 
 // Perlin on lattices too large to tabulate (issue 49: period > 128 per axis, or an
@@ -109,7 +109,7 @@ void BM_GradientLattice(benchmark::State& state) {
     state.SetLabel("period " + std::to_string(period) + ", " + std::to_string(octaves) + " octave(s), " + simd_path_name(simd_path()));
     set_simd_path(SimdPath::Auto);
 }
-BENCHMARK(BM_GradientLattice)->ArgsProduct({{128, 256}, {1}, {1, 2, 3}})->Args({8, 8, 1})->Args({8, 8, 2})->Args({8, 8, 3})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GradientLattice)->ArgsProduct({{128, 256}, {1}, {1, 2, 3, 4}})->Args({8, 8, 1})->Args({8, 8, 2})->Args({8, 8, 3})->Args({8, 8, 4})->Unit(benchmark::kMillisecond);
 
 #if defined(ATLAS_BENCH_FNL)
 } // namespace

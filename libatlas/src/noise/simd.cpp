@@ -26,20 +26,31 @@ bool cpu_has(SimdPath p) {
 #else
         return false;
 #endif
+    case SimdPath::Avx512:
+#if defined(__SSE2__)
+        return __builtin_cpu_supports("avx512f") != 0;
+#else
+        return false;
+#endif
 #else
     case SimdPath::Sse2:
-    case SimdPath::Avx2: return false;
+    case SimdPath::Avx2:
+    case SimdPath::Avx512: return false;
 #endif
     }
     return false;
 }
 
-SimdPath fastest() { return cpu_has(SimdPath::Avx2) ? SimdPath::Avx2 : cpu_has(SimdPath::Sse2) ? SimdPath::Sse2 : SimdPath::Scalar; }
+SimdPath fastest() {
+    for (SimdPath p : {SimdPath::Avx512, SimdPath::Avx2, SimdPath::Sse2})
+        if (cpu_has(p)) return p;
+    return SimdPath::Scalar;
+}
 
 void require(SimdPath p, const char* where) {
     if (!cpu_has(p))
         throw Error(std::string(where) + ": the SIMD path '" + simd_path_name(p) + "' is not supported by this CPU (supported: scalar" +
-                    (cpu_has(SimdPath::Sse2) ? ", sse2" : "") + (cpu_has(SimdPath::Avx2) ? ", avx2" : "") + ")");
+                    (cpu_has(SimdPath::Sse2) ? ", sse2" : "") + (cpu_has(SimdPath::Avx2) ? ", avx2" : "") + (cpu_has(SimdPath::Avx512) ? ", avx512" : "") + ")");
 }
 
 // -1: not forced by set_simd_path.
@@ -70,7 +81,7 @@ const EnvChoice& env_choice() {
 
 std::vector<SimdPath> supported_simd_paths() {
     std::vector<SimdPath> r{SimdPath::Scalar};
-    for (SimdPath p : {SimdPath::Sse2, SimdPath::Avx2})
+    for (SimdPath p : {SimdPath::Sse2, SimdPath::Avx2, SimdPath::Avx512})
         if (cpu_has(p)) r.push_back(p);
     return r;
 }
@@ -94,14 +105,15 @@ const char* simd_path_name(SimdPath p) {
     case SimdPath::Scalar: return "scalar";
     case SimdPath::Sse2: return "sse2";
     case SimdPath::Avx2: return "avx2";
+    case SimdPath::Avx512: return "avx512";
     }
     return "?";
 }
 
 SimdPath parse_simd_path(const std::string& name) {
-    for (SimdPath p : {SimdPath::Auto, SimdPath::Scalar, SimdPath::Sse2, SimdPath::Avx2})
+    for (SimdPath p : {SimdPath::Auto, SimdPath::Scalar, SimdPath::Sse2, SimdPath::Avx2, SimdPath::Avx512})
         if (name == simd_path_name(p)) return p;
-    throw Error("unknown SIMD path '" + name + "' (expected auto, scalar, sse2 or avx2)");
+    throw Error("unknown SIMD path '" + name + "' (expected auto, scalar, sse2, avx2 or avx512)");
 }
 
 namespace detail {
@@ -111,6 +123,7 @@ const SimdKernels* active_kernels() {
 #if defined(__SSE2__)
     case SimdPath::Sse2: return &sse2_kernels();
     case SimdPath::Avx2: return &avx2_kernels();
+    case SimdPath::Avx512: return &avx512_kernels();
 #endif
     default: return nullptr;
     }

@@ -1,6 +1,6 @@
 // Internal: the SIMD kernels (3D gradient, Worley, Alligator octaves) and
 // their dispatch. Every path (scalar in engine.cpp, SSE2 in simd_sse2.cpp,
-// AVX2 in simd_avx2.cpp) performs the same IEEE operations in the same order
+// AVX2 in simd_avx2.cpp, AVX-512 in simd_avx512.cpp) performs the same IEEE operations in the same order
 // on every sample, so all of them write the same bytes (tests/noise/
 // simd_test.cpp). The ISA translation units see only plain data (LatticeView):
 // they call no inline function that another translation unit also emits, so
@@ -43,5 +43,6 @@ const SimdKernels* active_kernels();
 
 const SimdKernels& sse2_kernels();
 const SimdKernels& avx2_kernels();
+const SimdKernels& avx512_kernels();
 
 } // namespace atlas::noise::detail

@@ -7,13 +7,13 @@
 
 namespace atlas::noise {
 
-enum class SimdPath { Auto, Scalar, Sse2, Avx2 };
+enum class SimdPath { Auto, Scalar, Sse2, Avx2, Avx512 };
 
 // The paths this machine can run, scalar first.
 std::vector<SimdPath> supported_simd_paths();
 
 // Forces a path for every later fill in this process (Auto: the fastest
-// supported, unless the environment variable ATLAS_SIMD=scalar|sse2|avx2|auto
+// supported, unless the environment variable ATLAS_SIMD=scalar|sse2|avx2|avx512|auto
 // names one). Throws atlas::Error for a path the machine lacks.
 void set_simd_path(SimdPath p);
 
