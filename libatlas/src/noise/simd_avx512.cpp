@@ -8,7 +8,9 @@
 // GCC 12's avx512fintrin.h starts many intrinsics from _mm512_undefined_*()
 // and then warns that the value "may be used uninitialized" where inlined
 // (a known false positive of the header): silenced for this file only.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #define ATLAS_NOISE_ISA avx512
 #include "simd_kernels.h"
 
