@@ -17,20 +17,12 @@ bool cpu_has(SimdPath p) {
 #if defined(__x86_64__) || defined(__i386__)
 #if defined(__SSE2__)
     case SimdPath::Sse2: return true;
+    case SimdPath::Avx2: return __builtin_cpu_supports("avx2") != 0;
+    case SimdPath::Avx512: return __builtin_cpu_supports("avx512f") != 0;
 #else
-    case SimdPath::Sse2: return false;
-#endif
+    case SimdPath::Sse2:
     case SimdPath::Avx2:
-#if defined(__SSE2__)
-        return __builtin_cpu_supports("avx2") != 0;
-#else
-        return false;
-#endif
-    case SimdPath::Avx512:
-#if defined(__SSE2__)
-        return __builtin_cpu_supports("avx512f") != 0;
-#else
-        return false;
+    case SimdPath::Avx512: return false;
 #endif
 #else
     case SimdPath::Sse2:
