@@ -20,21 +20,20 @@ namespace atlas::noise::detail {
 namespace avx512 {
 namespace {
 
+// What gradient3 reads of the traits (the cellular kernels, which also need
+// fload, fabs, sqrt1 and the reductions, stay on AVX2's: avx512_kernels below).
 struct Isa {
     using F = __m512;
     using V = __m512i;
     static constexpr int W = 16;
 
     static F fset(float v) { return _mm512_set1_ps(v); }
-    static F fload(const float* p) { return _mm512_load_ps(p); }
     static void fstore(float* p, F v) { _mm512_storeu_ps(p, v); }
     static F add(F a, F b) { return _mm512_add_ps(a, b); }
     static F sub(F a, F b) { return _mm512_sub_ps(a, b); }
     static F mul(F a, F b) { return _mm512_mul_ps(a, b); }
     static F fmin(F a, F b) { return _mm512_min_ps(a, b); } // a < b ? a : b, as MINPS
     static F fmax(F a, F b) { return _mm512_max_ps(a, b); } // a > b ? a : b
-    static F fabs(F a) { return _mm512_castsi512_ps(_mm512_and_si512(_mm512_castps_si512(a), _mm512_set1_epi32(0x7FFFFFFF))); }
-    static float sqrt1(float v) { return _mm_cvtss_f32(_mm_sqrt_ss(_mm_set_ss(v))); }
 
     static V iset(int v) { return _mm512_set1_epi32(v); }
     static V iload(const int* p) { return _mm512_load_si512(p); }

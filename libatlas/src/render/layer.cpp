@@ -9,7 +9,6 @@
 #include "layer_march.h"
 #include "layer_model.h"
 #include "render_common.h"
-#include "atlas/core/parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -18,7 +17,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <limits>
 #include <memory>
 
 namespace atlas::render {

@@ -10,8 +10,10 @@
 #include "render_common.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace atlas::render::layer_detail {

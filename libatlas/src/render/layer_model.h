@@ -388,6 +388,17 @@ public:
     // shape over the noise texture, so coverage c leaves a fraction c of a
     // full-profile column cloudy (the noise's own range, 0.39..0.97 for the
     // HZD Perlin-Worley, would otherwise turn coverage 0.3 into overcast).
+    // kQuantiles + 1 evenly spaced quantiles of sorted values (the nearest rank).
+    static auto quantiles_of(const std::vector<float>& sorted) {
+        std::array<double, kQuantiles + 1> q{};
+        for (int k = 0; k <= kQuantiles; ++k) q[size_t(k)] = sorted[std::min(sorted.size() - 1, size_t(double(k) / kQuantiles * double(sorted.size() - 1) + 0.5))];
+        return q;
+    }
+    // HZD's coverage remap of a base value: remap(base, thr, 1, 0, 1) * coverage,
+    // in [0, 1] (0 where thr >= 1: no cloud).
+    static double coverage_shaped(double base, double thr, double coverage) {
+        return thr < 1.0 ? std::clamp((base - thr) / (1.0 - thr) * coverage, 0.0, 1.0) : 0.0;
+    }
     void build_coverage_table(const Field3D& n, bool mean_table) {
         const int c = n.channels();
         auto r = n.channel(0), g = n.channel(std::min(1, c - 1)), b = n.channel(std::min(2, c - 1)), a = n.channel(std::min(3, c - 1));
@@ -395,7 +406,7 @@ public:
         const size_t stride = std::max<size_t>(1, r.size() / 65536);
         for (size_t i = 0; i < r.size(); i += stride) v.push_back(float(ndf::dilated_base(r[i], g[i], b[i], a[i])));
         std::sort(v.begin(), v.end());
-        for (int k = 0; k <= kQuantiles; ++k) quantile_[size_t(k)] = v[std::min(v.size() - 1, size_t(double(k) / kQuantiles * double(v.size() - 1) + 0.5))];
+        quantile_ = quantiles_of(v);
         equalised_ = true;
         base_max_ = quantile_[kQuantiles];
         if (!mean_table) return;
@@ -419,16 +430,14 @@ public:
                     read.push_back(float(ndf::dilated_base(t[0], t[1], t[2], t[3])));
                 }
         std::sort(read.begin(), read.end());
-        std::array<double, kQuantiles + 1> spread{};
-        for (int k = 0; k <= kQuantiles; ++k) spread[size_t(k)] = read[std::min(read.size() - 1, size_t(double(k) / kQuantiles * double(read.size() - 1) + 0.5))];
+        const std::array<double, kQuantiles + 1> spread = quantiles_of(read);
         mean_shape_.assign(size_t(kMeanSteps + 1) * size_t(kMeanSteps + 1), 0.0);
         for (int j = 0; j <= kMeanSteps; ++j) {
             const double cov = double(j) / kMeanSteps, thr = coverage_threshold(cov);
-            if (!(thr < 1.0)) continue;
             for (int i = 0; i <= kMeanSteps; ++i) {
                 const double profile = double(i) / kMeanSteps;
                 double sum = 0;
-                for (double q : spread) sum += std::clamp((q * profile - thr) / (1.0 - thr) * cov, 0.0, 1.0);
+                for (double q : spread) sum += coverage_shaped(q * profile, thr, cov);
                 mean_shape_[size_t(j) * (kMeanSteps + 1) + size_t(i)] = sum / double(spread.size());
             }
         }
@@ -522,9 +531,8 @@ public:
         base *= profile;
         // Coverage grows the shape and scales its density: HZD's
         // remap(base, 1 - coverage, 1, 0, 1) * coverage with the equalised threshold.
-        double shaped = thr < 1.0 ? (base - thr) / (1.0 - thr) * c.coverage : 0.0;
+        const double shaped = coverage_shaped(base, thr, c.coverage);
         if (!(shaped > 0)) return 0;
-        shaped = std::min(shaped, 1.0);
         if (col_out) *col_out = c;
         if (shape_out) *shape_out = shaped;
         if (!full || !detail_.ok()) return shaped * s_.density_scale;
